@@ -1,0 +1,20 @@
+#pragma once
+// Registration of the subcommands of the `afmkit` program. Each domain owns its own file in apps/.
+namespace CLI {
+class App;
+}
+
+namespace afmkit::cli {
+
+void register_impact(CLI::App& app);            // impact_cmd.cpp:        afmkit impact
+void register_tapping(CLI::App& app);           // tapping_cmd.cpp:       afmkit tapping …
+void register_tapping_orbit(CLI::App& tapping); // tapping_orbit_cmd.cpp: afmkit tapping orbit
+void register_tapping_hb(CLI::App& tapping);    // tapping_hb_cmd.cpp:    afmkit tapping hb
+void register_tapping_sweep(CLI::App& tapping); // tapping_sweep_cmd.cpp: afmkit tapping sweep
+void register_control(CLI::App& app);           // control_cmd.cpp:       afmkit control …
+void register_control_tf(CLI::App& control);        // control_tf_cmd.cpp:       control tf
+void register_control_analysis(CLI::App& control);  // control_analysis_cmd.cpp: control roots|margin|chart|tune
+void register_control_simulate(CLI::App& control);  // control_simulate_cmd.cpp: control simulate
+void register_demo(CLI::App& app);              // demo_cmd.cpp:          afmkit demo (the Quick-start main job)
+
+}  // namespace afmkit::cli

@@ -1,0 +1,86 @@
+#pragma once
+// ParamSet: the named, typed, range-checked parameters of one command. Values come from (in increasing
+// priority) the built-in default, a TOML file given with --config, and command-line flags.
+//   TOML key  `quality_factor = 400`      <->  flag `--quality-factor 400`
+// Unknown TOML keys, malformed TOML, a missing file, a wrong type or a value out of range raise
+// afmkit::InputError / afmkit::InvalidParameter naming the key (or file) and the allowed range.
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+namespace CLI {
+class App;
+}
+
+namespace afmkit::io {
+
+/// Allowed range of a numeric parameter.
+struct Range {
+  double lo = -1e308;
+  double hi = 1e308;
+  bool lo_open = false;  // true: value > lo, false: value >= lo
+  bool hi_open = false;
+  static Range positive() { return {0.0, 1e308, true, false}; }
+  static Range non_negative() { return {0.0, 1e308, false, false}; }
+  static Range any() { return {}; }
+  static Range closed(double a, double b) { return {a, b, false, false}; }
+  std::string describe() const;
+  bool contains(double v) const;
+};
+
+class ParamSet {
+ public:
+  using Value = std::variant<double, long, std::string, bool, std::vector<double>>;
+
+  ParamSet& real(const std::string& key, double def, const std::string& help, Range range = Range::any());
+  ParamSet& integer(const std::string& key, long def, const std::string& help, long lo, long hi);
+  ParamSet& text(const std::string& key, const std::string& def, const std::string& help,
+                 std::vector<std::string> choices = {});
+  ParamSet& flag(const std::string& key, bool def, const std::string& help);
+  /// A list of reals: TOML array, or a comma-separated flag value "1,0.5,0.2".
+  ParamSet& reals(const std::string& key, std::vector<double> def, const std::string& help,
+                  Range range = Range::any());
+
+  /// Adds `--config FILE` and one `--<key-with-dashes>` option per parameter to `app`.
+  void add_options(CLI::App& app);
+  /// Call after parsing: loads --config (if any), applies flags, validates. Throws on bad input.
+  void resolve();
+  /// Load values from TOML text (used by resolve() and by tests). `origin` names the source in messages.
+  void load_toml_text(const std::string& text, const std::string& origin);
+  /// Set one value from its textual form (as a flag would), validating it.
+  void set_from_string(const std::string& key, const std::string& text);
+
+  double real(const std::string& key) const;
+  long integer(const std::string& key) const;
+  const std::string& text(const std::string& key) const;
+  bool flag(const std::string& key) const;
+  const std::vector<double>& reals(const std::string& key) const;
+  bool was_set(const std::string& key) const;  ///< given by TOML or flag (not the default)
+
+  /// All parameters and their values, for the JSON sidecar.
+  nlohmann::json to_json() const;
+  /// Path given with --config ("" if none).
+  const std::string& config_path() const { return config_path_; }
+
+ private:
+  struct Entry {
+    Value value;
+    std::string help;
+    Range range;
+    long ilo = 0, ihi = 0;
+    std::vector<std::string> choices;
+    bool set = false;
+    std::optional<std::string> cli_text;  // raw flag text captured by CLI11
+  };
+  void check(const std::string& key, const Entry& e, const std::string& origin) const;
+  const Entry& entry(const std::string& key) const;
+  std::map<std::string, Entry> entries_;
+  std::vector<std::string> order_;
+  std::string config_path_;
+};
+
+}  // namespace afmkit::io

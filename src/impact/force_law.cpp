@@ -1,0 +1,116 @@
+#include "afmkit/impact/force_law.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/core/validate.hpp"
+
+namespace afmkit::impact {
+
+PiecewiseLinearLaw::PiecewiseLinearLaw(double ka, double kb, double fa, double fb)
+    : approach_stiffness(validate::non_negative("approach_stiffness", ka)),
+      departure_stiffness(validate::non_negative("departure_stiffness", kb)),
+      approach_adhesion(validate::non_negative("approach_adhesion", fa)),
+      departure_adhesion(validate::finite("departure_adhesion", fb)) {
+  validate::require(fb >= fa, "departure_adhesion", fb,
+                    fmt::format(">= approach_adhesion = {} (0 <= F_a <= F_b, seed-1 eq. 26)", fa));
+}
+
+PiecewiseLinearLaw PiecewiseLinearLaw::linear_repulsive(double k) { return {k, k, 0.0, 0.0}; }
+PiecewiseLinearLaw PiecewiseLinearLaw::linear_hysteresis(double ka, double kb) { return {ka, kb, 0.0, 0.0}; }
+PiecewiseLinearLaw PiecewiseLinearLaw::repulsive_attractive(double ka, double kb, double fa, double fb) {
+  return {ka, kb, fa, fb};
+}
+double PiecewiseLinearLaw::departure_stiffness_for_restitution(double ka, double e) {
+  validate::non_negative("approach_stiffness", ka);
+  validate::in_range("restitution", e, 0.0, 1.0);
+  return e * e * ka;
+}
+
+DmtLaw::DmtLaw(double ea, double eb, double r, double ha, double hb, double a0)
+    : effective_modulus_approach(validate::positive("effective_modulus_approach", ea)),
+      effective_modulus_departure(validate::positive("effective_modulus_departure", eb)),
+      tip_radius(validate::positive("tip_radius", r)),
+      hamaker_approach(validate::non_negative("hamaker_approach", ha)),
+      hamaker_departure(validate::non_negative("hamaker_departure", hb)),
+      intermolecular_distance(validate::positive("intermolecular_distance", a0)) {}
+
+namespace {
+// force in nN for gap d [nm], modulus [GPa], radius [nm], Hamaker [J]: J/nm = 1e18 nN
+double dmt(double d, double modulus, double radius, double hamaker, double a0) {
+  constexpr double joule_per_nm_in_nN = 1e18;
+  if (d >= a0) return -hamaker * joule_per_nm_in_nN * radius / (6.0 * d * d);
+  const double delta = a0 - d;
+  return -hamaker * joule_per_nm_in_nN * radius / (6.0 * a0 * a0) +
+         4.0 / 3.0 * modulus * std::sqrt(radius) * delta * std::sqrt(delta);
+}
+}  // namespace
+
+double DmtLaw::approach(double d) const {
+  return dmt(d, effective_modulus_approach, tip_radius, hamaker_approach, intermolecular_distance);
+}
+double DmtLaw::departure(double d) const {
+  return dmt(d, effective_modulus_departure, tip_radius, hamaker_departure, intermolecular_distance);
+}
+
+ForceLaw::ForceLaw(PiecewiseLinearLaw law) : kind_(law) { refresh(); }
+ForceLaw::ForceLaw(DmtLaw law) : kind_(law) { refresh(); }
+ForceLaw::ForceLaw(CustomLaw law) : kind_(std::move(law)) {
+  const auto& c = std::get<CustomLaw>(kind_);
+  if (!c.approach || !c.departure) throw InvalidParameter("force_law", "custom force law: both branches must be set");
+  refresh();
+}
+
+void ForceLaw::refresh() {
+  switching_gaps_.clear();
+  scaled_linear_.reset();
+  if (auto* p = std::get_if<PiecewiseLinearLaw>(&kind_)) {
+    switching_gaps_ = {0.0};
+    scaled_linear_ = std::make_shared<PiecewiseLinearLaw>(p->approach_stiffness * scale_, p->departure_stiffness * scale_,
+                                                          p->approach_adhesion * scale_, p->departure_adhesion * scale_);
+  } else if (auto* d = std::get_if<DmtLaw>(&kind_)) {
+    switching_gaps_ = {d->intermolecular_distance};
+  } else {
+    switching_gaps_ = std::get<CustomLaw>(kind_).switching_gaps;
+    std::sort(switching_gaps_.begin(), switching_gaps_.end());
+  }
+}
+
+double ForceLaw::approach(double gap) const {
+  return scale_ * std::visit([gap](const auto& k) { return k.approach(gap); }, kind_);
+}
+double ForceLaw::departure(double gap) const {
+  return scale_ * std::visit([gap](const auto& k) { return k.departure(gap); }, kind_);
+}
+double ForceLaw::force(double gap, double rate) const {
+  if (rate < 0) return approach(gap);
+  if (rate > 0) return departure(gap);
+  return 0.5 * (approach(gap) + departure(gap));
+}
+
+const PiecewiseLinearLaw* ForceLaw::piecewise_linear() const { return scaled_linear_.get(); }
+
+ForceLaw ForceLaw::scaled(double factor) const {
+  validate::positive("force_scale", factor);
+  ForceLaw out = *this;
+  out.scale_ = scale_ * factor;
+  out.refresh();
+  return out;
+}
+
+std::string ForceLaw::name() const {
+  struct V {
+    std::string operator()(const PiecewiseLinearLaw& p) const {
+      if (p.approach_adhesion == 0 && p.departure_adhesion == 0)
+        return p.approach_stiffness == p.departure_stiffness ? "linear_repulsive" : "linear_hysteresis";
+      return "repulsive_attractive";
+    }
+    std::string operator()(const DmtLaw&) const { return "dmt"; }
+    std::string operator()(const CustomLaw& c) const { return c.name; }
+  };
+  return std::visit(V{}, kind_);
+}
+
+}  // namespace afmkit::impact

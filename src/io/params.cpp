@@ -1,0 +1,263 @@
+#include "afmkit/io/params.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+#include <toml++/toml.h>
+
+#include "afmkit/core/error.hpp"
+
+namespace afmkit::io {
+
+namespace {
+std::string dashed(std::string key) {
+  std::replace(key.begin(), key.end(), '_', '-');
+  return key;
+}
+
+double parse_real(const std::string& key, const std::string& text, const std::string& origin) {
+  std::size_t pos = 0;
+  double v = 0;
+  std::string t = text;
+  // accept nan/inf textually so that they are rejected by the range check with a clear message
+  try {
+    v = std::stod(t, &pos);
+  } catch (...) {
+    throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not a number", origin, key, text));
+  }
+  if (pos != t.size()) throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not a number", origin, key, text));
+  return v;
+}
+}  // namespace
+
+bool Range::contains(double v) const {
+  if (!std::isfinite(v)) return false;
+  bool ok_lo = lo_open ? v > lo : v >= lo;
+  bool ok_hi = hi_open ? v < hi : v <= hi;
+  return ok_lo && ok_hi;
+}
+
+std::string Range::describe() const {
+  bool has_lo = lo > -1e307, has_hi = hi < 1e307;
+  if (has_lo && has_hi) return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
+  if (has_lo) return fmt::format("{} {} (finite)", lo_open ? ">" : ">=", lo);
+  if (has_hi) return fmt::format("{} {} (finite)", hi_open ? "<" : "<=", hi);
+  return "a finite number";
+}
+
+ParamSet& ParamSet::real(const std::string& key, double def, const std::string& help, Range range) {
+  entries_[key] = Entry{def, help, range};
+  order_.push_back(key);
+  return *this;
+}
+ParamSet& ParamSet::integer(const std::string& key, long def, const std::string& help, long lo, long hi) {
+  Entry e{def, help, Range::any()};
+  e.ilo = lo;
+  e.ihi = hi;
+  entries_[key] = e;
+  order_.push_back(key);
+  return *this;
+}
+ParamSet& ParamSet::text(const std::string& key, const std::string& def, const std::string& help,
+                         std::vector<std::string> choices) {
+  Entry e{def, help, Range::any()};
+  e.choices = std::move(choices);
+  entries_[key] = e;
+  order_.push_back(key);
+  return *this;
+}
+ParamSet& ParamSet::flag(const std::string& key, bool def, const std::string& help) {
+  entries_[key] = Entry{def, help, Range::any()};
+  order_.push_back(key);
+  return *this;
+}
+ParamSet& ParamSet::reals(const std::string& key, std::vector<double> def, const std::string& help, Range range) {
+  entries_[key] = Entry{std::move(def), help, range};
+  order_.push_back(key);
+  return *this;
+}
+
+void ParamSet::add_options(CLI::App& app) {
+  app.add_option("--config", config_path_, "TOML file with parameters (keys as below, with underscores)");
+  for (const auto& key : order_) {
+    Entry& e = entries_[key];
+    std::string desc = e.help;
+    std::visit(
+        [&](const auto& v) {
+          using T = std::decay_t<decltype(v)>;
+          if constexpr (std::is_same_v<T, double>) {
+            desc += fmt::format(" [default {}; {}]", v, e.range.describe());
+          } else if constexpr (std::is_same_v<T, long>) {
+            desc += fmt::format(" [default {}; integer in [{}, {}]]", v, e.ilo, e.ihi);
+          } else if constexpr (std::is_same_v<T, std::string>) {
+            desc += fmt::format(" [default '{}'{}]", v,
+                                e.choices.empty() ? "" : fmt::format("; one of {}", fmt::join(e.choices, ", ")));
+          } else if constexpr (std::is_same_v<T, bool>) {
+            desc += fmt::format(" [default {}]", v ? "true" : "false");
+          } else {
+            desc += fmt::format(" [default {}; comma-separated]", fmt::join(v, ","));
+          }
+        },
+        e.value);
+    auto* opt = app.add_option_function<std::string>(
+        "--" + dashed(key), [&e](const std::string& s) { e.cli_text = s; }, desc);
+    if (std::holds_alternative<bool>(e.value)) opt->expected(0, 1)->default_str("true");
+  }
+}
+
+void ParamSet::check(const std::string& key, const Entry& e, const std::string& origin) const {
+  std::visit(
+      [&](const auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, double>) {
+          if (!e.range.contains(v))
+            throw InvalidParameter(key, fmt::format("{}{}{} = {} is out of range: must be {}", origin,
+                                                    origin.empty() ? "" : ": ", key, v, e.range.describe()));
+        } else if constexpr (std::is_same_v<T, long>) {
+          if (v < e.ilo || v > e.ihi)
+            throw InvalidParameter(key, fmt::format("{}{}{} = {} is out of range: must be an integer in [{}, {}]",
+                                                    origin, origin.empty() ? "" : ": ", key, v, e.ilo, e.ihi));
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          if (!e.choices.empty() && std::find(e.choices.begin(), e.choices.end(), v) == e.choices.end())
+            throw InvalidParameter(key, fmt::format("{}{}{} = '{}' is not allowed: must be one of {}", origin,
+                                                    origin.empty() ? "" : ": ", key, v, fmt::join(e.choices, ", ")));
+        } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+          for (double x : v)
+            if (!e.range.contains(x))
+              throw InvalidParameter(key, fmt::format("{}{}{} contains {}: every entry must be {}", origin,
+                                                      origin.empty() ? "" : ": ", key, x, e.range.describe()));
+        }
+      },
+      e.value);
+}
+
+void ParamSet::set_from_string(const std::string& key, const std::string& text) {
+  auto it = entries_.find(key);
+  if (it == entries_.end()) throw InputError(fmt::format("unknown parameter '{}'", key));
+  Entry& e = it->second;
+  const std::string origin = "--" + dashed(key);
+  std::visit(
+      [&](auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, double>) {
+          v = parse_real(key, text, origin);
+        } else if constexpr (std::is_same_v<T, long>) {
+          double d = parse_real(key, text, origin);
+          if (d != std::floor(d) || !std::isfinite(d))
+            throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not an integer", origin, key, text));
+          v = static_cast<long>(d);
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          v = text;
+        } else if constexpr (std::is_same_v<T, bool>) {
+          if (text == "true" || text == "1" || text.empty()) v = true;
+          else if (text == "false" || text == "0") v = false;
+          else throw InvalidParameter(key, fmt::format("{}: {} = '{}' must be true or false", origin, key, text));
+        } else {
+          std::vector<double> out;
+          std::stringstream ss(text);
+          std::string item;
+          while (std::getline(ss, item, ',')) out.push_back(parse_real(key, item, origin));
+          v = out;
+        }
+      },
+      e.value);
+  e.set = true;
+  check(key, e, "");
+}
+
+void ParamSet::load_toml_text(const std::string& text, const std::string& origin) {
+  toml::table tbl;
+  try {
+    tbl = toml::parse(text, origin);
+  } catch (const toml::parse_error& err) {
+    const auto& b = err.source().begin;
+    throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, b.line, b.column, err.description()));
+  }
+  for (auto&& [k, node] : tbl) {
+    std::string key(k.str());
+    auto it = entries_.find(key);
+    if (it == entries_.end()) {
+      std::vector<std::string> known(order_.begin(), order_.end());
+      throw InputError(fmt::format("{}: unknown key '{}' (allowed keys: {})", origin, key, fmt::join(known, ", ")));
+    }
+    Entry& e = it->second;
+    auto type_error = [&](const char* want) {
+      throw InvalidParameter(key, fmt::format("{}: key '{}' must be {}", origin, key, want));
+    };
+    std::visit(
+        [&](auto& v) {
+          using T = std::decay_t<decltype(v)>;
+          if constexpr (std::is_same_v<T, double>) {
+            if (auto d = node.value<double>()) v = *d;
+            else type_error("a number");
+          } else if constexpr (std::is_same_v<T, long>) {
+            if (auto i = node.value<int64_t>(); i && node.is_integer()) v = static_cast<long>(*i);
+            else type_error("an integer");
+          } else if constexpr (std::is_same_v<T, std::string>) {
+            if (auto s = node.value<std::string>()) v = *s;
+            else type_error("a string");
+          } else if constexpr (std::is_same_v<T, bool>) {
+            if (auto b = node.value<bool>()) v = *b;
+            else type_error("true or false");
+          } else {
+            const toml::array* arr = node.as_array();
+            if (!arr) type_error("an array of numbers");
+            std::vector<double> out;
+            for (auto&& el : *arr) {
+              auto d = el.value<double>();
+              if (!d) type_error("an array of numbers");
+              out.push_back(*d);
+            }
+            v = out;
+          }
+        },
+        e.value);
+    e.set = true;
+    check(key, e, origin);
+  }
+}
+
+void ParamSet::resolve() {
+  if (!config_path_.empty()) {
+    std::ifstream in(config_path_);
+    if (!in) throw InputError(fmt::format("--config: cannot open file '{}'", config_path_));
+    std::stringstream buf;
+    buf << in.rdbuf();
+    load_toml_text(buf.str(), config_path_);
+  }
+  for (const auto& key : order_) {
+    Entry& e = entries_[key];
+    if (e.cli_text) set_from_string(key, *e.cli_text);
+  }
+  for (const auto& key : order_) check(key, entries_.at(key), "");
+}
+
+const ParamSet::Entry& ParamSet::entry(const std::string& key) const {
+  auto it = entries_.find(key);
+  if (it == entries_.end()) throw std::logic_error("ParamSet: no parameter named '" + key + "'");
+  return it->second;
+}
+double ParamSet::real(const std::string& key) const { return std::get<double>(entry(key).value); }
+long ParamSet::integer(const std::string& key) const { return std::get<long>(entry(key).value); }
+const std::string& ParamSet::text(const std::string& key) const { return std::get<std::string>(entry(key).value); }
+bool ParamSet::flag(const std::string& key) const { return std::get<bool>(entry(key).value); }
+const std::vector<double>& ParamSet::reals(const std::string& key) const {
+  return std::get<std::vector<double>>(entry(key).value);
+}
+bool ParamSet::was_set(const std::string& key) const { return entry(key).set; }
+
+nlohmann::json ParamSet::to_json() const {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& key : order_) {
+    std::visit([&](const auto& v) { j[key] = v; }, entries_.at(key).value);
+  }
+  return j;
+}
+
+}  // namespace afmkit::io

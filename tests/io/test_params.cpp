@@ -1,0 +1,95 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/params.hpp"
+
+using afmkit::InputError;
+using afmkit::InvalidParameter;
+using afmkit::io::ParamSet;
+using afmkit::io::Range;
+
+namespace {
+ParamSet make() {
+  ParamSet p;
+  p.real("quality_factor", 100.0, "Q", Range::positive())
+      .integer("points", 10, "number of points", 1, 1000)
+      .text("law", "hysteresis", "force law", {"linear", "hysteresis"})
+      .flag("verbose", false, "talk")
+      .reals("amplitudes", {1.0, 0.5}, "harmonic amplitudes", Range::non_negative());
+  return p;
+}
+}  // namespace
+
+TEST(ParamSet, TomlValuesAreRead) {
+  auto p = make();
+  p.load_toml_text("quality_factor = 400\npoints = 3\nlaw = 'linear'\nverbose = true\namplitudes = [1, 2, 3]\n", "t.toml");
+  EXPECT_DOUBLE_EQ(p.real("quality_factor"), 400.0);
+  EXPECT_EQ(p.integer("points"), 3);
+  EXPECT_EQ(p.text("law"), "linear");
+  EXPECT_TRUE(p.flag("verbose"));
+  EXPECT_EQ(p.reals("amplitudes").size(), 3u);
+  EXPECT_TRUE(p.was_set("points"));
+}
+
+TEST(ParamSet, UnknownKeyIsRejectedWithItsName) {
+  auto p = make();
+  try {
+    p.load_toml_text("qualty_factor = 4\n", "t.toml");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("qualty_factor"), std::string::npos);
+  }
+}
+
+TEST(ParamSet, MalformedTomlNamesFileAndLine) {
+  auto p = make();
+  try {
+    p.load_toml_text("quality_factor = = 4\n", "bad.toml");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.toml:1"), std::string::npos);
+  }
+}
+
+TEST(ParamSet, OutOfRangeNamesParameterAndRange) {
+  auto p = make();
+  try {
+    p.set_from_string("quality_factor", "-1");
+    FAIL();
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "quality_factor");
+    EXPECT_NE(std::string(e.what()).find("> 0"), std::string::npos);
+  }
+  EXPECT_THROW(p.set_from_string("quality_factor", "nan"), InvalidParameter);
+  EXPECT_THROW(p.set_from_string("quality_factor", "inf"), InvalidParameter);
+  EXPECT_THROW(p.set_from_string("quality_factor", "12abc"), InvalidParameter);
+  EXPECT_THROW(p.set_from_string("points", "0"), InvalidParameter);
+  EXPECT_THROW(p.set_from_string("points", "2.5"), InvalidParameter);
+  EXPECT_THROW(p.set_from_string("law", "dmt2"), InvalidParameter);
+  EXPECT_THROW(p.set_from_string("amplitudes", "1,-2"), InvalidParameter);
+  EXPECT_THROW(p.load_toml_text("quality_factor = 'high'\n", "t.toml"), InvalidParameter);
+  EXPECT_THROW(p.load_toml_text("quality_factor = nan\n", "t.toml"), InvalidParameter);
+}
+
+TEST(Output, CsvRoundTripsDoublesAndWritesAtomically) {
+  afmkit::io::Table t({"a", "b", "c"});
+  t.add_row({0.1, 2L, std::string("x")});
+  t.add_row({1.0 / 3.0, -1L, true});
+  EXPECT_THROW(t.add_row({1.0}), std::logic_error);
+  const std::string csv = t.to_csv();
+  EXPECT_EQ(csv.substr(0, 6), "a,b,c\n");
+  EXPECT_NE(csv.find("0.3333333333333333,"), std::string::npos);
+  auto dir = std::filesystem::temp_directory_path() / "afmkit_test_output";
+  std::filesystem::remove_all(dir);
+  afmkit::io::write_table((dir / "sub/t.csv").string(), t, afmkit::io::make_sidecar("test", {{"x", 1}}));
+  EXPECT_TRUE(std::filesystem::exists(dir / "sub/t.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "sub/t.csv.json"));
+  for (auto& f : std::filesystem::directory_iterator(dir / "sub"))
+    EXPECT_EQ(f.path().string().find(".tmp."), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
