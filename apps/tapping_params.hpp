@@ -1,0 +1,18 @@
+#pragma once
+// Model parameters shared by `afmkit tapping orbit | hb | sweep` (and the demo), in normalised or physical
+// units (docs/units.md). Keys of the other unit system are rejected when given explicitly.
+#include "afmkit/io/params.hpp"
+#include "afmkit/tapping/model.hpp"
+#include "afmkit/tapping/units.hpp"
+
+namespace afmkit::cli {
+
+/// units, cantilever, drive, force law, separation.
+void add_tapping_model_params(io::ParamSet& p);
+/// The normalised model at the parameter `separation` (nm in physical units).
+tapping::TappingModel tapping_model_from(const io::ParamSet& p);
+using TappingScales = tapping::UnitScales;
+/// Factors converting model quantities to the user's units (all 1 for normalised units).
+TappingScales tapping_scales_from(const io::ParamSet& p);
+
+}  // namespace afmkit::cli
