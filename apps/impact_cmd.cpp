@@ -1,10 +1,234 @@
-#include <CLI/CLI.hpp>
+// afmkit impact: one two-body impact with a hysteresis force law (seed-1 §II, eqs. 1–6; MATH.md A.1).
+// Prints a summary (or the result as JSON with --json); --output FILE writes the time history as CSV
+// (t, gap, gap_rate, force, x1, v1, x2, v2) with a JSON sidecar holding the parameters and the summary.
+//
+// Units: any consistent set for the piecewise-linear laws. For law = dmt the force law is in nN for gaps in
+// nm (E* in GPa, R in nm, Hamaker in J); then masses in kg and speeds in nm/s give times in s
+// (1 nN / 1 kg = 1 nm/s²) and energies in nN·nm (1e-18 J).
+#include <cmath>
+#include <memory>
+#include <string>
 
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/impact/impact.hpp"
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/params.hpp"
 #include "commands.hpp"
 
 namespace afmkit::cli {
 
-// Placeholder registration: the subcommand is added when its domain lands.
-void register_impact(CLI::App& /*app*/) {}
+namespace {
+
+using io::Range;
+
+const char* const linear_keys[] = {"approach_stiffness", "departure_stiffness", "approach_adhesion",
+                                   "departure_adhesion", "restitution"};
+const char* const dmt_keys[] = {"effective_modulus", "departure_modulus", "tip_radius", "hamaker",
+                                "departure_hamaker", "intermolecular_distance"};
+
+void add_impact_params(io::ParamSet& p) {
+  p.real("mass1", 1.0, "mass m1 of the lower body (kg for law = dmt)", Range::positive())
+      .real("mass2", 1.0, "mass m2 of the upper body (kg for law = dmt)", Range::positive())
+      .real("velocity", 1.0,
+            "relative approach speed -(v2 - v1) > 0, centre of mass at rest (nm/s for law = dmt); or give v1, v2",
+            Range::positive())
+      .real("v1", 0.0, "initial velocity of body 1 (instead of velocity; needs v2 - v1 < 0)", Range::any())
+      .real("v2", 0.0, "initial velocity of body 2 (instead of velocity)", Range::any())
+      .real("gap", 1.0, "initial gap d(t_s) = x2 - x1 (nm for law = dmt); contact for d < 0 (a0 for dmt)", Range::any())
+      .real("force1", 0.0, "constant external force F1 on body 1 (seed-1 eq. 1; nN for dmt)", Range::any())
+      .real("force2", 0.0, "constant external force F2 on body 2", Range::any())
+      .text("law", "hysteresis",
+            "interaction H(d, d'): linear (eq. 10), hysteresis (eq. 11), attractive (eq. 26), dmt (Hertz + van der Waals)",
+            {"linear", "hysteresis", "attractive", "dmt"})
+      .real("approach_stiffness", 10.0, "K_a, contact stiffness while approaching", Range::non_negative())
+      .real("departure_stiffness", 8.0, "K_b, contact stiffness while departing (hysteresis, attractive)",
+            Range::non_negative())
+      .real("approach_adhesion", 0.0, "F_a >= 0, attraction at the contact edge while approaching (attractive)",
+            Range::non_negative())
+      .real("departure_adhesion", 0.0, "F_b >= F_a, attraction at the contact edge while departing (attractive)",
+            Range::non_negative())
+      .real("restitution", 0.0, "if > 0: set K_b = e^2 K_a for restitution e (MATH.md ext. E0; hysteresis, attractive)",
+            Range::closed(0.0, 1.0))
+      .real("effective_modulus", 1.0, "[dmt] effective modulus E* while approaching (GPa)", Range::positive())
+      .real("departure_modulus", 1.0, "[dmt] E* while departing (GPa; default: effective_modulus)", Range::positive())
+      .real("tip_radius", 10.0, "[dmt] tip radius R (nm)", Range::positive())
+      .real("hamaker", 6.4e-20, "[dmt] Hamaker constant while approaching (J)", Range::non_negative())
+      .real("departure_hamaker", 6.4e-20, "[dmt] Hamaker constant while departing (J; default: hamaker)",
+            Range::non_negative())
+      .real("intermolecular_distance", 0.165, "[dmt] intermolecular distance a0 (nm)", Range::positive())
+      .text("method", "automatic", "solver: automatic (closed form for linear laws), closed_form, integrator",
+            {"automatic", "closed_form", "integrator"})
+      .real("relative_tolerance", 1e-11, "integrator relative tolerance", {0.0, 1e-2, true, false})
+      .real("absolute_tolerance", 1e-13, "integrator absolute tolerance (scaled state)", Range::positive())
+      .integer("points", 400, "time-history samples written with --output (>= 2; events are added)", 2, 10000000)
+      .flag("json", false, "print the result as JSON instead of the summary")
+      .text("output", "", "CSV file for the time history (JSON sidecar written next to it); empty: none");
+}
+
+void reject_foreign_keys(const io::ParamSet& p) {
+  const std::string& law = p.text("law");
+  auto reject = [&](const char* key, const std::string& why) {
+    if (p.was_set(key)) throw InvalidParameter(key, fmt::format("{} does not apply to law = {}: {}", key, law, why));
+  };
+  if (law == "dmt") {
+    for (const char* k : linear_keys) reject(k, "it is a parameter of the piecewise-linear laws");
+  } else {
+    for (const char* k : dmt_keys) reject(k, "it is a parameter of law = dmt");
+    if (law == "linear") {
+      for (const char* k : {"departure_stiffness", "approach_adhesion", "departure_adhesion", "restitution"})
+        reject(k, "the linear law (eq. 10) has one stiffness and no adhesion; use hysteresis or attractive");
+    } else if (law == "hysteresis") {
+      for (const char* k : {"approach_adhesion", "departure_adhesion"})
+        reject(k, "use law = attractive (eq. 26) for adhesion");
+    }
+  }
+  if (p.was_set("restitution") && p.was_set("departure_stiffness") && p.real("restitution") > 0)
+    throw InvalidParameter("restitution", "give either restitution or departure_stiffness, not both");
+  if (p.was_set("velocity") && (p.was_set("v1") || p.was_set("v2")))
+    throw InvalidParameter("velocity", "give either velocity (relative approach speed) or v1 and v2, not both");
+}
+
+impact::ForceLaw law_from(const io::ParamSet& p) {
+  const std::string& law = p.text("law");
+  if (law == "dmt") {
+    const double ea = p.real("effective_modulus");
+    const double eb = p.was_set("departure_modulus") ? p.real("departure_modulus") : ea;
+    const double ha = p.real("hamaker");
+    const double hb = p.was_set("departure_hamaker") ? p.real("departure_hamaker") : ha;
+    return impact::DmtLaw(ea, eb, p.real("tip_radius"), ha, hb, p.real("intermolecular_distance"));
+  }
+  const double ka = p.real("approach_stiffness");
+  if (law == "linear") return impact::PiecewiseLinearLaw::linear_repulsive(ka);
+  const double e = p.real("restitution");
+  const double kb = e > 0 ? impact::PiecewiseLinearLaw::departure_stiffness_for_restitution(ka, e)
+                          : p.real("departure_stiffness");
+  if (law == "hysteresis") return impact::PiecewiseLinearLaw::linear_hysteresis(ka, kb);
+  return impact::PiecewiseLinearLaw::repulsive_attractive(ka, kb, p.real("approach_adhesion"),
+                                                          p.real("departure_adhesion"));
+}
+
+impact::ImpactProblem problem_from(const io::ParamSet& p) {
+  reject_foreign_keys(p);
+  const double m1 = p.real("mass1"), m2 = p.real("mass2"), total = m1 + m2, gap = p.real("gap");
+  double v1 = 0, v2 = 0;
+  if (p.was_set("v1") || p.was_set("v2")) {
+    v1 = p.real("v1");
+    v2 = p.real("v2");
+  } else {  // centre of mass at rest
+    v1 = m2 / total * p.real("velocity");
+    v2 = -m1 / total * p.real("velocity");
+  }
+  impact::ExternalForces ext;
+  ext.on_body1 = p.real("force1");
+  ext.on_body2 = p.real("force2");
+  return {{m1, -m2 / total * gap, v1}, {m2, m1 / total * gap, v2}, law_from(p), ext};
+}
+
+nlohmann::json body_json(const impact::Body& b) {
+  return {{"mass", b.mass}, {"position", b.position}, {"velocity", b.velocity}};
+}
+
+nlohmann::json result_json(const impact::ImpactResult& r, const impact::ForceLaw& law) {
+  nlohmann::json j = {{"outcome", impact::to_string(r.outcome)},
+                      {"method", r.method},
+                      {"law", law.name()},
+                      {"reduced_mass", r.reduced_mass},
+                      {"start_time", r.start_time},
+                      {"minimum_time", r.minimum_time},
+                      {"end_time", r.end_time},
+                      {"reference_gap", r.reference_gap},
+                      {"minimum_gap", r.minimum_gap},
+                      {"contact_gap", r.contact_gap},
+                      {"max_penetration", r.max_penetration},
+                      {"contact", r.contact},
+                      {"contact_start", r.contact_start},
+                      {"contact_end", r.contact_end},
+                      {"contact_duration", r.contact_duration},
+                      {"approach_gap_rate", r.approach_gap_rate},
+                      {"departure_gap_rate", r.departure_gap_rate},
+                      {"restitution", r.restitution},
+                      {"kinetic_energy_before", r.kinetic_energy_before},
+                      {"kinetic_energy_after", r.kinetic_energy_after},
+                      {"kinetic_energy_loss", r.kinetic_energy_loss},
+                      {"energy_loss_restitution", r.energy_loss_restitution},
+                      {"energy_loss_area", r.energy_loss_area},
+                      {"peak_force", r.peak_force},
+                      {"min_force", r.min_force},
+                      {"body1_after", body_json(r.body1_after)},
+                      {"body2_after", body_json(r.body2_after)},
+                      {"steps", r.steps}};
+  if (r.outcome == impact::ImpactOutcome::captured) j["capture_reason"] = r.capture_reason;
+  if (const auto* lin = law.piecewise_linear(); lin && lin->approach_stiffness > 0)
+    j["restitution_impulsive_limit"] = std::sqrt(lin->departure_stiffness / lin->approach_stiffness);  // ext. E0
+  return j;  // NaN (undefined quantities) is written as null
+}
+
+void print_summary(const impact::ImpactResult& r, const impact::ForceLaw& law) {
+  auto num = [](double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.10g}", v); };
+  fmt::print("impact ({} law, {}): {}\n", law.name(), r.method, impact::to_string(r.outcome));
+  if (r.outcome == impact::ImpactOutcome::captured) fmt::print("  capture: {}\n", r.capture_reason);
+  fmt::print("  reduced mass               {}\n", num(r.reduced_mass));
+  fmt::print("  gap d(t_s) -> minimum      {} -> {} (max penetration {})\n", num(r.reference_gap), num(r.minimum_gap),
+             num(r.max_penetration));
+  fmt::print("  times t_s, t_min, t_f      {}, {}, {}\n", num(r.start_time), num(r.minimum_time), num(r.end_time));
+  if (r.contact)
+    fmt::print("  contact                    {} .. {} (duration {})\n", num(r.contact_start), num(r.contact_end),
+               num(r.contact_duration));
+  else
+    fmt::print("  contact                    none\n");
+  fmt::print("  gap rate before / after    {} / {}\n", num(r.approach_gap_rate), num(r.departure_gap_rate));
+  fmt::print("  restitution e (eq. 2)      {}\n", num(r.restitution));
+  fmt::print("  kinetic energy loss        {} (simulated)\n", num(r.kinetic_energy_loss));
+  fmt::print("                             {} (eq. 3, from e)\n", num(r.energy_loss_restitution));
+  fmt::print("                             {} (eq. 6, area between branches)\n", num(r.energy_loss_area));
+  fmt::print("  peak force / min force     {} / {}\n", num(r.peak_force), num(r.min_force));
+  fmt::print("  after: v1 = {}, v2 = {}\n", num(r.body1_after.velocity), num(r.body2_after.velocity));
+}
+
+void run_impact(const io::ParamSet& p) {
+  const impact::ImpactProblem problem = problem_from(p);
+  impact::ImpactOptions options;
+  const std::string& method = p.text("method");
+  options.method = method == "closed_form" ? impact::ImpactMethod::closed_form
+                   : method == "integrator" ? impact::ImpactMethod::integrator
+                                            : impact::ImpactMethod::automatic;
+  options.relative_tolerance = p.real("relative_tolerance");
+  options.absolute_tolerance = p.real("absolute_tolerance");
+  const std::string output = p.text("output");
+  options.history_points = output.empty() ? 0 : p.integer("points");
+  const impact::ImpactResult r = impact::simulate_impact(problem, options);
+  const nlohmann::json summary = result_json(r, problem.law());
+
+  if (!output.empty()) {
+    io::Table table({"t", "gap", "gap_rate", "force", "x1", "v1", "x2", "v2"});
+    for (const impact::ImpactSample& s : r.history)
+      table.add_row({s.time, s.gap, s.gap_rate, s.force, s.position1, s.velocity1, s.position2, s.velocity2});
+    io::write_table(output, table, io::make_sidecar("impact", p.to_json(), summary));
+  }
+  if (p.flag("json")) {
+    fmt::print("{}\n", summary.dump(2));
+  } else {
+    print_summary(r, problem.law());
+    if (!output.empty()) fmt::print("wrote {} rows to {} (summary in {}.json)\n", r.history.size(), output, output);
+  }
+}
+
+}  // namespace
+
+void register_impact(CLI::App& app) {
+  auto params = std::make_shared<io::ParamSet>();
+  add_impact_params(*params);
+  auto* cmd = app.add_subcommand(
+      "impact", "two-body impact with a hysteresis force law: restitution, energy loss, contact (seed-1 eqs. 1-6)");
+  params->add_options(*cmd);
+  cmd->callback([params] {
+    params->resolve();
+    run_impact(*params);
+  });
+}
 
 }  // namespace afmkit::cli

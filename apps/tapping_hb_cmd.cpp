@@ -1,10 +1,98 @@
-#include <CLI/CLI.hpp>
+// afmkit tapping hb: the harmonic-balance separation–amplitude curve (seed-1 eqs. 18–19, 32–33, MATH.md A.7)
+// sampled over the penetration parameter q, as CSV (q, separation, amplitude, offset, phase, branch) with a
+// JSON sidecar holding the folds (jump points), the free amplitude and the solutions at `separation`.
+#include <memory>
+#include <string>
 
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/params.hpp"
+#include "afmkit/tapping/harmonic_balance.hpp"
+#include "afmkit/tapping/hb_approximations.hpp"
 #include "commands.hpp"
+#include "tapping_params.hpp"
 
 namespace afmkit::cli {
 
-// Placeholder registration: the subcommand is added when its domain lands.
-void register_tapping_hb(CLI::App& /*tapping*/) {}
+namespace {
+
+nlohmann::json point_json(const tapping::HbPoint& p, const TappingScales& s) {
+  return {{"q", p.q},
+          {"separation", p.separation * s.length},
+          {"amplitude", p.amplitude * s.length},
+          {"offset", p.offset * s.length},
+          {"phase", p.phase},
+          {"branch", tapping::branch_name(p.branch)}};
+}
+
+void run_hb(const io::ParamSet& p) {
+  const double q_min = p.real("q_min");
+  const double q_max = p.real("q_max");
+  if (!(q_min < q_max))
+    throw InvalidParameter("q_max", fmt::format("q_max = {} is out of range: must be > q_min = {}", q_max, q_min));
+  const tapping::TappingModel model = tapping_model_from(p);
+  const TappingScales scales = tapping_scales_from(p);
+
+  tapping::HbCurveOptions options;
+  options.q_min = q_min;
+  options.q_max = q_max;
+  options.points = static_cast<std::size_t>(p.integer("points"));
+  options.spacing = p.text("spacing") == "uniform" ? tapping::HbCurveSpacing::Uniform
+                                                   : tapping::HbCurveSpacing::RefinedGrazing;
+  options.min_gap = p.real("min_gap");
+  options.include_minus = p.flag("minus_branch");
+  const std::vector<tapping::HbPoint> curve = tapping::harmonic_balance_curve(model, options);
+
+  io::Table table({"q", "separation", "amplitude", "offset", "phase", "branch"});
+  for (const tapping::HbPoint& pt : curve)
+    table.add_row({pt.q, pt.separation * scales.length, pt.amplitude * scales.length, pt.offset * scales.length,
+                   pt.phase, std::string(tapping::branch_name(pt.branch))});
+
+  const tapping::HarmonicBalance hb(model);
+  nlohmann::json folds = nlohmann::json::array();
+  for (const tapping::HbFold& f : hb.folds()) {
+    nlohmann::json j = point_json(f.point, scales);
+    j["kind"] = f.separation_maximum ? "maximum" : "minimum";
+    folds.push_back(j);
+  }
+  nlohmann::json solutions = nlohmann::json::array();
+  for (const tapping::HbPoint& s : hb.solutions(model.separation)) solutions.push_back(point_json(s, scales));
+  nlohmann::json results = {{"folds", folds},
+                            {"free_amplitude", hb.free_amplitude() * scales.length},
+                            {"solutions_at_separation", solutions},
+                            {"rows", table.size()}};
+  if (const auto limit = tapping::minimum_separation_limit(model))
+    results["minimum_separation_limit"] = *limit * scales.length;  // ext. E8 (−∞ written as null)
+  const std::string output = p.text("output");
+  io::write_table(output, table, io::make_sidecar("tapping hb", p.to_json(), results));
+  fmt::print("wrote {} rows to {} ({} fold(s), {} solution(s) at separation {})\n", table.size(), output,
+             folds.size(), solutions.size(), p.real("separation"));
+}
+
+}  // namespace
+
+void register_tapping_hb(CLI::App& tapping) {
+  auto params = std::make_shared<io::ParamSet>();
+  add_tapping_model_params(*params);
+  params->real("q_min", -1.0, "smallest penetration parameter q = (A + l)/B of the curve", io::Range::any())
+      .real("q_max", 1.5, "largest q (> q_min); q >= 1 is the free oscillation", io::Range::any())
+      .integer("points", 2000, "number of q samples (>= 2)", 2, 100000000)
+      .text("spacing", "refined", "q sampling: uniform, or refined (half the samples log-spaced in 1 - q near grazing)",
+            {"uniform", "refined"})
+      .real("min_gap", 1e-10, "smallest 1 - q of the refined samples", {0.0, 1.0, true, true})
+      .flag("minus_branch", true, "also write the '-' root of the quadratic (MATH.md E2) where it exists")
+      .text("output", "out/tapping_hb.csv", "output CSV path (JSON sidecar written next to it)");
+  auto* cmd = tapping.add_subcommand(
+      "hb", "harmonic-balance separation-amplitude curve over q (piecewise-linear laws), with folds (jump points)");
+  params->add_options(*cmd);
+  cmd->callback([params] {
+    params->resolve();
+    run_hb(*params);
+  });
+}
 
 }  // namespace afmkit::cli

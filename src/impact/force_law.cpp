@@ -1,5 +1,6 @@
 #include "afmkit/impact/force_law.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>

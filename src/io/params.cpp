@@ -171,6 +171,11 @@ void ParamSet::set_from_string(const std::string& key, const std::string& text) 
   check(key, e, "");
 }
 
+void ParamSet::set_default(const std::string& key, const std::string& text) {
+  set_from_string(key, text);
+  entries_.at(key).set = false;
+}
+
 void ParamSet::load_toml_text(const std::string& text, const std::string& origin) {
   toml::table tbl;
   try {

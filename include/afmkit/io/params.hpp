@@ -51,6 +51,8 @@ class ParamSet {
   void resolve();
   /// Load values from TOML text (used by resolve() and by tests). `origin` names the source in messages.
   void load_toml_text(const std::string& text, const std::string& origin);
+  /// Change the default of a registered parameter (textual form, validated); it still counts as "not set".
+  void set_default(const std::string& key, const std::string& text);
   /// Set one value from its textual form (as a flag would), validating it.
   void set_from_string(const std::string& key, const std::string& text);
 

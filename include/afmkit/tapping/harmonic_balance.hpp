@@ -10,9 +10,11 @@
 //
 // HB applies only to piecewise-linear laws (model.law.piecewise_linear() non-null); every function here
 // throws InvalidParameter("law", …) otherwise.
+#include <cstddef>
 #include <optional>
 #include <vector>
 
+#include "afmkit/tapping/hb_branch.hpp"
 #include "afmkit/tapping/model.hpp"
 
 namespace afmkit::tapping {
@@ -40,31 +42,72 @@ std::vector<HbPoint> harmonic_balance_solutions(const TappingModel& model);
 /// Minus gives nullopt. Free with q < 1 gives nullopt. NaN / infinite q -> InvalidParameter("q").
 std::optional<HbPoint> harmonic_balance_at_q(const TappingModel& model, double q, HbBranch branch);
 
-/// A fold (jump point) of the separation–amplitude curve: dl/dq = 0 on a contact branch (ext. E6).
+/// A fold (jump point) of the separation–amplitude curve: a local extremum of l along a contact branch,
+/// dl/dq = 0 (ext. E6). Slowly sweeping l past l_jump = point.separation makes the state leave the branch.
 struct HbFold {
-  HbPoint point;  // q*, l_jump = l(q*), B, A, φ there
-  double curvature;  // d²l/dq² at q* (sign tells whether l(q*) is a local max (<0) or min (>0))
+  HbPoint point;           // q*, l_jump = l(q*), B, A, φ there (branch Plus or Minus)
+  bool separation_maximum; // true: l(q) has a local maximum at q* (two solutions disappear for l > l_jump)
 };
-
-/// Every fold of the "+" and "−" contact branches for q in [q_min, 1) (sorted by q), located to |Δq| ≤ 1e-10.
-/// q_min must be finite and < 1.
-std::vector<HbFold> harmonic_balance_folds(const TappingModel& model, double q_min = -20.0);
 
 /// Options of harmonic_balance_curve.
+enum class HbCurveSpacing {
+  Uniform,          // q uniform on [q_min, q_max]
+  RefinedGrazing,   // half the samples uniform in q, half log-uniform in 1 − q (the steep part near q → 1⁻)
+};
 struct HbCurveOptions {
   double q_min = -2.0;
-  double q_max = 2.0;
-  std::size_t points = 1000;  // ≥ 2 samples in q (log-spaced in 1 − q near grazing when log_near_grazing)
-  bool log_near_grazing = true;  // cluster samples at q → 1⁻ (the steep part of l(q) for stiff samples)
-  bool include_minus = true;     // also sample the "−" branch (only where it exists)
+  double q_max = 2.0;            // > q_min
+  std::size_t points = 1000;     // ≥ 2 samples in q
+  HbCurveSpacing spacing = HbCurveSpacing::RefinedGrazing;
+  double min_gap = 1e-10;        // smallest 1 − q of the log samples (RefinedGrazing), in (0, 1)
+  bool include_minus = true;     // also sample the "−" branch where it exists
 };
 
-/// The parametric HB curve (l(q), B(q), A(q), φ(q)) (seed-1 eq. 19) sampled over q ∈ [q_min, q_max]:
-/// each sample q gives the Free point (q ≥ 1) or the Plus point and, if it exists, the Minus point.
-/// Output order: Plus/Free points by increasing q, then Minus points by increasing q.
+/// The parametric HB curve (l(q), B(q), A(q), φ(q)) (seed-1 eq. 19) sampled over q: each sample gives the
+/// Free point (q ≥ 1) or the Plus point (if it exists) and, when include_minus, the Minus point (if it exists).
+/// Order: Free/Plus points by increasing q, then Minus points by increasing q.
+/// Bad options (q_min ≥ q_max, points < 2, non-finite bounds, min_gap ∉ (0, 1)) -> InvalidParameter.
 std::vector<HbPoint> harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options);
-
-/// Same, writing into `out` (cleared first; its capacity is reused, no allocation when large enough).
+/// Same, writing into `out` (cleared first; its capacity is reused: no allocation when large enough).
 void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out);
+
+/// Every fold of the "+" and "−" branches (sorted by q), each located to |Δq| ≤ 1e-10.
+std::vector<HbFold> harmonic_balance_folds(const TappingModel& model);
+
+/// Harmonic balance of one model (the separation is an input of each query). The constructor scans both
+/// branches once over q ∈ [−1e12, 1) (a log grid in the contact angle near grazing, i.e. 1 − q down to
+/// ~1e-15; a uniform grid in the angle elsewhere; a log grid in −q for permanent contact), locates where each
+/// branch exists and every fold; afterwards each branch is monotone between consecutive scan nodes and
+/// solutions(l) only brackets and refines (TOMS 748). Use it for sweeps over many separations.
+class HarmonicBalance {
+ public:
+  explicit HarmonicBalance(const TappingModel& model);
+
+  /// Every solution at separation l (finite), sorted by increasing amplitude.
+  std::vector<HbPoint> solutions(double separation) const;
+  /// The point at q on a branch (see harmonic_balance_at_q).
+  std::optional<HbPoint> at_q(double q, HbBranch branch) const;
+  /// Folds (sorted by q).
+  const std::vector<HbFold>& folds() const { return folds_; }
+  /// Free amplitude Γ|L(iω)|: the free solution exists for l ≥ this (ext. E7: jump-down point).
+  double free_amplitude() const { return coefficients_.free_amplitude(); }
+  const HbCoefficients& coefficients() const { return coefficients_; }
+
+ private:
+  struct Node {
+    bool permanent;     // parameter is q (q ≤ −1), else the contact angle
+    double parameter;
+    double separation;
+    double derivative;  // dl/dparameter
+  };
+  using Run = std::vector<Node>;  // consecutive nodes on which the branch exists, monotone between nodes
+
+  HbCoefficients coefficients_;
+  std::vector<Run> runs_[2];  // [0]: Plus, [1]: Minus
+  std::vector<HbFold> folds_;
+
+  void scan_branch(int sign);
+  HbBranchEvaluation evaluate(const Node& like, double parameter, int sign) const;
+};
 
 }  // namespace afmkit::tapping

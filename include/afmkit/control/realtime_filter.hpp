@@ -1,0 +1,137 @@
+#pragma once
+// Real-time first-harmonic-rejection filter for instruments (seed-2 controller, eqs. 15, 6, 20).
+//
+// One call per sample: u_n = step(m_n). The controller ż = A z + b m, u = −K c_rᵀ z (oscillator_bank.hpp) is
+// sampled at f_s (h = 1/f_s) in one of two forms (SampledForm, discretisation.hpp):
+//
+// ZeroOrderHold (default) — exact for a sample held over the interval:
+//   z_{n+1} = Φ z_n + Γ m_n,   u_n = −K c_rᵀ z_n     (Φ = e^{Ah}, Γ = ∫₀ʰ e^{As} ds b)
+// so step() returns the continuous controller's output at the sampling instant (no direct feed-through) and then
+// advances the state with the new sample. Φ = e^{(A0 − b c_eᵀ)h} is dense in the oscillator coordinates (the
+// rank-1 coupling does not commute with the rotations), but A is diagonalisable with well separated eigenvalues
+// (≈ ikΩ − α for (20)), so the filter runs in real modal coordinates q (z = V q): each complex pair σ ± iω is a
+// damped rotation e^{σh}R(ωh) of two numbers, a real eigenvalue a scalar, u = w·q — O(N) per sample and equal to
+// e^{Ah} up to rounding (checked against the dense matrix exponential when configured). If V is ill-conditioned
+// (cond > 1e8, near-defective couplings) the filter falls back to the dense Φ (O(N²)); see uses_modal_form().
+//
+// BlockZeroOrderHold — the block scheme sampled: e_n = m_n − x0 − Σ_kept x_k held over the interval, each
+// oscillator rotated exactly by kΩh and driven by e_n (rotations plus a rank-1 coupling, O(N), no eigenvectors).
+// Exact rejection of harmonic 1 and exact pass-through of harmonics 0, 2..N in the samples.
+//
+// step() is noexcept, lock-free and allocation-free. A non-finite sample is skipped: the returned output is the
+// previous one (held), skipped_samples() is incremented, and the state advances as if the sample had equalled the
+// controller's own reconstruction of the kept harmonics (m = x0 + Σ_{k kept} x_k, i.e. e = 0 at that instant), so
+// the oscillators keep their phase and no NaN/Inf ever enters the state.
+//
+// reconfigure() changes any parameter while running without a jump: the oscillator states (x0, x_k, z_k) are
+// kept (new oscillators start at 0, removed ones are dropped), the rejected oscillators are rescaled by
+// K_old/K_new so that u = −K Σ_rej x_k is continuous, and the discretisation is recomputed. Strong guarantee: on
+// InvalidParameter the filter is unchanged.
+//
+// save_state()/restore_state(): a flat array of doubles (layout below); restoring into a filter with the same
+// configuration reproduces the future outputs bit for bit; into a different configuration the physical state is
+// carried over as in reconfigure() (no gain rescaling).
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "afmkit/control/discretisation.hpp"
+#include "afmkit/control/oscillator_bank.hpp"
+
+namespace afmkit::control {
+
+class RealtimeFilter {
+ public:
+  /// sample_rate f_s [samples/s] with Ω in rad/s. Validated: f_s finite and N Ω < π f_s (Nyquist for the highest
+  /// oscillator) → InvalidParameter("sample_rate", …allowed range…).
+  RealtimeFilter(const OscillatorBank& controller, double sample_rate,
+                 SampledForm form = SampledForm::ZeroOrderHold);
+  /// Couplings (20): a0 = α, a_k = 2α, b_k = −2β/k; only harmonic 1 rejected.
+  static RealtimeFilter with_couplings(double sample_rate, double rotation_frequency, int harmonics, double alpha,
+                                       double beta, double gain, SampledForm form = SampledForm::ZeroOrderHold);
+
+  /// Output u_n for the measured sample m_n (see above). noexcept, O(N).
+  double step(double measured) noexcept;
+  /// step() for each sample; in and out may alias; processes min(in.size(), out.size()) samples.
+  void step_block(std::span<const double> in, std::span<double> out) noexcept;
+
+  /// Bumpless change of all parameters (see above).
+  void reconfigure(const OscillatorBank& controller, double sample_rate);
+  void reconfigure(const OscillatorBank& controller, double sample_rate, SampledForm form);
+  /// Bumpless change of K only.
+  void set_gain(double gain);
+  /// Zero state, zero held output, counters cleared.
+  void reset() noexcept;
+
+  // ---- state ------------------------------------------------------------------------------------------------
+  /// Layout: [0] magic 0x41464D4B, [1] layout version (1), [2] N, [3] internal size n_i, [4..5] configuration
+  /// fingerprint (two 32-bit halves), [6] held output, [7] skipped samples, [8] samples processed, [9] physical
+  /// size n = 2N+1, then n_i internal (modal or physical) coordinates, then the n physical coordinates
+  /// (x0, x1, z1, …, xN, zN).
+  std::size_t state_size() const noexcept;
+  /// Throws InvalidParameter("state") if the buffer is smaller than state_size().
+  void save_state(std::span<double> out) const;
+  std::vector<double> save_state() const;
+  /// Throws InvalidParameter("state") for a malformed buffer (magic, version, sizes, non-finite values); the filter
+  /// is then unchanged.
+  void restore_state(std::span<const double> in);
+
+  /// Physical controller state (x0, x1, z1, …, xN, zN).
+  Eigen::VectorXd controller_state() const;
+  /// Replace the physical state (size 2N+1, finite), e.g. to start from the steady state.
+  void set_controller_state(const Eigen::VectorXd& z);
+
+  std::uint64_t skipped_samples() const noexcept { return skipped_; }
+  std::uint64_t samples() const noexcept { return samples_; }
+  double last_output() const noexcept { return held_; }
+  const OscillatorBank& controller() const noexcept { return bank_; }
+  double sample_rate() const noexcept { return sample_rate_; }
+  SampledForm form() const noexcept { return form_; }
+  /// ZeroOrderHold form running in modal coordinates (O(N)); false for the dense fallback and for the block form.
+  bool uses_modal_form() const noexcept { return disc_.kind == Kind::Modal; }
+
+  /// The sampled controller in the oscillator coordinates, z_{n+1} = Φ z_n + Γ m_n, u_n = C z_n (dense Φ, Γ, C),
+  /// reconstructed from the internal form; for tests and inspection.
+  Eigen::MatrixXd transition_matrix() const;
+  Eigen::VectorXd input_vector() const;
+  Eigen::RowVectorXd output_vector() const;
+
+ private:
+  enum class Kind { Modal, Dense, Block };
+  struct Discretisation {
+    Kind kind = Kind::Modal;
+    int pairs = 0, reals = 0;
+    // modal form: per pair j (q1, q2): q1' = c q1 + s q2 + g1 m, q2' = −s q1 + c q2 + g2 m; u = Σ w1 q1 + w2 q2
+    std::vector<double> c, s, g1, g2, w1, w2, e1, e2;
+    // per real mode: q' = r q + gr m; u = Σ wr q
+    std::vector<double> r, gr, wr, er;
+    // dense fallback (row-major Φ), Γ, output row, error row (c_e)
+    std::vector<double> phi, gamma, out, err;
+    // block form, internal order (x0, x1..xN, z1..zN): rotation cos/sin of kΩh, input (gx, gz) per oscillator,
+    // g0 = a0 h, kept (1/0) and output weight (−K for rejected, else 0) per oscillator
+    std::vector<double> rc, rs, gx, gz, kept, wout;
+    double g0 = 0.0;
+    int n = 0;                  // 2N+1
+    Eigen::MatrixXd basis;      // V: z = V q (identity for dense)
+    Eigen::MatrixXd basis_inv;  // V⁻¹
+    std::uint64_t fingerprint = 0;
+  };
+  static Discretisation discretise(const OscillatorBank& bank, double sample_rate, SampledForm form);
+  double advance(double m) noexcept;
+  double coast_input() const noexcept;
+  void load_physical(const Eigen::VectorXd& z);  // q = V⁻¹ z
+
+  OscillatorBank bank_;
+  double sample_rate_;
+  SampledForm form_;
+  Discretisation disc_;
+  std::vector<double> q_, q_tmp_;  // internal coordinates: modal (q1 of all pairs, q2 of all pairs, reals),
+                                   // physical (dense) or (x0, x1..xN, z1..zN) (block)
+  double held_ = 0.0;
+  std::uint64_t skipped_ = 0, samples_ = 0;
+};
+
+}  // namespace afmkit::control

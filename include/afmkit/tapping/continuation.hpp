@@ -1,0 +1,49 @@
+#pragma once
+// Pseudo-arclength continuation of periodic orbits in the separation l, through folds.
+// Unknowns u = (x(0), ẋ(0), l); equations G(u) = P_l(x(0), ẋ(0)) − (x(0), ẋ(0)) = 0 (shooting, period T)
+// plus the arclength condition τ·(u − u_pred) = 0, with the exact Jacobian [M − I | ∂P/∂l]. The tangent τ is
+// the null vector of that 2×3 Jacobian, oriented to keep going. Each point gets its Floquet stability, so the
+// unstable middle branch between two folds (or a fold and a grazing point) is produced and flagged.
+// A contact branch that ends at grazing (contact vanishing; the saltation matrices and multipliers grow without
+// bound there) turns non-smoothly into the free branch: the continuation hops onto the grazing free orbit and
+// follows the free branch towards larger l.
+#include <string>
+#include <vector>
+
+#include "afmkit/tapping/sweep.hpp"
+
+namespace afmkit::tapping {
+
+struct ContinuationOptions {
+  double initial_step = 0.02;  // arclength step (model length units; u is scaled by the orbit amplitude)
+  double min_step = 1e-7;
+  double max_step = 0.2;
+  int max_points = 5000;
+  int max_corrector_iterations = 12;
+  double tolerance = 1e-10;  // corrector convergence (scaled residual)
+  double time_budget_seconds = 60.0;  // whole continuation -> stops with stop_reason "time budget"
+  bool harmonic_balance = true;
+  bool parallel = true;      // metrics and HB of the points on both cores
+  ShootingOptions shooting;  // integrator options; tolerance used for the starting orbit
+  void validate() const;
+};
+
+struct ContinuationResult {
+  std::vector<SweepPoint> points;  // direction = continuation, in arclength order
+  std::vector<double> folds;       // separations where l turned (dl/ds changed sign)
+  /// Separations where a contact branch ran into grazing and the continuation hopped onto the free branch.
+  std::vector<double> grazing;
+  std::string stop_reason;         // "left range", "max points", "step below min_step (…)" …
+};
+
+/// Continue the period-1 branch through `start` (a converged orbit at start.separation) for l within
+/// [l_min, l_max], first moving in the direction of increasing l if `increasing` (else decreasing).
+ContinuationResult continue_orbits(const TappingModel& base, const PeriodicOrbit& start, double l_min, double l_max,
+                                   bool increasing, const ContinuationOptions& options = {});
+
+/// Convenience for the CLI: start from the largest-amplitude stable orbit found at l_min (find_orbits) and
+/// continue towards increasing l until l leaves [l_min, l_max] or the budget ends.
+ContinuationResult sweep_continuation(const TappingModel& base, double l_min, double l_max,
+                                      const ContinuationOptions& options = {});
+
+}  // namespace afmkit::tapping

@@ -1,0 +1,92 @@
+#pragma once
+// Modes, guards (witness functions) and events of the tapping cantilever (seed-1 eqs. 8, 11, 26).
+//
+// A mode fixes the smooth vector field used between events:
+//   region  — index of the gap interval between the law's switching gaps s_0 < … < s_{m−1}
+//             (region r: s_{r−1} ≤ x + l < s_r); region 0 = deepest (in contact).
+//   branch  — approach (ẋ < 0, H_a), departure (ẋ > 0, H_b), or sticking (ẋ = 0 held: the tip rests).
+// Guards, each with the crossing direction that ends the mode (Drake-style witness functions):
+//   gap       x + l − s_i          falling (enter region below) or rising (enter region above)
+//   velocity  ẋ                    rising in approach, falling in departure (branch switch, or sticking)
+//   release   a_b(t) (departure acceleration at rest)  rising  -> leave sticking upwards
+//             a_a(t) (approach acceleration at rest)   falling -> leave sticking downwards
+// Crossings are isolated by bracketing root finding to a few ulps of time; the event time is taken at the
+// post-crossing end of the final bracket, so the state after the event is consistent with the new mode.
+
+namespace afmkit::tapping {
+
+/// Tip state (x, ẋ) in model units.
+struct TipState {
+  double position = 0.0;  // x
+  double velocity = 0.0;  // ẋ
+};
+
+/// Which force branch is active (seed-1 eq. 4 as corrected in MATH.md A.1).
+enum class ContactBranch { approach, departure, sticking };
+const char* contact_branch_name(ContactBranch branch);
+
+struct Mode {
+  int region = 0;  // gap interval index (0 = below the lowest switching gap)
+  ContactBranch branch = ContactBranch::approach;
+  friend bool operator==(const Mode&, const Mode&) = default;
+};
+
+/// Kinds of guard (witness) functions.
+enum class GuardKind { gap, velocity, release_departure, release_approach };
+const char* guard_kind_name(GuardKind kind);
+
+enum class CrossingDirection { rising, falling };
+
+struct Guard {
+  GuardKind kind = GuardKind::gap;
+  CrossingDirection direction = CrossingDirection::falling;
+  double level = 0.0;  // switching gap s_i for GuardKind::gap, 0 otherwise
+};
+
+/// A located mode switch.
+struct Event {
+  double time = 0.0;
+  Guard guard;
+  Mode before;
+  Mode after;
+  TipState state;  // state at the event (after the switch)
+};
+
+/// Isolate the crossing of a scalar witness `g` over [t_lo, t_hi] given that g(t_lo) is strictly on the
+/// pre-crossing side and g(t_hi) on the post-crossing side (or zero) for `direction`. Returns the post-crossing
+/// end of the final bracket, which shrinks to at most `time_tolerance` (or to adjacent doubles). Pure
+/// bracketing (secant/bisection, Illinois-safeguarded), so it never leaves [t_lo, t_hi].
+template <class Witness>
+double isolate_crossing(Witness&& g, double t_lo, double t_hi, CrossingDirection direction, double time_tolerance) {
+  // Orient so that the pre-crossing side is positive.
+  const double sign = direction == CrossingDirection::falling ? 1.0 : -1.0;
+  double a = t_lo, b = t_hi;
+  double fa = sign * g(a), fb = sign * g(b);
+  int side = 0;
+  for (int it = 0; it < 200 && b - a > time_tolerance; ++it) {
+    // regula falsi (Illinois) step, falling back to bisection when it stalls
+    double c = (fb < 0.0 && fa > 0.0) ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
+    if (!(c > a && c < b) || (it % 4 == 3)) c = 0.5 * (a + b);
+    if (c <= a || c >= b) break;  // adjacent doubles
+    const double fc = sign * g(c);
+    if (fc > 0.0) {
+      a = c;
+      fa = fc;
+      if (side == -1) fb *= 0.5;
+      side = -1;
+    } else {
+      b = c;
+      fb = fc;
+      if (side == 1) fa *= 0.5;
+      side = 1;
+    }
+  }
+  return b;
+}
+
+/// True if the witness values (before, after) show a crossing in `direction` (pre-crossing side strict).
+inline bool crosses(double before, double after, CrossingDirection direction) {
+  return direction == CrossingDirection::falling ? (before > 0.0 && after <= 0.0) : (before < 0.0 && after >= 0.0);
+}
+
+}  // namespace afmkit::tapping

@@ -1,0 +1,61 @@
+#pragma once
+// Periodic steady states by shooting: Newton's method on the stroboscopic map P^n (n drive periods, drive at
+// phase 0 at t = 0), with the exact monodromy matrix M = ∂P^n/∂(x, ẋ) from the variational equations and the
+// saltation matrices of every event. Floquet multipliers = eigenvalues of M; the orbit is (asymptotically)
+// stable when max |μ| < 1.
+#include <array>
+#include <complex>
+#include <optional>
+
+#include <Eigen/Core>
+
+#include "afmkit/tapping/simulation.hpp"
+
+namespace afmkit::tapping {
+
+struct ShootingOptions {
+  double tolerance = 1e-11;        // converged when |P^n(y) − y| ≤ tolerance · max(1, |y|) (per component scale)
+  int max_iterations = 30;         // Newton iterations -> NumericalFailure when exceeded (shoot) / nullopt (try_shoot)
+  double time_budget_seconds = 5;  // wall-clock budget of one shooting solve
+  SimulationOptions simulation;    // integrator used for the map (sensitivity is switched on internally)
+  void validate() const;
+};
+
+/// A periodic orbit of period n·T (T = 2π/ω), given by its state at t = 0 (drive Γ cos ωt at phase 0).
+struct PeriodicOrbit {
+  double separation = 0.0;   // l
+  int period_multiple = 1;   // n
+  TipState initial;          // state at t = 0 (= state at t = nT)
+  Eigen::Matrix2d monodromy = Eigen::Matrix2d::Identity();          // ∂P^n/∂(x, ẋ)
+  Eigen::Vector2d separation_sensitivity = Eigen::Vector2d::Zero();  // ∂P^n/∂l (used by continuation)
+  std::array<std::complex<double>, 2> floquet_multipliers{};
+  double floquet_max = 0.0;  // max |μ|
+  bool stable = false;       // floquet_max < 1
+  double residual = 0.0;     // final |P^n(y) − y| (scaled)
+  int iterations = 0;
+  SimulationStats stats;     // of the last period evaluation (events, impacts, sticking)
+};
+
+/// One evaluation of the map: state after n periods and its sensitivities (columns x, ẋ, l).
+struct StroboscopicMap {
+  TipState end;
+  Eigen::Matrix3d sensitivity;
+  SimulationStats stats;
+};
+StroboscopicMap stroboscopic_map(const TappingModel& model, TipState start, int period_multiple,
+                                 const SimulationOptions& options);
+
+/// Newton shooting from `guess`. Returns nullopt when Newton does not converge within the iteration budget
+/// (so callers can try another guess); throws NumericalFailure when the time budget is exhausted.
+std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess, int period_multiple,
+                                       const ShootingOptions& options = {});
+/// As try_shoot, but non-convergence -> NumericalFailure with the residual in the message.
+PeriodicOrbit shoot(const TappingModel& model, TipState guess, int period_multiple, const ShootingOptions& options = {});
+
+/// Fill monodromy-derived fields (multipliers, floquet_max, stable) of `orbit` from `orbit.monodromy`.
+void set_floquet(PeriodicOrbit& orbit);
+
+/// The exact periodic response of the cantilever without contact (linear oscillator), state at t = 0.
+TipState free_response_state(const TappingModel& model);
+
+}  // namespace afmkit::tapping

@@ -1,0 +1,72 @@
+#pragma once
+// Time-domain simulation of the tapping cantilever (seed-1 eq. 8):
+//   ẍ + 2ξω_n ẋ + ω_n² x = Γ cos(ωt) − h(x, ẋ),   h = −H(x + l, ẋ)
+// The three concerns are separate (as in Boost.Odeint):
+//   * what the system is      — TappingSystem (system.hpp): modes, branch accelerations, guards;
+//   * how it is integrated    — Integrator::closed_form (exact flow of the piecewise-linear laws, eqs. 10/11/26)
+//                               or Integrator::adaptive (Dormand–Prince 5(4) with dense output, any law);
+//   * what is recorded        — a TrajectoryObserver (observer.hpp) receiving every smooth segment and event.
+// Mode switches are events located on the guard (witness) functions of events.hpp: the gap x + l crossing a
+// switching gap of the law (with its direction) and the sign change of ẋ (approach ↔ departure branch).
+// Sticking (ẋ = 0 with both branches pushing back onto ẋ = 0) is a mode of its own: the tip rests until the
+// drive can move it; it is counted, never looped on.
+#include <Eigen/Core>
+
+#include "afmkit/tapping/events.hpp"
+#include "afmkit/tapping/model.hpp"
+
+namespace afmkit::tapping {
+
+class TrajectoryObserver;
+
+/// How the flow between events is computed.
+enum class Integrator {
+  automatic,    // closed_form for piecewise-linear laws, adaptive otherwise
+  closed_form,  // exact (to rounding) flow of the linear modes; piecewise-linear laws only
+  adaptive,     // Dormand–Prince 5(4) (Boost.Odeint runge_kutta_dopri5, dense output) + event isolation
+};
+const char* integrator_name(Integrator integrator);
+
+struct SimulationOptions {
+  Integrator integrator = Integrator::automatic;
+  double relative_tolerance = 1e-10;  // adaptive integrator only
+  double absolute_tolerance = 1e-12;  // adaptive integrator only (in model length units)
+  /// Largest step of the adaptive integrator and of the closed-form guard scan, as a fraction of the shortest
+  /// period present (drive period, damped mode period): a crossing can never be stepped over.
+  double max_step_fraction = 1.0 / 24.0;
+  long max_events = 1'000'000;  // exceeded -> NumericalFailure
+  long max_steps = 50'000'000;  // adaptive steps budget -> NumericalFailure
+  /// Propagate ∂(x, ẋ, l)(t_end)/∂(x, ẋ, l)(t_begin) (variational equations + saltation matrices at events).
+  bool sensitivity = false;
+
+  void validate() const;  // InvalidParameter on bad values
+};
+
+/// Counters of one simulation.
+struct SimulationStats {
+  long events = 0;            // all mode switches
+  long impacts = 0;           // entries into contact (gap falling through the lowest switching gap)
+  long sticking_count = 0;    // entries into the sticking mode
+  double sticking_duration = 0.0;  // total time spent sticking
+  long steps = 0;             // closed-form guard-scan intervals or adaptive steps
+};
+
+struct SimulationResult {
+  double time = 0.0;
+  TipState state;
+  Mode mode;
+  SimulationStats stats;
+  /// ∂(x, ẋ, l)(time)/∂(x, ẋ, l)(t_begin) when SimulationOptions::sensitivity (identity otherwise).
+  Eigen::Matrix3d sensitivity = Eigen::Matrix3d::Identity();
+};
+
+/// Integrate from (t_begin, start) to t_end ≥ t_begin. The initial mode follows from the state (see
+/// TappingSystem::initial_mode). Throws NumericalFailure when an event or step budget is exhausted and
+/// InvalidParameter for a non-finite state, t_end < t_begin, or closed_form with a non piecewise-linear law.
+SimulationResult simulate(const TappingModel& model, double t_begin, TipState start, double t_end,
+                          const SimulationOptions& options = {}, TrajectoryObserver* observer = nullptr);
+
+/// Integrator actually used for `model` under `requested` (resolves automatic; validates closed_form).
+Integrator resolve_integrator(const TappingModel& model, Integrator requested);
+
+}  // namespace afmkit::tapping

@@ -1,0 +1,77 @@
+#pragma once
+// What the tapping system is (independent of how it is integrated): for a TappingModel, the modes, the smooth
+// vector field of each mode, the guards that end a mode and the rules that pick the next mode at an event.
+//   ẍ = Γ cos(ωt) − 2ξω_n ẋ − ω_n² x − h_branch(x),   h_branch(x) = −H_branch(x + l)   (seed-1 eq. 8)
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "afmkit/tapping/events.hpp"
+#include "afmkit/tapping/model.hpp"
+
+namespace afmkit::tapping {
+
+class TappingSystem {
+ public:
+  explicit TappingSystem(const TappingModel& model);
+
+  const TappingModel& model() const { return model_; }
+  double separation() const { return model_.separation; }
+  double gap(double x) const { return x + model_.separation; }  // d = x + l
+  /// Number of gap regions (switching gaps + 1). Region r: s_{r−1} ≤ gap < s_r.
+  int region_count() const { return static_cast<int>(switching_.size()) + 1; }
+  int region_of(double gap) const;
+  /// Lowest switching gap (0 when the law has none): x + l below it counts as contact.
+  double contact_gap() const { return switching_.empty() ? 0.0 : switching_.front(); }
+  /// Whether approach and departure branches differ in `region` (else no velocity guard there).
+  bool branch_dependent(int region) const { return region < 64 && ((dependent_mask_ >> region) & 1u); }
+
+  double drive(double t) const;       // Γ cos ωt
+  double drive_rate(double t) const;  // d/dt Γ cos ωt
+  double damping() const { return damping_; }      // 2ξω_n
+  double stiffness() const { return stiffness_; }  // ω_n²
+
+  /// h of the given (fixed) branch at position x, extended smoothly (piecewise-linear laws) or continuously
+  /// (clamped gap, other laws) beyond the bounds of `region`; sticking uses the mean of the branches (eq. 4).
+  double interaction(ContactBranch branch, double x, int region) const;
+  /// ∂h/∂x of the same extension: exact for piecewise-linear laws, one-sided differences inside `region` else.
+  double interaction_slope(ContactBranch branch, double x, int region) const;
+  /// ẍ in `mode` at (t, x, ẋ) (0 while sticking).
+  double acceleration(const Mode& mode, double t, TipState s) const;
+  /// ẍ with the given branch's force in `region`.
+  double acceleration(ContactBranch branch, int region, double t, TipState s) const;
+
+  /// Mode of a state at time t (region from the gap, branch from ẋ, or from the accelerations when ẋ = 0).
+  Mode initial_mode(double t, TipState& s) const;
+  /// Mode when entering `region` at (t, s): branch from ẋ, or from the accelerations when ẋ = 0 (may stick).
+  Mode enter_region(int region, double t, TipState& s) const;
+  /// Mode after ẋ reached 0 coming from branch `from`: the branch whose acceleration moves the tip away from
+  /// ẋ = 0, or sticking (ẋ set to 0) when both push back onto it.
+  Mode after_velocity_zero(int region, ContactBranch from, double t, TipState& s) const;
+  /// Mode after the crossing of `guard` out of `mode` (s may be adjusted: ẋ = 0 on sticking / release).
+  Mode after_event(const Mode& mode, const Guard& guard, double t, TipState& s) const;
+
+  /// Guards that can end `mode` (at most 3). Returns their number.
+  int guards(const Mode& mode, std::array<Guard, 3>& out) const;
+  /// Value of a guard's witness function at (t, s) in `mode`.
+  double witness(const Guard& guard, const Mode& mode, double t, TipState s) const;
+  /// Time derivative of the witness along the mode's flow (detects double crossings inside a scan step).
+  double witness_rate(const Guard& guard, const Mode& mode, double t, TipState s) const;
+  /// Gradient of the witness with respect to (x, ẋ, l) and its explicit time derivative (saltation matrices).
+  void witness_gradient(const Guard& guard, const Mode& mode, double t, TipState s, double grad[3],
+                        double& time_partial) const;
+
+ private:
+  TappingModel model_;
+  std::vector<double> switching_;
+  unsigned long dependent_mask_ = 0;
+  std::optional<impact::PiecewiseLinearLaw> linear_;  // scaled coefficients when piecewise linear
+  double damping_;    // 2ξω_n
+  double stiffness_;  // ω_n²
+  double omega_;      // ω
+  double gamma_;      // Γ
+  double region_lo(int region) const;
+  double region_hi(int region) const;
+};
+
+}  // namespace afmkit::tapping

@@ -1,0 +1,38 @@
+#pragma once
+// Transients: simulate from a state until the stroboscopic sequence settles, detect its period (1..4 drive
+// periods) and converge it by shooting. What a physical instrument does when an orbit disappears (a jump).
+#include <optional>
+#include <string>
+
+#include "afmkit/tapping/shooting.hpp"
+
+namespace afmkit::tapping {
+
+struct TransientOptions {
+  int chunk_periods = 24;       // periods between checks (a multiple of 1..4 keeps the phase of period-n orbits)
+  int max_periods = 20000;      // give up (non-periodic / not settled) after this many periods
+  int max_period_multiple = 4;  // look for period-n responses, n = 1..max_period_multiple
+  /// Accept the shooting result once the simulated state is within this distance (relative to the orbit
+  /// amplitude) of a stable orbit of matching period, and the distance keeps decreasing.
+  double capture_distance = 0.02;
+  void validate() const;
+};
+
+enum class ResponseKind { periodic, not_settled };
+const char* response_kind_name(ResponseKind kind);
+
+struct TransientOutcome {
+  ResponseKind kind = ResponseKind::not_settled;
+  std::optional<PeriodicOrbit> orbit;  // set when kind == periodic (stable, period_multiple = n)
+  int periods_simulated = 0;
+  TipState final_state;  // state at the last stroboscopic instant (t = k T) simulated
+  std::string message;   // e.g. why it was reported not settled
+};
+
+/// Simulate from `start` (at drive phase 0) at model.separation until a stable periodic orbit of period
+/// n ≤ max_period_multiple captures the trajectory. A response that does not settle in max_periods (e.g.
+/// chaotic, or period > max_period_multiple) is reported as not_settled, never an endless loop.
+TransientOutcome settle(const TappingModel& model, TipState start, const TransientOptions& options = {},
+                        const ShootingOptions& shooting = {});
+
+}  // namespace afmkit::tapping

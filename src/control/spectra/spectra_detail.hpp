@@ -1,0 +1,114 @@
+#pragma once
+// Private to src/control/spectra: evaluation of Δ and Δ' (loop.hpp), the argument principle with adaptive
+// steps, Newton refinement, argument-principle subdivision search, and loop inspection helpers.
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <vector>
+
+#include "afmkit/control/loop.hpp"
+#include "afmkit/control/spectrum.hpp"
+
+namespace afmkit::control::spectra_detail {
+
+using cplx = std::complex<double>;
+
+/// Δ and Δ' up to a common positive factor (only ratios and phases are used).
+struct Eval {
+  cplx v, d;
+};
+
+inline Eval eval(const LoopSpec& loop, cplx s) {
+  const ScaledCharacteristic c = characteristic_scaled(loop, s);
+  return {c.value, c.derivative};
+}
+
+/// The parts of a loop needed by the bounds and the neutral diagnosis.
+struct LoopView {
+  const OscillatorBank* bank = nullptr;    // finite bank (plain or inside the Smith predictor)
+  const InfiniteBank* infinite = nullptr;  // N = ∞ bank (plain or inside the Smith predictor)
+  const SmithPredictor* smith = nullptr;
+  double omega = 1.0;
+};
+LoopView view(const LoopSpec& loop);
+
+/// Result of a winding-number computation.
+struct Winding {
+  bool ok = false;      // false: a zero on (or within rounding of) the boundary, or a non-integer total
+  int count = 0;
+  long evaluations = 0;
+};
+
+/// Winding number of f along the positively oriented boundary of `box`. f(s) returns Eval (value, derivative).
+/// Steps are accepted when the phase increment is ≤ 0.5 rad and agrees with the trapezoidal prediction
+/// Im ∫ f'/f ds to 0.1 rad; otherwise halved. `scale` is the frequency scale (Ω) for the minimal step.
+template <class F>
+Winding winding(F&& f, const Box& box, double scale) {
+  const cplx corners[4] = {{box.real_min, box.imag_min},
+                           {box.real_max, box.imag_min},
+                           {box.real_max, box.imag_max},
+                           {box.real_min, box.imag_max}};
+  Winding w;
+  double total = 0.0;
+  const double min_step = 1e-13 * std::max(scale, std::abs(corners[2]) + std::abs(corners[0]));
+  for (int e = 0; e < 4; ++e) {
+    const cplx a = corners[e], b = corners[(e + 1) % 4];
+    const double length = std::abs(b - a);
+    if (length == 0.0) continue;
+    Eval cur = f(a);
+    ++w.evaluations;
+    if (!(std::isfinite(cur.v.real()) && std::isfinite(cur.v.imag())) || cur.v == 0.0) return w;
+    double t = 0.0, h = std::min(0.25, 0.5 * scale / length);
+    while (t < 1.0) {
+      const double tn = std::min(1.0, t + h);
+      const cplx ds = (b - a) * (tn - t);
+      const Eval nxt = f(a + (b - a) * tn);
+      ++w.evaluations;
+      if (!(std::isfinite(nxt.v.real()) && std::isfinite(nxt.v.imag())) || nxt.v == 0.0) return w;
+      const double dphi = std::arg(nxt.v / cur.v);
+      const double pred = 0.5 * std::imag((cur.d / cur.v + nxt.d / nxt.v) * ds);
+      if (std::abs(dphi) > 0.5 || std::abs(dphi - pred) > 0.1 || !std::isfinite(pred)) {
+        h *= 0.5;
+        if (h * length < min_step) return w;  // zero on the boundary
+        continue;
+      }
+      total += dphi;
+      t = tn;
+      cur = nxt;
+      h = std::min(1.0, 1.6 * h);
+    }
+  }
+  const double turns = total / (2.0 * std::numbers::pi);
+  const double rounded = std::round(turns);
+  if (std::abs(turns - rounded) > 0.05) return w;
+  w.ok = true;
+  w.count = static_cast<int>(rounded);
+  return w;
+}
+
+/// Winding of Δ of the loop.
+Winding winding(const LoopSpec& loop, const Box& box);
+
+/// Newton on Δ with step limiting. `multiplicity` > 1 uses the modified step m·Δ/Δ'.
+struct NewtonResult {
+  cplx root;
+  bool converged = false;
+  double correction = 0.0;
+  int iterations = 0;
+};
+NewtonResult newton(const LoopSpec& loop, cplx guess, double tolerance, int max_iterations = 80,
+                    int multiplicity = 1);
+
+/// All roots in `box` (which must contain exactly `count` roots, from a previous winding computation), by
+/// recursive bisection with argument-principle counts and Newton from box centres. Appends (root, multiplicity).
+void subdivision_search(const LoopSpec& loop, const Box& box, int count, double tolerance,
+                        std::vector<std::pair<cplx, int>>& out);
+
+/// Argument-principle count with automatic nudging of the box edges (up to 6 attempts) if a root lies on the
+/// boundary; `box` is updated to the box actually used. Returns false if every attempt failed.
+bool robust_count(const LoopSpec& loop, Box& box, int& count);
+
+/// Merge `s` into `roots` unless a root within `radius` is already present.
+bool add_unique(std::vector<cplx>& roots, cplx s, double radius);
+
+}  // namespace afmkit::control::spectra_detail

@@ -1,0 +1,87 @@
+// The parametric separation–amplitude curve (l(q), B(q), A(q), φ(q)) sampled over q (seed-1 eq. 19).
+#include <algorithm>
+#include <cmath>
+
+#include "afmkit/core/validate.hpp"
+#include "afmkit/tapping/harmonic_balance.hpp"
+
+namespace afmkit::tapping {
+
+namespace {
+
+void validate_options(const HbCurveOptions& o) {
+  validate::finite("q_min", o.q_min);
+  validate::finite("q_max", o.q_max);
+  validate::require(o.q_max > o.q_min, "q_max", o.q_max, "> q_min");
+  validate::require(o.points >= 2, "points", static_cast<double>(o.points), ">= 2");
+  validate::require(o.min_gap > 0.0 && o.min_gap < 1.0, "min_gap", o.min_gap, "in (0, 1)");
+}
+
+// Calls visit(q, gap) for every sample by increasing q (gap = 1 − q, exact for the log samples).
+template <class Visit>
+void for_each_sample(const HbCurveOptions& o, Visit visit) {
+  const std::size_t n = o.points;
+  // Log samples of the gap s = 1 − q on [max(min_gap, 1 − q_max), 1 − q_min], only where q < 1.
+  const double gap_hi = 1.0 - o.q_min;
+  const double gap_lo = std::max(o.min_gap, 1.0 - o.q_max);
+  const bool refined = o.spacing == HbCurveSpacing::RefinedGrazing && o.q_min < 1.0 && gap_lo < gap_hi;
+  const std::size_t n_log = refined && n >= 4 ? n / 2 : 0;  // both parts need ≥ 2 samples
+  const std::size_t n_uniform = n - n_log;
+  const double log_ratio = refined ? std::log(gap_lo / gap_hi) : 0.0;
+  auto uniform_q = [&](std::size_t k) {
+    if (k + 1 == n_uniform) return o.q_max;
+    return o.q_min + (o.q_max - o.q_min) * static_cast<double>(k) / static_cast<double>(n_uniform - 1);
+  };
+  auto log_gap = [&](std::size_t k) {
+    return gap_hi * std::exp(log_ratio * static_cast<double>(k) / static_cast<double>(n_log - 1));
+  };
+  // Merge both sequences by increasing q (uniform: increasing q; log: decreasing gap).
+  std::size_t i = 0;
+  std::size_t j = 0;
+  while (i < n_uniform || j < n_log) {
+    if (j >= n_log || (i < n_uniform && uniform_q(i) <= 1.0 - log_gap(j))) {
+      const double q = uniform_q(i++);
+      visit(q, 1.0 - q);
+    } else {
+      const double gap = log_gap(j++);
+      visit(1.0 - gap, gap);
+    }
+  }
+}
+
+HbPoint to_point(const HbBranchEvaluation& e, HbBranch branch) {
+  return {e.q, e.separation, e.amplitude, e.offset, e.phase, branch};
+}
+
+}  // namespace
+
+void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out) {
+  validate_options(options);
+  const HbCoefficients c(model);
+  out.clear();
+  const double b_free = c.free_amplitude();
+  const double phase_free = c.free_phase();
+  for_each_sample(options, [&](double q, double gap) {
+    if (gap <= 0.0) {
+      out.push_back({q, q * b_free, b_free, 0.0, phase_free, HbBranch::Free});
+      return;
+    }
+    const HbBranchEvaluation e = evaluate_branch_at_gap(c, gap, +1);
+    if (e.exists) out.push_back(to_point(e, HbBranch::Plus));
+  });
+  if (!options.include_minus || options.q_min >= 1.0) return;
+  for_each_sample(options, [&](double /*q*/, double gap) {
+    if (gap <= 0.0) return;
+    const HbBranchEvaluation e = evaluate_branch_at_gap(c, gap, -1);
+    if (e.exists) out.push_back(to_point(e, HbBranch::Minus));
+  });
+}
+
+std::vector<HbPoint> harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options) {
+  std::vector<HbPoint> out;
+  out.reserve(options.points);
+  harmonic_balance_curve(model, options, out);
+  return out;
+}
+
+}  // namespace afmkit::tapping

@@ -1,0 +1,99 @@
+#pragma once
+// Internal: the integration engine shared by the closed-form and the adaptive steppers — run state, the guard
+// scan of one interval, event handling with saltation matrices, and the sticking mode.
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include <Eigen/Core>
+
+#include "afmkit/tapping/events.hpp"
+#include "afmkit/tapping/observer.hpp"
+#include "afmkit/tapping/simulation.hpp"
+#include "afmkit/tapping/system.hpp"
+
+namespace afmkit::tapping::detail {
+
+struct RunState {
+  double t = 0.0;
+  TipState y;
+  Mode mode;
+  Eigen::Matrix3d jacobian = Eigen::Matrix3d::Identity();  // ∂(x, ẋ, l)(t)/∂(x, ẋ, l)(t_begin)
+  SimulationStats stats;
+};
+
+inline double time_tolerance(double t) { return 8.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t)); }
+
+/// Witness values and rates of the active guards at one instant.
+struct GuardSamples {
+  std::array<double, 3> value{};
+  std::array<double, 3> rate{};
+};
+
+inline void sample_guards(const TappingSystem& sys, const Mode& mode, const std::array<Guard, 3>& guards, int n,
+                          double t, TipState s, GuardSamples& out) {
+  for (int i = 0; i < n; ++i) {
+    out.value[i] = sys.witness(guards[i], mode, t, s);
+    out.rate[i] = sys.witness_rate(guards[i], mode, t, s);
+  }
+}
+
+struct Crossing {
+  double time;
+  int guard;
+};
+
+/// Earliest crossing of an active guard inside [ta, tb], given the samples at both ends. Detects a sign change,
+/// and also a double crossing hidden between two samples on the pre-crossing side (the witness rate changes
+/// sign towards the post side: the extremum is located and tested). `state(t)` evaluates the flow.
+template <class StateFn>
+std::optional<Crossing> first_crossing(const TappingSystem& sys, const Mode& mode, const std::array<Guard, 3>& guards,
+                                       int n, double ta, double tb, const GuardSamples& a, const GuardSamples& b,
+                                       StateFn&& state) {
+  std::optional<Crossing> best;
+  for (int i = 0; i < n; ++i) {
+    const Guard& g = guards[i];
+    auto witness = [&](double t) { return sys.witness(g, mode, t, state(t)); };
+    double hi = tb;
+    bool found = crosses(a.value[i], b.value[i], g.direction);
+    if (!found) {
+      const bool falling = g.direction == CrossingDirection::falling;
+      const bool pre_a = falling ? a.value[i] > 0 : a.value[i] < 0;
+      const bool pre_b = falling ? b.value[i] > 0 : b.value[i] < 0;
+      const bool towards = falling ? (a.rate[i] < 0 && b.rate[i] > 0) : (a.rate[i] > 0 && b.rate[i] < 0);
+      if (pre_a && pre_b && towards) {
+        auto rate = [&](double t) { return sys.witness_rate(g, mode, t, state(t)); };
+        const double tm = isolate_crossing(rate, ta, tb, falling ? CrossingDirection::rising : CrossingDirection::falling,
+                                           time_tolerance(tb));
+        if (crosses(a.value[i], witness(tm), g.direction)) {
+          found = true;
+          hi = tm;
+        }
+      }
+    }
+    if (!found) continue;
+    const double te = isolate_crossing(witness, ta, hi, g.direction, time_tolerance(hi));
+    if (!best || te < best->time) best = Crossing{te, i};
+  }
+  return best;
+}
+
+/// Apply an event at time te: pre_state = state reached by the flow of the old mode. Updates mode, state,
+/// statistics, the sensitivity (saltation matrix), notifies the observer; throws when the event budget ends.
+void handle_event(const TappingSystem& sys, RunState& rs, const Guard& guard, double te, TipState pre_state,
+                  const SimulationOptions& options, TrajectoryObserver* observer);
+
+/// Sticking mode: the tip rests at rs.y.position until a release guard fires or t_end.
+void run_sticking(const TappingSystem& sys, RunState& rs, double t_end, const SimulationOptions& options,
+                  TrajectoryObserver* observer);
+
+/// Scan step bound: fraction of the shortest period present.
+double scan_step(const TappingSystem& sys, double mode_period, const SimulationOptions& options);
+
+void run_closed_form(const TappingSystem& sys, RunState& rs, double t_end, const SimulationOptions& options,
+                     TrajectoryObserver* observer);
+void run_adaptive(const TappingSystem& sys, RunState& rs, double t_end, const SimulationOptions& options,
+                  TrajectoryObserver* observer);
+
+}  // namespace afmkit::tapping::detail

@@ -1,0 +1,99 @@
+#include "afmkit/tapping/observer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <boost/math/quadrature/gauss.hpp>
+
+#include "afmkit/core/validate.hpp"
+#include "afmkit/tapping/system.hpp"
+
+namespace afmkit::tapping {
+
+SampleRecorder::SampleRecorder(std::vector<double> times) : times_(std::move(times)) {
+  states_.reserve(times_.size());
+  modes_.reserve(times_.size());
+}
+
+void SampleRecorder::on_segment(const TappingSystem&, const Segment& segment) {
+  while (next_ < times_.size() && times_[next_] < segment.t_begin()) {
+    // times before the simulated interval: skip
+    ++next_;
+    states_.push_back({std::nan(""), std::nan("")});
+    modes_.push_back(segment.mode());
+  }
+  while (next_ < times_.size() && times_[next_] <= segment.t_end()) {
+    states_.push_back(segment.state(times_[next_]));
+    modes_.push_back(segment.mode());
+    ++next_;
+  }
+}
+
+OrbitIntegrals::OrbitIntegrals(double max_panel) : max_panel_(validate::positive("max_panel", max_panel)) {}
+
+void OrbitIntegrals::extremum(const TappingSystem& system, const Segment& segment, double a, double b) {
+  // the gap has an interior minimum where ẋ rises through 0
+  const TipState sa = segment.state(a), sb = segment.state(b);
+  if (!(sa.velocity < 0.0 && sb.velocity > 0.0)) return;
+  auto rate = [&](double t) { return segment.state(t).velocity; };
+  const double tm = isolate_crossing(rate, a, b, CrossingDirection::rising, 1e-15 * std::max(1.0, std::abs(b)));
+  const TipState sm = segment.state(tm);
+  min_gap = std::min(min_gap, system.gap(sm.position));
+  peak_force = std::max(peak_force, -system.interaction(segment.mode().branch, sm.position, segment.mode().region));
+}
+
+void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segment) {
+  using Rule = boost::math::quadrature::gauss<double, 20>;
+  const auto& nodes = Rule::abscissa();
+  const auto& weights = Rule::weights();
+  const double t0 = segment.t_begin(), t1 = segment.t_end();
+  if (!(t1 > t0)) return;
+  const Mode mode = segment.mode();
+  const double omega = system.model().drive.frequency;
+  const bool in_contact_region = mode.region == 0 && system.region_count() > 1;
+  duration += t1 - t0;
+  if (in_contact_region) contact_time += t1 - t0;
+  const int panels = std::max(1, static_cast<int>(std::ceil((t1 - t0) / max_panel_)));
+  const double width = (t1 - t0) / panels;
+  auto accumulate = [&](double t, double w) {
+    const TipState s = segment.state(t);
+    const double x = s.position, v = s.velocity;
+    const std::complex<double> e1 = std::polar(1.0, -omega * t);
+    std::complex<double> ek = 1.0;
+    for (int k = 0; k < 6; ++k) {
+      fourier[k] += w * x * ek;
+      ek *= e1;
+    }
+    const double h = mode.branch == ContactBranch::sticking ? 0.0 : system.interaction(mode.branch, x, mode.region);
+    drive_work += w * system.drive(t) * v;
+    viscous_dissipation += w * system.damping() * v * v;
+    contact_dissipation += w * h * v;
+    if (system.region_count() == 1 && system.gap(x) < 0) contact_time += w;
+    peak_force = std::max(peak_force, -system.interaction(mode.branch, x, mode.region));
+    min_gap = std::min(min_gap, system.gap(x));
+  };
+  for (int p = 0; p < panels; ++p) {
+    const double a = t0 + p * width, b = (p + 1 == panels) ? t1 : a + width;
+    const double mid = 0.5 * (a + b), half = 0.5 * (b - a);
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      if (nodes[i] == 0.0) {
+        accumulate(mid, half * weights[i]);
+      } else {
+        accumulate(mid - half * nodes[i], half * weights[i]);
+        accumulate(mid + half * nodes[i], half * weights[i]);
+      }
+    }
+    extremum(system, segment, a, b);
+  }
+  for (double t : {t0, t1}) {
+    const TipState s = segment.state(t);
+    min_gap = std::min(min_gap, system.gap(s.position));
+    peak_force = std::max(peak_force, -system.interaction(mode.branch, s.position, mode.region));
+  }
+}
+
+void OrbitIntegrals::on_event(const TappingSystem& system, const Event& event) {
+  min_gap = std::min(min_gap, system.gap(event.state.position));
+}
+
+}  // namespace afmkit::tapping

@@ -1,0 +1,137 @@
+#include "afmkit/tapping/shooting.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/LU>
+#include <fmt/format.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/core/validate.hpp"
+
+namespace afmkit::tapping {
+
+void ShootingOptions::validate() const {
+  validate::require(tolerance > 0 && tolerance < 1, "tolerance", tolerance, "in (0, 1)");
+  validate::require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
+  validate::positive("time_budget_seconds", time_budget_seconds);
+  simulation.validate();
+}
+
+StroboscopicMap stroboscopic_map(const TappingModel& model, TipState start, int period_multiple,
+                                 const SimulationOptions& options) {
+  validate::require(period_multiple >= 1, "period_multiple", period_multiple, ">= 1");
+  SimulationOptions o = options;
+  o.sensitivity = true;
+  const SimulationResult r = simulate(model, 0.0, start, period_multiple * model.period(), o);
+  return {r.state, r.sensitivity, r.stats};
+}
+
+void set_floquet(PeriodicOrbit& orbit) {
+  const Eigen::Matrix2d& m = orbit.monodromy;
+  const double half_trace = 0.5 * m.trace(), det = m.determinant();
+  const std::complex<double> root = std::sqrt(std::complex<double>(half_trace * half_trace - det, 0.0));
+  orbit.floquet_multipliers = {half_trace + root, half_trace - root};
+  orbit.floquet_max = std::max(std::abs(orbit.floquet_multipliers[0]), std::abs(orbit.floquet_multipliers[1]));
+  orbit.stable = orbit.floquet_max < 1.0;
+}
+
+TipState free_response_state(const TappingModel& model) {
+  // x_p(t) = Re[Γ L(iω) e^{iωt}] (seed-1 eq. 9)
+  const std::complex<double> z = model.drive.amplitude * model.cantilever.transfer({0.0, model.drive.frequency});
+  return {z.real(), -model.drive.frequency * z.imag()};
+}
+
+namespace {
+
+double scaled_norm(const Eigen::Vector2d& r, const Eigen::Vector2d& y, double omega) {
+  const double scale = std::max({1.0, std::abs(y.x()), std::abs(y.y()) / omega});
+  return std::max(std::abs(r.x()), std::abs(r.y()) / omega) / scale;
+}
+
+}  // namespace
+
+std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess, int period_multiple,
+                                       const ShootingOptions& options) {
+  options.validate();
+  validate::require(period_multiple >= 1, "period_multiple", period_multiple, ">= 1");
+  validate::finite("position", guess.position);
+  validate::finite("velocity", guess.velocity);
+  const auto start_time = std::chrono::steady_clock::now();
+  const double omega = model.drive.frequency;
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  };
+  Eigen::Vector2d y(guess.position, guess.velocity);
+  auto evaluate = [&](const Eigen::Vector2d& at) {
+    return stroboscopic_map(model, {at.x(), at.y()}, period_multiple, options.simulation);
+  };
+  StroboscopicMap map = evaluate(y);
+  Eigen::Vector2d r = Eigen::Vector2d(map.end.position, map.end.velocity) - y;
+  double norm = scaled_norm(r, y, omega);
+  for (int it = 0; it <= options.max_iterations; ++it) {
+    if (norm <= options.tolerance) {
+      PeriodicOrbit orbit;
+      orbit.separation = model.separation;
+      orbit.period_multiple = period_multiple;
+      orbit.initial = {y.x(), y.y()};
+      orbit.monodromy = map.sensitivity.topLeftCorner<2, 2>();
+      orbit.separation_sensitivity = map.sensitivity.topRightCorner<2, 1>();
+      orbit.residual = norm;
+      orbit.iterations = it;
+      orbit.stats = map.stats;
+      set_floquet(orbit);
+      // a period-n solution that repeats after a divisor m of n is reported with its minimal period
+      for (int m = 1; m < period_multiple; ++m) {
+        if (period_multiple % m != 0) continue;
+        const auto sub = simulate(model, 0.0, orbit.initial, m * model.period(), options.simulation);
+        const Eigen::Vector2d rs = Eigen::Vector2d(sub.state.position, sub.state.velocity) - y;
+        if (scaled_norm(rs, y, omega) <= 100.0 * options.tolerance) {
+          ShootingOptions again = options;
+          again.tolerance = std::max(options.tolerance, scaled_norm(rs, y, omega));
+          if (auto reduced = try_shoot(model, orbit.initial, m, again)) return reduced;
+        }
+      }
+      return orbit;
+    }
+    if (it == options.max_iterations) break;
+    if (elapsed() > options.time_budget_seconds)
+      throw NumericalFailure(fmt::format("shooting: time budget of {} s exhausted after {} Newton iterations "
+                                         "(residual {:.3g}) at separation {}",
+                                         options.time_budget_seconds, it, norm, model.separation));
+    const Eigen::Matrix2d jac = map.sensitivity.topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity();
+    const Eigen::FullPivLU<Eigen::Matrix2d> lu(jac);
+    if (!lu.isInvertible()) return std::nullopt;  // multiplier exactly 1: Newton cannot proceed
+    const Eigen::Vector2d step = -lu.solve(r);
+    if (!step.allFinite()) return std::nullopt;
+    // damped Newton: halve the step until the residual decreases (the map is only piecewise smooth)
+    double lambda = 1.0;
+    bool accepted = false;
+    for (int k = 0; k < 8; ++k, lambda *= 0.5) {
+      const Eigen::Vector2d trial = y + lambda * step;
+      StroboscopicMap m = evaluate(trial);
+      const Eigen::Vector2d rt = Eigen::Vector2d(m.end.position, m.end.velocity) - trial;
+      const double nt = scaled_norm(rt, trial, omega);
+      if (nt < norm || k == 7) {
+        y = trial;
+        map = m;
+        r = rt;
+        accepted = nt < norm;
+        norm = nt;
+        break;
+      }
+    }
+    if (!accepted && norm > 1e3 * options.tolerance) return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+PeriodicOrbit shoot(const TappingModel& model, TipState guess, int period_multiple, const ShootingOptions& options) {
+  if (auto orbit = try_shoot(model, guess, period_multiple, options)) return *orbit;
+  throw NumericalFailure(fmt::format("shooting: Newton did not converge to a period-{} orbit within {} iterations "
+                                     "from x(0) = {:.9g}, dx/dt(0) = {:.9g} at separation {}",
+                                     period_multiple, options.max_iterations, guess.position, guess.velocity,
+                                     model.separation));
+}
+
+}  // namespace afmkit::tapping

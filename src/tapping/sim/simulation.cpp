@@ -1,0 +1,153 @@
+#include "afmkit/tapping/simulation.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/core/validate.hpp"
+#include "engine.hpp"
+
+namespace afmkit::tapping {
+
+const char* integrator_name(Integrator integrator) {
+  switch (integrator) {
+    case Integrator::automatic: return "automatic";
+    case Integrator::closed_form: return "closed_form";
+    case Integrator::adaptive: return "adaptive";
+  }
+  return "?";
+}
+
+void SimulationOptions::validate() const {
+  validate::require(relative_tolerance > 0 && relative_tolerance < 1, "relative_tolerance", relative_tolerance,
+                    "in (0, 1)");
+  validate::positive("absolute_tolerance", absolute_tolerance);
+  validate::require(max_step_fraction > 0 && max_step_fraction <= 0.25, "max_step_fraction", max_step_fraction,
+                    "in (0, 0.25]");
+  validate::require(max_events >= 1, "max_events", static_cast<double>(max_events), ">= 1");
+  validate::require(max_steps >= 1, "max_steps", static_cast<double>(max_steps), ">= 1");
+}
+
+Integrator resolve_integrator(const TappingModel& model, Integrator requested) {
+  const bool linear = model.law.piecewise_linear() != nullptr;
+  if (requested == Integrator::automatic) return linear ? Integrator::closed_form : Integrator::adaptive;
+  if (requested == Integrator::closed_form && !linear)
+    throw InvalidParameter("integrator", fmt::format("integrator = closed_form needs a piecewise-linear force law "
+                                                     "(seed-1 eqs. 10, 11, 26); law '{}' is not",
+                                                     model.law.name()));
+  return requested;
+}
+
+SimulationResult simulate(const TappingModel& model, double t_begin, TipState start, double t_end,
+                          const SimulationOptions& options, TrajectoryObserver* observer) {
+  options.validate();
+  validate::finite("t_begin", t_begin);
+  validate::finite("t_end", t_end);
+  validate::require(t_end >= t_begin, "t_end", t_end, fmt::format(">= t_begin = {}", t_begin));
+  validate::finite("position", start.position);
+  validate::finite("velocity", start.velocity);
+  const Integrator integrator = resolve_integrator(model, options.integrator);
+  const TappingSystem sys(model);
+  detail::RunState rs;
+  rs.t = t_begin;
+  rs.y = start;
+  rs.mode = sys.initial_mode(t_begin, rs.y);
+  if (rs.mode.branch == ContactBranch::sticking) ++rs.stats.sticking_count;
+  if (integrator == Integrator::closed_form)
+    detail::run_closed_form(sys, rs, t_end, options, observer);
+  else
+    detail::run_adaptive(sys, rs, t_end, options, observer);
+  SimulationResult out;
+  out.time = rs.t;
+  out.state = rs.y;
+  out.mode = rs.mode;
+  out.stats = rs.stats;
+  out.sensitivity = rs.jacobian;
+  return out;
+}
+
+namespace detail {
+
+double scan_step(const TappingSystem& sys, double mode_period, const SimulationOptions& options) {
+  const double drive_period = sys.model().period();
+  return options.max_step_fraction * std::min(drive_period, mode_period);
+}
+
+void handle_event(const TappingSystem& sys, RunState& rs, const Guard& guard, double te, TipState pre_state,
+                  const SimulationOptions& options, TrajectoryObserver* observer) {
+  const Mode before = rs.mode;
+  TipState post = pre_state;
+  const Mode after = sys.after_event(before, guard, te, post);
+  if (options.sensitivity) {
+    // Saltation matrix S = I + (f⁺ − f⁻) ∇gᵀ / (∇g·f⁻ + ∂g/∂t), states (x, ẋ, l) with l̇ = 0.
+    const Eigen::Vector3d f_minus(pre_state.velocity, sys.acceleration(before, te, pre_state), 0.0);
+    const Eigen::Vector3d f_plus(post.velocity, sys.acceleration(after, te, post), 0.0);
+    double grad[3], dt_partial = 0.0;
+    sys.witness_gradient(guard, before, te, pre_state, grad, dt_partial);
+    const Eigen::Vector3d g(grad[0], grad[1], grad[2]);
+    const double denom = g.dot(f_minus) + dt_partial;
+    if (denom != 0.0 && std::isfinite(denom)) {
+      const Eigen::Matrix3d s = Eigen::Matrix3d::Identity() + (f_plus - f_minus) * g.transpose() / denom;
+      rs.jacobian = s * rs.jacobian;
+    }
+  }
+  ++rs.stats.events;
+  if (guard.kind == GuardKind::gap && guard.direction == CrossingDirection::falling && after.region == 0)
+    ++rs.stats.impacts;
+  if (after.branch == ContactBranch::sticking && before.branch != ContactBranch::sticking) ++rs.stats.sticking_count;
+  rs.t = te;
+  rs.y = post;
+  rs.mode = after;
+  if (observer) observer->on_event(sys, Event{te, guard, before, after, post});
+  if (rs.stats.events > options.max_events)
+    throw NumericalFailure(fmt::format(
+        "tapping simulation: event budget of {} events exhausted at t = {:.9g} (x = {:.9g}, dx/dt = {:.3g}, "
+        "{} branch); the motion chatters between modes — raise max_events or check the force law",
+        options.max_events, te, post.position, post.velocity, contact_branch_name(after.branch)));
+}
+
+namespace {
+class StaticSegment final : public Segment {
+ public:
+  StaticSegment(double a, double b, Mode m, double x) : Segment(a, b, m), x_(x) {}
+  TipState state(double) const override { return {x_, 0.0}; }
+
+ private:
+  double x_;
+};
+}  // namespace
+
+void run_sticking(const TappingSystem& sys, RunState& rs, double t_end, const SimulationOptions& options,
+                  TrajectoryObserver* observer) {
+  std::array<Guard, 3> guards;
+  const int n = sys.guards(rs.mode, guards);
+  const TipState rest{rs.y.position, 0.0};
+  auto state = [&](double) { return rest; };
+  const double h = scan_step(sys, std::numeric_limits<double>::infinity(), options);
+  const double t0 = rs.t;
+  double ta = t0;
+  GuardSamples a, b;
+  sample_guards(sys, rs.mode, guards, n, ta, rest, a);
+  while (ta < t_end) {
+    const double tb = std::min(ta + h, t_end);
+    sample_guards(sys, rs.mode, guards, n, tb, rest, b);
+    ++rs.stats.steps;
+    if (auto c = first_crossing(sys, rs.mode, guards, n, ta, tb, a, b, state)) {
+      rs.stats.sticking_duration += c->time - t0;
+      if (observer) observer->on_segment(sys, StaticSegment(t0, c->time, rs.mode, rest.position));
+      handle_event(sys, rs, guards[c->guard], c->time, rest, options, observer);
+      return;
+    }
+    ta = tb;
+    a = b;
+  }
+  rs.stats.sticking_duration += t_end - t0;
+  if (observer) observer->on_segment(sys, StaticSegment(t0, t_end, rs.mode, rest.position));
+  rs.t = t_end;
+  rs.y = rest;
+}
+
+}  // namespace detail
+}  // namespace afmkit::tapping

@@ -1,0 +1,213 @@
+#include "afmkit/tapping/system.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace afmkit::tapping {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}
+
+TappingSystem::TappingSystem(const TappingModel& model)
+    : model_(model),
+      switching_(model.law.switching_gaps()),
+      damping_(2.0 * model.cantilever.damping_ratio() * model.cantilever.natural_frequency),
+      stiffness_(model.cantilever.natural_frequency * model.cantilever.natural_frequency),
+      omega_(model.drive.frequency),
+      gamma_(model.drive.amplitude) {
+  if (const auto* p = model.law.piecewise_linear()) {
+    linear_ = *p;
+    const bool hysteretic = p->approach_stiffness != p->departure_stiffness ||
+                            p->approach_adhesion != p->departure_adhesion;
+    dependent_mask_ = hysteretic ? 1u : 0u;  // only the contact region can depend on the branch
+  } else if (const auto* d = std::get_if<impact::DmtLaw>(&model.law.kind())) {
+    const bool moduli = d->effective_modulus_approach != d->effective_modulus_departure;
+    const bool hamaker = d->hamaker_approach != d->hamaker_departure;
+    dependent_mask_ = ((moduli || hamaker) ? 1u : 0u) | (hamaker ? 2u : 0u);
+  } else {
+    dependent_mask_ = ~0ul;  // custom law: assume branches differ everywhere
+  }
+}
+
+int TappingSystem::region_of(double gap) const {
+  return static_cast<int>(std::upper_bound(switching_.begin(), switching_.end(), gap) - switching_.begin());
+}
+
+double TappingSystem::region_lo(int region) const { return region == 0 ? -kInf : switching_[region - 1]; }
+double TappingSystem::region_hi(int region) const {
+  return region >= static_cast<int>(switching_.size()) ? kInf : switching_[region];
+}
+
+double TappingSystem::drive(double t) const { return gamma_ * std::cos(omega_ * t); }
+double TappingSystem::drive_rate(double t) const { return -gamma_ * omega_ * std::sin(omega_ * t); }
+
+double TappingSystem::interaction(ContactBranch branch, double x, int region) const {
+  const double d = gap(x);
+  if (linear_) {
+    if (region != 0) return 0.0;
+    // h = F + K d in contact (seed-1 eq. 26), smooth extension beyond d = 0
+    switch (branch) {
+      case ContactBranch::approach: return linear_->approach_adhesion + linear_->approach_stiffness * d;
+      case ContactBranch::departure: return linear_->departure_adhesion + linear_->departure_stiffness * d;
+      case ContactBranch::sticking:
+        return 0.5 * (linear_->approach_adhesion + linear_->departure_adhesion +
+                      (linear_->approach_stiffness + linear_->departure_stiffness) * d);
+    }
+  }
+  // continuous extension: clamp the gap into the region (open upper end: stay just below the switching gap)
+  double dc = std::max(d, region_lo(region));
+  const double hi = region_hi(region);
+  if (dc >= hi) dc = std::nextafter(hi, -kInf);
+  switch (branch) {
+    case ContactBranch::approach: return -model_.law.approach(dc);
+    case ContactBranch::departure: return -model_.law.departure(dc);
+    case ContactBranch::sticking: return -0.5 * (model_.law.approach(dc) + model_.law.departure(dc));
+  }
+  return 0.0;
+}
+
+double TappingSystem::interaction_slope(ContactBranch branch, double x, int region) const {
+  if (linear_) {
+    if (region != 0) return 0.0;
+    switch (branch) {
+      case ContactBranch::approach: return linear_->approach_stiffness;
+      case ContactBranch::departure: return linear_->departure_stiffness;
+      case ContactBranch::sticking: return 0.5 * (linear_->approach_stiffness + linear_->departure_stiffness);
+    }
+  }
+  const double d = gap(x);
+  const double step = 1e-6 * std::max(1.0, std::abs(d));
+  const double lo = region_lo(region), hi = region_hi(region);
+  auto h = [&](double dd) { return interaction(branch, dd - model_.separation, region); };
+  if (d - step >= lo && d + step < hi) return (h(d + step) - h(d - step)) / (2.0 * step);
+  if (d + 2 * step < hi) return (-3.0 * h(d) + 4.0 * h(d + step) - h(d + 2 * step)) / (2.0 * step);
+  return (3.0 * h(d) - 4.0 * h(d - step) + h(d - 2 * step)) / (2.0 * step);
+}
+
+double TappingSystem::acceleration(ContactBranch branch, int region, double t, TipState s) const {
+  return drive(t) - damping_ * s.velocity - stiffness_ * s.position - interaction(branch, s.position, region);
+}
+
+double TappingSystem::acceleration(const Mode& mode, double t, TipState s) const {
+  if (mode.branch == ContactBranch::sticking) return 0.0;
+  return acceleration(mode.branch, mode.region, t, s);
+}
+
+Mode TappingSystem::initial_mode(double t, TipState& s) const { return enter_region(region_of(gap(s.position)), t, s); }
+
+Mode TappingSystem::enter_region(int region, double t, TipState& s) const {
+  if (s.velocity < 0) return {region, ContactBranch::approach};
+  if (s.velocity > 0) return {region, ContactBranch::departure};
+  if (!branch_dependent(region)) {
+    const double a = acceleration(ContactBranch::approach, region, t, s);
+    return {region, a < 0 ? ContactBranch::approach : ContactBranch::departure};
+  }
+  const double aa = acceleration(ContactBranch::approach, region, t, s);
+  const double ab = acceleration(ContactBranch::departure, region, t, s);
+  if (aa < 0) return {region, ContactBranch::approach};
+  if (ab > 0) return {region, ContactBranch::departure};
+  s.velocity = 0.0;
+  return {region, ContactBranch::sticking};
+}
+
+Mode TappingSystem::after_velocity_zero(int region, ContactBranch from, double t, TipState& s) const {
+  TipState rest{s.position, 0.0};
+  const double aa = acceleration(ContactBranch::approach, region, t, rest);
+  const double ab = acceleration(ContactBranch::departure, region, t, rest);
+  if (from == ContactBranch::approach) {
+    if (ab > 0) return {region, ContactBranch::departure};
+    if (aa < 0) {
+      s.velocity = 0.0;
+      return {region, ContactBranch::approach};
+    }
+  } else {
+    if (aa < 0) return {region, ContactBranch::approach};
+    if (ab > 0) {
+      s.velocity = 0.0;
+      return {region, ContactBranch::departure};
+    }
+  }
+  s.velocity = 0.0;  // both branches push back onto ẋ = 0: the tip sticks
+  return {region, ContactBranch::sticking};
+}
+
+Mode TappingSystem::after_event(const Mode& mode, const Guard& guard, double t, TipState& s) const {
+  switch (guard.kind) {
+    case GuardKind::gap:
+      return enter_region(guard.direction == CrossingDirection::falling ? mode.region - 1 : mode.region + 1, t, s);
+    case GuardKind::velocity:
+      return after_velocity_zero(mode.region, mode.branch, t, s);
+    case GuardKind::release_departure:
+      s.velocity = 0.0;
+      return {mode.region, ContactBranch::departure};
+    case GuardKind::release_approach:
+      s.velocity = 0.0;
+      return {mode.region, ContactBranch::approach};
+  }
+  return mode;
+}
+
+int TappingSystem::guards(const Mode& mode, std::array<Guard, 3>& out) const {
+  int n = 0;
+  if (mode.branch == ContactBranch::sticking) {
+    out[n++] = {GuardKind::release_departure, CrossingDirection::rising, 0.0};
+    out[n++] = {GuardKind::release_approach, CrossingDirection::falling, 0.0};
+    return n;
+  }
+  if (mode.region > 0) out[n++] = {GuardKind::gap, CrossingDirection::falling, switching_[mode.region - 1]};
+  if (mode.region < static_cast<int>(switching_.size()))
+    out[n++] = {GuardKind::gap, CrossingDirection::rising, switching_[mode.region]};
+  if (branch_dependent(mode.region)) {
+    out[n++] = {GuardKind::velocity,
+                mode.branch == ContactBranch::approach ? CrossingDirection::rising : CrossingDirection::falling, 0.0};
+  }
+  return n;
+}
+
+double TappingSystem::witness(const Guard& guard, const Mode& mode, double t, TipState s) const {
+  switch (guard.kind) {
+    case GuardKind::gap: return gap(s.position) - guard.level;
+    case GuardKind::velocity: return s.velocity;
+    case GuardKind::release_departure:
+      return acceleration(ContactBranch::departure, mode.region, t, {s.position, 0.0});
+    case GuardKind::release_approach:
+      return acceleration(ContactBranch::approach, mode.region, t, {s.position, 0.0});
+  }
+  return 0.0;
+}
+
+double TappingSystem::witness_rate(const Guard& guard, const Mode& mode, double t, TipState s) const {
+  switch (guard.kind) {
+    case GuardKind::gap: return s.velocity;
+    case GuardKind::velocity: return acceleration(mode, t, s);
+    case GuardKind::release_departure:
+    case GuardKind::release_approach: return drive_rate(t);
+  }
+  return 0.0;
+}
+
+void TappingSystem::witness_gradient(const Guard& guard, const Mode& mode, double t, TipState s, double grad[3],
+                                     double& time_partial) const {
+  time_partial = 0.0;
+  switch (guard.kind) {
+    case GuardKind::gap:
+      grad[0] = 1.0, grad[1] = 0.0, grad[2] = 1.0;  // g = x + l − s_i
+      return;
+    case GuardKind::velocity:
+      grad[0] = 0.0, grad[1] = 1.0, grad[2] = 0.0;
+      return;
+    case GuardKind::release_departure:
+    case GuardKind::release_approach: {
+      const ContactBranch b =
+          guard.kind == GuardKind::release_departure ? ContactBranch::departure : ContactBranch::approach;
+      const double slope = interaction_slope(b, s.position, mode.region);  // g = Γcos ωt − ω_n² x − h(x + l)
+      grad[0] = -stiffness_ - slope, grad[1] = -damping_, grad[2] = -slope;
+      time_partial = drive_rate(t);
+      return;
+    }
+  }
+}
+
+}  // namespace afmkit::tapping

@@ -1,0 +1,61 @@
+#pragma once
+// Runs the built `afmkit` program (path AFMKIT_CLI from CMake) in a fresh temporary folder.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace afmkit_test {
+
+struct RunResult {
+  int status;
+  std::string out;
+  std::string err;
+};
+
+/// A fresh empty folder per test (removed at destruction).
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    path = std::filesystem::temp_directory_path() /
+           ("afmkit_cli_" + std::to_string(::getpid()) + "_" + std::to_string(counter()++));
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() { std::filesystem::remove_all(path); }
+  static int& counter() {
+    static int c = 0;
+    return c;
+  }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+  void write(const std::string& name, const std::string& text) const { std::ofstream(path / name) << text; }
+  std::size_t count_files() const {
+    std::size_t n = 0;
+    for (auto& e : std::filesystem::recursive_directory_iterator(path))
+      if (e.is_regular_file()) ++n;
+    return n;
+  }
+};
+
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Run `afmkit <args>` with the working directory `dir`.
+inline RunResult run_cli(const std::string& args, const TempDir& dir) {
+  const std::string out = dir.file(".stdout"), err = dir.file(".stderr");
+  const std::string cmd = "cd '" + dir.path.string() + "' && '" + std::string(AFMKIT_CLI) + "' " + args + " >'" + out +
+                          "' 2>'" + err + "'";
+  const int raw = std::system(cmd.c_str());
+  RunResult r{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
+  std::filesystem::remove(out);
+  std::filesystem::remove(err);
+  return r;
+}
+
+}  // namespace afmkit_test

@@ -1,0 +1,121 @@
+// Time-domain simulation: the exact closed-form stepper against the adaptive Dormand–Prince stepper with event
+// location (an independent integration of the same equations), sensitivities against difference quotients,
+// sticking, budgets and input validation.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/tapping/observer.hpp"
+#include "afmkit/tapping/shooting.hpp"
+#include "afmkit/tapping/simulation.hpp"
+#include "fixtures.hpp"
+
+namespace afmkit::tapping {
+namespace {
+
+using testing::attractive_model;
+using testing::make_model;
+using testing::repulsive_model;
+
+SimulationOptions tight_adaptive() {
+  SimulationOptions o;
+  o.integrator = Integrator::adaptive;
+  o.relative_tolerance = 1e-12;
+  o.absolute_tolerance = 1e-13;
+  return o;
+}
+
+void expect_same_trajectory(const TappingModel& model, double periods) {
+  const TipState start = free_response_state(model);
+  const double t_end = periods * model.period();
+  EventRecorder exact_events, adaptive_events;
+  const auto exact = simulate(model, 0.0, start, t_end, {}, &exact_events);
+  const auto adaptive = simulate(model, 0.0, start, t_end, tight_adaptive(), &adaptive_events);
+  ASSERT_GT(exact.stats.impacts, 0);
+  EXPECT_EQ(exact.stats.impacts, adaptive.stats.impacts);
+  ASSERT_EQ(exact_events.events().size(), adaptive_events.events().size());
+  for (std::size_t i = 0; i < exact_events.events().size(); ++i) {
+    const Event& a = exact_events.events()[i];
+    const Event& b = adaptive_events.events()[i];
+    EXPECT_EQ(a.guard.kind, b.guard.kind);
+    EXPECT_EQ(a.after, b.after);
+    EXPECT_NEAR(a.time, b.time, 1e-8) << "event " << i;
+  }
+  EXPECT_NEAR(exact.state.position, adaptive.state.position, 1e-8);
+  EXPECT_NEAR(exact.state.velocity, adaptive.state.velocity, 1e-8);
+}
+
+TEST(Simulation, ClosedFormMatchesAdaptiveRepulsive) { expect_same_trajectory(repulsive_model(10.0), 6); }
+TEST(Simulation, ClosedFormMatchesAdaptiveAttractive) { expect_same_trajectory(attractive_model(10.0), 6); }
+TEST(Simulation, ClosedFormMatchesAdaptiveDeepContact) { expect_same_trajectory(repulsive_model(2.0), 4); }
+
+TEST(Simulation, FreeResponseIsExactlyPeriodicWithoutContact) {
+  const auto model = repulsive_model(30.0);  // free amplitude 20 < 30: never touches
+  const TipState start = free_response_state(model);
+  const auto r = simulate(model, 0.0, start, 3 * model.period());
+  EXPECT_EQ(r.stats.events, 0);
+  EXPECT_NEAR(r.state.position, start.position, 1e-12);
+  EXPECT_NEAR(r.state.velocity, start.velocity, 1e-12);
+}
+
+Eigen::Matrix3d difference_jacobian(const TappingModel& model, TipState s, double t_end, const SimulationOptions& o) {
+  Eigen::Matrix3d j;
+  const double h = 1e-6;
+  for (int c = 0; c < 3; ++c) {
+    TipState p = s, m = s;
+    double lp = model.separation, lm = model.separation;
+    if (c == 0) p.position += h, m.position -= h;
+    if (c == 1) p.velocity += h, m.velocity -= h;
+    if (c == 2) lp += h, lm -= h;
+    const auto rp = simulate(model.with_separation(lp), 0.0, p, t_end, o);
+    const auto rm = simulate(model.with_separation(lm), 0.0, m, t_end, o);
+    j(0, c) = (rp.state.position - rm.state.position) / (2 * h);
+    j(1, c) = (rp.state.velocity - rm.state.velocity) / (2 * h);
+    j(2, c) = c == 2 ? 1.0 : 0.0;
+  }
+  return j;
+}
+
+TEST(Simulation, SensitivityMatchesDifferenceQuotients) {
+  for (const auto& model : {repulsive_model(10.0), attractive_model(9.0)}) {
+    SimulationOptions o;
+    o.sensitivity = true;
+    const TipState s = free_response_state(model);
+    const double t_end = 1.5 * model.period();
+    const auto r = simulate(model, 0.0, s, t_end, o);
+    ASSERT_GT(r.stats.impacts, 0);
+    const Eigen::Matrix3d fd = difference_jacobian(model, s, t_end, {});
+    EXPECT_LT((r.sensitivity - fd).cwiseAbs().maxCoeff(), 1e-6 * fd.cwiseAbs().maxCoeff()) << r.sensitivity << "\n"
+                                                                                            << fd;
+    // the adaptive stepper's variational equations + saltation matrices agree as well
+    SimulationOptions oa = tight_adaptive();
+    oa.sensitivity = true;
+    const auto ra = simulate(model, 0.0, s, t_end, oa);
+    EXPECT_LT((ra.sensitivity - r.sensitivity).cwiseAbs().maxCoeff(), 1e-6 * fd.cwiseAbs().maxCoeff());
+  }
+}
+
+TEST(Simulation, EventBudgetExhaustedIsNumericalFailure) {
+  SimulationOptions o;
+  o.max_events = 3;
+  const auto model = repulsive_model(10.0);
+  EXPECT_THROW(simulate(model, 0.0, free_response_state(model), 10 * model.period(), o), NumericalFailure);
+}
+
+TEST(Simulation, RejectsBadInput) {
+  const auto model = repulsive_model(10.0);
+  EXPECT_THROW(simulate(model, 1.0, {0, 0}, 0.5), InvalidParameter);
+  EXPECT_THROW(simulate(model, 0.0, {std::nan(""), 0}, 1.0), InvalidParameter);
+  SimulationOptions o;
+  o.max_step_fraction = 0.0;
+  EXPECT_THROW(simulate(model, 0.0, {0, 0}, 1.0, o), InvalidParameter);
+  const TappingModel dmt(Cantilever(1.0, 100.0), Drive(0.2, 1.0),
+                         impact::ForceLaw(impact::DmtLaw(1.0, 1.0, 10.0, 1e-19, 1e-19, 0.2)), 10.0);
+  SimulationOptions cf;
+  cf.integrator = Integrator::closed_form;
+  EXPECT_THROW(simulate(dmt, 0.0, {0, 0}, 1.0, cf), InvalidParameter);
+}
+
+}  // namespace
+}  // namespace afmkit::tapping
