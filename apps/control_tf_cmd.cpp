@@ -1,10 +1,155 @@
-#include <CLI/CLI.hpp>
+// afmkit control tf: frequency response of the seed-2 controller, plant, loop, sensitivity or closed loop
+// (MATH.md B.2–B.7) on a frequency grid, as CSV (frequency, magnitude, phase, real, imag) with a JSON sidecar
+// holding the τ = 0 stability verdicts (eqs. 13, 22–24, 40–42, β_c(N)) and |S| at the harmonics.
+//   frequency is ω/Ω (harmonic number; the grid bounds frequency_min/max are in the same unit),
+//   magnitude = |G(iω)|, phase = arg G(iω) unwrapped along the grid [rad], real/imag = G(iω).
+// --json prints the summary (no CSV). Controller/plant parameters and units: control_params.hpp.
+#include <memory>
+#include <string>
 
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/control/frequency_response.hpp"
+#include "afmkit/control/stability_tau0.hpp"
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/params.hpp"
 #include "commands.hpp"
+#include "control_params.hpp"
 
 namespace afmkit::cli {
 
-// Placeholder registration: the subcommand is added when its domain lands.
-void register_control_tf(CLI::App& /*control*/) {}
+namespace {
+
+control::LoopSystem system_from(const std::string& s) {
+  if (s == "plant") return control::LoopSystem::Plant;
+  if (s == "loop") return control::LoopSystem::Loop;
+  if (s == "sensitivity") return control::LoopSystem::Sensitivity;
+  if (s == "closed_loop") return control::LoopSystem::ClosedLoop;
+  return control::LoopSystem::Controller;
+}
+
+nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+// τ = 0 verdicts: eigenvalues for finite banks (any K, plant), closed-form conditions at the design point K = γ.
+nlohmann::json stability_summary(const ControlSettings& c, const control::LoopSpec& loop) {
+  nlohmann::json j;
+  const double w = c.rotation_frequency;
+  const std::string inner = c.controller == "smith" ? c.smith_bank : c.controller;
+  if (inner != "infinite") {
+    // delay-free loop with the bank alone (for the Smith predictor: its nominal loop with an exact model)
+    const control::LoopSpec plain(c.controller == "smith" ? control_controller_from([&] {
+      ControlSettings b = c;
+      b.controller = c.smith_bank;
+      return b;
+    }()) : loop.controller, c.plant, c.plant_rate, 0.0);
+    const double abscissa = control::undelayed_spectral_abscissa(plain);
+    j["delay_free_spectral_abscissa"] = abscissa;
+    j["delay_free_stable"] = abscissa < 0.0;
+    j["delay_free_basis"] = "eigenvalues of the closed-loop state matrix with tau = 0";
+  }
+  if (inner == "single") {
+    j["eq13_stable"] = control::single_oscillator_stable_tau0(w, c.a, c.b, c.gain, c.plant_rate);
+    j["eq13_b_limit"] = c.plant_rate * w / c.gain;
+  } else {
+    const bool infinite = inner == "infinite";
+    const auto bc = infinite ? control::critical_beta_limit(w) : control::critical_beta(c.harmonics, w);
+    j["beta_critical"] = bc.beta;
+    j["beta_critical_over_omega"] = bc.beta / w;
+    j["crossing_frequency"] = bc.crossing_frequency;
+    j["design_point_stable"] = c.alpha > 0.0 && c.beta > bc.beta;
+    j["design_point_basis"] = infinite ? "eq. (24): alpha > 0 and beta > -Omega/4 (K = gamma, static plant, tau = 0)"
+                                       : "alpha > 0 and beta > beta_c(N) (K = gamma, static plant, tau = 0)";
+    if (!infinite) {
+      const auto nc = control::necessary_conditions(c.harmonics, w, c.alpha, c.beta);
+      j["eq40_coefficient"] = nc.coefficient_2n;
+      j["eq41_coefficient_normalised"] = nc.coefficient_1_normalised;
+      j["eq42_limit_condition"] = nc.limit_condition;
+    }
+  }
+  return j;
+}
+
+nlohmann::json summary(const ControlSettings& c, const control::LoopSpec& loop) {
+  nlohmann::json j;
+  j["loop"] = loop.describe();
+  j["settings"] = c.to_json();
+  j["gain_ratio"] = loop.gain_ratio();
+  j["tau0"] = stability_summary(c, loop);
+  nlohmann::json harmonics = nlohmann::json::array();
+  const int kmax = c.controller == "single" ? 3 : std::min(c.controller == "infinite" ? 5 : c.harmonics + 1, 8);
+  for (int k = 1; k <= kmax; ++k) {
+    const std::complex<double> s(0.0, k * c.rotation_frequency);
+    harmonics.push_back({{"harmonic", k},
+                         {"sensitivity_magnitude", finite_or_null(std::abs(control::sensitivity(loop, s)))},
+                         {"closed_loop_magnitude", finite_or_null(std::abs(control::disturbance_response(loop, s)))}});
+  }
+  j["at_harmonics"] = harmonics;
+  return j;
+}
+
+void run_tf(const io::ParamSet& p) {
+  const ControlSettings c = control_settings_from(p);
+  const control::LoopSpec loop = control_loop_from(c);
+  const nlohmann::json results = summary(c, loop);
+  if (p.flag("json")) {
+    fmt::print("{}\n", results.dump(2));
+    return;
+  }
+  const double fmin = p.real("frequency_min"), fmax = p.real("frequency_max");
+  const bool log_spacing = p.flag("log_spacing");
+  if (!(fmax > fmin))
+    throw InvalidParameter("frequency_max",
+                           fmt::format("frequency_max = {} is out of range: must be > frequency_min = {}", fmax, fmin));
+  if (log_spacing && fmin <= 0.0)
+    throw InvalidParameter("frequency_min", fmt::format("frequency_min = {} is out of range: must be > 0 with "
+                                                        "log_spacing (or set --log-spacing false)", fmin));
+  const double w = c.rotation_frequency;
+  const std::vector<double> omegas =
+      control::frequency_grid(fmin * w, fmax * w, static_cast<int>(p.integer("points")), log_spacing);
+  const auto response = control::frequency_response(loop, system_from(p.text("system")), omegas);
+
+  io::Table table({"frequency", "magnitude", "phase", "real", "imag"});
+  for (std::size_t i = 0; i < response.size(); ++i)
+    table.add_row({response.omega[i] / w, response.magnitude[i], response.phase[i], response.response[i].real(),
+                   response.response[i].imag()});
+  nlohmann::json res = results;
+  res["system"] = p.text("system");
+  res["columns"] = {{"frequency", "omega/Omega"},
+                    {"magnitude", "|G(i omega)|"},
+                    {"phase", "unwrapped arg G(i omega) [rad]"},
+                    {"real", "Re G(i omega)"},
+                    {"imag", "Im G(i omega)"}};
+  res["rows"] = table.size();
+  const std::string output = p.text("output");
+  io::write_table(output, table, io::make_sidecar("control tf", p.to_json(), res));
+  fmt::print("wrote {} rows ({} of {}) to {}\n", table.size(), p.text("system"), loop.describe(), output);
+}
+
+}  // namespace
+
+void register_control_tf(CLI::App& control) {
+  auto params = std::make_shared<io::ParamSet>();
+  add_control_params(*params);
+  params->text("system", "controller",
+               "response to tabulate: controller C, plant P = exp(-s tau) P0, loop L = P C, sensitivity "
+               "1/(1 + L), closed_loop (disturbance f -> output y)",
+               {"controller", "plant", "loop", "sensitivity", "closed_loop"})
+      .real("frequency_min", 0.01, "lowest frequency of the grid [units of Omega]", io::Range::non_negative())
+      .real("frequency_max", 10.0, "highest frequency of the grid [units of Omega]", io::Range::positive())
+      .integer("points", 1000, "number of grid points", 2, 10000000)
+      .flag("log_spacing", true, "logarithmic grid (false: linear)")
+      .flag("json", false, "print the tau = 0 stability summary as JSON to stdout instead of writing the CSV")
+      .text("output", "out/control_tf.csv", "output CSV path (JSON sidecar written next to it)");
+  auto* cmd = control.add_subcommand(
+      "tf", "frequency response of the harmonic-rejection controller / loop (seed 2), tau = 0 stability summary");
+  params->add_options(*cmd);
+  cmd->callback([params] {
+    params->resolve();
+    run_tf(*params);
+  });
+}
 
 }  // namespace afmkit::cli

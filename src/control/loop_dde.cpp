@@ -31,15 +31,16 @@ const OscillatorBank& finite_bank(const Bank& bank) {
 
 DelayDifferentialSystem closed_loop_dde(const LoopSpec& loop) {
   const SmithPredictor* sp = std::get_if<SmithPredictor>(&loop.controller);
-  const OscillatorBank& bank = sp ? finite_bank(sp->bank)
-                                  : finite_bank(std::visit(
-                                        [](const auto& c) -> Bank {
-                                          if constexpr (std::is_same_v<std::decay_t<decltype(c)>, SmithPredictor>)
-                                            return c.bank;
-                                          else
-                                            return c;
-                                        },
-                                        loop.controller));
+  const Bank bank_variant = sp ? sp->bank
+                               : std::visit(
+                                     [](const auto& c) -> Bank {
+                                       if constexpr (std::is_same_v<std::decay_t<decltype(c)>, SmithPredictor>)
+                                         return c.bank;
+                                       else
+                                         return c;
+                                     },
+                                     loop.controller);
+  const OscillatorBank& bank = finite_bank(bank_variant);
   // Bank realisation z' = A z + b m̂, w = c_out z (u = −w); without x0 when a0 = 0 (disconnected integrator).
   const int off = bank.a0() == 0.0 ? 1 : 0;
   const int nz = bank.state_size() - off;

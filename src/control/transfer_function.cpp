@@ -4,7 +4,7 @@
 #include <limits>
 
 #include <fmt/format.h>
-#include <unsupported/Eigen/Polynomials>
+#include <Eigen/Eigenvalues>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
@@ -12,6 +12,43 @@
 namespace afmkit::control {
 
 // ---------------------------------------------------------------- Polynomial
+namespace {
+// Parlett–Reinsch balancing with radix-2 scalings (as LAPACK dgebal), in place. Eigen's PolynomialSolver
+// lost roots of the badly scaled p_N (N = 15) that this recovers to ~1e-8.
+void balance(Eigen::MatrixXd& a) {
+  const auto n = a.rows();
+  bool done = false;
+  while (!done) {
+    done = true;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double c = 0.0, r = 0.0;
+      for (Eigen::Index j = 0; j < n; ++j) {
+        if (j == i) continue;
+        c += std::abs(a(j, i));
+        r += std::abs(a(i, j));
+      }
+      if (c == 0.0 || r == 0.0) continue;
+      const double s = c + r;
+      double f = 1.0, g = r / 2.0;
+      while (c < g) {
+        f *= 2.0;
+        c *= 4.0;
+      }
+      g = r * 2.0;
+      while (c > g) {
+        f /= 2.0;
+        c /= 4.0;
+      }
+      if ((c + r) / f < 0.95 * s) {
+        done = false;
+        a.row(i) /= f;
+        a.col(i) *= f;
+      }
+    }
+  }
+}
+}  // namespace
+
 Polynomial::Polynomial(std::vector<double> ascending) : c_(std::move(ascending)) {
   for (double x : c_)
     if (!std::isfinite(x)) throw InvalidParameter("coefficients", "coefficients: all must be finite numbers");
@@ -88,8 +125,13 @@ std::vector<std::complex<double>> Polynomial::roots() const {
     if (n == 1) {
       out.emplace_back(-c(0) / c(1));
     } else {
-      Eigen::PolynomialSolver<double, Eigen::Dynamic> solver(c);
-      for (int j = 0; j < n; ++j) out.push_back(solver.roots()(j));
+      // companion matrix (last column = −c_j/c_n), Parlett–Reinsch balancing, real Schur eigenvalues
+      Eigen::MatrixXd m = Eigen::MatrixXd::Zero(n, n);
+      for (int i = 1; i < n; ++i) m(i, i - 1) = 1.0;
+      for (int i = 0; i < n; ++i) m(i, n - 1) = -c(i) / c(n);
+      balance(m);
+      const Eigen::VectorXcd ev = Eigen::EigenSolver<Eigen::MatrixXd>(m, false).eigenvalues();
+      for (int j = 0; j < n; ++j) out.push_back(ev(j));
     }
   }
   return out;

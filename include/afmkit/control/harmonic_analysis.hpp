@@ -35,8 +35,9 @@ struct EnvelopeFit {
   int first_period;    // fit window (inclusive)
   int last_period;
 };
-/// Window: a growing envelope (last value above the value at the middle of the run) is fitted over the second
-/// half; a decaying one from period 1 up to the last period before it first reaches 100× its floor (minimum).
+/// Window: a growing envelope (last value above twice the value at the middle of the run) is fitted over the
+/// second half; a decaying one from period 1 up to the last period above 100× its floor (minimum), or over the
+/// whole run if that leaves fewer than three periods.
 EnvelopeFit fit_log_envelope(std::span<const double> envelope, double period);
 
 }  // namespace afmkit::control

@@ -20,6 +20,11 @@
 // · [γ̂ for a first-order model]) with the matrices of closed_loop_dde() below. Static plant, K = γ, τ = 0,
 // couplings (20): Δ = p_N(s)/Π k²Ω² with p_N of eq. (22) (stability_tau0.hpp).
 //
+// If a0 = 0 (single oscillator, eqs. 5–6) the integrator x0 is disconnected: it is left out of Δ (no root at 0
+// from it) and of closed_loop_dde, so the single oscillator gives exactly eq. (12) times 1/Ω².
+// Smith predictor: Δ contains terms of size e^{−Re(s)τ_i} that cancel (exactly, for an exact model), so zeros far
+// in the left half plane (Re s · τ_i ≪ −1) are ill-conditioned (relative error ~ 1e-16 e^{−Re(s)τ_i}).
+//
 // Evaluation is O(N), allocation-free, and keeps a separate exponential scale so that Δ and Δ' can be
 // formed even where Δ itself overflows a double (|s| ≫ NΩ, large N, Re s ≪ 0 with delay): use
 // characteristic_scaled() or newton_step() there; characteristic() returns ±inf if the value overflows.

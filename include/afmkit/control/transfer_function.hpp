@@ -30,7 +30,7 @@ class Polynomial {
 
   std::complex<double> operator()(std::complex<double> s) const;  // Horner
   Polynomial derivative() const;
-  /// Complex roots (Eigen companion matrix with balancing).
+  /// Complex roots: eigenvalues of the balanced companion matrix (as numpy.roots).
   std::vector<std::complex<double>> roots() const;
 
   friend Polynomial operator+(const Polynomial& a, const Polynomial& b);

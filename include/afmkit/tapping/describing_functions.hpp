@@ -37,6 +37,17 @@ BarFunctions bar_functions_from_gap(double gap);
 BarFunctions bar_functions_from_contact_angle(double angle);
 /// d/da of the bar functions at contact angle a ∈ [0, π] (all smooth in a, unlike d/dq at q = ±1).
 BarFunctions bar_function_derivatives_in_angle(double angle);
+/// Contact range |q| < 1: the bar functions and their d/da at once (one inverse-trigonometric call).
+struct ContactBarFunctions {
+  double angle;                   // a = arccos q
+  double sine;                    // sin a = √(1 − q²)
+  BarFunctions value;
+  BarFunctions angle_derivative;  // d/da
+};
+/// From the gap s = 1 − q ∈ (0, 2) (accurate for s → 0⁺).
+ContactBarFunctions contact_bar_functions_from_gap(double gap);
+/// From the contact angle a ∈ [0, π].
+ContactBarFunctions contact_bar_functions_from_angle(double angle);
 /// d/dq of the bar functions on the permanent-contact range q ≤ −1.
 BarFunctions bar_function_derivatives_permanent_contact();
 

@@ -1,4 +1,8 @@
 #pragma once
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
 // Modes, guards (witness functions) and events of the tapping cantilever (seed-1 eqs. 8, 11, 26).
 //
 // A mode fixes the smooth vector field used between events:
@@ -80,6 +84,51 @@ double isolate_crossing(Witness&& g, double t_lo, double t_hi, CrossingDirection
       if (side == 1) fa *= 0.5;
       side = 1;
     }
+  }
+  return b;
+}
+
+/// As isolate_crossing, with the witness rate available: `g(t)` returns {value, rate}. Safeguarded Newton
+/// (falls back to bisection when a step leaves the bracket or progress stalls); the result is still the
+/// post-crossing end of a bracket no wider than `time_tolerance`. g_lo, g_hi: witness values at the ends.
+template <class WitnessWithRate>
+double isolate_crossing_newton(WitnessWithRate&& g, double t_lo, double g_lo, double t_hi, double g_hi,
+                               CrossingDirection direction, double time_tolerance) {
+  const double sign = direction == CrossingDirection::falling ? 1.0 : -1.0;
+  double a = t_lo, b = t_hi;
+  const double fa = sign * g_lo, fb = sign * g_hi;
+  double t = (fa > 0.0 && fb < 0.0) ? b - fb * (b - a) / (fb - fa) : 0.5 * (a + b);
+  if (!(t > a && t < b)) t = 0.5 * (a + b);
+  double dx = b - a, dx_old = dx;
+  for (int it = 0; it < 100 && b - a > time_tolerance; ++it) {
+    auto [f, r] = g(t);
+    f *= sign, r *= sign;
+    if (f > 0.0) a = t; else b = t;
+    if (b - a <= time_tolerance) break;
+    // Newton step unless it leaves the bracket or does not halve the step before last (rtsafe rule)
+    dx_old = dx;
+    const double newton = r != 0.0 ? t - f / r : std::numeric_limits<double>::quiet_NaN();
+    double next;
+    if (newton >= a - time_tolerance && newton <= b + time_tolerance &&
+        (std::abs(newton - a) < time_tolerance || std::abs(newton - b) < time_tolerance ||
+         std::abs(newton - t) < time_tolerance)) {
+      // the root is pinned to within the tolerance: close the bracket around it with two probes
+      const double c = std::clamp(newton, a, b);
+      const double lo = std::max(a, c - 0.4 * time_tolerance), hi = std::min(b, c + 0.4 * time_tolerance);
+      if (lo > a && sign * g(lo).first > 0.0) a = lo;
+      if (hi < b && sign * g(hi).first <= 0.0) b = hi;
+      if (b - a <= time_tolerance) break;
+      dx = 0.5 * (b - a);
+      next = a + dx;
+    } else if (!(newton > a && newton < b) || std::abs(2.0 * f) > std::abs(dx_old * r)) {
+      dx = 0.5 * (b - a);
+      next = a + dx;
+    } else {
+      dx = t - newton;
+      next = newton;
+    }
+    if (next <= a || next >= b) break;  // adjacent doubles
+    t = next;
   }
   return b;
 }

@@ -33,6 +33,10 @@ class LinearModeFlow {
   }
   /// ∂y(t0 + τ)/∂l for a fixed y0.
   Eigen::Vector2d separation_sensitivity(double tau) const;
+  /// Same, from the propagator E(τ) already evaluated.
+  Eigen::Vector2d separation_sensitivity(const Eigen::Matrix2d& propagator) const {
+    return offset_slope_ * Eigen::Vector2d(1.0 - propagator(0, 0), -propagator(1, 0));
+  }
 
   /// Upper bound of |x_h(t0+τ)| for τ ≥ 0 given the homogeneous part h0 at t0 (for skipping guard scans).
   double homogeneous_bound(const Eigen::Vector2d& homogeneous0) const;

@@ -68,15 +68,15 @@ struct HbCurveOptions {
 /// Order: Free/Plus points by increasing q, then Minus points by increasing q.
 /// Bad options (q_min ≥ q_max, points < 2, non-finite bounds, min_gap ∉ (0, 1)) -> InvalidParameter.
 std::vector<HbPoint> harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options);
-/// Same, writing into `out` (cleared first; its capacity is reused: no allocation when large enough).
+/// Same, writing into `out` (overwritten; no allocation when out.capacity() ≥ 2·points).
 void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out);
 
 /// Every fold of the "+" and "−" branches (sorted by q), each located to |Δq| ≤ 1e-10.
 std::vector<HbFold> harmonic_balance_folds(const TappingModel& model);
 
 /// Harmonic balance of one model (the separation is an input of each query). The constructor scans both
-/// branches once over q ∈ [−1e12, 1) (a log grid in the contact angle near grazing, i.e. 1 − q down to
-/// ~1e-15; a uniform grid in the angle elsewhere; a log grid in −q for permanent contact), locates where each
+/// branches once over q ∈ [−1e7, 1) (a log grid in the contact angle near grazing, i.e. 1 − q down to
+/// ~1e-16; a uniform grid in the angle elsewhere; a log grid in −q for permanent contact), locates where each
 /// branch exists and every fold; afterwards each branch is monotone between consecutive scan nodes and
 /// solutions(l) only brackets and refines (TOMS 748). Use it for sweeps over many separations.
 class HarmonicBalance {

@@ -53,4 +53,12 @@ HbBranchEvaluation evaluate_branch_permanent(const HbCoefficients& c, double q, 
 /// Point at gap s = 1 − q > 0 (any q < 1), accurate for s → 0.
 HbBranchEvaluation evaluate_branch_at_gap(const HbCoefficients& c, double gap, int sign);
 
+/// Both roots at gap s = 1 − q > 0 from one evaluation of the bar functions; the slopes
+/// (parameter_derivative, separation_slope) are computed only when with_slope (else left 0).
+struct HbRoots {
+  HbBranchEvaluation plus;   // B₊
+  HbBranchEvaluation minus;  // B₋
+};
+HbRoots evaluate_branches_at_gap(const HbCoefficients& c, double gap, bool with_slope = true);
+
 }  // namespace afmkit::tapping

@@ -11,13 +11,14 @@
 
 namespace afmkit::tapping {
 
+/// A view of a TappingModel: the model must outlive the system.
 class TappingSystem {
  public:
   explicit TappingSystem(const TappingModel& model);
 
-  const TappingModel& model() const { return model_; }
-  double separation() const { return model_.separation; }
-  double gap(double x) const { return x + model_.separation; }  // d = x + l
+  const TappingModel& model() const { return *model_; }
+  double separation() const { return separation_; }
+  double gap(double x) const { return x + separation_; }  // d = x + l
   /// Number of gap regions (switching gaps + 1). Region r: s_{r−1} ≤ gap < s_r.
   int region_count() const { return static_cast<int>(switching_.size()) + 1; }
   int region_of(double gap) const;
@@ -62,7 +63,8 @@ class TappingSystem {
                         double& time_partial) const;
 
  private:
-  TappingModel model_;
+  const TappingModel* model_;
+  double separation_;
   std::vector<double> switching_;
   unsigned long dependent_mask_ = 0;
   std::optional<impact::PiecewiseLinearLaw> linear_;  // scaled coefficients when piecewise linear

@@ -75,15 +75,15 @@ EnvelopeFit fit_log_envelope(std::span<const double> env, double period) {
   EnvelopeFit fit{std::numeric_limits<double>::quiet_NaN(), 0, -1};
   if (n < 2) return fit;
   int first = 1, last = n - 1;
-  if (n >= 4 && env[n - 1] > env[n / 2]) {
-    first = n / 2;
+  if (n >= 4 && env[n - 1] > 2.0 * env[n / 2]) {
+    first = n / 2;  // growing: the dominant (rightmost) mode has taken over in the second half
   } else {
+    // decaying: stop before the floor (integrator/rounding level) is reached; if the envelope never comes
+    // within 100× of its minimum after period 1 (no floor reached), the whole run is used
     const double floor = *std::min_element(env.begin(), env.end());
-    for (int p = 1; p < n; ++p)
-      if (env[p] <= 100.0 * floor) {
-        last = p - 1;
-        break;
-      }
+    int end = n - 1;
+    while (end > 0 && env[end] <= 100.0 * floor) --end;
+    if (end >= first + 2) last = end;
     if (n == 2) first = 0;
   }
   double sx = 0, sy = 0, sxx = 0, sxy = 0;

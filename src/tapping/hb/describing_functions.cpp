@@ -15,37 +15,34 @@ namespace {
 constexpr double pi = std::numbers::pi;
 constexpr double series_threshold = 0.5;  // contact angle below which the cancelling differences use series
 
-// sin a − a cos a = Σ_{k≥1} (−1)^{k+1} 2k a^{2k+1}/(2k+1)!   (2π Ω̄ for small a)
-double sin_minus_a_cos(double a) {
-  const double a2 = a * a;
-  double power = a * a2;  // a^{2k+1}
+// Series of the two cancelling differences, in x = a²:
+//   sin a − a cos a  = a³ Σ_{k≥1} (−1)^{k+1} 2k  x^{k−1}/(2k+1)!   (2π Ω̄)
+//   a − sin a cos a  = a³ Σ_{k≥1} (−1)^{k+1} 4^k x^{k−1}/(2k+1)!   (2π Ψ̄_R)
+// Ten terms reach rounding level for a < 0.5 (the 11th is below 1e-22 relative).
+constexpr int series_terms = 10;
+struct SeriesCoefficients {
+  double omega[series_terms];
+  double psi[series_terms];
+};
+constexpr SeriesCoefficients make_series() {
+  SeriesCoefficients c{};
   double factorial = 6.0;  // (2k+1)!
-  double sum = 0.0;
-  double sign = 1.0;
-  for (int k = 1; k <= 12; ++k) {
-    sum += sign * 2.0 * k * power / factorial;
-    power *= a2;
-    factorial *= (2.0 * k + 2.0) * (2.0 * k + 3.0);
-    sign = -sign;
-  }
-  return sum;
-}
-
-// a − sin a cos a = Σ_{k≥1} (−1)^{k+1} 4^k a^{2k+1}/(2k+1)!   (2π Ψ̄_R for small a)
-double a_minus_sin_cos(double a) {
-  const double a2 = a * a;
-  double power = a * a2;
   double four_k = 4.0;
-  double factorial = 6.0;
-  double sum = 0.0;
   double sign = 1.0;
-  for (int k = 1; k <= 12; ++k) {
-    sum += sign * four_k * power / factorial;
-    power *= a2;
-    four_k *= 4.0;
+  for (int k = 1; k <= series_terms; ++k) {
+    c.omega[k - 1] = sign * 2.0 * k / factorial;
+    c.psi[k - 1] = sign * four_k / factorial;
     factorial *= (2.0 * k + 2.0) * (2.0 * k + 3.0);
+    four_k *= 4.0;
     sign = -sign;
   }
+  return c;
+}
+constexpr SeriesCoefficients series = make_series();
+
+double horner(const double (&c)[series_terms], double x) {
+  double sum = c[series_terms - 1];
+  for (int k = series_terms - 2; k >= 0; --k) sum = sum * x + c[k];
   return sum;
 }
 
@@ -56,13 +53,37 @@ BarFunctions permanent_contact(double q) { return {0.5, -0.5 * q, 0.0, 2.0 / pi,
 
 // |q| < 1 from a = arccos q, sin a, cos a = q and the gap s = 1 − q (all consistent to rounding).
 BarFunctions contact(double a, double sin_a, double cos_a, double gap) {
-  const double sin_minus = a < series_threshold ? sin_minus_a_cos(a) : sin_a - a * cos_a;
-  const double a_minus = a < series_threshold ? a_minus_sin_cos(a) : a - sin_a * cos_a;
+  const double a3 = a * a * a;
+  const double sin_minus = a < series_threshold ? a3 * horner(series.omega, a * a) : sin_a - a * cos_a;
+  const double a_minus = a < series_threshold ? a3 * horner(series.psi, a * a) : a - sin_a * cos_a;
   return {a / (2.0 * pi), sin_minus / (2.0 * pi), sin_a / pi, gap / pi, a_minus / (2.0 * pi),
           gap * gap / (2.0 * pi)};
 }
 
+// d/da of the bar functions (sin a, cos a, gap = 1 − cos a).
+BarFunctions contact_derivatives(double a, double sin_a, double cos_a, double gap) {
+  return {1.0 / (2.0 * pi), a * sin_a / (2.0 * pi), cos_a / pi, sin_a / pi, sin_a * sin_a / pi, gap * sin_a / pi};
+}
+
 }  // namespace
+
+ContactBarFunctions contact_bar_functions_from_gap(double gap) {
+  if (!(gap > 0.0 && gap < 2.0)) validate::require(false, "gap", gap, "in (0, 2) (|q| < 1: contact)");
+  const double a = gap < 0.5 ? 2.0 * std::asin(std::sqrt(0.5 * gap)) : std::acos(1.0 - gap);
+  const double sin_a = std::sqrt(gap * (2.0 - gap));
+  const double cos_a = 1.0 - gap;
+  return {a, sin_a, contact(a, sin_a, cos_a, gap), contact_derivatives(a, sin_a, cos_a, gap)};
+}
+
+ContactBarFunctions contact_bar_functions_from_angle(double angle) {
+  if (!(angle >= 0.0 && angle <= pi)) validate::in_range("contact_angle", angle, 0.0, pi);
+  const double half_sine = std::sin(0.5 * angle);
+  const double gap = 2.0 * half_sine * half_sine;
+  const double sin_a = std::sin(angle);
+  const double cos_a = std::cos(angle);
+  const BarFunctions value = angle == 0.0 ? no_contact() : contact(angle, sin_a, cos_a, gap);
+  return {angle, sin_a, value, contact_derivatives(angle, sin_a, cos_a, gap)};
+}
 
 BarFunctions bar_functions_from_gap(double gap) {
   if (!std::isfinite(gap)) validate::finite("gap", gap);  // (checks only build strings on failure: hot path)
@@ -88,12 +109,7 @@ BarFunctions bar_functions_from_contact_angle(double angle) {
 }
 
 BarFunctions bar_function_derivatives_in_angle(double angle) {
-  if (!(angle >= 0.0 && angle <= pi)) validate::in_range("contact_angle", angle, 0.0, pi);
-  const double s = std::sin(angle);
-  const double c = std::cos(angle);
-  const double half_sine = std::sin(0.5 * angle);
-  const double gap = 2.0 * half_sine * half_sine;  // 1 − cos a
-  return {1.0 / (2.0 * pi), angle * s / (2.0 * pi), c / pi, s / pi, s * s / pi, gap * s / pi};
+  return contact_bar_functions_from_angle(angle).angle_derivative;
 }
 
 BarFunctions bar_function_derivatives_permanent_contact() { return {0.0, -0.5, 0.0, 0.0, 0.0, -2.0 / pi}; }

@@ -24,35 +24,38 @@ struct Location {
   BarFunctions dbar;   // d/dθ
 };
 
-Location contact_location(double angle, const BarFunctions& bar, double gap) {
+Location contact_location(const ContactBarFunctions& b, double gap) {
   // θ = a: q = cos a, dq/da = −sin a.
-  return {1.0 - gap, gap, angle, -std::sin(angle), bar, bar_function_derivatives_in_angle(angle)};
+  return {1.0 - gap, gap, b.angle, -b.sine, b.value, b.angle_derivative};
 }
 
-HbBranchEvaluation evaluate(const HbCoefficients& c, const Location& at, int sign) {
-  HbBranchEvaluation r;
-  r.q = at.q;
-  r.gap = at.gap;
-  r.contact_angle = at.angle;
+// Both roots of (E1) at one location (shared work done once); slopes only when with_slope.
+HbRoots evaluate(const HbCoefficients& c, const Location& at, bool with_slope) {
+  HbRoots out;
+  for (HbBranchEvaluation* r : {&out.plus, &out.minus}) {
+    r->q = at.q;
+    r->gap = at.gap;
+    r->contact_angle = at.angle;
+  }
   const auto& law = c.law;
   const double sum_k = law.approach_stiffness + law.departure_stiffness;  // Σ_K
   const double sum_f = law.approach_adhesion + law.departure_adhesion;    // Σ_F
   const std::complex<double> psi = stiffness_term(law, at.bar);           // Ψ (eq. 30)
   const std::complex<double> phi = adhesion_term(law, at.bar);            // Φ (eq. 30)
   const std::complex<double> m = c.inverse_transfer + psi;                // M = L(iω)⁻¹ + Ψ
-  const double m_abs = std::abs(m);
-  const double m2 = m_abs * m_abs;
-  if (!(m2 > 0.0)) return r;
+  const double m2 = std::norm(m);
+  if (!(m2 > 0.0) || !std::isfinite(m2)) return out;
+  const double m_abs = std::sqrt(m2);
   const std::complex<double> p = m * std::conj(phi);  // MΦ*
   const double gamma = c.drive;
   // E2 discriminant Γ²|M|² − Im(MΦ*)², factored to avoid cancellation.
   const double im_abs = std::abs(p.imag());
   const double disc = (gamma * m_abs - im_abs) * (gamma * m_abs + im_abs);
-  if (disc < 0.0) return r;
+  if (disc < 0.0) return out;
   const double root = std::sqrt(disc);
-  const double phi_abs = std::abs(phi);
+  const double phi_abs = std::sqrt(std::norm(phi));
   const double product = (phi_abs - gamma) * (phi_abs + gamma) / m2;  // B₊B₋ = (|Φ|² − Γ²)/|M|²
-  // Numerically stable roots: take the one without cancellation directly, the other from the product.
+  // Numerically stable roots: the one without cancellation directly, the other from the product.
   double b_plus;
   double b_minus;
   if (p.real() <= 0.0) {
@@ -62,25 +65,46 @@ HbBranchEvaluation evaluate(const HbCoefficients& c, const Location& at, int sig
     b_minus = (-p.real() - root) / m2;
     b_plus = b_minus != 0.0 ? product / b_minus : (-p.real() + root) / m2;
   }
-  const double b = sign > 0 ? b_plus : b_minus;
-  if (!(b > 0.0) || !std::isfinite(b)) return r;
-  r.exists = true;
-  r.amplitude = b;
-  r.offset = c.static_gain * (sum_k * at.bar.omega * b - sum_f * at.bar.chi);  // E3
-  r.separation = (at.gap < 0.5 ? b - at.gap * b : at.q * b) - r.offset;         // E4: l = qB − A
-  const std::complex<double> z = m * b + phi;                                   // Γ e^{iφ} (E5)
-  r.phase = std::atan2(z.imag(), z.real());
-  // Slope along the branch: F(B, θ) = |MB + Φ|² − Γ² = 0  ->  dB/dθ = −Re((M'B + Φ') z*) / Re(M z*).
-  const std::complex<double> dm = stiffness_term(law, at.dbar);
-  const std::complex<double> dphi = adhesion_term(law, at.dbar);
-  const double f_b = (m * std::conj(z)).real();
-  const double f_theta = ((dm * b + dphi) * std::conj(z)).real();
-  const double db = -f_theta / f_b;
-  const double da = c.static_gain * (sum_k * (at.dbar.omega * b + at.bar.omega * db) - sum_f * at.dbar.chi);
-  r.parameter_derivative = at.dq * b + at.q * db - da;
-  r.separation_slope = r.parameter_derivative / at.dq;
-  return r;
+  std::complex<double> dm;
+  std::complex<double> dphi;
+  if (with_slope) {
+    dm = stiffness_term(law, at.dbar);
+    dphi = adhesion_term(law, at.dbar);
+  }
+  for (const int sign : {+1, -1}) {
+    HbBranchEvaluation& r = sign > 0 ? out.plus : out.minus;
+    const double b = sign > 0 ? b_plus : b_minus;
+    if (!(b > 0.0) || !std::isfinite(b)) continue;
+    r.exists = true;
+    r.amplitude = b;
+    r.offset = c.static_gain * (sum_k * at.bar.omega * b - sum_f * at.bar.chi);  // E3
+    r.separation = (at.gap < 0.5 ? b - at.gap * b : at.q * b) - r.offset;         // E4: l = qB − A
+    const std::complex<double> z = m * b + phi;                                   // Γ e^{iφ} (E5)
+    r.phase = std::atan2(z.imag(), z.real());
+    if (!with_slope) continue;
+    // Slope along the branch: F(B, θ) = |MB + Φ|² − Γ² = 0  ->  dB/dθ = −Re((M'B + Φ') z*) / Re(M z*).
+    const double f_b = (m * std::conj(z)).real();
+    const double f_theta = ((dm * b + dphi) * std::conj(z)).real();
+    const double db = -f_theta / f_b;
+    const double da = c.static_gain * (sum_k * (at.dbar.omega * b + at.bar.omega * db) - sum_f * at.dbar.chi);
+    r.parameter_derivative = at.dq * b + at.q * db - da;
+    r.separation_slope = r.parameter_derivative / at.dq;
+  }
+  return out;
 }
+
+Location permanent_location(double q) {
+  if (!(q <= -1.0 && std::isfinite(q))) validate::require(false, "q", q, "finite and <= -1 (permanent contact)");
+  return {q, 1.0 - q, pi, 1.0, bar_functions(q), bar_function_derivatives_permanent_contact()};
+}
+
+Location gap_location(double gap) {
+  if (!(gap > 0.0 && std::isfinite(gap))) validate::require(false, "gap", gap, "finite and > 0 (q < 1: contact)");
+  if (gap >= 2.0) return permanent_location(1.0 - gap);
+  return contact_location(contact_bar_functions_from_gap(gap), gap);
+}
+
+const HbBranchEvaluation& pick(const HbRoots& roots, int sign) { return sign > 0 ? roots.plus : roots.minus; }
 
 }  // namespace
 
@@ -98,22 +122,21 @@ HbCoefficients::HbCoefficients(const TappingModel& model)
       law(require_piecewise_linear(model.law)) {}
 
 HbBranchEvaluation evaluate_branch_at_angle(const HbCoefficients& c, double contact_angle, int sign) {
-  const BarFunctions bar = bar_functions_from_contact_angle(contact_angle);
+  const ContactBarFunctions b = contact_bar_functions_from_angle(contact_angle);
   const double half_sine = std::sin(0.5 * contact_angle);
-  return evaluate(c, contact_location(contact_angle, bar, 2.0 * half_sine * half_sine), sign);
+  return pick(evaluate(c, contact_location(b, 2.0 * half_sine * half_sine), true), sign);
 }
 
 HbBranchEvaluation evaluate_branch_permanent(const HbCoefficients& c, double q, int sign) {
-  if (!(q <= -1.0 && std::isfinite(q))) validate::require(false, "q", q, "finite and <= -1 (permanent contact)");
-  const Location at{q, 1.0 - q, pi, 1.0, bar_functions(q), bar_function_derivatives_permanent_contact()};
-  return evaluate(c, at, sign);
+  return pick(evaluate(c, permanent_location(q), true), sign);
 }
 
 HbBranchEvaluation evaluate_branch_at_gap(const HbCoefficients& c, double gap, int sign) {
-  if (!(gap > 0.0 && std::isfinite(gap))) validate::require(false, "gap", gap, "finite and > 0 (q < 1: contact)");
-  if (gap >= 2.0) return evaluate_branch_permanent(c, 1.0 - gap, sign);
-  const double angle = gap < 0.5 ? 2.0 * std::asin(std::sqrt(0.5 * gap)) : std::acos(1.0 - gap);
-  return evaluate(c, contact_location(angle, bar_functions_from_gap(gap), gap), sign);
+  return pick(evaluate(c, gap_location(gap), true), sign);
+}
+
+HbRoots evaluate_branches_at_gap(const HbCoefficients& c, double gap, bool with_slope) {
+  return evaluate(c, gap_location(gap), with_slope);
 }
 
 }  // namespace afmkit::tapping

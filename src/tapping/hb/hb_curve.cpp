@@ -58,28 +58,31 @@ HbPoint to_point(const HbBranchEvaluation& e, HbBranch branch) {
 void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out) {
   validate_options(options);
   const HbCoefficients c(model);
-  out.clear();
+  const std::size_t n = options.points;
+  // One pass: Plus/Free points fill out[0, …), Minus points out[n, …); then the Minus block is moved down.
+  // No allocation when out.capacity() ≥ 2n.
+  out.resize(2 * n);
+  std::size_t n_plus = 0;
+  std::size_t n_minus = 0;
   const double b_free = c.free_amplitude();
   const double phase_free = c.free_phase();
   for_each_sample(options, [&](double q, double gap) {
     if (gap <= 0.0) {
-      out.push_back({q, q * b_free, b_free, 0.0, phase_free, HbBranch::Free});
+      out[n_plus++] = {q, q * b_free, b_free, 0.0, phase_free, HbBranch::Free};
       return;
     }
-    const HbBranchEvaluation e = evaluate_branch_at_gap(c, gap, +1);
-    if (e.exists) out.push_back(to_point(e, HbBranch::Plus));
+    const HbRoots roots = evaluate_branches_at_gap(c, gap, false);
+    if (roots.plus.exists) out[n_plus++] = to_point(roots.plus, HbBranch::Plus);
+    if (options.include_minus && roots.minus.exists) out[n + n_minus++] = to_point(roots.minus, HbBranch::Minus);
   });
-  if (!options.include_minus || options.q_min >= 1.0) return;
-  for_each_sample(options, [&](double /*q*/, double gap) {
-    if (gap <= 0.0) return;
-    const HbBranchEvaluation e = evaluate_branch_at_gap(c, gap, -1);
-    if (e.exists) out.push_back(to_point(e, HbBranch::Minus));
-  });
+  std::copy(out.begin() + static_cast<std::ptrdiff_t>(n), out.begin() + static_cast<std::ptrdiff_t>(n + n_minus),
+            out.begin() + static_cast<std::ptrdiff_t>(n_plus));
+  out.resize(n_plus + n_minus);
 }
 
 std::vector<HbPoint> harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options) {
   std::vector<HbPoint> out;
-  out.reserve(options.points);
+  out.reserve(2 * options.points);
   harmonic_balance_curve(model, options, out);
   return out;
 }

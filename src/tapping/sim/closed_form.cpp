@@ -114,8 +114,9 @@ void run_closed_form(const TappingSystem& sys, RunState& rs, double t_end, const
     if (observer) observer->on_segment(sys, ClosedFormSegment(t0, t1, mode, flow, h0));
     if (options.sensitivity) {
       Eigen::Matrix3d seg = Eigen::Matrix3d::Identity();
-      seg.topLeftCorner<2, 2>() = flow.propagator(t1 - t0);
-      seg.topRightCorner<2, 1>() = flow.separation_sensitivity(t1 - t0);
+      const Eigen::Matrix2d e = flow.propagator(t1 - t0);
+      seg.topLeftCorner<2, 2>() = e;
+      seg.topRightCorner<2, 1>() = flow.separation_sensitivity(e);
       rs.jacobian = seg * rs.jacobian;
     }
     if (hit) {

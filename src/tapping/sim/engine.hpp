@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include <Eigen/Core>
 
@@ -55,7 +56,7 @@ std::optional<Crossing> first_crossing(const TappingSystem& sys, const Mode& mod
   for (int i = 0; i < n; ++i) {
     const Guard& g = guards[i];
     auto witness = [&](double t) { return sys.witness(g, mode, t, state(t)); };
-    double hi = tb;
+    double hi = tb, g_hi = b.value[i];
     bool found = crosses(a.value[i], b.value[i], g.direction);
     if (!found) {
       const bool falling = g.direction == CrossingDirection::falling;
@@ -66,14 +67,21 @@ std::optional<Crossing> first_crossing(const TappingSystem& sys, const Mode& mod
         auto rate = [&](double t) { return sys.witness_rate(g, mode, t, state(t)); };
         const double tm = isolate_crossing(rate, ta, tb, falling ? CrossingDirection::rising : CrossingDirection::falling,
                                            time_tolerance(tb));
-        if (crosses(a.value[i], witness(tm), g.direction)) {
+        const double gm = witness(tm);
+        if (crosses(a.value[i], gm, g.direction)) {
           found = true;
           hi = tm;
+          g_hi = gm;
         }
       }
     }
     if (!found) continue;
-    const double te = isolate_crossing(witness, ta, hi, g.direction, time_tolerance(hi));
+    auto witness_and_rate = [&](double t) {
+      const TipState s = state(t);
+      return std::pair<double, double>(sys.witness(g, mode, t, s), sys.witness_rate(g, mode, t, s));
+    };
+    const double te =
+        isolate_crossing_newton(witness_and_rate, ta, a.value[i], hi, g_hi, g.direction, time_tolerance(hi));
     if (!best || te < best->time) best = Crossing{te, i};
   }
   return best;

@@ -21,13 +21,15 @@ const char* integrator_name(Integrator integrator) {
 }
 
 void SimulationOptions::validate() const {
-  validate::require(relative_tolerance > 0 && relative_tolerance < 1, "relative_tolerance", relative_tolerance,
-                    "in (0, 1)");
-  validate::positive("absolute_tolerance", absolute_tolerance);
-  validate::require(max_step_fraction > 0 && max_step_fraction <= 0.25, "max_step_fraction", max_step_fraction,
-                    "in (0, 0.25]");
-  validate::require(max_events >= 1, "max_events", static_cast<double>(max_events), ">= 1");
-  validate::require(max_steps >= 1, "max_steps", static_cast<double>(max_steps), ">= 1");
+  // cheap when valid (called for every simulation): build messages only on failure
+  if (!(relative_tolerance > 0 && relative_tolerance < 1))
+    validate::require(false, "relative_tolerance", relative_tolerance, "in (0, 1)");
+  if (!(absolute_tolerance > 0 && std::isfinite(absolute_tolerance)))
+    validate::positive("absolute_tolerance", absolute_tolerance);
+  if (!(max_step_fraction > 0 && max_step_fraction <= 0.25))
+    validate::require(false, "max_step_fraction", max_step_fraction, "in (0, 0.25]");
+  if (max_events < 1) validate::require(false, "max_events", static_cast<double>(max_events), ">= 1");
+  if (max_steps < 1) validate::require(false, "max_steps", static_cast<double>(max_steps), ">= 1");
 }
 
 Integrator resolve_integrator(const TappingModel& model, Integrator requested) {
@@ -43,11 +45,11 @@ Integrator resolve_integrator(const TappingModel& model, Integrator requested) {
 SimulationResult simulate(const TappingModel& model, double t_begin, TipState start, double t_end,
                           const SimulationOptions& options, TrajectoryObserver* observer) {
   options.validate();
-  validate::finite("t_begin", t_begin);
-  validate::finite("t_end", t_end);
-  validate::require(t_end >= t_begin, "t_end", t_end, fmt::format(">= t_begin = {}", t_begin));
-  validate::finite("position", start.position);
-  validate::finite("velocity", start.velocity);
+  if (!std::isfinite(t_begin)) validate::finite("t_begin", t_begin);
+  if (!std::isfinite(t_end)) validate::finite("t_end", t_end);
+  if (!(t_end >= t_begin)) validate::require(false, "t_end", t_end, fmt::format(">= t_begin = {}", t_begin));
+  if (!std::isfinite(start.position)) validate::finite("position", start.position);
+  if (!std::isfinite(start.velocity)) validate::finite("velocity", start.velocity);
   const Integrator integrator = resolve_integrator(model, options.integrator);
   const TappingSystem sys(model);
   detail::RunState rs;

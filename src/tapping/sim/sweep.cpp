@@ -27,9 +27,8 @@ void SweepOptions::validate() const {
   validate::require(jump_check_distance > 0, "jump_check_distance", jump_check_distance, "> 0");
 }
 
-void attach_harmonic_balance(const TappingModel& base, SweepPoint& point) {
-  if (!base.law.piecewise_linear()) return;
-  const auto solutions = harmonic_balance_solutions(base.with_separation(point.separation));
+namespace {
+void attach_from(const std::vector<HbPoint>& solutions, SweepPoint& point) {
   point.hb_solutions = static_cast<int>(solutions.size());
   double best = std::numeric_limits<double>::infinity();
   for (const HbPoint& p : solutions) {
@@ -41,6 +40,12 @@ void attach_harmonic_balance(const TappingModel& base, SweepPoint& point) {
       point.hb_phase = p.phase;
     }
   }
+}
+}  // namespace
+
+void attach_harmonic_balance(const TappingModel& base, SweepPoint& point) {
+  if (!base.law.piecewise_linear()) return;
+  attach_from(harmonic_balance_solutions(base.with_separation(point.separation)), point);
 }
 
 namespace {
@@ -134,13 +139,15 @@ namespace detail {
 
 void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
                    bool harmonic_balance, bool parallel) {
+  std::optional<HarmonicBalance> hb;  // branch scan once, cheap queries
+  if (harmonic_balance && base.law.piecewise_linear()) hb.emplace(base);
   std::exception_ptr error;
 #pragma omp parallel for schedule(dynamic) if (parallel)
   for (std::size_t i = 0; i < points.size(); ++i) {
     try {
       SweepPoint& p = points[i];
       p.metrics = analyse_orbit(base.with_separation(p.separation), p.orbit, simulation);
-      if (harmonic_balance) attach_harmonic_balance(base, p);
+      if (hb) attach_from(hb->solutions(p.separation), p);
     } catch (...) {
 #pragma omp critical(afmkit_sweep_error)
       if (!error) error = std::current_exception();

@@ -11,7 +11,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }
 
 TappingSystem::TappingSystem(const TappingModel& model)
-    : model_(model),
+    : model_(&model),
+      separation_(model.separation),
       switching_(model.law.switching_gaps()),
       damping_(2.0 * model.cantilever.damping_ratio() * model.cantilever.natural_frequency),
       stiffness_(model.cantilever.natural_frequency * model.cantilever.natural_frequency),
@@ -61,9 +62,9 @@ double TappingSystem::interaction(ContactBranch branch, double x, int region) co
   const double hi = region_hi(region);
   if (dc >= hi) dc = std::nextafter(hi, -kInf);
   switch (branch) {
-    case ContactBranch::approach: return -model_.law.approach(dc);
-    case ContactBranch::departure: return -model_.law.departure(dc);
-    case ContactBranch::sticking: return -0.5 * (model_.law.approach(dc) + model_.law.departure(dc));
+    case ContactBranch::approach: return -model_->law.approach(dc);
+    case ContactBranch::departure: return -model_->law.departure(dc);
+    case ContactBranch::sticking: return -0.5 * (model_->law.approach(dc) + model_->law.departure(dc));
   }
   return 0.0;
 }
@@ -80,7 +81,7 @@ double TappingSystem::interaction_slope(ContactBranch branch, double x, int regi
   const double d = gap(x);
   const double step = 1e-6 * std::max(1.0, std::abs(d));
   const double lo = region_lo(region), hi = region_hi(region);
-  auto h = [&](double dd) { return interaction(branch, dd - model_.separation, region); };
+  auto h = [&](double dd) { return interaction(branch, dd - separation_, region); };
   if (d - step >= lo && d + step < hi) return (h(d + step) - h(d - step)) / (2.0 * step);
   if (d + 2 * step < hi) return (-3.0 * h(d) + 4.0 * h(d + step) - h(d + 2 * step)) / (2.0 * step);
   return (3.0 * h(d) - 4.0 * h(d - step) + h(d - 2 * step)) / (2.0 * step);
