@@ -1,10 +1,136 @@
-#include <CLI/CLI.hpp>
+// afmkit tapping orbit: every harmonic-balance solution and every periodic orbit found at one separation
+// (shooting from each HB solution, and transients from rest and from the free response), with Floquet
+// stability and the orbit observables. CSV: one row per orbit; JSON sidecar: HB solutions and transients.
+#include <cmath>
+#include <memory>
+#include <string>
 
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/params.hpp"
+#include "afmkit/tapping/orbit.hpp"
 #include "commands.hpp"
+#include "tapping_params.hpp"
+#include "tapping_sim_params.hpp"
 
 namespace afmkit::cli {
 
-// Placeholder registration: the subcommand is added when its domain lands.
-void register_tapping_orbit(CLI::App& /*tapping*/) {}
+namespace {
+
+nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+nlohmann::json orbit_json(const tapping::FoundOrbit& f, const TappingScales& s) {
+  const auto& m = f.metrics;
+  const auto& o = f.orbit;
+  return {{"source", tapping::orbit_source_name(f.source)},
+          {"period_multiple", o.period_multiple},
+          {"stable", o.stable},
+          {"floquet_max", number(o.floquet_max)},
+          {"floquet_multipliers",
+           {{{"re", o.floquet_multipliers[0].real()}, {"im", o.floquet_multipliers[0].imag()}},
+            {{"re", o.floquet_multipliers[1].real()}, {"im", o.floquet_multipliers[1].imag()}}}},
+          {"amplitude", m.amplitude * s.length},
+          {"offset", m.offset * s.length},
+          {"phase", m.phase},
+          {"harmonics", {m.harmonics[0] * s.length, m.harmonics[1] * s.length, m.harmonics[2] * s.length,
+                         m.harmonics[3] * s.length}},
+          {"contact_fraction", m.contact_fraction},
+          {"peak_force", m.peak_force * s.force},
+          {"min_gap", m.min_gap * s.length},
+          {"drive_work", m.drive_work * s.energy},
+          {"viscous_dissipation", m.viscous_dissipation * s.energy},
+          {"contact_dissipation", m.contact_dissipation * s.energy},
+          {"energy_dissipated", m.energy_dissipated() * s.energy},
+          {"sticking_time", m.sticking_duration * s.time},
+          {"initial_position", o.initial.position * s.length},
+          {"initial_velocity", o.initial.velocity * s.length / s.time},
+          {"shooting_residual", o.residual}};
+}
+
+void run_orbit(const io::ParamSet& p) {
+  const tapping::TappingModel model = tapping_model_from(p);
+  const TappingScales scales = tapping_scales_from(p);
+  tapping::OrbitSearchOptions options;
+  options.shooting = shooting_options_from(p);
+  options.transient = transient_options_from(p);
+  const tapping::OrbitSearchResult r = tapping::find_orbits(model, options);
+
+  io::Table table({"source", "period_multiple", "stable", "amplitude", "offset", "phase", "harmonic_2", "harmonic_3",
+                   "harmonic_4", "harmonic_5", "contact_fraction", "peak_force", "min_gap", "energy_dissipated",
+                   "viscous_dissipation", "contact_dissipation", "floquet_max", "sticking_time", "initial_position",
+                   "initial_velocity"});
+  nlohmann::json orbits = nlohmann::json::array();
+  for (const tapping::FoundOrbit& f : r.orbits) {
+    const auto& m = f.metrics;
+    const double l = scales.length;
+    table.add_row({std::string(tapping::orbit_source_name(f.source)), static_cast<long>(f.orbit.period_multiple),
+                   f.orbit.stable, m.amplitude * l, m.offset * l, m.phase, m.harmonics[0] * l, m.harmonics[1] * l,
+                   m.harmonics[2] * l, m.harmonics[3] * l, m.contact_fraction, m.peak_force * scales.force,
+                   m.min_gap * l, m.energy_dissipated() * scales.energy, m.viscous_dissipation * scales.energy,
+                   m.contact_dissipation * scales.energy, f.orbit.floquet_max, m.sticking_duration * scales.time,
+                   f.orbit.initial.position * l, f.orbit.initial.velocity * l / scales.time});
+    orbits.push_back(orbit_json(f, scales));
+  }
+  nlohmann::json hb = nlohmann::json::array();
+  for (const tapping::HbPoint& h : r.harmonic_balance)
+    hb.push_back({{"branch", tapping::branch_name(h.branch)},
+                  {"q", h.q},
+                  {"amplitude", h.amplitude * scales.length},
+                  {"offset", h.offset * scales.length},
+                  {"phase", h.phase}});
+  nlohmann::json transients = nlohmann::json::array();
+  for (const tapping::TransientOutcome& t : r.transients) {
+    nlohmann::json j = {{"kind", tapping::response_kind_name(t.kind)}, {"periods_simulated", t.periods_simulated}};
+    if (t.orbit) j["period_multiple"] = t.orbit->period_multiple;
+    if (!t.message.empty()) j["message"] = t.message;
+    transients.push_back(j);
+  }
+  const nlohmann::json summary = {{"separation", p.real("separation")},
+                                  {"free_amplitude", model.free_amplitude() * scales.length},
+                                  {"harmonic_balance", hb},
+                                  {"orbits", orbits},
+                                  {"transients", transients}};
+  const std::string output = p.text("output");
+  if (!output.empty()) io::write_table(output, table, io::make_sidecar("tapping orbit", p.to_json(), summary));
+  if (p.flag("json")) {
+    fmt::print("{}\n", summary.dump(2));
+    return;
+  }
+  fmt::print("separation {}: {} HB solution(s), {} periodic orbit(s)\n", p.real("separation"), hb.size(),
+             r.orbits.size());
+  for (const tapping::HbPoint& h : r.harmonic_balance)
+    fmt::print("  HB {:5s} amplitude {:.6g}  offset {:.6g}  phase {:.6g}\n", tapping::branch_name(h.branch),
+               h.amplitude * scales.length, h.offset * scales.length, h.phase);
+  for (const tapping::FoundOrbit& f : r.orbits)
+    fmt::print("  orbit ({}{}) amplitude {:.6g}  offset {:.6g}  phase {:.6g}  {}  |mu|max {:.4g}  contact {:.3g}\n",
+               tapping::orbit_source_name(f.source),
+               f.orbit.period_multiple > 1 ? fmt::format(", period {}", f.orbit.period_multiple) : std::string(),
+               f.metrics.amplitude * scales.length, f.metrics.offset * scales.length, f.metrics.phase,
+               f.orbit.stable ? "stable" : "unstable", f.orbit.floquet_max, f.metrics.contact_fraction);
+  for (const tapping::TransientOutcome& t : r.transients)
+    if (t.kind != tapping::ResponseKind::periodic) fmt::print("  transient: {}\n", t.message);
+  if (!output.empty()) fmt::print("wrote {} rows to {} (details in {}.json)\n", table.size(), output, output);
+}
+
+}  // namespace
+
+void register_tapping_orbit(CLI::App& tapping) {
+  auto params = std::make_shared<io::ParamSet>();
+  add_tapping_model_params(*params);
+  add_tapping_sim_params(*params);
+  params->flag("json", false, "print the result as JSON instead of the summary")
+      .text("output", "out/tapping_orbit.csv", "output CSV path (JSON sidecar next to it); empty: no file");
+  auto* cmd = tapping.add_subcommand(
+      "orbit", "all periodic orbits at one separation: shooting from every HB solution and from transients, "
+               "Floquet stability, harmonics, contact, energy");
+  params->add_options(*cmd);
+  cmd->callback([params] {
+    params->resolve();
+    run_orbit(*params);
+  });
+}
 
 }  // namespace afmkit::cli

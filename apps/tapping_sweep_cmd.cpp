@@ -1,10 +1,134 @@
-#include <CLI/CLI.hpp>
+// afmkit tapping sweep: separation sweeps of periodic orbits — as an instrument does (approach then retract,
+// each orbit continued from the previous one, transients where a branch ends: jumps and hysteresis) and/or by
+// pseudo-arclength continuation through folds (unstable branches included). HB value beside each point.
+#include <cmath>
+#include <memory>
+#include <string>
 
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/params.hpp"
+#include "afmkit/io/progress.hpp"
+#include "afmkit/tapping/continuation.hpp"
+#include "afmkit/tapping/sweep.hpp"
 #include "commands.hpp"
+#include "tapping_params.hpp"
+#include "tapping_sim_params.hpp"
 
 namespace afmkit::cli {
 
-// Placeholder registration: the subcommand is added when its domain lands.
-void register_tapping_sweep(CLI::App& /*tapping*/) {}
+namespace {
+
+void add_rows(io::Table& table, const std::vector<tapping::SweepPoint>& points, const TappingScales& s) {
+  for (const tapping::SweepPoint& pt : points) {
+    const auto& m = pt.metrics;
+    table.add_row({pt.separation * s.length, std::string(tapping::direction_name(pt.direction)),
+                   m.amplitude * s.length, m.offset * s.length, m.phase, pt.orbit.stable, m.contact_fraction,
+                   m.energy_dissipated() * s.energy, m.peak_force * s.force, m.min_gap * s.length,
+                   pt.orbit.floquet_max, static_cast<long>(pt.orbit.period_multiple), pt.periodic, pt.jumped,
+                   pt.arclength, m.harmonics[0] * s.length, m.harmonics[1] * s.length, pt.hb_amplitude * s.length,
+                   pt.hb_offset * s.length, pt.hb_phase, static_cast<long>(pt.hb_solutions)});
+  }
+}
+
+nlohmann::json scaled(const std::vector<double>& v, double f) {
+  nlohmann::json j = nlohmann::json::array();
+  for (double x : v) j.push_back(x * f);
+  return j;
+}
+
+void run_sweep(const io::ParamSet& p) {
+  const tapping::TappingModel base = tapping_model_from(p);
+  const TappingScales scales = tapping_scales_from(p);
+  const double l_min = p.real("separation_min") / scales.length, l_max = p.real("separation_max") / scales.length;
+  if (!(l_min < l_max))
+    throw InvalidParameter("separation_min", fmt::format("separation_min = {} is out of range: must be < "
+                                                         "separation_max = {}",
+                                                         p.real("separation_min"), p.real("separation_max")));
+  const int points = static_cast<int>(p.integer("points"));
+  const std::string& mode = p.text("mode");
+  const bool instrument = mode == "instrument" || mode == "both";
+  const bool continuation = mode == "continuation" || mode == "both";
+  const bool quiet = p.flag("json") || p.flag("quiet");
+
+  io::Table table({"separation", "direction", "amplitude", "offset", "phase", "stable", "contact_fraction",
+                   "energy_dissipated", "peak_force", "min_gap", "floquet_max", "period_multiple", "periodic",
+                   "jumped", "arclength", "harmonic_2", "harmonic_3", "hb_amplitude", "hb_offset", "hb_phase",
+                   "hb_solutions"});
+  nlohmann::json results = nlohmann::json::object();
+  if (instrument) {
+    io::Progress progress("tapping sweep (approach + retract)", 2L * points, !quiet);
+    tapping::SweepOptions options;
+    options.shooting = shooting_options_from(p);
+    options.transient = transient_options_from(p);
+    options.progress = [&progress](long n) { progress.advance(n); };
+    const tapping::SweepResult r = tapping::sweep_instrument(base, l_min, l_max, points, options);
+    progress.finish();
+    add_rows(table, r.approach, scales);
+    add_rows(table, r.retract, scales);
+    results["approach_jumps"] = scaled(r.approach_jumps, scales.length);
+    results["retract_jumps"] = scaled(r.retract_jumps, scales.length);
+  }
+  if (continuation) {
+    tapping::ContinuationOptions options;
+    options.shooting = shooting_options_from(p);
+    options.max_step = p.real("max_arclength_step") / scales.length;
+    options.initial_step = std::min(options.initial_step, options.max_step);
+    options.max_points = static_cast<int>(p.integer("max_continuation_points"));
+    const tapping::ContinuationResult c = tapping::sweep_continuation(base, l_min, l_max, options);
+    add_rows(table, c.points, scales);
+    results["folds"] = scaled(c.folds, scales.length);
+    results["grazing"] = scaled(c.grazing, scales.length);
+    results["continuation_stop"] = c.stop_reason;
+    results["continuation_points"] = c.points.size();
+  }
+  results["free_amplitude"] = base.free_amplitude() * scales.length;
+  results["rows"] = table.size();
+  const std::string output = p.text("output");
+  if (!output.empty()) io::write_table(output, table, io::make_sidecar("tapping sweep", p.to_json(), results));
+  if (p.flag("json")) {
+    fmt::print("{}\n", results.dump(2));
+    return;
+  }
+  if (instrument)
+    fmt::print("instrument sweep: jumps on approach at {}, on retract at {}\n", results["approach_jumps"].dump(),
+               results["retract_jumps"].dump());
+  if (continuation)
+    fmt::print("continuation: {} points, folds at {}, grazing at {} ({})\n", results["continuation_points"].dump(),
+               results["folds"].dump(), results["grazing"].dump(), results["continuation_stop"].get<std::string>());
+  if (!output.empty()) fmt::print("wrote {} rows to {} (details in {}.json)\n", table.size(), output, output);
+}
+
+}  // namespace
+
+void register_tapping_sweep(CLI::App& tapping) {
+  auto params = std::make_shared<io::ParamSet>();
+  add_tapping_model_params(*params);
+  add_tapping_sim_params(*params);
+  params->real("separation_min", 5.0, "smallest separation of the sweep (nm)", io::Range::any())
+      .real("separation_max", 15.0, "largest separation of the sweep (nm), > separation_min", io::Range::any())
+      .integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000)
+      .text("mode", "instrument",
+            "instrument (approach then retract, jumps and hysteresis), continuation (pseudo-arclength through "
+            "folds, unstable branches) or both",
+            {"instrument", "continuation", "both"})
+      .real("max_arclength_step", 0.2, "largest continuation step (nm, scaled arclength)", io::Range::positive())
+      .integer("max_continuation_points", 5000, "continuation point budget", 2, 100000000)
+      .flag("json", false, "print the summary (jumps, folds) as JSON")
+      .flag("quiet", false, "no progress output")
+      .text("output", "out/tapping_sweep.csv", "output CSV path (JSON sidecar next to it); empty: no file");
+  auto* cmd = tapping.add_subcommand(
+      "sweep", "separation sweep of periodic orbits: instrument approach/retract (jumps, hysteresis) and/or "
+               "continuation through folds; HB beside each point");
+  params->add_options(*cmd);
+  cmd->callback([params] {
+    params->resolve();
+    run_sweep(*params);
+  });
+}
 
 }  // namespace afmkit::cli

@@ -39,3 +39,4 @@ static void BM_HysteresisAreaDmt(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(hysteresis_energy_loss(law, -4.0, 2.0));
 }
 BENCHMARK(BM_HysteresisAreaDmt);
+BENCHMARK_MAIN();

@@ -105,8 +105,8 @@ BankParts bank_parts(const OscillatorBank& bank, cplx s) {
       s_rej = s_rej * q;
     }
     p = p * q;
-    const double m = std::max({std::abs(p.v), std::abs(p.d), std::abs(s_keep.v), std::abs(s_keep.d),
-                               std::abs(s_rej.v), std::abs(s_rej.d)});
+    auto l1 = [](cplx z) { return std::abs(z.real()) + std::abs(z.imag()); };  // cheap size measure
+    const double m = std::max({l1(p.v), l1(p.d), l1(s_keep.v), l1(s_keep.d), l1(s_rej.v), l1(s_rej.d)});
     if (m > 1e100 || (m > 0.0 && m < 1e-100)) {
       const double inv = 1.0 / m;
       p = inv * p;

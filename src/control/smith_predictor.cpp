@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
 
 namespace afmkit::control {
@@ -52,6 +53,14 @@ double SmithPredictor::correction_delay() const {
 std::complex<double> SmithPredictor::model(std::complex<double> s) const {
   if (model_kind == PlantKind::Static) return 1.0 / model_rate;
   return 1.0 / (s + model_rate);
+}
+
+SmithRealisation smith_realisation(const SmithPredictor& sp) {
+  const auto* bank = std::get_if<OscillatorBank>(&sp.bank);
+  if (!bank)
+    throw InvalidParameter("bank", "bank: a state-space realisation needs a finite OscillatorBank (the N = infinity "
+                                   "bank is a neutral delay system, MATH.md B.8)");
+  return {ss(*bank), ss(sp.model_kind, sp.model_rate), sp.measurement_delay(), sp.correction_delay()};
 }
 
 }  // namespace afmkit::control

@@ -200,6 +200,7 @@ ImpactResult closed_form_impact(const ImpactProblem& problem, const ImpactOption
 
   // History: uniform grid plus the arc boundaries; at t̄ one row per branch.
   const auto times = sample_times(t, options.history_points, events);
+  r.history.reserve(times.size() + 2);
   for (std::size_t i = 0, k = 0; i < arcs.size(); ++i) {
     const Arc& a = arcs[i];
     const bool last = i + 1 == arcs.size();

@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 #include <cstdlib>
+#include <unistd.h>
+#include <sys/wait.h>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -13,12 +16,12 @@
 namespace {
 namespace fs = std::filesystem;
 
-struct Run {
+struct CliRun {
   int status;
   std::string err;
 };
 
-Run run(const std::string& args, const fs::path& dir) {
+CliRun run(const std::string& args, const fs::path& dir) {
   const fs::path err = dir / "stderr.txt";
   const std::string cmd = std::string(AFMKIT_CLI) + " control tf " + args + " > " + (dir / "stdout.txt").string() +
                           " 2> " + err.string();
@@ -46,7 +49,7 @@ class ControlTfCli : public ::testing::Test {
 
 TEST_F(ControlTfCli, SingleOscillatorCsvMatchesEq10) {
   const fs::path out = dir_ / "tf.csv";
-  const Run r = run("--controller single --a 0.5 --b 0.2 --gain 3 --points 7 --frequency-min 0.1 --frequency-max 3 "
+  const CliRun r = run("--controller single --a 0.5 --b 0.2 --gain 3 --points 7 --frequency-min 0.1 --frequency-max 3 "
                     "--output " + out.string(), dir_);
   ASSERT_EQ(r.status, 0) << r.err;
   std::ifstream in(out);
@@ -77,7 +80,7 @@ TEST_F(ControlTfCli, SingleOscillatorCsvMatchesEq10) {
 }
 
 TEST_F(ControlTfCli, JsonSummaryHasCriticalBetaAndRejection) {
-  const Run r = run("--harmonics 1 --json", dir_);
+  const CliRun r = run("--harmonics 1 --json", dir_);
   ASSERT_EQ(r.status, 0) << r.err;
   std::ifstream in(dir_ / "stdout.txt");
   const auto j = nlohmann::json::parse(in);
@@ -93,7 +96,7 @@ TEST_F(ControlTfCli, BadInputExitsWithStatus2NamingTheParameter) {
            {"--delay -0.5", "delay"},
            {"--frequency-min 0 --log-spacing true", "frequency_min"},
            {"--rejected 1,7 --harmonics 5", "rejected"}}) {
-    const Run r = run(args + " --output " + (dir_ / "x.csv").string(), dir_);
+    const CliRun r = run(args + " --output " + (dir_ / "x.csv").string(), dir_);
     EXPECT_EQ(r.status, 2) << args;
     EXPECT_NE(r.err.find(name), std::string::npos) << args << ": " << r.err;
   }

@@ -257,6 +257,34 @@ TEST(Loop, SmithPredictorRejectionClassicVsPeriodic) {
   }
 }
 
+TEST(Loop, SmithRealisationReproducesTheControllerResponse) {
+  const auto bank = general_bank();
+  for (auto st : {Structure::Classic, Structure::Periodic}) {
+    for (auto mk : {PlantKind::Static, PlantKind::FirstOrder}) {
+      const SmithPredictor sp(bank, mk, 13.0, 0.7 * kT, st);
+      const SmithRealisation r = smith_realisation(sp);
+      EXPECT_EQ(r.model.states(), mk == PlantKind::FirstOrder ? 1 : 0);
+      for (auto s : random_points(36, 10, 1.0, 4.0)) {
+        const cplx gb = r.bank(s), gm = r.model(s);
+        const cplx expected = gb * std::exp(-s * r.measurement_delay) /
+                              (1.0 + gb * gm * (1.0 - std::exp(-s * r.correction_delay)));
+        EXPECT_LT(rel_err(controller_response(sp, s), expected), 1e-11) << s;
+      }
+    }
+  }
+  EXPECT_THROW(smith_realisation(SmithPredictor(InfiniteBank(kOmega, 0.1, 0.0, 1.0), PlantKind::Static, 1.0, 0.1)),
+               InvalidParameter);
+  // delays of the two structures (smith_predictor.hpp): n = ⌈τ̂/T⌉
+  const SmithPredictor per(bank, PlantKind::Static, 1.0, 1.3 * kT), cla(bank, PlantKind::Static, 1.0, 1.3 * kT,
+                                                                       Structure::Classic);
+  EXPECT_EQ(per.model_periods(), 2);
+  EXPECT_NEAR(per.measurement_delay(), 0.7 * kT, 1e-12);
+  EXPECT_NEAR(per.correction_delay(), 2.0 * kT, 1e-12);
+  EXPECT_EQ(cla.measurement_delay(), 0.0);
+  EXPECT_NEAR(cla.correction_delay(), 1.3 * kT, 1e-15);
+  EXPECT_EQ(SmithPredictor(bank, PlantKind::Static, 1.0, 0.0).model_periods(), 0);
+}
+
 TEST(Loop, BadInputNamesTheParameter) {
   const auto bank = OscillatorBank::with_couplings(kOmega, 3, 0.1, -0.1, 20.0);
   auto expect_param = [](auto&& f, const std::string& name) {

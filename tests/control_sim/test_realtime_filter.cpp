@@ -67,6 +67,29 @@ TEST(RealtimeFilter, ModalFormEqualsDenseMatrixExponential) {
   }
 }
 
+TEST(RealtimeFilter, DefectiveControllerFallsBackToDenseForm) {
+  // N = 2, only harmonic 1 rejected: the kept loop (x0, x2, z2) has the characteristic polynomial
+  // s³ + (a0 + a2)s² + (4Ω² − 2Ω b2)s + 4Ω² a0 (eq. 18 with N = 2); a0 = 1/4, a2 = 11/4, b2 = 1/2 (Ω = 1) make it
+  // (s + 1)³: a Jordan block, no eigenvector basis. The filter must still be exactly e^{Ah}.
+  const OscillatorBank bank(1.0, 0.25, {0.3, 2.75}, {0.1, 0.5}, 5.0, {1});
+  const double fs = 50.0 / kT;
+  RealtimeFilter f(bank, fs);
+  EXPECT_FALSE(f.uses_modal_form());
+  const ZeroOrderHold zoh = zero_order_hold(bank.state_matrix(), bank.input_vector(), 1.0 / fs);
+  EXPECT_LT((f.transition_matrix() - zoh.transition).norm(), 1e-14);
+  Eigen::VectorXd z0 = Eigen::VectorXd::LinSpaced(bank.state_size(), 0.2, -0.6);
+  f.set_controller_state(z0);
+  EXPECT_NEAR(f.step(0.3), (-bank.output_vector() * z0)(0), 1e-14);
+  const Eigen::VectorXd ref = simref::integrate_linear(bank.state_matrix(), bank.input_vector() * 0.3, z0, 1.0 / fs);
+  EXPECT_LT((f.controller_state() - ref).norm(), 1e-11);
+  // save/restore and skipping work in the dense form too
+  const auto st = f.save_state();
+  const double u1 = f.step(std::nan("")), u2 = f.step(0.1);
+  f.restore_state(st);
+  EXPECT_EQ(f.step(std::nan("")), u1);
+  EXPECT_EQ(f.step(0.1), u2);
+}
+
 TEST(RealtimeFilter, ZeroOrderHoldMatchesRungeKuttaWithHeldSample) {
   const auto bank = OscillatorBank::with_couplings(kOmega, 5, 0.2, 0.05, 15.0, {1, 3});
   const double fs = 37.0 / kT, h = 1.0 / fs, m = 0.81;

@@ -60,12 +60,25 @@ TEST(Curve, RefinedSamplesReachGrazing) {
   double smallest_gap = INFINITY;
   for (std::size_t k = 0; k < curve.size(); ++k) {
     if (k > 0) {
-      EXPECT_GE(curve[k].q, curve[k - 1].q);
+      EXPECT_GT(curve[k].q, curve[k - 1].q);  // no repeated samples
     }
     if (curve[k].q < 1.0) smallest_gap = std::min(smallest_gap, 1.0 - curve[k].q);
   }
   EXPECT_NEAR(smallest_gap, 1e-9, 1e-12);
   EXPECT_EQ(curve.back().branch, HbBranch::Free);
+}
+
+TEST(Curve, RefinedSamplesBelowGrazingAreDistinct) {
+  HbCurveOptions o;
+  o.q_min = -0.5;
+  o.q_max = 0.9;  // 1 − q_max > min_gap: the log samples stop short of q_max
+  o.points = 101;
+  o.include_minus = false;
+  const auto curve = harmonic_balance_curve(model, o);
+  ASSERT_EQ(curve.size(), 101u);
+  EXPECT_DOUBLE_EQ(curve.front().q, -0.5);
+  EXPECT_DOUBLE_EQ(curve.back().q, 0.9);
+  for (std::size_t k = 1; k < curve.size(); ++k) EXPECT_GT(curve[k].q, curve[k - 1].q);
 }
 
 TEST(Curve, BadOptions) {

@@ -8,6 +8,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/tapping/observer.hpp"
 #include "afmkit/tapping/shooting.hpp"
+#include "afmkit/tapping/orbit.hpp"
 #include "afmkit/tapping/simulation.hpp"
 #include "fixtures.hpp"
 
@@ -115,6 +116,45 @@ TEST(Simulation, RejectsBadInput) {
   SimulationOptions cf;
   cf.integrator = Integrator::closed_form;
   EXPECT_THROW(simulate(dmt, 0.0, {0, 0}, 1.0, cf), InvalidParameter);
+}
+
+}  // namespace
+}  // namespace afmkit::tapping
+
+namespace afmkit::tapping {
+namespace {
+
+// The same hysteresis law given as a custom callable (no closed form: the adaptive path with the generic
+// region/branch logic) must reproduce the closed-form orbit of the piecewise-linear law.
+TEST(Simulation, CustomLawOnAdaptivePathReproducesClosedFormOrbit) {
+  const double ka = 10, kb = 8, fa = 0.3, fb = 0.6, l = 9.5;
+  impact::CustomLaw custom{[=](double d) { return d < 0 ? -(fa + ka * d) : 0.0; },
+                           [=](double d) { return d < 0 ? -(fb + kb * d) : 0.0; }, {0.0}, "custom_hysteresis"};
+  const TappingModel linear = testing::attractive_model(l);
+  const TappingModel callable(linear.cantilever, linear.drive, impact::ForceLaw(custom), l);
+  const auto exact = shoot(linear, free_response_state(linear), 1);
+  ShootingOptions o;
+  o.simulation.relative_tolerance = 1e-12;
+  o.simulation.absolute_tolerance = 1e-13;
+  const auto generic = shoot(callable, exact.initial, 1, o);
+  EXPECT_EQ(resolve_integrator(callable, Integrator::automatic), Integrator::adaptive);
+  EXPECT_NEAR(generic.initial.position, exact.initial.position, 1e-8);
+  EXPECT_NEAR(generic.initial.velocity, exact.initial.velocity, 1e-8);
+  EXPECT_NEAR(generic.floquet_max, exact.floquet_max, 1e-5);  // monodromy: slopes by one-sided differences
+}
+
+// DMT (nonlinear, adaptive integrator): a periodic tapping orbit whose energy balance closes to the
+// integrator's accuracy.
+TEST(Simulation, DmtOrbitEnergyBalance) {
+  // k = 40 N/m cantilever: forces in nN / 40 -> normalised units (nm ω_n²)
+  const impact::DmtLaw dmt(1.0, 0.8, 10.0, 6.4e-20, 1.0e-19, 0.165);
+  const TappingModel model(Cantilever(1.0, 100.0), Drive(0.2, 1.0), impact::ForceLaw(dmt).scaled(1.0 / 40.0), 15.0);
+  const TransientOutcome t = settle(model, free_response_state(model));
+  ASSERT_EQ(t.kind, ResponseKind::periodic);
+  const auto m = analyse_orbit(model, *t.orbit);
+  EXPECT_LT(m.min_gap, 0.165);  // reaches contact (gap below a0)
+  EXPECT_GT(m.contact_dissipation, 0.0);
+  EXPECT_NEAR(m.drive_work, m.energy_dissipated(), 1e-7 * m.drive_work);
 }
 
 }  // namespace

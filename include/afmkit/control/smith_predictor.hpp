@@ -31,6 +31,7 @@
 #include "afmkit/control/infinite_bank.hpp"
 #include "afmkit/control/oscillator_bank.hpp"
 #include "afmkit/control/plant.hpp"
+#include "afmkit/control/state_space.hpp"
 
 namespace afmkit::control {
 
@@ -62,5 +63,16 @@ struct SmithPredictor {
   /// P̂0(s): 1/γ̂ or 1/(s + γ̂).
   std::complex<double> model(std::complex<double> s) const;
 };
+
+/// State-space pieces of a Smith predictor around a FINITE bank (InvalidParameter("bank") for N = ∞):
+///   m̂(t) = m(t − measurement_delay) + ŷ(t) − ŷ(t − correction_delay),   ŷ = model(u),   w = bank(m̂),   u = −w,
+/// so that W/M = bank(s) e^{−sτ_m} / (1 + bank(s) model(s) (1 − e^{−sτ_c})) = controller_response (loop.hpp).
+struct SmithRealisation {
+  StateSpace bank;           // m̂ → w (= −u): ss(bank), MATH.md B.3
+  StateSpace model;          // u → ŷ: P̂0 = 1/γ̂ (static gain) or dŷ/dt = −γ̂ ŷ + u
+  double measurement_delay;  // τ_m
+  double correction_delay;   // τ_c
+};
+SmithRealisation smith_realisation(const SmithPredictor& predictor);
 
 }  // namespace afmkit::control

@@ -124,8 +124,8 @@ struct ImpactResult {
   double kinetic_energy_loss = 0;      ///< simulated: KE(t_s) − KE(t_f)
   double energy_loss_restitution = 0;  ///< (1 − e²) μ/2 ḋ(t_s)², seed-1 eq. (3)
   double energy_loss_area = 0;         ///< ∫_{d(t̄)}^{d(t_s)} (H_a − H_b) dξ by quadrature, seed-1 eq. (6)
-  double peak_force = 0;               ///< max H over the impact (repulsive peak)
-  double min_force = 0;                ///< min H over the impact (strongest attraction; 0 if none)
+  double peak_force = 0;               ///< max H over the impact (repulsive peak); integrator: over steps and events
+  double min_force = 0;                ///< min H over the impact (negative: strongest attraction)
 
   Body body1_after{};  ///< state at t_f (or at the capture instant)
   Body body2_after{};

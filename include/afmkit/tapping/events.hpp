@@ -113,10 +113,11 @@ double isolate_crossing_newton(WitnessWithRate&& g, double t_lo, double g_lo, do
         (std::abs(newton - a) < time_tolerance || std::abs(newton - b) < time_tolerance ||
          std::abs(newton - t) < time_tolerance)) {
       // the root is pinned to within the tolerance: close the bracket around it with two probes
+      // (the side the last iterate t already pins needs no probe)
       const double c = std::clamp(newton, a, b);
       const double lo = std::max(a, c - 0.4 * time_tolerance), hi = std::min(b, c + 0.4 * time_tolerance);
-      if (lo > a && sign * g(lo).first > 0.0) a = lo;
-      if (hi < b && sign * g(hi).first <= 0.0) b = hi;
+      if (lo > a && !(t == a && a >= lo - time_tolerance) && sign * g(lo).first > 0.0) a = lo;
+      if (b - a > time_tolerance && hi < b && sign * g(hi).first <= 0.0) b = hi;
       if (b - a <= time_tolerance) break;
       dx = 0.5 * (b - a);
       next = a + dx;

@@ -47,7 +47,13 @@ class LinearModeFlow {
   double mode_period() const;
   double discriminant() const { return disc_; }  // D = α² − k
   double stiffness() const { return stiffness_; }  // k
-  double drive_frequency() const { return omega_; }
+  double damping() const { return damping_; }      // c
+  double force() const { return force_; }          // f
+  double drive_amplitude() const { return gamma_; }  // Γ
+  double drive_frequency() const { return omega_; }  // ω
+  std::complex<double> harmonic() const { return z_; }  // Z
+  bool underdamped() const { return disc_ < 0; }
+  double damped_frequency() const { return disc_ < 0 ? root_ : 0.0; }  // √(−D)
   /// Bound of |dⁿx/dtⁿ| for τ ≥ 0 (underdamped modes only, else +inf): ωⁿ|Z| + ρ kⁿᐟ², ρ = homogeneous amplitude
   /// (each derivative of e^{(−α ± i√−D)τ} multiplies its modulus by √k). Used for safe guard-scan steps.
   double derivative_bound(const Eigen::Vector2d& homogeneous0, int order) const;

@@ -78,7 +78,9 @@ std::vector<HbFold> harmonic_balance_folds(const TappingModel& model);
 /// branches once over q ∈ [−1e7, 1) (a log grid in the contact angle near grazing, i.e. 1 − q down to
 /// ~1e-16; a uniform grid in the angle elsewhere; a log grid in −q for permanent contact), locates where each
 /// branch exists and every fold; afterwards each branch is monotone between consecutive scan nodes and
-/// solutions(l) only brackets and refines (TOMS 748). Use it for sweeps over many separations.
+/// solutions(l) only brackets and refines (TOMS 748). Use it for sweeps over many separations (the scan costs
+/// ~0.5 ms; each solutions(l) ~10 µs). Not found: solutions with q < −1e7 (permanent contact, l within ~1e-7 of
+/// the limit E8) and pairs of solutions closer than one scan cell near a fold (|l − l_fold| ≲ 1e-12 relative).
 class HarmonicBalance {
  public:
   explicit HarmonicBalance(const TappingModel& model);

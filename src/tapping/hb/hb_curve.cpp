@@ -28,12 +28,16 @@ void for_each_sample(const HbCurveOptions& o, Visit visit) {
   const std::size_t n_log = refined && n >= 4 ? n / 2 : 0;  // both parts need ≥ 2 samples
   const std::size_t n_uniform = n - n_log;
   const double log_ratio = refined ? std::log(gap_lo / gap_hi) : 0.0;
+  // The log samples exclude gap_hi (q_min is a uniform sample) and, when gap_lo = 1 − q_max, also gap_lo.
+  const bool include_lo = o.min_gap > 1.0 - o.q_max;
+  const double log_steps = static_cast<double>(include_lo ? n_log : n_log + 1);
   auto uniform_q = [&](std::size_t k) {
     if (k + 1 == n_uniform) return o.q_max;
     return o.q_min + (o.q_max - o.q_min) * static_cast<double>(k) / static_cast<double>(n_uniform - 1);
   };
   auto log_gap = [&](std::size_t k) {
-    return gap_hi * std::exp(log_ratio * static_cast<double>(k) / static_cast<double>(n_log - 1));
+    if (include_lo && k + 1 == n_log) return gap_lo;
+    return gap_hi * std::exp(log_ratio * static_cast<double>(k + 1) / log_steps);
   };
   // Merge both sequences by increasing q (uniform: increasing q; log: decreasing gap).
   std::size_t i = 0;

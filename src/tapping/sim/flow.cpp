@@ -82,7 +82,9 @@ double LinearModeFlow::homogeneous_bound(const Eigen::Vector2d& h0) const {
 
 double LinearModeFlow::derivative_bound(const Eigen::Vector2d& h0, int order) const {
   if (!(disc_ < 0)) return std::numeric_limits<double>::infinity();
-  return std::pow(omega_, order) * std::abs(z_) + homogeneous_bound(h0) * std::pow(stiffness_, 0.5 * order);
+  double w = 1.0, k = 1.0;
+  for (int i = 0; i < order; ++i) w *= omega_, k *= stiffness_;
+  return w * std::abs(z_) + homogeneous_bound(h0) * std::sqrt(k);
 }
 
 double LinearModeFlow::mode_period() const {

@@ -2,7 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <numbers>
+#include <optional>
+#include <utility>
+
+#include <Eigen/LU>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/tapping/observer.hpp"
@@ -64,7 +69,8 @@ namespace {
 struct Task {
   OrbitSource source;
   TipState guess;
-  bool transient;  // settle first, then the outcome's orbit
+  bool transient;                // settle first, then the outcome's orbit
+  std::optional<HbPoint> hb{};   // the HB solution the guess comes from
 };
 
 double distance(TipState a, TipState b, double omega) {
@@ -87,6 +93,68 @@ bool same_orbit(const TappingModel& model, const PeriodicOrbit& a, const Periodi
 
 }  // namespace
 
+namespace {
+
+/// Newton on the impact section (the state at the instant the gap falls through the contact edge, as
+/// (impact time, impact velocity)) from the HB prediction of that impact; returns the stroboscopic state of
+/// the period-1 contact orbit found, for polishing by shooting. Unlike the stroboscopic map this section cannot
+/// slide onto a contact-free orbit, so it finds contact orbits that graze (tiny penetration), which Newton on
+/// the stroboscopic map loses to the free orbit when the HB guess misses the sample.
+std::optional<TipState> impact_section_guess(const TappingModel& model, const HbPoint& hb, const SimulationOptions& sim) {
+  const double omega = model.drive.frequency, period = model.period();
+  const double edge = model.law.switching_gaps().empty() ? 0.0 : model.law.switching_gaps().front();
+  const double x_edge = edge - model.separation;
+  const double q = std::clamp(hb.q, -1.0, 1.0);
+  if (!(hb.q < 1.0)) return std::nullopt;
+  // x = A + B cos(ωt − φ) reaches the edge going down at ωt − φ = π − arccos q
+  double ti = (hb.phase + std::numbers::pi - std::acos(q)) / omega;
+  ti -= std::floor(ti / period) * period;
+  double vi = -hb.amplitude * omega * std::sqrt(std::max(0.0, 1.0 - q * q));
+  if (!(vi < 0)) return std::nullopt;
+  SimulationOptions o = sim;
+  o.sensitivity = false;
+  // next impact after leaving contact: (time, velocity)
+  auto next_impact = [&](double t, double v) -> std::optional<std::pair<double, double>> {
+    EventRecorder events;
+    simulate(model, t, {x_edge, v}, t + 1.6 * period, o, &events);
+    bool left = false;
+    for (const Event& e : events.events()) {
+      if (e.guard.kind != GuardKind::gap) continue;
+      if (e.guard.direction == CrossingDirection::rising) left = true;
+      if (left && e.guard.direction == CrossingDirection::falling && e.after.region == 0)
+        return std::pair<double, double>(e.time, e.state.velocity);
+    }
+    return std::nullopt;
+  };
+  const double vscale = std::max(1e-12, hb.amplitude * omega);
+  for (int it = 0; it < 30; ++it) {
+    const auto f0 = next_impact(ti, vi);
+    if (!f0) return std::nullopt;
+    const Eigen::Vector2d r((f0->first - ti - period) * omega, (f0->second - vi) / vscale);
+    if (r.norm() < 1e-10) break;
+    Eigen::Matrix2d j;
+    const double ht = 1e-7 * period, hv = 1e-7 * std::max(std::abs(vi), 1e-3 * vscale);
+    const auto ft = next_impact(ti + ht, vi);
+    const auto fv = next_impact(ti, vi + hv);
+    if (!ft || !fv) return std::nullopt;
+    j.col(0) = (Eigen::Vector2d((ft->first - ti - ht - period) * omega, (ft->second - vi) / vscale) - r) / ht;
+    j.col(1) = (Eigen::Vector2d((fv->first - ti - period) * omega, (fv->second - vi - hv) / vscale) - r) / hv;
+    const Eigen::Vector2d step = -j.fullPivLu().solve(r);
+    if (!step.allFinite()) return std::nullopt;
+    // keep the impact velocity negative (an impact) and the step moderate
+    double lambda = 1.0;
+    while (vi + lambda * step.y() >= 0 && lambda > 1e-3) lambda *= 0.5;
+    ti += lambda * step.x();
+    vi += lambda * step.y();
+    if (!(vi < 0)) return std::nullopt;
+  }
+  // stroboscopic state at the next multiple of the period
+  const double t_strobe = std::ceil(ti / period + 1e-12) * period;
+  return simulate(model, ti, {x_edge, vi}, t_strobe, o).state;
+}
+
+}  // namespace
+
 OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOptions& options) {
   options.shooting.validate();
   options.transient.validate();
@@ -101,7 +169,7 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
       const OrbitSource src = p.branch == HbBranch::Free   ? OrbitSource::hb_free
                               : p.branch == HbBranch::Plus ? OrbitSource::hb_plus
                                                            : OrbitSource::hb_minus;
-      tasks.push_back({src, guess, false});
+      tasks.push_back({src, guess, false, p});
       // HB is accurate to ~1 %: when two orbits lie closer than that, Newton from the HB guess may pick the
       // wrong one; a transient from the same guess finds the attractor of that neighbourhood.
       if (options.from_transient && src != OrbitSource::hb_free) tasks.push_back({OrbitSource::transient, guess, true});
@@ -123,6 +191,14 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
         if (outcomes[i]->orbit) found[i] = outcomes[i]->orbit;
       } else {
         found[i] = try_shoot(model, tasks[i].guess, 1, options.shooting);
+        // HB predicts contact but Newton slid onto a contact-free orbit (a grazing contact orbit missed by the
+        // guess): seed again on the impact section
+        if (tasks[i].hb && tasks[i].hb->q < 1.0 && (!found[i] || found[i]->stats.impacts == 0)) {
+          if (auto guess = impact_section_guess(model, *tasks[i].hb, options.shooting.simulation)) {
+            auto again = try_shoot(model, *guess, 1, options.shooting);
+            if (again && again->stats.impacts > 0) found[i] = again;
+          }
+        }
       }
     } catch (const NumericalFailure&) {
       found[i].reset();  // this candidate failed; others may succeed
@@ -137,9 +213,17 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
       duplicate = duplicate || same_orbit(model, f.orbit, *found[i], options.duplicate_tolerance, sim);
     if (!duplicate) out.orbits.push_back({tasks[i].source, *found[i], {}});
   }
+  std::exception_ptr error;
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
-  for (std::size_t i = 0; i < out.orbits.size(); ++i)
-    out.orbits[i].metrics = analyse_orbit(model, out.orbits[i].orbit, options.shooting.simulation);
+  for (std::size_t i = 0; i < out.orbits.size(); ++i) {
+    try {
+      out.orbits[i].metrics = analyse_orbit(model, out.orbits[i].orbit, options.shooting.simulation);
+    } catch (...) {
+#pragma omp critical(afmkit_orbit_error)
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
   std::sort(out.orbits.begin(), out.orbits.end(),
             [](const FoundOrbit& a, const FoundOrbit& b) { return a.metrics.amplitude < b.metrics.amplitude; });
   return out;

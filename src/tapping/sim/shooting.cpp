@@ -58,6 +58,10 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
   validate::finite("position", guess.position);
   validate::finite("velocity", guess.velocity);
   const auto start_time = std::chrono::steady_clock::now();
+  // the adaptive integrator's map is only as smooth as its tolerance: do not ask Newton for more
+  const double tolerance = resolve_integrator(model, options.simulation.integrator) == Integrator::adaptive
+                               ? std::max(options.tolerance, 10.0 * options.simulation.relative_tolerance)
+                               : options.tolerance;
   const double omega = model.drive.frequency;
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
@@ -70,7 +74,7 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
   Eigen::Vector2d r = Eigen::Vector2d(map.end.position, map.end.velocity) - y;
   double norm = scaled_norm(r, y, omega);
   for (int it = 0; it <= options.max_iterations; ++it) {
-    if (norm <= options.tolerance) {
+    if (norm <= tolerance) {
       PeriodicOrbit orbit;
       orbit.separation = model.separation;
       orbit.period_multiple = period_multiple;
@@ -86,9 +90,9 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
         if (period_multiple % m != 0) continue;
         const auto sub = simulate(model, 0.0, orbit.initial, m * model.period(), options.simulation);
         const Eigen::Vector2d rs = Eigen::Vector2d(sub.state.position, sub.state.velocity) - y;
-        if (scaled_norm(rs, y, omega) <= 100.0 * options.tolerance) {
+        if (scaled_norm(rs, y, omega) <= 100.0 * tolerance) {
           ShootingOptions again = options;
-          again.tolerance = std::max(options.tolerance, scaled_norm(rs, y, omega));
+          again.tolerance = std::max(tolerance, scaled_norm(rs, y, omega));
           if (auto reduced = try_shoot(model, orbit.initial, m, again)) return reduced;
         }
       }
@@ -121,7 +125,7 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
         break;
       }
     }
-    if (!accepted && norm > 1e3 * options.tolerance) return std::nullopt;
+    if (!accepted && norm > 1e3 * tolerance) return std::nullopt;
   }
   return std::nullopt;
 }

@@ -96,7 +96,12 @@ double TappingSystem::acceleration(const Mode& mode, double t, TipState s) const
   return acceleration(mode.branch, mode.region, t, s);
 }
 
-Mode TappingSystem::initial_mode(double t, TipState& s) const { return enter_region(region_of(gap(s.position)), t, s); }
+Mode TappingSystem::initial_mode(double t, TipState& s) const {
+  int region = region_of(gap(s.position));
+  // exactly on a switching gap and moving down: the motion continues in the region below
+  if (region > 0 && gap(s.position) == switching_[region - 1] && s.velocity < 0) --region;
+  return enter_region(region, t, s);
+}
 
 Mode TappingSystem::enter_region(int region, double t, TipState& s) const {
   if (s.velocity < 0) return {region, ContactBranch::approach};

@@ -92,8 +92,18 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
       } catch (const NumericalFailure&) {
         orbit.reset();
       }
-      if (!orbit || !orbit->stable) continue;
+      if (!orbit) continue;
       const double d = distance(y, orbit->initial, omega);
+      // The simulated response itself repeats after n periods to the shooting tolerance (e.g. a tip resting in
+      // the sticking mode: neutrally stable, multipliers 1 and 0): it is that orbit, whatever its multipliers.
+      if (diff[n] <= 100.0 * shooting.tolerance * scale && d <= 100.0 * shooting.tolerance * scale) {
+        out.kind = ResponseKind::periodic;
+        out.orbit = orbit;
+        out.periods_simulated = k;
+        out.final_state = y;
+        return out;
+      }
+      if (!orbit->stable) continue;
       if (d <= options.capture_distance * std::max(scale, magnitude(orbit->initial, omega))) {
         candidate = orbit;
         candidate_distance = d;

@@ -1,0 +1,21 @@
+#pragma once
+// The CSV tables of tapping results, shared by `tapping hb`, `tapping sweep` and `demo`, so that their
+// column names (which users rely on) are defined once.
+#include <vector>
+
+#include "afmkit/io/output.hpp"
+#include "afmkit/tapping/harmonic_balance.hpp"
+#include "afmkit/tapping/sweep.hpp"
+#include "afmkit/tapping/units.hpp"
+
+namespace afmkit::cli {
+
+/// Columns: q, separation, amplitude, offset, phase, branch.
+io::Table hb_table(const std::vector<tapping::HbPoint>& curve, const tapping::UnitScales& scales);
+
+/// Columns: separation, direction, amplitude, offset, phase, stable, contact_fraction, energy_dissipated,
+/// then jumped, floquet_max, peak_force, min_gap, harmonic_2..5, hb_amplitude, hb_offset, hb_phase, hb_solutions.
+io::Table sweep_table_columns();
+void add_sweep_rows(io::Table& table, const std::vector<tapping::SweepPoint>& points, const tapping::UnitScales& scales);
+
+}  // namespace afmkit::cli
