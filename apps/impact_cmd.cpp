@@ -162,7 +162,8 @@ nlohmann::json result_json(const impact::ImpactResult& r, const impact::ForceLaw
                       {"body2_after", body_json(r.body2_after)},
                       {"steps", r.steps}};
   if (r.outcome == impact::ImpactOutcome::captured) j["capture_reason"] = r.capture_reason;
-  if (const auto* lin = law.piecewise_linear(); lin && lin->approach_stiffness > 0)
+  if (const auto* lin = law.piecewise_linear();
+      lin && lin->approach_stiffness > 0 && lin->approach_adhesion == 0 && lin->departure_adhesion == 0)
     j["restitution_impulsive_limit"] = std::sqrt(lin->departure_stiffness / lin->approach_stiffness);  // ext. E0
   return j;  // NaN (undefined quantities) is written as null
 }

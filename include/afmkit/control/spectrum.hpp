@@ -63,6 +63,9 @@ struct Spectrum {
   double spectral_abscissa = 0; ///< max Re over roots (and the neutral bound for N = ∞)
   int unstable_count = 0;       ///< roots with Re s ≥ 0 in the box (−1: infinitely many, neutral chain in Re ≥ 0)
   std::optional<double> neutral_bound;      ///< ln|B4/A4|/T for the N = ∞ bank
+  /// N = ∞: roots between the neutral bound and box.real_min found by Newton from the chain asymptotics
+  /// s_m ≈ bound + i(m [+ ½])Ω (not certified; they enter the spectral abscissa)
+  std::vector<std::complex<double>> near_chain;
   std::vector<StructuralRoot> structural;   ///< MATH.md B.8 diagnosis of the neutral realisation
   std::vector<std::string> notes;
 };

@@ -80,7 +80,8 @@ std::vector<HbFold> harmonic_balance_folds(const TappingModel& model);
 /// branch exists and every fold; afterwards each branch is monotone between consecutive scan nodes and
 /// solutions(l) only brackets and refines (TOMS 748). Use it for sweeps over many separations (the scan costs
 /// ~0.5 ms; each solutions(l) ~10 µs). Not found: solutions with q < −1e7 (permanent contact, l within ~1e-7 of
-/// the limit E8) and pairs of solutions closer than one scan cell near a fold (|l − l_fold| ≲ 1e-12 relative).
+/// the limit E8) and the two extra solutions on a wiggle of l(q) whose two folds fall into one scan cell
+/// (cells: 4 % of a for a < 0.3, Δa = 0.005 above, 6 % of |q| for q < −1).
 class HarmonicBalance {
  public:
   explicit HarmonicBalance(const TappingModel& model);

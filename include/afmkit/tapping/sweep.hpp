@@ -40,7 +40,9 @@ struct SweepPoint {
   SweepDirection direction = SweepDirection::approach;
   PeriodicOrbit orbit;
   OrbitMetrics metrics;
-  bool jumped = false;  // reached through a transient (the previous branch ended or Newton failed there)
+  /// The response left the branch followed so far: the orbit was reached by a transient and does not continue
+  /// the previous orbit (Newton from it at the previous separation does not return there).
+  bool jumped = false;
   bool periodic = true;  // false: the transient did not settle (metrics then describe one period of it)
   double arclength = 0.0;  // pseudo-arclength (continuation only)
   // Nearest harmonic-balance solution at the same l (NaN when none / not applicable).
@@ -53,7 +55,7 @@ struct SweepPoint {
 struct SweepResult {
   std::vector<SweepPoint> approach;  // l decreasing from l_max to l_min
   std::vector<SweepPoint> retract;   // l increasing from l_min to l_max
-  /// Separations where the response jumped (first point reached through a transient), per direction.
+  /// Separations where the response jumped (first point on the new branch), per direction.
   std::vector<double> approach_jumps;
   std::vector<double> retract_jumps;
 };

@@ -40,8 +40,9 @@ struct Winding {
 };
 
 /// Winding number of f along the positively oriented boundary of `box`. f(s) returns Eval (value, derivative).
-/// Steps are accepted when the phase increment is ≤ 0.5 rad and agrees with the trapezoidal prediction
-/// Im ∫ f'/f ds to 0.1 rad; otherwise halved. `scale` is the frequency scale (Ω) for the minimal step.
+/// Steps are accepted when the phase increment is ≤ 0.5 rad, agrees with the trapezoidal prediction
+/// Im ∫ f'/f ds to 0.1 rad, and the step is at most half the Newton distance |f/f'| at both ends (so that no
+/// zero can hide next to the step); otherwise halved. `scale` is the frequency scale (Ω) for the minimal step.
 template <class F>
 Winding winding(F&& f, const Box& box, double scale) {
   const cplx corners[4] = {{box.real_min, box.imag_min},
@@ -66,8 +67,11 @@ Winding winding(F&& f, const Box& box, double scale) {
       ++w.evaluations;
       if (!(std::isfinite(nxt.v.real()) && std::isfinite(nxt.v.imag())) || nxt.v == 0.0) return w;
       const double dphi = std::arg(nxt.v / cur.v);
-      const double pred = 0.5 * std::imag((cur.d / cur.v + nxt.d / nxt.v) * ds);
-      if (std::abs(dphi) > 0.5 || std::abs(dphi - pred) > 0.1 || !std::isfinite(pred)) {
+      const cplx lc = cur.d / cur.v, ln = nxt.d / nxt.v;  // logarithmic derivatives
+      const double pred = 0.5 * std::imag((lc + ln) * ds);
+      // a step longer than half the Newton distance |f/f'| at either end could pass next to a zero unseen
+      const double reach = 0.5 / std::max(std::abs(lc), std::abs(ln));
+      if (std::abs(dphi) > 0.5 || std::abs(dphi - pred) > 0.1 || !std::isfinite(pred) || std::abs(ds) > reach) {
         h *= 0.5;
         if (h * length < min_step) return w;  // zero on the boundary
         continue;

@@ -224,7 +224,21 @@ Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
   double abscissa = -INFINITY;
   for (const auto& r : out.roots) abscissa = std::max(abscissa, r.value.real());
   if (out.roots.empty() && !cand.empty()) abscissa = cand.front().real();
-  if (out.neutral_bound) abscissa = std::max(abscissa, bound);
+  if (out.neutral_bound) {
+    abscissa = std::max(abscissa, bound);
+    if (std::isfinite(bound)) {
+      // roots between the chain bound and the box: Newton from the chain asymptotics (B4/A4 < 0: half-integers)
+      const double half = std::abs(v.infinite->alpha) > omega / std::numbers::pi ? 0.5 : 0.0;
+      for (int m = 0; m <= 64; ++m) {
+        const auto r = spectra_detail::newton(loop, cplx(bound + 1e-3 * omega, (m + half) * omega), o.tolerance, 40);
+        if (!r.converged || r.root.real() <= bound || r.root.real() >= out.box.real_min) continue;
+        const cplx s = r.root.imag() < 0 ? std::conj(r.root) : r.root;
+        if (spectra_detail::add_unique(out.near_chain, s, 1e-8 * std::max(omega, std::abs(s))))
+          abscissa = std::max(abscissa, s.real());
+      }
+      std::sort(out.near_chain.begin(), out.near_chain.end(), [](cplx a, cplx b) { return a.real() > b.real(); });
+    }
+  }
   out.spectral_abscissa = abscissa;
   if (bound >= 0.0) {
     out.unstable_count = -1;

@@ -113,7 +113,23 @@ SweepPoint continue_point(const TappingModel& model, const SweepPoint& previous,
   }
   // Newton failed, found an unstable orbit or moved far: do what the instrument does — the tip keeps moving
   // from where it was and settles on whatever attracts it.
-  return from_transient(model, previous.orbit.initial, direction, options);
+  SweepPoint p = from_transient(model, previous.orbit.initial, direction, options);
+  if (p.periodic && previous.periodic) {
+    // Not a jump if the new orbit continues the previous branch: Newton from it at the previous separation
+    // returns to the previous orbit (a long step on a steep branch, not the end of the branch).
+    std::optional<PeriodicOrbit> back;
+    try {
+      back = try_shoot(model.with_separation(previous.separation), p.orbit.initial, p.orbit.period_multiple,
+                       options.shooting);
+    } catch (const NumericalFailure&) {
+      back.reset();
+    }
+    const double scale = std::max(1e-9, magnitude(previous.orbit.initial, omega));
+    if (back && back->period_multiple == previous.orbit.period_multiple &&
+        distance(back->initial, previous.orbit.initial, omega) <= 1e-6 * scale)
+      p.jumped = false;
+  }
+  return p;
 }
 
 std::vector<SweepPoint> run_direction(const TappingModel& base, const std::vector<double>& ls, SweepPoint first,

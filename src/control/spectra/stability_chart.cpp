@@ -1,0 +1,205 @@
+// Spectral-abscissa chart with warm-started root tracking and certified region labels (stability_chart.hpp).
+#include "afmkit/control/stability_chart.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <queue>
+
+#include <omp.h>
+
+#include "afmkit/control/delay_margin.hpp"
+#include "afmkit/control/spectrum.hpp"
+#include "afmkit/core/validate.hpp"
+#include "tracking.hpp"
+
+namespace afmkit::control {
+
+using spectra_detail::RootTracker;
+using spectra_detail::TrackedSpectrum;
+
+namespace {
+std::vector<double> linspace(double a, double b, int n) {
+  std::vector<double> v(n);
+  for (int i = 0; i < n; ++i) v[i] = n == 1 ? a : a + (b - a) * i / (n - 1);
+  return v;
+}
+
+void check_spec(const ChartSpec& s) {
+  validate::finite("x_min", s.x_min);
+  validate::finite("x_max", s.x_max);
+  validate::finite("y_min", s.y_min);
+  validate::finite("y_max", s.y_max);
+  validate::require(s.x_max > s.x_min, "x_max", s.x_max, "> x_min");
+  validate::require(s.y_max > s.y_min, "y_max", s.y_max, "> y_min");
+  validate::in_range("x_points", static_cast<long>(s.x_points), 2L, 100000L);
+  validate::in_range("y_points", static_cast<long>(s.y_points), 2L, 100000L);
+  validate::in_range("threads", static_cast<long>(s.threads), 0L, 1024L);
+  validate::in_range("tracked_roots", static_cast<long>(s.tracked_roots), 1L, 1000L);
+  validate::in_range("seed_interval", static_cast<long>(s.seed_interval), 1L, 1000000L);
+}
+
+// Runs body(i) for i in [0, n) on `threads` OpenMP threads; rethrows the first exception.
+template <class F>
+void parallel_for(long n, int threads, F&& body) {
+  std::exception_ptr error;
+  std::mutex m;
+  const int nt = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+  for (long i = 0; i < n; ++i) {
+    try {
+      body(i);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(m);
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+}
+
+// Connected components of equal tracked counts; each labelled by a certified count at its most interior point.
+void label_regions(const ChartSpec& spec, StabilityChart& c, const std::vector<int>& tracked) {
+  const int nx = spec.x_points, ny = spec.y_points;
+  c.region.assign(static_cast<std::size_t>(nx) * ny, -1);
+  const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+  int next = 0;
+  std::vector<int> dist(c.region.size(), -1);
+  for (int start = 0; start < nx * ny; ++start) {
+    if (c.region[start] >= 0) continue;
+    const int id = next++;
+    std::vector<int> members{start};
+    c.region[start] = id;
+    for (std::size_t q = 0; q < members.size(); ++q) {
+      const int p = members[q], px = p % nx, py = p / nx;
+      for (int k = 0; k < 4; ++k) {
+        const int qx = px + dx[k], qy = py + dy[k];
+        if (qx < 0 || qy < 0 || qx >= nx || qy >= ny) continue;
+        const int n = qy * nx + qx;
+        if (c.region[n] < 0 && tracked[n] == tracked[start]) {
+          c.region[n] = id;
+          members.push_back(n);
+        }
+      }
+    }
+    // distance transform inside the component (BFS from its border)
+    std::queue<int> bfs;
+    for (int p : members) {
+      const int px = p % nx, py = p / nx;
+      bool border = false;
+      for (int k = 0; k < 4; ++k) {
+        const int qx = px + dx[k], qy = py + dy[k];
+        if (qx < 0 || qy < 0 || qx >= nx || qy >= ny || c.region[qy * nx + qx] != id) border = true;
+      }
+      dist[p] = border ? 0 : -1;
+      if (border) bfs.push(p);
+    }
+    int best = members.front();
+    while (!bfs.empty()) {
+      const int p = bfs.front();
+      bfs.pop();
+      if (dist[p] > dist[best]) best = p;
+      const int px = p % nx, py = p / nx;
+      for (int k = 0; k < 4; ++k) {
+        const int qx = px + dx[k], qy = py + dy[k];
+        if (qx < 0 || qy < 0 || qx >= nx || qy >= ny) continue;
+        const int n = qy * nx + qx;
+        if (c.region[n] == id && dist[n] < 0) {
+          dist[n] = dist[p] + 1;
+          bfs.push(n);
+        }
+      }
+    }
+    ChartRegion r;
+    r.id = id;
+    r.tracked_roots = tracked[start];
+    r.unstable_roots = tracked[start];
+    r.points = static_cast<long>(members.size());
+    r.x = c.x[best % nx];
+    r.y = c.y[best / nx];
+    c.regions.push_back(r);
+  }
+  if (spec.certify_regions) {
+    parallel_for(static_cast<long>(c.regions.size()), spec.threads, [&](long i) {
+      ChartRegion& r = c.regions[i];
+      if (r.tracked_roots < 0) {  // neutral chain in Re s ≥ 0: proven by the formula of the bound
+        r.certified = true;
+        return;
+      }
+      const UnstableCount u = unstable_roots(spec.family.at(r.x, r.y));
+      r.unstable_roots = u.count;
+      r.certified = !u.marginal;
+    });
+  }
+  c.unstable_roots.assign(c.region.size(), 0);
+  for (std::size_t p = 0; p < c.region.size(); ++p) {
+    const ChartRegion& r = c.regions[c.region[p]];
+    c.unstable_roots[p] = r.unstable_roots;
+    if (r.unstable_roots != tracked[p]) ++c.mismatched_points;
+  }
+}
+}  // namespace
+
+StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(long, long)>& progress) {
+  check_spec(spec);
+  const int nx = spec.x_points, ny = spec.y_points;
+  StabilityChart c;
+  c.x = linspace(spec.x_min, spec.x_max, nx);
+  c.y = linspace(spec.y_min, spec.y_max, ny);
+  c.abscissa.assign(static_cast<std::size_t>(nx) * ny, 0.0);
+  std::vector<int> tracked(c.abscissa.size(), 0);
+  const RootTracker tracker(spec.tracked_roots);
+  const long total = static_cast<long>(nx) * ny;
+
+  // column 0, marching in y (fresh initialisation every 16 rows merged in)
+  std::vector<TrackedSpectrum> row_start(ny);
+  TrackedSpectrum cur = tracker.initial(spec.family.at(c.x[0], c.y[0]));
+  for (int j = 0; j < ny; ++j) {
+    const LoopSpec loop = spec.family.at(c.x[0], c.y[j]);
+    cur = tracker.update(loop, cur, true);
+    if (j % 16 == 15) cur = tracker.merge(cur, tracker.initial(loop));
+    row_start[j] = cur;
+  }
+  // rows in parallel, warm starts along x
+  parallel_for(ny, spec.threads, [&](long j) {
+    TrackedSpectrum s = row_start[j];
+    for (int i = 0; i < nx; ++i) {
+      if (i > 0) s = tracker.update(spec.family.at(c.x[i], c.y[j]), s, i % spec.seed_interval == 0);
+      const std::size_t p = static_cast<std::size_t>(j) * nx + i;
+      c.abscissa[p] = s.abscissa();
+      tracked[p] = s.unstable();
+    }
+    if (progress) progress(static_cast<long>(nx), total);
+  });
+  label_regions(spec, c, tracked);
+  if (spec.boundaries) c.boundaries = stability_boundaries(spec.family, spec.x_min, spec.x_max, spec.y_min, spec.y_max);
+  return c;
+}
+
+MarginMap delay_margin_map(const LoopFamily& family, double x_min, double x_max, int x_points, double y_min,
+                           double y_max, int y_points, int threads, const std::function<void(long, long)>& progress) {
+  validate::finite("x_min", x_min);
+  validate::finite("x_max", x_max);
+  validate::finite("y_min", y_min);
+  validate::finite("y_max", y_max);
+  validate::require(x_max > x_min, "x_max", x_max, "> x_min");
+  validate::require(y_max > y_min, "y_max", y_max, "> y_min");
+  validate::in_range("x_points", static_cast<long>(x_points), 2L, 100000L);
+  validate::in_range("y_points", static_cast<long>(y_points), 2L, 100000L);
+  MarginMap m;
+  m.x = linspace(x_min, x_max, x_points);
+  m.y = linspace(y_min, y_max, y_points);
+  const std::size_t n = static_cast<std::size_t>(x_points) * y_points;
+  m.critical_delay.assign(n, 0.0);
+  m.crossing_frequency.assign(n, 0.0);
+  parallel_for(static_cast<long>(n), threads, [&](long p) {
+    const int i = static_cast<int>(p % x_points), j = static_cast<int>(p / x_points);
+    const DelayMargin dm = delay_margin(family.at(m.x[i], m.y[j]));
+    m.critical_delay[p] = dm.stable_at_reference ? dm.upper : std::numeric_limits<double>::quiet_NaN();
+    m.crossing_frequency[p] = dm.upper_frequency;
+    if (progress) progress(1, static_cast<long>(n));
+  });
+  return m;
+}
+
+}  // namespace afmkit::control
