@@ -91,6 +91,14 @@ void run_simulate(const io::ParamSet& p) {
   if (c.controller == "smith")
     throw InvalidParameter("controller", "controller = smith is not simulated in the time domain: must be single, "
                                          "bank or infinite");
+  if (c.controller == "infinite" && p.text("method") != "ab3")
+    throw InvalidParameter("method", fmt::format("method = {} is not available for controller = infinite: must be ab3 "
+                                                 "(the neutral realisation, eqs. 32-33, is stepped by AB3)",
+                                                 p.text("method")));
+  if (p.real("delay_variation") > p.real("delay"))
+    throw InvalidParameter("delay_variation",
+                           fmt::format("delay_variation = {} is out of range: must be <= delay = {} (units of T; the "
+                                       "delay must stay >= 0)", p.real("delay_variation"), p.real("delay")));
   const control::Controller any = control_controller_from(c);
   control::Bank bank = std::holds_alternative<control::InfiniteBank>(any)
                            ? control::Bank(std::get<control::InfiniteBank>(any))

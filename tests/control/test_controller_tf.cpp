@@ -159,7 +159,9 @@ TEST(ControllerTf, InfiniteForms29And31AgreeAndAreTheLimitOfCN) {
     for (auto s : pts) d = std::max(d, std::abs(couplings_tf(kOmega, n, alpha, beta, k, s) - infinite_tf(inf, s)));
     EXPECT_LT(d, prev);
     prev = d;
-    if (n >= 200) EXPECT_NEAR(n * d, 1.14, 0.05) << n;
+    if (n >= 200) {
+      EXPECT_NEAR(n * d, 1.14, 0.05) << n;
+    }
   }
 }
 

@@ -187,7 +187,9 @@ TEST(Loop, NewtonStepSurvivesOverflow) {
     return d + std::exp(-s * tau) * h1;
   };
   for (cplx s : {cplx(5.0, 1000.0), cplx(-3.0, 730.5), cplx(200.0, 10.0)}) {
-    if (std::abs(s) > 500.0) EXPECT_FALSE(std::isfinite(std::abs(characteristic(loop, s))));
+    if (std::abs(s) > 500.0) {
+      EXPECT_FALSE(std::isfinite(std::abs(characteristic(loop, s))));
+    }
     cplx qlog = 1.0 / s;
     for (int k = 1; k <= n; ++k) qlog += 2.0 * s / (s * s + double(k * k) * kOmega * kOmega);
     const double h = 1e-3;
@@ -204,10 +206,15 @@ TEST(Loop, SensitivityVanishesAtRejectedAndIsOneAtKeptHarmonics) {
     for (int k = 1; k <= 6; ++k) {
       const cplx s(0.0, k * kOmega);
       const cplx sens = sensitivity(loop, s);
-      if (k == 1 || k == 3) EXPECT_EQ(std::abs(sens), 0.0) << k;
-      else EXPECT_LT(std::abs(sens - 1.0), 1e-15) << k;
+      if (k == 1 || k == 3) {
+        EXPECT_EQ(std::abs(sens), 0.0) << k;
+      } else {
+        EXPECT_LT(std::abs(sens - 1.0), 1e-15) << k;
+      }
       const cplx expected_dist = kind == PlantKind::Static ? 1.0 : 20.0 / (s + 20.0);  // uncontrolled response
-      if (k != 1 && k != 3) EXPECT_LT(std::abs(disturbance_response(loop, s) - expected_dist), 1e-15);
+      if (k != 1 && k != 3) {
+        EXPECT_LT(std::abs(disturbance_response(loop, s) - expected_dist), 1e-15);
+      }
     }
     EXPECT_LT(std::abs(sensitivity(loop, 0.0) - 1.0), 1e-15);  // x0 holds the offset
   }
@@ -226,9 +233,11 @@ TEST(Loop, SmithPredictorWithExactModelRemovesTheDelay) {
   for (auto st : {Structure::Classic, Structure::Periodic}) {
     for (double tau : {0.3 * kT, 0.9 * kT, 2.4 * kT}) {
       const LoopSpec loop(SmithPredictor(bank, PlantKind::FirstOrder, 20.0, tau, st), PlantKind::FirstOrder, 20.0, tau);
-      for (const auto& z : delay_free)
-        if (std::exp(-z.real() * tau) < 1e4)  // far-left poles: the cancelling predictor terms are ~e^{−Re(s)τ}
+      for (const auto& z : delay_free) {
+        if (std::exp(-z.real() * tau) < 1e4) {  // far-left poles: the cancelling predictor terms are ~e^{−Re(s)τ}
           EXPECT_LT(std::abs(newton_step(loop, z)), 1e-9 * (1.0 + std::abs(z))) << tau << " " << z;
+        }
+      }
       EXPECT_LT(std::abs(characteristic(loop, -20.0)), 1e-12);  // the model's own (stable) mode s = −γ̂
     }
   }

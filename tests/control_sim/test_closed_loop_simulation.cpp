@@ -171,6 +171,29 @@ TEST(ClosedLoopSimulation, GrowthRateEqualsRightmostRootAboveCriticalDelay) {
   }
 }
 
+TEST(ClosedLoopSimulation, FirstOrderPlantGrowthRateMatchesRootWithDenseAb3Output) {
+  // Plant (1), one oscillator (a, b) = (0.5, 0)Ω, K = γ, τ = 0.25T: closed-loop poles solve
+  // (s² + Ω²)(s + γ) + K e^{−sτ}(a s − bΩ) = 0 (Newton). AB3 feeds the plant its dense output (u cubic in t), so
+  // the growth rate is right already at 500 steps per period; with u held (zoh) it is off by O(h).
+  const double a = 0.5 * kOmega, tau = 0.25 * kT;
+  std::complex<double> s(0.1, 1.2);
+  for (int it = 0; it < 60; ++it) {
+    const std::complex<double> e = std::exp(-s * tau);
+    const std::complex<double> g = (s * s + kOmega * kOmega) * (s + kGamma) + kGamma * e * a * s;
+    const std::complex<double> dg =
+        2.0 * s * (s + kGamma) + (s * s + kOmega * kOmega) + kGamma * e * (a - tau * a * s);
+    s -= g / dg;
+  }
+  ASSERT_GT(s.real(), 0.05);
+  const Plant plant(PlantKind::FirstOrder, kGamma, kOmega, tau, Disturbance(0.0, {{1, 1.0, 0.0}}));
+  const auto bank = OscillatorBank::single(kOmega, a, 0.0, kGamma);
+  const double ab3 = simulate_closed_loop(plant, bank, opts(100, 500)).report.growth_rate;
+  EXPECT_NEAR(ab3, s.real(), 3e-3 * s.real());
+  const double z1 = simulate_closed_loop(plant, bank, opts(100, 1000, ControllerStepping::ZeroOrderHold)).report.growth_rate;
+  const double z2 = simulate_closed_loop(plant, bank, opts(100, 2000, ControllerStepping::ZeroOrderHold)).report.growth_rate;
+  EXPECT_NEAR((z1 - s.real()) / (z2 - s.real()), 2.0, 0.3);  // first order in h (sampling delay h/2 + h/2)
+}
+
 TEST(ClosedLoopSimulation, DelayBeyondPeriodIsFlaggedNotRejected) {
   const Plant plant(PlantKind::Static, kGamma, kOmega, 1.02 * kT, Disturbance::paper_example());
   const auto r = simulate_closed_loop(plant, OscillatorBank::with_couplings(kOmega, 10, 0.02, 0.0, kGamma),

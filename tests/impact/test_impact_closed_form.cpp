@@ -166,7 +166,9 @@ TEST(ImpactClosedForm, HistoryIsConsistent) {
   int rows_at_minimum = 0;
   for (std::size_t i = 0; i < r.history.size(); ++i) {
     const auto& s = r.history[i];
-    if (i) EXPECT_GE(s.time, r.history[i - 1].time);
+    if (i) {
+      EXPECT_GE(s.time, r.history[i - 1].time);
+    }
     EXPECT_NEAR(s.gap, s.position2 - s.position1, 1e-14);
     EXPECT_NEAR(s.gap_rate, s.velocity2 - s.velocity1, 1e-13);
     EXPECT_GE(s.gap, r.minimum_gap - 1e-15);

@@ -263,6 +263,16 @@ ClosedLoopSimulation::ClosedLoopSimulation(Plant plant, Bank controller, Simulat
   validate::in_range("periods", static_cast<long>(o.periods), 1L, 100000000L);
   validate::in_range("steps_per_period", static_cast<long>(o.steps_per_period), 8L, 100000000L);
   validate::in_range("record_every", static_cast<long>(o.record_every), 0L, 1000000000L);
+  if (o.record_every > 0) {
+    const double rows = static_cast<double>(o.periods) * o.steps_per_period / o.record_every;
+    if (rows > 5e7)
+      throw InvalidParameter("record_every",
+                             fmt::format("record_every = {} is out of range: the run would record {:.3g} rows of the time "
+                                         "series; must be >= {} (at most 5e7 rows) or 0 (no time series)",
+                                         o.record_every, rows,
+                                         static_cast<long>(std::ceil(static_cast<double>(o.periods) *
+                                                                     o.steps_per_period / 5e7))));
+  }
   const bool infinite = std::holds_alternative<InfiniteBank>(controller_);
   int highest = max_disturbance_order(plant_.disturbance);
   if (!infinite) highest = std::max(highest, std::get<OscillatorBank>(controller_).harmonics());

@@ -71,8 +71,9 @@ class Objective {
       for (double tau : taus_) {
         if (tau > 0.0) {
           s = advance(x, y, rhos_[j], s, prev, tau);
-          // finite banks: merge a fresh collocation spectrum at every grid delay
-          if (!spec_.family.neutral()) s = tracker_.merge(s, tracker_.initial(spec_.family.at(x, y, tau, rhos_[j])));
+          // finite banks: merge a fresh collocation spectrum at the largest delay (chain roots from −∞)
+          if (!spec_.family.neutral() && tau == taus_.back())
+            s = tracker_.merge(s, tracker_.initial(spec_.family.at(x, y, tau, rhos_[j])));
         }
         prev = tau;
         const double decay = -s.abscissa();
@@ -87,6 +88,12 @@ class Objective {
   }
   const std::vector<double>& taus() const { return taus_; }
 
+  // number of roots of `a` within 0.5 Ω of the abscissa of `ref` (the ones that matter for J)
+  static std::size_t relevant(const TrackedSpectrum& a, const TrackedSpectrum& ref) {
+    const double cut = ref.abscissa() - 0.5 * ref.omega;
+    return static_cast<std::size_t>(std::count_if(a.roots.begin(), a.roots.end(), [cut](auto r) { return r.real() >= cut; }));
+  }
+
   // τ continuation from t0 to t1 in sub-steps; a step that loses tracked roots (two Newton runs converging to the
   // same root) is halved, down to T/2000.
   TrackedSpectrum advance(double x, double y, double rho, TrackedSpectrum s, double t0, double t1) const {
@@ -95,7 +102,7 @@ class Objective {
     while (t < t1) {
       const double tn = std::min(t1, t + h);
       TrackedSpectrum next = tracker_.update(spec_.family.at(x, y, tn, rho), s, tn == t1);
-      if (next.roots.size() < s.roots.size() && h > period / 2000.0) {
+      if (relevant(next, s) < relevant(s, s) && h > period / 2000.0) {
         h *= 0.5;
         continue;
       }

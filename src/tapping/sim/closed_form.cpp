@@ -77,9 +77,16 @@ class FlowSampler {
   void advance(int steps = 1) {
     k_ += steps;
     if (flow_->underdamped()) {
-      for (int i = 0; i < steps; ++i) {
-        u_ *= du_;
-        w_ *= dw_;
+      if (k_ - synced_ >= 64) {  // re-synchronise the rotations now and then (rounding drift)
+        const double tau = k_ * h_;
+        u_ = std::polar(1.0, flow_->drive_frequency() * (t0_ + tau));
+        w_ = std::exp(lambda_ * tau);
+        synced_ = k_;
+      } else {
+        for (int i = 0; i < steps; ++i) {
+          u_ *= du_;
+          w_ *= dw_;
+        }
       }
     }
     evaluate();
@@ -104,7 +111,7 @@ class FlowSampler {
   const LinearModeFlow* flow_;
   double t0_, h_;
   Eigen::Vector2d h0_;
-  long k_ = 0;
+  long k_ = 0, synced_ = 0;
   double t_ = 0;
   TipState s_;
   double a_ = 0;

@@ -45,23 +45,24 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
   sim.sensitivity = false;
 
   TransientOutcome out;
-  std::vector<TipState> strobe;  // stroboscopic points y_k = x(kT)
-  strobe.reserve(options.max_periods + 1);
-  strobe.push_back(start);
-  TipState y = start;
   const int nmax = options.max_period_multiple;
+  std::deque<TipState> strobe{start};  // the last nmax + 1 stroboscopic points y_k = x(kT)
+  int k = 0;                           // periods simulated
+  TipState y = start;
   // The drive is T-periodic: every period restarts at t = 0, which keeps the drive phase exact.
   auto advance = [&](int periods) {
-    for (int k = 0; k < periods; ++k) {
+    for (int i = 0; i < periods; ++i) {
       y = simulate(model, 0.0, y, period, sim).state;
       strobe.push_back(y);
+      if (static_cast<int>(strobe.size()) > nmax + 1) strobe.pop_front();
+      ++k;
     }
   };
   std::optional<PeriodicOrbit> candidate;
   double candidate_distance = 0.0;
-  while (static_cast<int>(strobe.size()) - 1 < options.max_periods) {
+  while (k < options.max_periods) {
     advance(options.chunk_periods);
-    const int k = static_cast<int>(strobe.size()) - 1;
+    const int last = static_cast<int>(strobe.size()) - 1;
     const double scale = std::max(1e-9, magnitude(y, omega));
     if (candidate) {
       // verify the capture: the distance to the candidate orbit point of the same phase keeps decreasing
@@ -83,8 +84,8 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
     }
     // stroboscopic differences over n periods suggest which period to look for
     std::vector<double> diff(nmax + 1, 1e300);
-    for (int n = 1; n <= nmax && n <= k; ++n) diff[n] = distance(strobe[k], strobe[k - n], omega);
-    for (int n = 1; n <= nmax && n <= k; ++n) {
+    for (int n = 1; n <= nmax && n <= last; ++n) diff[n] = distance(strobe[last], strobe[last - n], omega);
+    for (int n = 1; n <= nmax && n <= last; ++n) {
       if (n > 1 && !(diff[n] < 0.5 * diff[1])) continue;
       std::optional<PeriodicOrbit> orbit;
       try {
@@ -112,7 +113,7 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
     }
   }
   out.kind = ResponseKind::not_settled;
-  out.periods_simulated = static_cast<int>(strobe.size()) - 1;
+  out.periods_simulated = k;
   out.final_state = y;
   out.message = fmt::format("no stable periodic orbit of period <= {} captured the response within {} drive periods "
                             "(non-periodic, longer period, or slower transient)",
