@@ -15,6 +15,7 @@
 #include "afmkit/tapping/hb_approximations.hpp"
 #include "commands.hpp"
 #include "tapping_params.hpp"
+#include "tapping_tables.hpp"
 
 namespace afmkit::cli {
 
@@ -47,10 +48,7 @@ void run_hb(const io::ParamSet& p) {
   options.include_minus = p.flag("minus_branch");
   const std::vector<tapping::HbPoint> curve = tapping::harmonic_balance_curve(model, options);
 
-  io::Table table({"q", "separation", "amplitude", "offset", "phase", "branch"});
-  for (const tapping::HbPoint& pt : curve)
-    table.add_row({pt.q, pt.separation * scales.length, pt.amplitude * scales.length, pt.offset * scales.length,
-                   pt.phase, std::string(tapping::branch_name(pt.branch))});
+  const io::Table table = hb_table(curve, scales);
 
   const tapping::HarmonicBalance hb(model);
   nlohmann::json folds = nlohmann::json::array();

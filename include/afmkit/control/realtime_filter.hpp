@@ -103,19 +103,18 @@ class RealtimeFilter {
   enum class Kind { Modal, Dense, Block };
   struct Discretisation {
     Kind kind = Kind::Modal;
-    int pairs = 0, reals = 0;
-    // modal form: per pair j (q1, q2): q1' = c q1 + s q2 + g1 m, q2' = −s q1 + c q2 + g2 m; u = Σ w1 q1 + w2 q2
-    std::vector<double> c, s, g1, g2, w1, w2, e1, e2;
-    // per real mode: q' = r q + gr m; u = Σ wr q
-    std::vector<double> r, gr, wr, er;
-    // dense fallback (row-major Φ), Γ, output row, error row (c_e)
-    std::vector<double> phi, gamma, out, err;
-    // block form, internal order (x0, x1..xN, z1..zN): rotation cos/sin of kΩh, input (gx, gz) per oscillator,
-    // g0 = a0 h, kept (1/0) and output weight (−K for rejected, else 0) per oscillator
-    std::vector<double> rc, rs, gx, gz, kept, wout;
-    double g0 = 0.0;
-    int n = 0;                  // 2N+1
-    Eigen::MatrixXd basis;      // V: z = V q (identity for dense)
+    int n = 0;       // 2N+1
+    int offset = 0;  // first index of the 2×2 blocks in the internal state (block form: 1, after x0)
+    int pairs = 0;   // number of 2×2 blocks: modal pairs σ ± iω, or oscillators (block form)
+    int reals = 0;   // modal real eigenvalues (stored after the pairs)
+    // 2×2 blocks, interleaved two doubles per block: q ← c ⊙ q + s ⊙ swap(q) + g·input
+    std::vector<double> c, s, g;
+    std::vector<double> w, e;   // modal: u = w·q, coasting input m = e·q (pairs, then reals)
+    std::vector<double> r, gr;  // modal real modes: q ← r q + gr m
+    double g0 = 0.0;            // block form: x0 ← x0 + g0·e
+    std::vector<double> kw;     // block form, per oscillator: (1 if kept, −K if rejected), interleaved
+    std::vector<double> phi, gamma, out, err;  // dense fallback: row-major Φ, Γ, output row, c_e
+    Eigen::MatrixXd basis;      // V: physical z = V q
     Eigen::MatrixXd basis_inv;  // V⁻¹
     std::uint64_t fingerprint = 0;
   };
@@ -128,8 +127,7 @@ class RealtimeFilter {
   double sample_rate_;
   SampledForm form_;
   Discretisation disc_;
-  std::vector<double> q_, q_tmp_;  // internal coordinates: modal (q1 of all pairs, q2 of all pairs, reals),
-                                   // physical (dense) or (x0, x1..xN, z1..zN) (block)
+  std::vector<double> q_, q_tmp_;  // internal coordinates: modal ((q1, q2) per pair, then reals) or physical
   double held_ = 0.0;
   std::uint64_t skipped_ = 0, samples_ = 0;
 };

@@ -58,6 +58,8 @@ class TappingSystem {
   double witness(const Guard& guard, const Mode& mode, double t, TipState s) const;
   /// Time derivative of the witness along the mode's flow (detects double crossings inside a scan step).
   double witness_rate(const Guard& guard, const Mode& mode, double t, TipState s) const;
+  /// Second time derivative of the witness along the mode's flow (Newton on the witness rate).
+  double witness_rate_derivative(const Guard& guard, const Mode& mode, double t, TipState s) const;
   /// Gradient of the witness with respect to (x, ẋ, l) and its explicit time derivative (saltation matrices).
   void witness_gradient(const Guard& guard, const Mode& mode, double t, TipState s, double grad[3],
                         double& time_partial) const;

@@ -9,6 +9,7 @@
 #include "afmkit/control/discretisation.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
+#include "pair_kernels.hpp"
 
 namespace afmkit::control {
 
@@ -67,27 +68,22 @@ RealtimeFilter::Discretisation RealtimeFilter::discretise(const OscillatorBank& 
     Discretisation d;
     d.kind = Kind::Block;
     d.n = n;
+    d.offset = 1;  // internal state = physical (x0, x1, z1, …, xN, zN)
+    d.pairs = nosc;
     d.g0 = bank.a0() * h;
     for (int k = 1; k <= nosc; ++k) {
-      // e^{J_k h} = rotation by θ = kΩh; ∫₀ʰ e^{J_k s} ds (a_k, b_k)ᵀ = [[sin θ, cos θ − 1], [1 − cos θ, sin θ]] (a, b)ᵀ/(kΩ)
+      // e^{J_k h} = rotation by θ = kΩh: x' = cos θ x − sin θ z, z' = sin θ x + cos θ z;
+      // ∫₀ʰ e^{J_k s} ds (a_k, b_k)ᵀ = [[sin θ, cos θ − 1], [1 − cos θ, sin θ]] (a_k, b_k)ᵀ / (kΩ)
       const double w = k * bank.rotation_frequency(), th = w * h;
       const double c = std::cos(th), sn = std::sin(th);
       const double one_minus_c = 2.0 * std::sin(0.5 * th) * std::sin(0.5 * th);  // 1 − cos θ without cancellation
-      d.rc.push_back(c);
-      d.rs.push_back(sn);
-      d.gx.push_back((sn * bank.a(k) - one_minus_c * bank.b(k)) / w);
-      d.gz.push_back((one_minus_c * bank.a(k) + sn * bank.b(k)) / w);
-      d.kept.push_back(bank.is_rejected(k) ? 0.0 : 1.0);
-      d.wout.push_back(bank.is_rejected(k) ? -bank.gain() : 0.0);
+      d.c.insert(d.c.end(), {c, c});
+      d.s.insert(d.s.end(), {-sn, sn});
+      d.g.insert(d.g.end(), {(sn * bank.a(k) - one_minus_c * bank.b(k)) / w, (one_minus_c * bank.a(k) + sn * bank.b(k)) / w});
+      d.kw.insert(d.kw.end(), {bank.is_rejected(k) ? 0.0 : 1.0, bank.is_rejected(k) ? -bank.gain() : 0.0});
     }
-    // internal order (x0, x1..xN, z1..zN) → physical (x0, x1, z1, …): z = P q
-    d.basis = Eigen::MatrixXd::Zero(n, n);
-    d.basis(0, 0) = 1.0;
-    for (int k = 1; k <= nosc; ++k) {
-      d.basis(2 * k - 1, k) = 1.0;
-      d.basis(2 * k, nosc + k) = 1.0;
-    }
-    d.basis_inv = d.basis.transpose();
+    d.basis = Eigen::MatrixXd::Identity(n, n);
+    d.basis_inv = d.basis;
     d.fingerprint = fingerprint(bank, fs, static_cast<int>(d.kind));
     return d;
   }
@@ -123,8 +119,8 @@ RealtimeFilter::Discretisation RealtimeFilter::discretise(const OscillatorBank& 
   Eigen::MatrixXd v(n, n), blocks = Eigen::MatrixXd::Zero(n, n);
   if (ok) {
     for (int j = 0; j < pairs; ++j) {
-      v.col(j) = pair_vec[j].real();
-      v.col(pairs + j) = pair_vec[j].imag();
+      v.col(2 * j) = pair_vec[j].real();
+      v.col(2 * j + 1) = pair_vec[j].imag();
     }
     for (int j = 0; j < reals; ++j) v.col(2 * pairs + j) = real_vec[j].real();
     // (Eigen's eigenvectors have unit complex norm; the two columns of a pair must share one scale, so no
@@ -142,30 +138,27 @@ RealtimeFilter::Discretisation RealtimeFilter::discretise(const OscillatorBank& 
     const Eigen::RowVectorXd w = out * v, e = err * v;
     d.pairs = pairs;
     d.reals = reals;
+    d.w.assign(w.data(), w.data() + n);
+    d.e.assign(e.data(), e.data() + n);
     for (int j = 0; j < pairs; ++j) {
-      // block [[σ, ω], [−ω, σ]] in (q1, q2) ⇔ c = q1 + i q2 obeys ċ = μ c + (β1 + iβ2) m, μ = σ − iω
+      // block [[σ, ω], [−ω, σ]] in (q1, q2) ⇔ c = q1 + i q2 obeys ċ = μ c + (β1 + iβ2) m, μ = σ − iω;
+      // e^{μh} = P − iS ⇒ q1' = P q1 + S q2, q2' = P q2 − S q1
       const std::complex<double> mu = std::conj(pair_lambda[j]);
       const std::complex<double> e_mu = std::exp(mu * h);
-      const std::complex<double> g = h * phi_function(1, mu * h) * std::complex<double>(beta(j), beta(pairs + j));
-      d.c.push_back(e_mu.real());
-      d.s.push_back(-e_mu.imag());
-      d.g1.push_back(g.real());
-      d.g2.push_back(g.imag());
-      d.w1.push_back(w(j));
-      d.w2.push_back(w(pairs + j));
-      d.e1.push_back(e(j));
-      d.e2.push_back(e(pairs + j));
-      blocks(j, j) = blocks(pairs + j, pairs + j) = e_mu.real();
-      blocks(j, pairs + j) = -e_mu.imag();
-      blocks(pairs + j, j) = e_mu.imag();
+      const std::complex<double> g = h * phi_function(1, mu * h) * std::complex<double>(beta(2 * j), beta(2 * j + 1));
+      const double pp = e_mu.real(), ss = -e_mu.imag();
+      d.c.insert(d.c.end(), {pp, pp});
+      d.s.insert(d.s.end(), {ss, -ss});
+      d.g.insert(d.g.end(), {g.real(), g.imag()});
+      blocks(2 * j, 2 * j) = blocks(2 * j + 1, 2 * j + 1) = pp;
+      blocks(2 * j, 2 * j + 1) = ss;
+      blocks(2 * j + 1, 2 * j) = -ss;
     }
     for (int j = 0; j < reals; ++j) {
       const double lam = real_lambda[j].real();
       const int i = 2 * pairs + j;
       d.r.push_back(std::exp(lam * h));
       d.gr.push_back(h * phi_function(1, lam * h) * beta(i));
-      d.wr.push_back(w(i));
-      d.er.push_back(e(i));
       blocks(i, i) = d.r.back();
     }
     // The modal form must reproduce the dense matrix exponential.
@@ -201,96 +194,56 @@ RealtimeFilter RealtimeFilter::with_couplings(double fs, double omega, int n, do
 }
 
 double RealtimeFilter::advance(double m) noexcept {
-  double u0 = 0.0, u1 = 0.0;
-  if (disc_.kind == Kind::Block) {
-    const int nosc = static_cast<int>(disc_.rc.size());
-    double* __restrict x = q_.data() + 1;
-    double* __restrict z = x + nosc;
-    const double* __restrict kept = disc_.kept.data();
-    const double* __restrict wout = disc_.wout.data();
-    double e0 = m - q_[0], e1 = 0.0;
-    for (int k = 0; k < nosc; ++k) {
-      u0 += wout[k] * x[k];
-      e1 += kept[k] * x[k];
+  const Discretisation& d = disc_;
+  double* q = q_.data();
+  if (d.kind == Kind::Modal) {
+    const int p = d.pairs, np = 2 * p;
+    // output from the old state, damped rotation of every modal pair, then the real modes
+    double u = detail::rotate_pairs_dot(q, d.c.data(), d.s.data(), d.g.data(), d.w.data(), m, p);
+    for (int j = 0; j < d.reals; ++j) {
+      const double x = q[np + j];
+      u += d.w[np + j] * x;
+      q[np + j] = d.r[j] * x + d.gr[j] * m;
     }
-    const double e = e0 - e1;
-    q_[0] += disc_.g0 * e;
-    const double* __restrict c = disc_.rc.data();
-    const double* __restrict s = disc_.rs.data();
-    const double* __restrict gx = disc_.gx.data();
-    const double* __restrict gz = disc_.gz.data();
-    for (int k = 0; k < nosc; ++k) {
-      const double a = x[k], b = z[k];
-      x[k] = c[k] * a - s[k] * b + gx[k] * e;
-      z[k] = s[k] * a + c[k] * b + gz[k] * e;
-    }
-    return u0;
+    return u;
   }
-  if (disc_.kind == Kind::Modal) {
-    const int p = disc_.pairs;
-    double* __restrict q1 = q_.data();
-    double* __restrict q2 = q1 + p;
-    double* __restrict qr = q2 + p;
-    const double* __restrict c = disc_.c.data();
-    const double* __restrict s = disc_.s.data();
-    const double* __restrict g1 = disc_.g1.data();
-    const double* __restrict g2 = disc_.g2.data();
-    const double* __restrict w1 = disc_.w1.data();
-    const double* __restrict w2 = disc_.w2.data();
-    // output from the old state: a reduction, kept apart so that the update loop vectorises; four partial sums
-    // shorten the dependency chain
-    double u2 = 0.0, u3 = 0.0;
-    int j = 0;
-    for (; j + 1 < p; j += 2) {
-      u0 += w1[j] * q1[j];
-      u1 += w2[j] * q2[j];
-      u2 += w1[j + 1] * q1[j + 1];
-      u3 += w2[j + 1] * q2[j + 1];
-    }
-    if (j < p) {
-      u0 += w1[j] * q1[j];
-      u1 += w2[j] * q2[j];
-    }
-    u0 += u2;
-    u1 += u3;
-    for (int j = 0; j < p; ++j) {  // damped rotation of each modal pair + input
-      const double a = q1[j], b = q2[j];
-      q1[j] = c[j] * a + s[j] * b + g1[j] * m;
-      q2[j] = c[j] * b - s[j] * a + g2[j] * m;
-    }
-    for (int j = 0; j < disc_.reals; ++j) {
-      u0 += disc_.wr[j] * qr[j];
-      qr[j] = disc_.r[j] * qr[j] + disc_.gr[j] * m;
-    }
-    return u0 + u1;
+  if (d.kind == Kind::Block) {
+    double kept_sum, u;
+    detail::accumulate_first(d.kw.data(), q + 1, d.pairs, kept_sum, u);  // Σ_kept x_k, −K Σ_rej x_k
+    const double e = m - q[0] - kept_sum;                               // e_n, held over the step
+    q[0] += d.g0 * e;
+    detail::rotate_pairs(q + 1, d.c.data(), d.s.data(), d.g.data(), e, d.pairs);
+    return u;
   }
-  const int n = disc_.n;
-  const double* z = q_.data();
+  const int n = d.n;
   double* zn = q_tmp_.data();
-  for (int j = 0; j < n; ++j) u0 += disc_.out[j] * z[j];
+  double u = 0.0;
+  for (int j = 0; j < n; ++j) u += d.out[j] * q[j];
   for (int i = 0; i < n; ++i) {
-    const double* row = disc_.phi.data() + static_cast<std::size_t>(i) * n;
-    double acc = disc_.gamma[i] * m;
-    for (int j = 0; j < n; ++j) acc += row[j] * z[j];
+    const double* row = d.phi.data() + static_cast<std::size_t>(i) * n;
+    double acc = d.gamma[i] * m;
+    for (int j = 0; j < n; ++j) acc += row[j] * q[j];
     zn[i] = acc;
   }
   q_.swap(q_tmp_);  // vectors of equal size: swaps pointers only, no allocation
-  return u0;
+  return u;
 }
 
 double RealtimeFilter::coast_input() const noexcept {
-  double m = 0.0;
-  if (disc_.kind == Kind::Block) {
-    const int nosc = static_cast<int>(disc_.rc.size());
-    m = q_[0];
-    for (int k = 0; k < nosc; ++k) m += disc_.kept[k] * q_[1 + k];
-  } else if (disc_.kind == Kind::Modal) {
-    const int p = disc_.pairs;
-    for (int j = 0; j < p; ++j) m += disc_.e1[j] * q_[j] + disc_.e2[j] * q_[p + j];
-    for (int j = 0; j < disc_.reals; ++j) m += disc_.er[j] * q_[2 * p + j];
-  } else {
-    for (int j = 0; j < disc_.n; ++j) m += disc_.err[j] * q_[j];
+  const Discretisation& d = disc_;
+  const double* q = q_.data();
+  if (d.kind == Kind::Modal) {
+    double m = detail::dot_pairs(d.e.data(), q, d.pairs);
+    for (int j = 0; j < d.reals; ++j) m += d.e[2 * d.pairs + j] * q[2 * d.pairs + j];
+    return m;
   }
+  if (d.kind == Kind::Block) {
+    double kept_sum, u;
+    detail::accumulate_first(d.kw.data(), q + 1, d.pairs, kept_sum, u);
+    return q[0] + kept_sum;
+  }
+  double m = 0.0;
+  for (int j = 0; j < d.n; ++j) m += d.err[j] * q[j];
   return m;
 }
 
@@ -422,74 +375,51 @@ void RealtimeFilter::restore_state(std::span<const double> in) {
 }
 
 Eigen::MatrixXd RealtimeFilter::transition_matrix() const {
-  if (disc_.kind == Kind::Block) {  // Φ = R − G c_eᵀ in the physical coordinates
-    const Eigen::Index n = disc_.n;
-    Eigen::MatrixXd r = Eigen::MatrixXd::Identity(n, n);
-    Eigen::VectorXd g = input_vector();
-    Eigen::RowVectorXd ce = Eigen::RowVectorXd::Zero(n);
-    ce(0) = 1.0;
-    for (std::size_t k = 0; k < disc_.rc.size(); ++k) {
-      const auto i = static_cast<Eigen::Index>(2 * k + 1);
-      r(i, i) = r(i + 1, i + 1) = disc_.rc[k];
-      r(i, i + 1) = -disc_.rs[k];
-      r(i + 1, i) = disc_.rs[k];
-      ce(i) = disc_.kept[k];
-    }
-    return r - g * ce;
-  }
-  if (disc_.kind == Kind::Dense) {
-    Eigen::MatrixXd phi(disc_.n, disc_.n);
-    for (int i = 0; i < disc_.n; ++i)
-      for (int j = 0; j < disc_.n; ++j) phi(i, j) = disc_.phi[static_cast<std::size_t>(i) * disc_.n + j];
+  const Discretisation& d = disc_;
+  if (d.kind == Kind::Dense) {
+    Eigen::MatrixXd phi(d.n, d.n);
+    for (int i = 0; i < d.n; ++i)
+      for (int j = 0; j < d.n; ++j) phi(i, j) = d.phi[static_cast<std::size_t>(i) * d.n + j];
     return phi;
   }
-  const int p = disc_.pairs;
-  Eigen::MatrixXd blocks = Eigen::MatrixXd::Zero(disc_.n, disc_.n);
-  for (int j = 0; j < p; ++j) {
-    blocks(j, j) = blocks(p + j, p + j) = disc_.c[j];
-    blocks(j, p + j) = disc_.s[j];
-    blocks(p + j, j) = -disc_.s[j];
+  // internal transition: 2×2 blocks (c, s) from `offset`, real modes after them (modal) or x0 (block)
+  Eigen::MatrixXd t = Eigen::MatrixXd::Identity(d.n, d.n);
+  for (int j = 0; j < d.pairs; ++j) {
+    const int i = d.offset + 2 * j;
+    t(i, i) = d.c[2 * j];
+    t(i, i + 1) = d.s[2 * j];
+    t(i + 1, i + 1) = d.c[2 * j + 1];
+    t(i + 1, i) = d.s[2 * j + 1];
   }
-  for (int j = 0; j < disc_.reals; ++j) blocks(2 * p + j, 2 * p + j) = disc_.r[j];
-  return disc_.basis * blocks * disc_.basis_inv;
+  for (int j = 0; j < d.reals; ++j) t(2 * d.pairs + j, 2 * d.pairs + j) = d.r[j];
+  if (d.kind == Kind::Block) {  // the held error e = m − c_eᵀ z couples every state: Φ = R − Γ c_eᵀ
+    Eigen::RowVectorXd ce = Eigen::RowVectorXd::Zero(d.n);
+    ce(0) = 1.0;
+    for (int j = 0; j < d.pairs; ++j) ce(1 + 2 * j) = d.kw[2 * j];
+    return t - input_vector() * ce;
+  }
+  return d.basis * t * d.basis_inv;
 }
 
 Eigen::VectorXd RealtimeFilter::input_vector() const {
-  if (disc_.kind == Kind::Block) {
-    Eigen::VectorXd g(disc_.n);
-    g(0) = disc_.g0;
-    for (std::size_t k = 0; k < disc_.rc.size(); ++k) {
-      g(static_cast<Eigen::Index>(2 * k + 1)) = disc_.gx[k];
-      g(static_cast<Eigen::Index>(2 * k + 2)) = disc_.gz[k];
-    }
-    return g;
-  }
-  if (disc_.kind == Kind::Dense) return Eigen::Map<const Eigen::VectorXd>(disc_.gamma.data(), disc_.n);
-  Eigen::VectorXd g(disc_.n);
-  const int p = disc_.pairs;
-  for (int j = 0; j < p; ++j) {
-    g(j) = disc_.g1[j];
-    g(p + j) = disc_.g2[j];
-  }
-  for (int j = 0; j < disc_.reals; ++j) g(2 * p + j) = disc_.gr[j];
-  return disc_.basis * g;
+  const Discretisation& d = disc_;
+  if (d.kind == Kind::Dense) return Eigen::Map<const Eigen::VectorXd>(d.gamma.data(), d.n);
+  Eigen::VectorXd g(d.n);
+  if (d.kind == Kind::Block) g(0) = d.g0;
+  for (int j = 0; j < 2 * d.pairs; ++j) g(d.offset + j) = d.g[j];
+  for (int j = 0; j < d.reals; ++j) g(2 * d.pairs + j) = d.gr[j];
+  return d.basis * g;
 }
 
 Eigen::RowVectorXd RealtimeFilter::output_vector() const {
-  if (disc_.kind == Kind::Block) {
-    Eigen::RowVectorXd w = Eigen::RowVectorXd::Zero(disc_.n);
-    for (std::size_t k = 0; k < disc_.rc.size(); ++k) w(static_cast<Eigen::Index>(2 * k + 1)) = disc_.wout[k];
+  const Discretisation& d = disc_;
+  if (d.kind == Kind::Dense) return Eigen::Map<const Eigen::RowVectorXd>(d.out.data(), d.n);
+  if (d.kind == Kind::Block) {
+    Eigen::RowVectorXd w = Eigen::RowVectorXd::Zero(d.n);
+    for (int j = 0; j < d.pairs; ++j) w(1 + 2 * j) = d.kw[2 * j + 1];
     return w;
   }
-  if (disc_.kind == Kind::Dense) return Eigen::Map<const Eigen::RowVectorXd>(disc_.out.data(), disc_.n);
-  Eigen::RowVectorXd w(disc_.n);
-  const int p = disc_.pairs;
-  for (int j = 0; j < p; ++j) {
-    w(j) = disc_.w1[j];
-    w(p + j) = disc_.w2[j];
-  }
-  for (int j = 0; j < disc_.reals; ++j) w(2 * p + j) = disc_.wr[j];
-  return w * disc_.basis_inv;
+  return Eigen::Map<const Eigen::RowVectorXd>(d.w.data(), d.n) * d.basis_inv;
 }
 
 }  // namespace afmkit::control

@@ -64,9 +64,13 @@ std::optional<Crossing> first_crossing(const TappingSystem& sys, const Mode& mod
       const bool pre_b = falling ? b.value[i] > 0 : b.value[i] < 0;
       const bool towards = falling ? (a.rate[i] < 0 && b.rate[i] > 0) : (a.rate[i] > 0 && b.rate[i] < 0);
       if (pre_a && pre_b && towards) {
-        auto rate = [&](double t) { return sys.witness_rate(g, mode, t, state(t)); };
-        const double tm = isolate_crossing(rate, ta, tb, falling ? CrossingDirection::rising : CrossingDirection::falling,
-                                           time_tolerance(tb));
+        auto rate = [&](double t) {
+          const TipState s = state(t);
+          return std::pair<double, double>(sys.witness_rate(g, mode, t, s), sys.witness_rate_derivative(g, mode, t, s));
+        };
+        const double tm = isolate_crossing_newton(rate, ta, a.rate[i], tb, b.rate[i],
+                                                  falling ? CrossingDirection::rising : CrossingDirection::falling,
+                                                  time_tolerance(tb));
         const double gm = witness(tm);
         if (crosses(a.value[i], gm, g.direction)) {
           found = true;

@@ -194,6 +194,21 @@ double TappingSystem::witness_rate(const Guard& guard, const Mode& mode, double 
   return 0.0;
 }
 
+double TappingSystem::witness_rate_derivative(const Guard& guard, const Mode& mode, double t, TipState s) const {
+  switch (guard.kind) {
+    case GuardKind::gap: return acceleration(mode, t, s);
+    case GuardKind::velocity: {
+      if (mode.branch == ContactBranch::sticking) return 0.0;
+      // jerk: d/dt (Γ cos ωt − cẋ − ω_n² x − h(x)) = −Γω sin ωt − c ẍ − (ω_n² + h'(x)) ẋ
+      const double a = acceleration(mode, t, s);
+      return drive_rate(t) - damping_ * a - (stiffness_ + interaction_slope(mode.branch, s.position, mode.region)) * s.velocity;
+    }
+    case GuardKind::release_departure:
+    case GuardKind::release_approach: return -omega_ * omega_ * drive(t);
+  }
+  return 0.0;
+}
+
 void TappingSystem::witness_gradient(const Guard& guard, const Mode& mode, double t, TipState s, double grad[3],
                                      double& time_partial) const {
   time_partial = 0.0;
