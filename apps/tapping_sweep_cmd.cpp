@@ -18,22 +18,11 @@
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
+#include "tapping_tables.hpp"
 
 namespace afmkit::cli {
 
 namespace {
-
-void add_rows(io::Table& table, const std::vector<tapping::SweepPoint>& points, const TappingScales& s) {
-  for (const tapping::SweepPoint& pt : points) {
-    const auto& m = pt.metrics;
-    table.add_row({pt.separation * s.length, std::string(tapping::direction_name(pt.direction)),
-                   m.amplitude * s.length, m.offset * s.length, m.phase, pt.orbit.stable, m.contact_fraction,
-                   m.energy_dissipated() * s.energy, m.peak_force * s.force, m.min_gap * s.length,
-                   pt.orbit.floquet_max, static_cast<long>(pt.orbit.period_multiple), pt.periodic, pt.jumped,
-                   pt.arclength, m.harmonics[0] * s.length, m.harmonics[1] * s.length, pt.hb_amplitude * s.length,
-                   pt.hb_offset * s.length, pt.hb_phase, static_cast<long>(pt.hb_solutions)});
-  }
-}
 
 nlohmann::json scaled(const std::vector<double>& v, double f) {
   nlohmann::json j = nlohmann::json::array();
@@ -55,10 +44,7 @@ void run_sweep(const io::ParamSet& p) {
   const bool continuation = mode == "continuation" || mode == "both";
   const bool quiet = p.flag("json") || p.flag("quiet");
 
-  io::Table table({"separation", "direction", "amplitude", "offset", "phase", "stable", "contact_fraction",
-                   "energy_dissipated", "peak_force", "min_gap", "floquet_max", "period_multiple", "periodic",
-                   "jumped", "arclength", "harmonic_2", "harmonic_3", "hb_amplitude", "hb_offset", "hb_phase",
-                   "hb_solutions"});
+  io::Table table = sweep_table_columns();
   nlohmann::json results = nlohmann::json::object();
   if (instrument) {
     io::Progress progress("tapping sweep (approach + retract)", 2L * points, !quiet);
@@ -68,8 +54,8 @@ void run_sweep(const io::ParamSet& p) {
     options.progress = [&progress](long n) { progress.advance(n); };
     const tapping::SweepResult r = tapping::sweep_instrument(base, l_min, l_max, points, options);
     progress.finish();
-    add_rows(table, r.approach, scales);
-    add_rows(table, r.retract, scales);
+    add_sweep_rows(table, r.approach, scales);
+    add_sweep_rows(table, r.retract, scales);
     results["approach_jumps"] = scaled(r.approach_jumps, scales.length);
     results["retract_jumps"] = scaled(r.retract_jumps, scales.length);
   }
@@ -80,7 +66,7 @@ void run_sweep(const io::ParamSet& p) {
     options.initial_step = std::min(options.initial_step, options.max_step);
     options.max_points = static_cast<int>(p.integer("max_continuation_points"));
     const tapping::ContinuationResult c = tapping::sweep_continuation(base, l_min, l_max, options);
-    add_rows(table, c.points, scales);
+    add_sweep_rows(table, c.points, scales);
     results["folds"] = scaled(c.folds, scales.length);
     results["grazing"] = scaled(c.grazing, scales.length);
     results["continuation_stop"] = c.stop_reason;

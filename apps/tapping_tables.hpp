@@ -14,7 +14,8 @@ namespace afmkit::cli {
 io::Table hb_table(const std::vector<tapping::HbPoint>& curve, const tapping::UnitScales& scales);
 
 /// Columns: separation, direction, amplitude, offset, phase, stable, contact_fraction, energy_dissipated,
-/// then jumped, floquet_max, peak_force, min_gap, harmonic_2..5, hb_amplitude, hb_offset, hb_phase, hb_solutions.
+/// then peak_force, min_gap, floquet_max, period_multiple, periodic, jumped, arclength, harmonic_2, harmonic_3,
+/// hb_amplitude, hb_offset, hb_phase, hb_solutions.
 io::Table sweep_table_columns();
 void add_sweep_rows(io::Table& table, const std::vector<tapping::SweepPoint>& points, const tapping::UnitScales& scales);
 

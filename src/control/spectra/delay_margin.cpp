@@ -132,6 +132,8 @@ std::vector<DelayCrossing> delay_crossings(const LoopSpec& loop, const MarginOpt
 DelayMargin delay_margin(const LoopSpec& loop, const MarginOptions& o) {
   const double period = loop.period();
   const bool smith = std::holds_alternative<SmithPredictor>(loop.controller);
+  validate::in_range("grid_points_per_omega", static_cast<long>(o.grid_points_per_omega), 4L, 100000L);
+  if (!std::isnan(o.max_frequency)) validate::positive("max_frequency", o.max_frequency);
   DelayMargin m;
   m.reference_delay = std::isnan(o.reference_delay)
                           ? (smith ? std::get<SmithPredictor>(loop.controller).model_delay : 0.0)
