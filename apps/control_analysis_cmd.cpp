@@ -29,7 +29,6 @@ namespace afmkit::cli {
 
 namespace {
 using io::Range;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf")); }
 
@@ -103,6 +102,8 @@ void run_roots(const io::ParamSet& p) {
     res["roots"] = nlohmann::json::array();
     for (const auto& r : sp.roots)
       res["roots"].push_back({{"real", r.value.real() / w}, {"imag", r.value.imag() / w}, {"multiplicity", r.multiplicity}});
+    res["near_chain"] = nlohmann::json::array();
+    for (const auto& s : sp.near_chain) res["near_chain"].push_back({{"real", s.real() / w}, {"imag", s.imag() / w}});
     fmt::print("{}\n", res.dump(2));
     return;
   }
@@ -291,6 +292,7 @@ void run_chart(const io::ParamSet& p) {
                        {"points", r.points}, {"x", r.x / w}, {"y", r.y / w}, {"certified", r.certified}});
   res["regions"] = regions;
   res["mismatched_points"] = chart.mismatched_points;
+  res["recomputed_points"] = chart.recomputed_points;
   const std::string bout = p.text("boundaries_output");
   res["boundaries_file"] = bout;
   res["columns"] = {{"x", std::string(family.x_name()) + " / Omega"}, {"y", std::string(family.y_name()) + " / Omega"},

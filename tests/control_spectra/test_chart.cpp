@@ -172,6 +172,28 @@ TEST(StabilityChart, MarginMapMatchesDelayMargin) {
     }
 }
 
+TEST(LoopFamily, RoundTripsEveryControllerKind) {
+  const double tau = 0.17 * kT;
+  const std::vector<LoopSpec> loops{
+      LoopSpec(OscillatorBank::single(kOmega, 0.3, -0.2, 15.0), PlantKind::Static, kGamma, tau),
+      LoopSpec(OscillatorBank::with_couplings(kOmega, 6, 0.2, -0.1, 15.0, {1, 2}), PlantKind::FirstOrder, kGamma, tau),
+      LoopSpec(InfiniteBank(kOmega, 0.2, -0.1, 15.0), PlantKind::Static, kGamma, tau),
+      LoopSpec(SmithPredictor(OscillatorBank::with_couplings(kOmega, 4, 0.2, -0.1, 15.0), PlantKind::Static, 18.0, 0.2 * kT),
+               PlantKind::Static, kGamma, tau)};
+  const double xy[][2] = {{0.3, -0.2}, {0.2, -0.1}, {0.2, -0.1}, {0.2, -0.1}};
+  for (std::size_t i = 0; i < loops.size(); ++i) {
+    const LoopFamily f = LoopFamily::from_loop(loops[i]);
+    const LoopSpec back = f.at(xy[i][0], xy[i][1]);
+    for (std::complex<double> s : {std::complex<double>(0.1, 0.7), std::complex<double>(-0.3, 2.2)})
+      EXPECT_LT(std::abs(characteristic(back, s) - characteristic(loops[i], s)), 1e-13 * std::abs(characteristic(loops[i], s)))
+          << f.describe();
+    // ρ = K/γ changes the plant rate only
+    const LoopSpec half = f.at(xy[i][0], xy[i][1], tau, 0.5);
+    EXPECT_DOUBLE_EQ(half.gain_ratio(), 0.5);
+    EXPECT_DOUBLE_EQ(half.gain(), loops[i].gain());
+  }
+}
+
 TEST(StabilityChart, BadInput) {
   ChartSpec s = fig2(10, 0.1);
   s.x_points = 1;

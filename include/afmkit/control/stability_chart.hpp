@@ -36,6 +36,7 @@ struct ChartSpec {
   int threads = 0;           ///< OpenMP threads (0: default)
   int tracked_roots = 16;    ///< roots tracked per grid point
   int seed_interval = 8;     ///< add the asymptotic seeds every this many grid points (1 = always)
+  long max_recomputed_points = 2000;  ///< mismatched points recomputed with certified spectra (if not more)
 };
 
 struct ChartRegion {
@@ -55,6 +56,7 @@ struct StabilityChart {
   std::vector<ChartRegion> regions;
   std::vector<BoundaryCurve> boundaries;
   long mismatched_points = 0;         ///< tracked count ≠ certified region count
+  long recomputed_points = 0;         ///< of those, abscissa recomputed with rightmost_roots()
   double at(int ix, int iy) const { return abscissa[static_cast<std::size_t>(iy) * x.size() + ix]; }
 };
 

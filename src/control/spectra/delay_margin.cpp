@@ -10,8 +10,10 @@
 #include <fmt/format.h>
 
 #include "afmkit/control/spectrum.hpp"
+#include "afmkit/control/stability_tau0.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
+#include "fast_characteristic.hpp"
 #include "spectra_detail.hpp"
 
 namespace afmkit::control {
@@ -34,38 +36,36 @@ bool is_single_oscillator(const LoopSpec& loop) {
   return b && b->harmonics() == 1 && b->a0() == 0.0 && loop.plant_kind == PlantKind::Static;
 }
 
-// Δ(iν; τ) = X + Y e^{−iντ}: X and Y from Δ at τ = 0 and at one of two auxiliary delays.
+// Δ(iν; τ)/Q(iν) = X + Y e^{−iντ} (fast_characteristic.hpp); G = (|X|² − |Y|²)/(|X|² + |Y|²) ∈ [−1, 1]
+// (the normaliser Q cancels; G stays bounded next to the oscillator poles).
 class CrossingFunction {
  public:
-  CrossingFunction(const LoopSpec& loop, double nu_max)
-      : l0_(loop.with_delay(0.0)),
-        l1_(loop.with_delay(0.5 * std::numbers::pi / nu_max)),
-        l2_(loop.with_delay(10.0 * loop.period())),
-        tau1_(0.5 * std::numbers::pi / nu_max),
-        tau2_(10.0 * loop.period()) {}
-
-  void xy(double nu, cplx& x, cplx& y) const {
-    const cplx s(0.0, nu);
-    const ScaledCharacteristic e0 = characteristic_scaled(l0_, s);
-    const cplx a = 1.0 - std::exp(cplx(0.0, -nu * tau1_)), b = 1.0 - std::exp(cplx(0.0, -nu * tau2_));
-    const bool first = std::abs(a) >= std::abs(b);
-    const ScaledCharacteristic ej = characteristic_scaled(first ? l1_ : l2_, s);
-    const cplx dj = ej.value * std::exp(ej.log_scale - e0.log_scale);
-    y = (e0.value - dj) / (first ? a : b);
-    x = e0.value - y;
-  }
-  // (|X|² − |Y|²)/(|X|² + |Y|²)
+  explicit CrossingFunction(const LoopSpec& loop) : f_(loop) {}
+  void xy(double nu, cplx& x, cplx& y) const { f_.crossing_parts(nu, x, y); }
   double g(double nu) const {
     cplx x, y;
-    xy(nu, x, y);
+    f_.crossing_parts(nu, x, y);
     const double ax = std::norm(x), ay = std::norm(y);
     return (ax - ay) / (ax + ay);
   }
 
  private:
-  LoopSpec l0_, l1_, l2_;
-  double tau1_, tau2_;
+  spectra_detail::FastCharacteristic f_;
 };
+
+// Unstable roots at the reference delay: closed-loop eigenvalues for a plain finite bank at τ = 0 (polynomial
+// case), the argument principle otherwise.
+UnstableCount reference_count(const LoopSpec& loop) {
+  const bool finite_plain = std::holds_alternative<OscillatorBank>(loop.controller);
+  if (!(finite_plain && loop.delay == 0.0)) return unstable_roots(loop);
+  UnstableCount u;
+  const double omega = loop.rotation_frequency();
+  for (const auto& e : undelayed_poles(loop)) {
+    if (std::abs(e.real()) <= 1e-11 * (omega + std::abs(e))) u.marginal = true;
+    else if (e.real() > 0.0) ++u.count;
+  }
+  return u;
+}
 }  // namespace
 
 std::vector<DelayCrossing> single_oscillator_crossings(double a, double b, double kappa, double omega) {
@@ -101,13 +101,13 @@ std::vector<DelayCrossing> delay_crossings(const LoopSpec& loop, const MarginOpt
     const auto v = spectra_detail::view(loop);
     nu_max = rb.proven ? rb.imag_max : ((v.bank ? v.bank->harmonics() : 1) + 20) * omega;
   }
-  const CrossingFunction f(loop, nu_max);
+  const CrossingFunction f(loop);
   const double h = omega / o.grid_points_per_omega;
   const long steps = static_cast<long>(std::ceil(nu_max / h));
   std::vector<DelayCrossing> out;
   double nu_prev = 1e-6 * omega, g_prev = f.g(nu_prev);
   for (long k = 1; k <= steps; ++k) {
-    const double nu = std::min(k * h, nu_max);
+    const double nu = std::min((k + 0.0137) * h, nu_max);  // offset: never exactly on an oscillator pole kΩ
     const double g = f.g(nu);
     double root = std::numeric_limits<double>::quiet_NaN();
     if (g == 0.0) {
@@ -140,7 +140,7 @@ DelayMargin delay_margin(const LoopSpec& loop, const MarginOptions& o) {
                           : validate::non_negative("reference_delay", o.reference_delay);
   const LoopSpec at_ref = loop.with_delay(m.reference_delay);
   if (o.check_reference) {
-    const UnstableCount u = unstable_roots(at_ref);
+    const UnstableCount u = reference_count(at_ref);
     m.unstable_at_reference = u.count;
     m.marginal_at_reference = u.marginal;
     m.stable_at_reference = u.count == 0 && !u.marginal;

@@ -7,6 +7,14 @@ namespace afmkit::control::spectra_detail {
 
 using cplx = std::complex<double>;
 
+namespace {
+// 1/z without the overflow guards of the library complex division (|z| is moderate here)
+inline cplx reciprocal(cplx z) {
+  const double n = z.real() * z.real() + z.imag() * z.imag();
+  return {z.real() / n, -z.imag() / n};
+}
+}  // namespace
+
 FastCharacteristic::FastCharacteristic(const LoopSpec& loop) : omega_(loop.rotation_frequency()) {
   const auto set_bank = [this](const Bank& b) {
     if (const auto* o = std::get_if<OscillatorBank>(&b)) {
@@ -49,19 +57,21 @@ FastCharacteristic::FastCharacteristic(const LoopSpec& loop) : omega_(loop.rotat
   }
 }
 
-void FastCharacteristic::bank(cplx s, cplx& d, cplx& dd, cplx& n, cplx& dn, cplx& log_dq) const {
+void FastCharacteristic::bank(cplx s, cplx& d, cplx& dd, cplx& n, cplx& dn, cplx& log_dq, cplx& q) const {
   if (!infinite_) {
-    const cplx inv_s = 1.0 / s;
+    const cplx inv_s = reciprocal(s);
     d = 1.0 + a0_ * inv_s;
     dd = -a0_ * inv_s * inv_s;
     n = dn = 0.0;
     log_dq = a0_ != 0.0 ? inv_s : cplx(0.0);  // Q'/Q, Q = [s] Π (1 + s²/(k²Ω²))
+    q = a0_ != 0.0 ? s : cplx(1.0);
     const cplx s2 = s * s;
     for (std::size_t k = 0; k < a_.size(); ++k) {
-      const cplx inv = 1.0 / (s2 + kw2_[k]);
+      const cplx inv = reciprocal(s2 + kw2_[k]);
       const cplx g = (a_[k] * s - bkw_[k]) * inv;  // G_k
       const cplx dg = (a_[k] - 2.0 * s * g) * inv;  // G_k'
       log_dq += 2.0 * s * inv;
+      q *= 1.0 + s2 / kw2_[k];
       if (rejected_[k]) {
         n += g;
         dn += dg;
@@ -78,17 +88,18 @@ void FastCharacteristic::bank(cplx s, cplx& d, cplx& dd, cplx& n, cplx& dn, cplx
   cplx coth;
   if (u.real() >= 0.0) {
     const cplx e = std::exp(-2.0 * u);
-    coth = (1.0 + e) / (1.0 - e);
+    coth = (1.0 + e) * reciprocal(1.0 - e);
   } else {
     const cplx e = std::exp(2.0 * u);
-    coth = -(1.0 + e) / (1.0 - e);
+    coth = -(1.0 + e) * reciprocal(1.0 - e);
   }
   const cplx dcoth = c * (1.0 - coth * coth);
   log_dq = c * coth;  // Q∞'/Q∞
-  const cplx inv_s = 1.0 / s;
+  q = std::sinh(u) / c;  // Q∞ = (Ω/π) sinh(πs/Ω)
+  const cplx inv_s = reciprocal(s);
   const cplx lin = c * (alpha_ + beta_ * omega_ * inv_s);  // (π/Ω)(α + βΩ/s)
   const cplx dlin = -c * beta_ * omega_ * inv_s * inv_s;
-  const cplx inv_w = 1.0 / (s * s + omega_ * omega_);
+  const cplx inv_w = reciprocal(s * s + omega_ * omega_);
   const cplx h1 = 2.0 * (alpha_ * s + beta_ * omega_) * inv_w;
   const cplx dh1 = (2.0 * alpha_ - 2.0 * s * h1) * inv_w;
   d = 1.0 + lin * coth - beta_ * omega_ * inv_s * inv_s - h1;
@@ -98,13 +109,35 @@ void FastCharacteristic::bank(cplx s, cplx& d, cplx& dd, cplx& n, cplx& dn, cplx
 }
 
 void FastCharacteristic::evaluate(cplx s, cplx& f, cplx& df) const {
-  cplx lq;
-  evaluate(s, f, df, lq);
+  cplx lq, q;
+  evaluate(s, f, df, lq, q);
 }
 
-void FastCharacteristic::evaluate(cplx s, cplx& f, cplx& df, cplx& log_dq) const {
+void FastCharacteristic::entire(cplx s, cplx& delta, cplx& ddelta) const {
+  cplx f, df, lq, q;
+  evaluate(s, f, df, lq, q);
+  delta = q * f;
+  ddelta = q * (lq * f + df);
+}
+
+void FastCharacteristic::crossing_parts(double nu, cplx& x, cplx& y) const {
+  const cplx s(0.0, nu);
+  cplx d, dd, n, dn, lq, q;
+  bank(s, d, dd, n, dn, lq, q);
+  const cplx m = first_order_ ? 1.0 + s / rate_ : cplx(1.0);
+  if (!smith_) {
+    x = m * d;
+    y = rho_ * n;
+    return;
+  }
+  const cplx mh = model_first_order_ ? 1.0 + s / model_rate_ : cplx(1.0);
+  x = m * mh * d + k_over_model_ * m * (1.0 - std::exp(-s * correction_delay_)) * n;
+  y = rho_ * mh * std::exp(-s * measurement_delay_) * n;
+}
+
+void FastCharacteristic::evaluate(cplx s, cplx& f, cplx& df, cplx& log_dq, cplx& q) const {
   cplx d, dd, n, dn;
-  bank(s, d, dd, n, dn, log_dq);
+  bank(s, d, dd, n, dn, log_dq, q);
   const cplx m = first_order_ ? 1.0 + s / rate_ : cplx(1.0);
   const double dm = first_order_ ? 1.0 / rate_ : 0.0;
   cplx cd, dcd, cn, dcn;
@@ -130,8 +163,8 @@ void FastCharacteristic::evaluate(cplx s, cplx& f, cplx& df, cplx& log_dq) const
 }
 
 cplx FastCharacteristic::newton_step(cplx s) const {
-  cplx f, df, lq;
-  evaluate(s, f, df, lq);
+  cplx f, df, lq, q;
+  evaluate(s, f, df, lq, q);
   return 1.0 / (lq + df / f);
 }
 

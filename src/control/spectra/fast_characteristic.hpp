@@ -23,13 +23,18 @@ class FastCharacteristic {
   void evaluate(std::complex<double> s, std::complex<double>& f, std::complex<double>& df) const;
   /// Newton step Δ/Δ' = 1/(Q'/Q + f'/f) of the entire Δ = Q f (robust next to the poles of f).
   std::complex<double> newton_step(std::complex<double> s) const;
+  /// The entire Δ = Q f and Δ' (Q = [s] Π_k (1 + s²/(k²Ω²)) or (Ω/π) sinh(πs/Ω)); same zeros and scale as
+  /// characteristic() of loop.hpp. May be non-finite exactly at a pole of f or where Q overflows.
+  void entire(std::complex<double> s, std::complex<double>& delta, std::complex<double>& ddelta) const;
+  /// Δ/Q at s = iν split as X + Y e^{−iντ} (τ the loop delay): X, Y independent of τ (delay_margin.hpp).
+  void crossing_parts(double nu, std::complex<double>& x, std::complex<double>& y) const;
   double rotation_frequency() const { return omega_; }
 
  private:
   void bank(std::complex<double> s, std::complex<double>& d, std::complex<double>& dd, std::complex<double>& n,
-            std::complex<double>& dn, std::complex<double>& log_dq) const;
+            std::complex<double>& dn, std::complex<double>& log_dq, std::complex<double>& q) const;
   void evaluate(std::complex<double> s, std::complex<double>& f, std::complex<double>& df,
-                std::complex<double>& log_dq) const;
+                std::complex<double>& log_dq, std::complex<double>& q) const;
   double omega_;
   bool infinite_ = false;
   // finite bank: per harmonic a_k, b_k kΩ, k²Ω², rejected flag

@@ -61,12 +61,13 @@ std::vector<StructuralRoot> neutral_realisation_roots(const LoopSpec& loop) {
   if (!v.infinite) return out;
   const double omega = v.omega;
   const auto f = [&](cplx s) { return realisation(loop, *v.infinite, v.smith, s); };
+  const spectra_detail::Evaluator reduced(loop);
   for (const cplx centre : {cplx(0.0, 0.0), cplx(0.0, omega), cplx(0.0, -omega)}) {
     double r = 0.0123 * omega;
     for (int attempt = 0; attempt < 6; ++attempt, r *= 0.61) {
       const Box box{centre.real() - r, centre.real() + 1.07 * r, centre.imag() - 0.93 * r, centre.imag() + r};
       const auto wn = spectra_detail::winding(f, box, omega);
-      const auto wr = spectra_detail::winding(loop, box);
+      const auto wr = spectra_detail::winding(reduced, box);
       if (!wn.ok || !wr.ok) continue;
       const int m = wn.count - wr.count;
       if (m > 0) {

@@ -25,17 +25,15 @@ LoopView view(const LoopSpec& loop) {
   return v;
 }
 
-Winding winding(const LoopSpec& loop, const Box& box) {
-  return winding([&loop](cplx s) { return eval(loop, s); }, box, loop.rotation_frequency());
-}
+Winding winding(const Evaluator& f, const Box& box) { return winding(f, box, f.omega()); }
 
-NewtonResult newton(const LoopSpec& loop, cplx guess, double tolerance, int max_iterations, int multiplicity) {
-  const double omega = loop.rotation_frequency();
+NewtonResult newton(const Evaluator& f, cplx guess, double tolerance, int max_iterations, int multiplicity) {
+  const double omega = f.omega();
   NewtonResult r;
   cplx s = guess;
   double last = INFINITY;
   for (int it = 1; it <= max_iterations; ++it) {
-    const Eval e = eval(loop, s);
+    const Eval e = f(s);
     cplx step = static_cast<double>(multiplicity) * e.v / e.d;
     if (!(std::isfinite(step.real()) && std::isfinite(step.imag()))) break;
     const double limit = 0.5 * (omega + std::abs(s));
@@ -62,10 +60,10 @@ bool add_unique(std::vector<cplx>& roots, cplx s, double radius) {
   return true;
 }
 
-bool robust_count(const LoopSpec& loop, Box& box, int& count) {
-  const double omega = loop.rotation_frequency();
+bool robust_count(const Evaluator& f, Box& box, int& count) {
+  const double omega = f.omega();
   for (int attempt = 0; attempt < 6; ++attempt) {
-    const Winding w = winding(loop, box);
+    const Winding w = winding(f, box);
     if (w.ok) {
       count = w.count;
       return true;
@@ -86,17 +84,17 @@ bool inside(const Box& b, cplx s, double slack) {
          s.imag() <= b.imag_max + slack;
 }
 
-void search(const LoopSpec& loop, const Box& box, int count, double tolerance, int depth,
+void search(const Evaluator& f, const Box& box, int count, double tolerance, int depth,
             std::vector<std::pair<cplx, int>>& out) {
   if (count <= 0) return;
-  const double omega = loop.rotation_frequency();
+  const double omega = f.omega();
   const double wr = box.real_max - box.real_min, wi = box.imag_max - box.imag_min;
   const cplx centre(0.5 * (box.real_min + box.real_max), 0.5 * (box.imag_min + box.imag_max));
   const double diameter = std::hypot(wr, wi);
   const bool tiny = diameter < 1e-7 * std::max(omega, std::abs(centre)) || depth > 60;
   if (count == 1 || tiny) {
     // simple root, or an unresolvable cluster treated as one root of multiplicity `count`
-    const NewtonResult r = newton(loop, centre, tolerance, 80, count);
+    const NewtonResult r = newton(f, centre, tolerance, 80, count);
     if (r.converged && inside(box, r.root, 1e-9 * std::max(omega, std::abs(r.root)))) {
       out.emplace_back(r.root, count);
       return;
@@ -109,32 +107,32 @@ void search(const LoopSpec& loop, const Box& box, int count, double tolerance, i
   // split the longer side near its middle (offset to avoid symmetric root positions)
   const double frac = 0.5 + 0.0173 * ((depth % 3) - 1);
   for (int attempt = 0; attempt < 5; ++attempt) {
-    const double f = frac + 0.0311 * attempt * (attempt % 2 ? 1 : -1);
+    const double g = frac + 0.0311 * attempt * (attempt % 2 ? 1 : -1);
     Box b1 = box, b2 = box;
     if (wr >= wi) {
-      const double x = box.real_min + f * wr;
+      const double x = box.real_min + g * wr;
       b1.real_max = x;
       b2.real_min = x;
     } else {
-      const double y = box.imag_min + f * wi;
+      const double y = box.imag_min + g * wi;
       b1.imag_max = y;
       b2.imag_min = y;
     }
-    const Winding w1 = winding(loop, b1);
+    const Winding w1 = winding(f, b1);
     if (!w1.ok || w1.count < 0 || w1.count > count) continue;
-    search(loop, b1, w1.count, tolerance, depth + 1, out);
-    search(loop, b2, count - w1.count, tolerance, depth + 1, out);
+    search(f, b1, w1.count, tolerance, depth + 1, out);
+    search(f, b2, count - w1.count, tolerance, depth + 1, out);
     return;
   }
   // could not split cleanly: best effort from the centre
-  const NewtonResult r = newton(loop, centre, tolerance, 80, 1);
+  const NewtonResult r = newton(f, centre, tolerance, 80, 1);
   if (r.converged) out.emplace_back(r.root, count);
 }
 }  // namespace
 
-void subdivision_search(const LoopSpec& loop, const Box& box, int count, double tolerance,
+void subdivision_search(const Evaluator& f, const Box& box, int count, double tolerance,
                         std::vector<std::pair<cplx, int>>& out) {
-  search(loop, box, count, tolerance, 0, out);
+  search(f, box, count, tolerance, 0, out);
 }
 
 }  // namespace afmkit::control::spectra_detail

@@ -8,6 +8,7 @@
 
 #include "afmkit/control/loop.hpp"
 #include "afmkit/control/spectrum.hpp"
+#include "fast_characteristic.hpp"
 
 namespace afmkit::control::spectra_detail {
 
@@ -18,10 +19,29 @@ struct Eval {
   cplx v, d;
 };
 
-inline Eval eval(const LoopSpec& loop, cplx s) {
-  const ScaledCharacteristic c = characteristic_scaled(loop, s);
-  return {c.value, c.derivative};
-}
+/// Δ and Δ' of a loop: the fast plain-complex evaluation (fast_characteristic.hpp, same scale as loop.hpp's
+/// characteristic()), falling back to the scaled evaluation of loop.hpp where it is not finite.
+/// Holds a reference to the loop: it must outlive the evaluator.
+class Evaluator {
+ public:
+  explicit Evaluator(const LoopSpec& loop) : loop_(&loop), fast_(loop), omega_(loop.rotation_frequency()) {}
+  Eval operator()(cplx s) const {
+    cplx v, d;
+    fast_.entire(s, v, d);
+    if (std::isfinite(v.real()) && std::isfinite(v.imag()) && std::isfinite(d.real()) && std::isfinite(d.imag()) &&
+        v != 0.0)
+      return {v, d};
+    const ScaledCharacteristic c = characteristic_scaled(*loop_, s);
+    return {c.value, c.derivative};
+  }
+  const LoopSpec& loop() const { return *loop_; }
+  double omega() const { return omega_; }
+
+ private:
+  const LoopSpec* loop_;
+  FastCharacteristic fast_;
+  double omega_;
+};
 
 /// The parts of a loop needed by the bounds and the neutral diagnosis.
 struct LoopView {
@@ -91,7 +111,7 @@ Winding winding(F&& f, const Box& box, double scale) {
 }
 
 /// Winding of Δ of the loop.
-Winding winding(const LoopSpec& loop, const Box& box);
+Winding winding(const Evaluator& f, const Box& box);
 
 /// Newton on Δ with step limiting. `multiplicity` > 1 uses the modified step m·Δ/Δ'.
 struct NewtonResult {
@@ -100,17 +120,17 @@ struct NewtonResult {
   double correction = 0.0;
   int iterations = 0;
 };
-NewtonResult newton(const LoopSpec& loop, cplx guess, double tolerance, int max_iterations = 80,
+NewtonResult newton(const Evaluator& f, cplx guess, double tolerance, int max_iterations = 80,
                     int multiplicity = 1);
 
 /// All roots in `box` (which must contain exactly `count` roots, from a previous winding computation), by
 /// recursive bisection with argument-principle counts and Newton from box centres. Appends (root, multiplicity).
-void subdivision_search(const LoopSpec& loop, const Box& box, int count, double tolerance,
+void subdivision_search(const Evaluator& f, const Box& box, int count, double tolerance,
                         std::vector<std::pair<cplx, int>>& out);
 
 /// Argument-principle count with automatic nudging of the box edges (up to 6 attempts) if a root lies on the
 /// boundary; `box` is updated to the box actually used. Returns false if every attempt failed.
-bool robust_count(const LoopSpec& loop, Box& box, int& count);
+bool robust_count(const Evaluator& f, Box& box, int& count);
 
 /// Merge `s` into `roots` unless a root within `radius` is already present.
 bool add_unique(std::vector<cplx>& roots, cplx s, double radius);

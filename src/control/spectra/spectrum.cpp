@@ -17,7 +17,6 @@ namespace afmkit::control {
 using spectra_detail::cplx;
 
 namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 void check_options(const SpectrumOptions& o) {
   if (!std::isnan(o.min_real)) validate::finite("min_real", o.min_real);
@@ -40,9 +39,10 @@ std::vector<cplx> collocation_candidates(const LoopSpec& loop, const SpectrumOpt
   const DelayDifferentialSystem sys = closed_loop_dde(loop);
   const auto ev = collocation_eigenvalues(sys, o.collocation_nodes, scale);
   std::vector<cplx> cand;
+  const spectra_detail::Evaluator f(loop);
   for (cplx e : ev) {
     if (e.imag() < -1e-9 * omega || std::abs(e) > 4.0 * scale) continue;
-    const auto r = spectra_detail::newton(loop, e, o.tolerance, 60);
+    const auto r = spectra_detail::newton(f, e, o.tolerance, 60);
     if (!r.converged) continue;
     cplx s = r.root;
     if (std::abs(s.imag()) < 1e-10 * std::max(omega, std::abs(s))) s = s.real();
@@ -62,7 +62,7 @@ int count_roots(const LoopSpec& loop, const Box& box) {
   validate::finite("imag_max", box.imag_max);
   validate::require(box.real_max > box.real_min, "real_max", box.real_max, "> real_min");
   validate::require(box.imag_max > box.imag_min, "imag_max", box.imag_max, "> imag_min");
-  const auto w = spectra_detail::winding(loop, box);
+  const auto w = spectra_detail::winding(spectra_detail::Evaluator(loop), box);
   if (!w.ok)
     throw NumericalFailure(fmt::format("argument principle: a root lies on the boundary of the box [{}, {}] x [{}, {}]",
                                        box.real_min, box.real_max, box.imag_min, box.imag_max));
@@ -73,7 +73,7 @@ CharacteristicRoot refine_root(const LoopSpec& loop, std::complex<double> guess,
   validate::finite("guess.real", guess.real());
   validate::finite("guess.imag", guess.imag());
   validate::in_range("tolerance", tolerance, 1e-15, 1e-3);
-  const auto r = spectra_detail::newton(loop, guess, tolerance, 100);
+  const auto r = spectra_detail::newton(spectra_detail::Evaluator(loop), guess, tolerance, 100);
   if (!r.converged)
     throw NumericalFailure(fmt::format("Newton from {}{:+}i did not converge (last correction {:.3g})", guess.real(),
                                        guess.imag(), r.correction));
@@ -89,6 +89,7 @@ Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
   if (v.infinite) out.structural = neutral_realisation_roots(loop);
   const double bound = out.neutral_bound.value_or(-INFINITY);
   const double cap = o.max_imag_cap_periods * omega;
+  const spectra_detail::Evaluator f(loop);
 
   // 1. candidates (finite banks: collocation + Newton)
   std::vector<cplx> cand;
@@ -150,7 +151,7 @@ Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
   }
   out.box = Box{sigma_min, real_max, -imag_max, imag_max};
   int n_box = 0;
-  if (!spectra_detail::robust_count(loop, out.box, n_box))
+  if (!spectra_detail::robust_count(f, out.box, n_box))
     throw NumericalFailure("argument principle: could not count the roots in the search box (root on the boundary)");
   out.box_count = n_box;
 
@@ -167,10 +168,10 @@ Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
     const double h = 0.000618 * omega;
     Box upper{out.box.real_min, out.box.real_max, -h, out.box.imag_max};
     int n_upper = 0;
-    if (!spectra_detail::robust_count(loop, upper, n_upper))
+    if (!spectra_detail::robust_count(f, upper, n_upper))
       throw NumericalFailure("argument principle: could not count the roots in the upper half of the box");
     std::vector<std::pair<cplx, int>> sub;
-    spectra_detail::subdivision_search(loop, upper, n_upper, o.tolerance, sub);
+    spectra_detail::subdivision_search(f, upper, n_upper, o.tolerance, sub);
     found.clear();
     have = 0;
     std::vector<cplx> uniq;
@@ -193,7 +194,7 @@ Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
   }
   for (const auto& [s, m] : found) {
     CharacteristicRoot root;
-    const auto nr = spectra_detail::newton(loop, s, o.tolerance, 3, m);  // correction estimate at the root
+    const auto nr = spectra_detail::newton(f, s, o.tolerance, 3, m);  // correction estimate at the root
     root.value = s;
     root.multiplicity = m;
     root.correction = nr.correction;
@@ -204,7 +205,7 @@ Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
       dmin = std::max(dmin, 1e-7 * std::max(omega, std::abs(s)));
       Box small{s.real() - dmin, s.real() + 1.03 * dmin, s.imag() - 0.97 * dmin, s.imag() + dmin};
       int c = 0;
-      if (spectra_detail::robust_count(loop, small, c)) {
+      if (spectra_detail::robust_count(f, small, c)) {
         root.multiplicity = c;
         root.certified = c >= 1;
       }
@@ -230,7 +231,7 @@ Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
       // roots between the chain bound and the box: Newton from the chain asymptotics (B4/A4 < 0: half-integers)
       const double half = std::abs(v.infinite->alpha) > omega / std::numbers::pi ? 0.5 : 0.0;
       for (int m = 0; m <= 64; ++m) {
-        const auto r = spectra_detail::newton(loop, cplx(bound + 1e-3 * omega, (m + half) * omega), o.tolerance, 40);
+        const auto r = spectra_detail::newton(f, cplx(bound + 1e-3 * omega, (m + half) * omega), o.tolerance, 40);
         if (!r.converged || r.root.real() <= bound || r.root.real() >= out.box.real_min) continue;
         const cplx s = r.root.imag() < 0 ? std::conj(r.root) : r.root;
         if (spectra_detail::add_unique(out.near_chain, s, 1e-8 * std::max(omega, std::abs(s))))
@@ -272,7 +273,8 @@ UnstableCount unstable_roots(const LoopSpec& loop) {
   if (!rb.proven) throw NumericalFailure("unstable_roots: no root-free bound for the right half-plane");
   // count in Re s ≥ 0; a root on the axis makes the count fail: then count in Re s ≥ ε and flag marginal
   const Box box{0.0, rb.real_max, -rb.imag_max, rb.imag_max};
-  const auto w = spectra_detail::winding(loop, box);
+  const spectra_detail::Evaluator f(loop);
+  const auto w = spectra_detail::winding(f, box);
   if (w.ok) {
     u.count = w.count;
     return u;
@@ -280,7 +282,7 @@ UnstableCount unstable_roots(const LoopSpec& loop) {
   u.marginal = true;
   Box shifted{1e-9 * omega, rb.real_max, -rb.imag_max * 1.0001, rb.imag_max * 1.0001};
   int n = 0;
-  if (!spectra_detail::robust_count(loop, shifted, n))
+  if (!spectra_detail::robust_count(f, shifted, n))
     throw NumericalFailure("unstable_roots: could not count the roots in the right half-plane");
   u.count = n;
   return u;

@@ -38,6 +38,7 @@ void check_spec(const ChartSpec& s) {
   validate::in_range("threads", static_cast<long>(s.threads), 0L, 1024L);
   validate::in_range("tracked_roots", static_cast<long>(s.tracked_roots), 1L, 1000L);
   validate::in_range("seed_interval", static_cast<long>(s.seed_interval), 1L, 1000000L);
+  validate::in_range("max_recomputed_points", s.max_recomputed_points, 0L, 1000000000L);
 }
 
 // Runs body(i) for i in [0, n) on `threads` OpenMP threads; rethrows the first exception.
@@ -132,10 +133,22 @@ void label_regions(const ChartSpec& spec, StabilityChart& c, const std::vector<i
     });
   }
   c.unstable_roots.assign(c.region.size(), 0);
+  std::vector<long> redo;
   for (std::size_t p = 0; p < c.region.size(); ++p) {
     const ChartRegion& r = c.regions[c.region[p]];
     c.unstable_roots[p] = r.unstable_roots;
-    if (r.unstable_roots != tracked[p]) ++c.mismatched_points;
+    if (r.unstable_roots != tracked[p]) {
+      ++c.mismatched_points;
+      redo.push_back(static_cast<long>(p));
+    }
+  }
+  // tracking lost roots there: recompute those points with the certified spectrum (bounded effort)
+  if (static_cast<long>(redo.size()) <= spec.max_recomputed_points) {
+    parallel_for(static_cast<long>(redo.size()), spec.threads, [&](long i) {
+      const long p = redo[i];
+      c.abscissa[p] = rightmost_roots(spec.family.at(c.x[p % nx], c.y[p / nx])).spectral_abscissa;
+    });
+    c.recomputed_points = static_cast<long>(redo.size());
   }
 }
 }  // namespace

@@ -26,13 +26,15 @@ int TrackedSpectrum::unstable() const {
 
 bool RootTracker::refine(const FastCharacteristic& f, cplx& s) const {
   const double omega = f.rotation_frequency();
+  const double tol2 = tolerance_ * tolerance_;
   for (int it = 0; it < 40; ++it) {
     cplx step = f.newton_step(s);
     if (!(std::isfinite(step.real()) && std::isfinite(step.imag()))) return false;
-    const double limit = 0.5 * (omega + std::abs(s));
-    if (std::abs(step) > limit) step *= limit / std::abs(step);
+    const double s2 = std::norm(s), st2 = std::norm(step);
+    const double limit = 0.5 * (omega + std::sqrt(s2));
+    if (st2 > limit * limit) step *= limit / std::sqrt(st2);
     s -= step;
-    if (std::abs(step) <= tolerance_ * std::max(omega, std::abs(s))) return std::abs(s) < 1e4 * omega;
+    if (st2 <= tol2 * std::max(omega * omega, s2)) return s2 < 1e8 * omega * omega;
   }
   return false;
 }
