@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "afmkit/control/loop.hpp"
+#include "afmkit/core/validate.hpp"
 #include "afmkit/control/spectrum.hpp"
 #include "fast_characteristic.hpp"
 
@@ -134,5 +135,15 @@ bool robust_count(const Evaluator& f, Box& box, int& count);
 
 /// Merge `s` into `roots` unless a root within `radius` is already present.
 bool add_unique(std::vector<cplx>& roots, cplx s, double radius);
+
+/// The (x, y) window of a chart or a tuning search: finite bounds, x_min < x_max, y_min < y_max.
+inline void validate_window(double x_min, double x_max, double y_min, double y_max) {
+  validate::finite("x_min", x_min);
+  validate::finite("x_max", x_max);
+  validate::finite("y_min", y_min);
+  validate::finite("y_max", y_max);
+  validate::require(x_max > x_min, "x_max", x_max, "> x_min");
+  validate::require(y_max > y_min, "y_max", y_max, "> y_min");
+}
 
 }  // namespace afmkit::control::spectra_detail

@@ -12,6 +12,7 @@
 #include "afmkit/control/delay_margin.hpp"
 #include "afmkit/control/spectrum.hpp"
 #include "afmkit/core/validate.hpp"
+#include "spectra_detail.hpp"
 #include "tracking.hpp"
 
 namespace afmkit::control {
@@ -27,12 +28,7 @@ std::vector<double> linspace(double a, double b, int n) {
 }
 
 void check_spec(const ChartSpec& s) {
-  validate::finite("x_min", s.x_min);
-  validate::finite("x_max", s.x_max);
-  validate::finite("y_min", s.y_min);
-  validate::finite("y_max", s.y_max);
-  validate::require(s.x_max > s.x_min, "x_max", s.x_max, "> x_min");
-  validate::require(s.y_max > s.y_min, "y_max", s.y_max, "> y_min");
+  spectra_detail::validate_window(s.x_min, s.x_max, s.y_min, s.y_max);
   validate::in_range("x_points", static_cast<long>(s.x_points), 2L, 100000L);
   validate::in_range("y_points", static_cast<long>(s.y_points), 2L, 100000L);
   validate::in_range("threads", static_cast<long>(s.threads), 0L, 1024L);

@@ -13,6 +13,7 @@
 #include "afmkit/control/delay_margin.hpp"
 #include "afmkit/control/spectrum.hpp"
 #include "afmkit/core/validate.hpp"
+#include "spectra_detail.hpp"
 #include "tracking.hpp"
 
 namespace afmkit::control {
@@ -28,12 +29,7 @@ void check(const RobustTuningSpec& s) {
   validate::positive("gain_ratio_max", s.gain_ratio_max);
   validate::require(s.gain_ratio_max >= s.gain_ratio_min, "gain_ratio_max", s.gain_ratio_max, ">= gain_ratio_min");
   validate::in_range("gain_points", static_cast<long>(s.gain_points), 1L, 10000L);
-  validate::finite("x_min", s.x_min);
-  validate::finite("x_max", s.x_max);
-  validate::finite("y_min", s.y_min);
-  validate::finite("y_max", s.y_max);
-  validate::require(s.x_max > s.x_min, "x_max", s.x_max, "> x_min");
-  validate::require(s.y_max > s.y_min, "y_max", s.y_max, "> y_min");
+  spectra_detail::validate_window(s.x_min, s.x_max, s.y_min, s.y_max);
   validate::in_range("coarse_points", static_cast<long>(s.coarse_points), 2L, 10000L);
   validate::in_range("max_evaluations", static_cast<long>(s.max_evaluations), 0L, 1000000L);
   validate::in_range("tolerance", s.tolerance, 1e-12, 1.0);
