@@ -38,9 +38,9 @@ void run_demo(const io::ParamSet& p) {
   hb_options.q_max = 1.5;
   hb_options.points = 4000;
   const auto curve = tapping::harmonic_balance_curve(model, hb_options);
-  const io::Table hb = hb_table(curve, scales);
+  const tapping::HarmonicBalance balance(model);
   nlohmann::json folds = nlohmann::json::array();
-  for (const auto& f : tapping::HarmonicBalance(model).folds())
+  for (const auto& f : balance.folds())
     folds.push_back({{"separation", f.point.separation * scales.length}, {"amplitude", f.point.amplitude * scales.length},
                      {"q", f.point.q}});
 
@@ -50,9 +50,6 @@ void run_demo(const io::ParamSet& p) {
   options.progress = [&progress](long n) { progress.advance(n); };
   const tapping::SweepResult sweep = tapping::sweep_instrument(model, l_min, l_max, points, options);
   progress.finish();
-  io::Table table = sweep_table_columns();
-  add_sweep_rows(table, sweep.approach, scales);
-  add_sweep_rows(table, sweep.retract, scales);
 
   nlohmann::json jumps = {{"approach", sweep.approach_jumps}, {"retract", sweep.retract_jumps}};
   for (auto& side : {"approach", "retract"})
@@ -60,8 +57,13 @@ void run_demo(const io::ParamSet& p) {
   const nlohmann::json results = {{"hb_folds", folds},
                                   {"sweep_jumps", jumps},
                                   {"free_amplitude", model.free_amplitude() * scales.length}};
-  io::write_table(dir + "/demo_hb.csv", hb, io::make_sidecar("demo (harmonic balance)", p.to_json(), results));
-  io::write_table(dir + "/demo_sweep.csv", table, io::make_sidecar("demo (sweep)", p.to_json(), results));
+  io::TableWriter hb(dir + "/demo_hb.csv", hb_columns());
+  write_hb_rows(hb, curve, scales);
+  io::TableWriter table(dir + "/demo_sweep.csv", sweep_columns());
+  write_sweep_rows(table, sweep.approach, scales);
+  write_sweep_rows(table, sweep.retract, scales);
+  hb.commit(io::make_sidecar("demo (harmonic balance)", p.to_json(), results));
+  table.commit(io::make_sidecar("demo (sweep)", p.to_json(), results));
 
   const char* unit = p.text("units") == "physical" ? " nm" : "";
   fmt::print("afmkit demo: tapping cantilever, law '{}', Q = {}, drive at {} x resonance\n", model.law.name(),

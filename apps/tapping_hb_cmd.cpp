@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
@@ -46,9 +47,12 @@ void run_hb(const io::ParamSet& p) {
                                                    : tapping::HbCurveSpacing::RefinedGrazing;
   options.min_gap = p.real("min_gap");
   options.include_minus = p.flag("minus_branch");
+  // The curve is held in memory (both branches: 2 points per q sample) before it is streamed out.
+  memory::require_fits("points", static_cast<double>(options.points), 2.0 * sizeof(tapping::HbPoint));
+  const std::string output = p.text("output");
+  io::TableWriter table(output, hb_columns());
   const std::vector<tapping::HbPoint> curve = tapping::harmonic_balance_curve(model, options);
-
-  const io::Table table = hb_table(curve, scales);
+  write_hb_rows(table, curve, scales);
 
   const tapping::HarmonicBalance hb(model);
   nlohmann::json folds = nlohmann::json::array();
@@ -65,8 +69,7 @@ void run_hb(const io::ParamSet& p) {
                             {"rows", table.size()}};
   if (const auto limit = tapping::minimum_separation_limit(model))
     results["minimum_separation_limit"] = *limit * scales.length;  // ext. E8 (−∞ written as null)
-  const std::string output = p.text("output");
-  io::write_table(output, table, io::make_sidecar("tapping hb", p.to_json(), results));
+  table.commit(io::make_sidecar("tapping hb", p.to_json(), results));
   fmt::print("wrote {} rows to {} ({} fold(s), {} solution(s) at separation {})\n", table.size(), output,
              folds.size(), solutions.size(), p.real("separation"));
 }

@@ -3,6 +3,7 @@
 // pseudo-arclength continuation through folds (unstable branches included). HB value beside each point.
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -44,7 +45,14 @@ void run_sweep(const io::ParamSet& p) {
   const bool continuation = mode == "continuation" || mode == "both";
   const bool quiet = p.flag("json") || p.flag("quiet");
 
-  io::Table table = sweep_table_columns();
+  const std::string output = p.text("output");
+  std::optional<io::TableWriter> table;
+  if (!output.empty()) table.emplace(output, sweep_columns());
+  long rows = 0;
+  const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) {
+    rows += static_cast<long>(points.size());
+    if (table) write_sweep_rows(*table, points, scales);
+  };
   nlohmann::json results = nlohmann::json::object();
   if (instrument) {
     io::Progress progress("tapping sweep (approach + retract)", 2L * points, !quiet);
@@ -54,8 +62,8 @@ void run_sweep(const io::ParamSet& p) {
     options.progress = [&progress](long n) { progress.advance(n); };
     const tapping::SweepResult r = tapping::sweep_instrument(base, l_min, l_max, points, options);
     progress.finish();
-    add_sweep_rows(table, r.approach, scales);
-    add_sweep_rows(table, r.retract, scales);
+    write_rows(r.approach);
+    write_rows(r.retract);
     results["approach_jumps"] = scaled(r.approach_jumps, scales.length);
     results["retract_jumps"] = scaled(r.retract_jumps, scales.length);
   }
@@ -66,16 +74,15 @@ void run_sweep(const io::ParamSet& p) {
     options.initial_step = std::min(options.initial_step, options.max_step);
     options.max_points = static_cast<int>(p.integer("max_continuation_points"));
     const tapping::ContinuationResult c = tapping::sweep_continuation(base, l_min, l_max, options);
-    add_sweep_rows(table, c.points, scales);
+    write_rows(c.points);
     results["folds"] = scaled(c.folds, scales.length);
     results["grazing"] = scaled(c.grazing, scales.length);
     results["continuation_stop"] = c.stop_reason;
     results["continuation_points"] = c.points.size();
   }
   results["free_amplitude"] = base.free_amplitude() * scales.length;
-  results["rows"] = table.size();
-  const std::string output = p.text("output");
-  if (!output.empty()) io::write_table(output, table, io::make_sidecar("tapping sweep", p.to_json(), results));
+  results["rows"] = rows;
+  if (table) table->commit(io::make_sidecar("tapping sweep", p.to_json(), results));
   if (p.flag("json")) {
     fmt::print("{}\n", results.dump(2));
     return;
@@ -86,7 +93,7 @@ void run_sweep(const io::ParamSet& p) {
   if (continuation)
     fmt::print("continuation: {} points, folds at {}, grazing at {} ({})\n", results["continuation_points"].dump(),
                results["folds"].dump(), results["grazing"].dump(), results["continuation_stop"].get<std::string>());
-  if (!output.empty()) fmt::print("wrote {} rows to {} (details in {}.json)\n", table.size(), output, output);
+  if (!output.empty()) fmt::print("wrote {} rows to {} (details in {}.json)\n", rows, output, output);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/io/number.hpp"
 
 namespace afmkit::io {
 
@@ -21,18 +22,33 @@ std::string dashed(std::string key) {
   return key;
 }
 
-double parse_real(const std::string& key, const std::string& text, const std::string& origin) {
-  std::size_t pos = 0;
-  double v = 0;
-  std::string t = text;
-  // accept nan/inf textually so that they are rejected by the range check with a clear message
-  try {
-    v = std::stod(t, &pos);
-  } catch (...) {
-    throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not a number", origin, key, text));
+double real_of(const std::string& key, const std::string& text, const std::string& origin) {
+  // nan / inf are accepted textually so that the range check rejects them with a clear message
+  if (const auto v = parse_real(text)) return *v;
+  throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not a number", origin, key, text));
+}
+/// Whether `text` is well-formed UTF-8 (no overlong forms, surrogates or code points above U+10FFFF).
+bool valid_utf8(const std::string& text) {
+  const auto* p = reinterpret_cast<const unsigned char*>(text.data());
+  const auto* end = p + text.size();
+  while (p < end) {
+    const unsigned c = *p;
+    int extra = 0;
+    unsigned min = 0, code = 0;
+    if (c < 0x80) extra = 0, code = c;
+    else if ((c & 0xE0) == 0xC0) extra = 1, code = c & 0x1F, min = 0x80;
+    else if ((c & 0xF0) == 0xE0) extra = 2, code = c & 0x0F, min = 0x800;
+    else if ((c & 0xF8) == 0xF0) extra = 3, code = c & 0x07, min = 0x10000;
+    else return false;
+    if (end - p <= extra) return false;  // truncated sequence
+    for (int i = 1; i <= extra; ++i) {
+      if ((p[i] & 0xC0) != 0x80) return false;
+      code = (code << 6) | (p[i] & 0x3F);
+    }
+    if (code < min || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return false;
+    p += extra + 1;
   }
-  if (pos != t.size()) throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not a number", origin, key, text));
-  return v;
+  return true;
 }
 }  // namespace
 
@@ -146,13 +162,16 @@ void ParamSet::set_from_string(const std::string& key, const std::string& text) 
       [&](auto& v) {
         using T = std::decay_t<decltype(v)>;
         if constexpr (std::is_same_v<T, double>) {
-          v = parse_real(key, text, origin);
+          v = real_of(key, text, origin);
         } else if constexpr (std::is_same_v<T, long>) {
-          double d = parse_real(key, text, origin);
-          if (d != std::floor(d) || !std::isfinite(d))
-            throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not an integer", origin, key, text));
-          v = static_cast<long>(d);
+          const auto i = parse_integer(text);
+          if (!i)
+            throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not an integer: must be an integer in [{}, {}]",
+                                                    origin, key, text, e.ilo, e.ihi));
+          v = *i;
         } else if constexpr (std::is_same_v<T, std::string>) {
+          if (!valid_utf8(text))
+            throw InvalidParameter(key, fmt::format("{}: {} is not valid UTF-8 text: must be UTF-8", origin, key));
           v = text;
         } else if constexpr (std::is_same_v<T, bool>) {
           if (text == "true" || text == "1" || text.empty()) v = true;
@@ -162,7 +181,7 @@ void ParamSet::set_from_string(const std::string& key, const std::string& text) 
           std::vector<double> out;
           std::stringstream ss(text);
           std::string item;
-          while (std::getline(ss, item, ',')) out.push_back(parse_real(key, item, origin));
+          while (std::getline(ss, item, ',')) out.push_back(real_of(key, item, origin));
           v = out;
         }
       },
@@ -184,8 +203,9 @@ void ParamSet::load_toml_text(const std::string& text, const std::string& origin
     const auto& b = err.source().begin;
     throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, b.line, b.column, err.description()));
   }
-  for (auto&& [k, node] : tbl) {
-    std::string key(k.str());
+  for (auto&& item : tbl) {  // (no structured binding: clang 14 cannot capture one in the lambda below)
+    const std::string key(item.first.str());
+    const toml::node& node = item.second;
     auto it = entries_.find(key);
     if (it == entries_.end()) {
       std::vector<std::string> known(order_.begin(), order_.end());
@@ -250,9 +270,9 @@ const ParamSet::Entry& ParamSet::entry(const std::string& key) const {
 }
 double ParamSet::real(const std::string& key) const { return std::get<double>(entry(key).value); }
 long ParamSet::integer(const std::string& key) const { return std::get<long>(entry(key).value); }
-const std::string& ParamSet::text(const std::string& key) const { return std::get<std::string>(entry(key).value); }
+const std::string& ParamSet::text(const std::string& key) const& { return std::get<std::string>(entry(key).value); }
 bool ParamSet::flag(const std::string& key) const { return std::get<bool>(entry(key).value); }
-const std::vector<double>& ParamSet::reals(const std::string& key) const {
+const std::vector<double>& ParamSet::reals(const std::string& key) const& {
   return std::get<std::vector<double>>(entry(key).value);
 }
 bool ParamSet::was_set(const std::string& key) const { return entry(key).set; }

@@ -5,7 +5,6 @@
 #include <fstream>
 
 #include "afmkit/core/error.hpp"
-#include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 
 using afmkit::InputError;
@@ -76,20 +75,3 @@ TEST(ParamSet, OutOfRangeNamesParameterAndRange) {
   EXPECT_THROW(p.load_toml_text("quality_factor = nan\n", "t.toml"), InvalidParameter);
 }
 
-TEST(Output, CsvRoundTripsDoublesAndWritesAtomically) {
-  afmkit::io::Table t({"a", "b", "c"});
-  t.add_row({0.1, 2L, std::string("x")});
-  t.add_row({1.0 / 3.0, -1L, true});
-  EXPECT_THROW(t.add_row({1.0}), std::logic_error);
-  const std::string csv = t.to_csv();
-  EXPECT_EQ(csv.substr(0, 6), "a,b,c\n");
-  EXPECT_NE(csv.find("0.3333333333333333,"), std::string::npos);
-  auto dir = std::filesystem::temp_directory_path() / "afmkit_test_output";
-  std::filesystem::remove_all(dir);
-  afmkit::io::write_table((dir / "sub/t.csv").string(), t, afmkit::io::make_sidecar("test", {{"x", 1}}));
-  EXPECT_TRUE(std::filesystem::exists(dir / "sub/t.csv"));
-  EXPECT_TRUE(std::filesystem::exists(dir / "sub/t.csv.json"));
-  for (auto& f : std::filesystem::directory_iterator(dir / "sub"))
-    EXPECT_EQ(f.path().string().find(".tmp."), std::string::npos);
-  std::filesystem::remove_all(dir);
-}

@@ -1,29 +1,73 @@
 #pragma once
-// Output files: CSV tables with a header row, a JSON sidecar (<file>.json) holding the command, the
-// parameters and the afmkit version, all written atomically (temporary file + rename), so a failed or
-// interrupted run never leaves a half-written output.
+// Output files: CSV tables with a header row and a JSON sidecar (<file>.json) holding the command, the
+// parameters, the afmkit version and summary results. Tables are streamed: each row is formatted into a small
+// buffer and appended to a temporary file next to the target; commit() renames it into place (atomic), so a
+// failed or interrupted run never leaves a half-written output and memory stays bounded by a buffer, not the
+// file. Undefined values (NaN) are written as `nan` (docs/conventions.md).
+#include <cstdio>
 #include <string>
-#include <variant>
+#include <string_view>
 #include <vector>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 namespace afmkit::io {
 
-/// A column-named table; each cell is a number, an integer, a string or a boolean (written 0/1).
-class Table {
+/// Streams a column-named CSV table to `path` atomically. Cells are numbers (shortest round-trip text),
+/// integers, strings or booleans (0/1). Usage:
+///   TableWriter out(path, {"separation", "amplitude"});
+///   for (...) out.row(l, B);
+///   out.commit(make_sidecar(...));     // rename into place, then write the sidecar
+/// A writer destroyed without commit() removes its temporary file.
+class TableWriter {
  public:
-  using Cell = std::variant<double, long, std::string, bool>;
-  explicit Table(std::vector<std::string> columns);
-  void add_row(std::vector<Cell> row);  ///< throws std::logic_error if the width differs
-  const std::vector<std::string>& columns() const { return columns_; }
-  const std::vector<std::vector<Cell>>& rows() const { return rows_; }
-  std::size_t size() const { return rows_.size(); }
-  std::string to_csv() const;  ///< shortest round-trip representation of doubles
+  /// Opens `<path>.tmp.<pid>` (creating parent folders). Throws afmkit::InputError when that is impossible.
+  TableWriter(std::string path, std::vector<std::string> columns);
+  ~TableWriter();
+  TableWriter(const TableWriter&) = delete;
+  TableWriter& operator=(const TableWriter&) = delete;
+
+  TableWriter& cell(double value);
+  TableWriter& cell(long value);
+  TableWriter& cell(int value) { return cell(static_cast<long>(value)); }
+  TableWriter& cell(std::size_t value) { return cell(static_cast<long>(value)); }
+  TableWriter& cell(bool value);
+  TableWriter& cell(std::string_view text);
+  TableWriter& cell(const char* text) { return cell(std::string_view(text)); }
+  TableWriter& cell(const std::string& text) { return cell(std::string_view(text)); }
+  /// Ends the current row; throws std::logic_error when its cell count differs from the column count.
+  void end_row();
+  /// One whole row.
+  template <class... Cells>
+  void row(const Cells&... cells) {
+    (cell(cells), ...);
+    end_row();
+  }
+
+  /// Flushes, renames the table into place and writes `<path>.json` (atomically). Throws InputError on an
+  /// I/O failure (nothing is left behind then).
+  void commit(const nlohmann::json& sidecar);
+
+  const std::vector<std::string>& columns() const& { return columns_; }
+  std::vector<std::string> columns() const&& { return columns_; }
+  std::size_t size() const { return rows_; }  ///< rows written so far
+  const std::string& path() const& { return path_; }
+  std::string path() const&& { return path_; }
 
  private:
+  std::string path_;
+  std::string temporary_;
   std::vector<std::string> columns_;
-  std::vector<std::vector<Cell>> rows_;
+  std::FILE* file_ = nullptr;
+  fmt::memory_buffer buffer_;
+  std::size_t rows_ = 0;
+  std::size_t cells_in_row_ = 0;
+  bool committed_ = false;
+
+  void separator();
+  void flush();
+  void discard() noexcept;
 };
 
 /// Write `content` to `path` atomically; creates parent directories. Throws afmkit::InputError on failure.
@@ -32,8 +76,5 @@ void write_file_atomic(const std::string& path, const std::string& content);
 /// Metadata of a run, written as the sidecar `<csv path>.json`.
 nlohmann::json make_sidecar(const std::string& command, const nlohmann::json& parameters,
                             const nlohmann::json& results = nlohmann::json::object());
-
-/// Write table to `csv_path` and the sidecar next to it (`csv_path + ".json"`).
-void write_table(const std::string& csv_path, const Table& table, const nlohmann::json& sidecar);
 
 }  // namespace afmkit::io

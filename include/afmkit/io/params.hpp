@@ -58,15 +58,18 @@ class ParamSet {
 
   double real(const std::string& key) const;
   long integer(const std::string& key) const;
-  const std::string& text(const std::string& key) const;
+  const std::string& text(const std::string& key) const&;
+  std::string text(const std::string& key) const&& { return text(key); }  // a temporary gives a copy
   bool flag(const std::string& key) const;
-  const std::vector<double>& reals(const std::string& key) const;
+  const std::vector<double>& reals(const std::string& key) const&;
+  std::vector<double> reals(const std::string& key) const&& { return reals(key); }
   bool was_set(const std::string& key) const;  ///< given by TOML or flag (not the default)
 
   /// All parameters and their values, for the JSON sidecar.
   nlohmann::json to_json() const;
   /// Path given with --config ("" if none).
-  const std::string& config_path() const { return config_path_; }
+  const std::string& config_path() const& { return config_path_; }
+  std::string config_path() const&& { return config_path_; }
 
  private:
   struct Entry {

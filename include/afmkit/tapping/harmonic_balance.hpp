@@ -91,10 +91,12 @@ class HarmonicBalance {
   /// The point at q on a branch (see harmonic_balance_at_q).
   std::optional<HbPoint> at_q(double q, HbBranch branch) const;
   /// Folds (sorted by q).
-  const std::vector<HbFold>& folds() const { return folds_; }
+  const std::vector<HbFold>& folds() const& { return folds_; }
+  std::vector<HbFold> folds() const&& { return folds_; }  // a temporary gives a copy, never a dangling reference
   /// Free amplitude Γ|L(iω)|: the free solution exists for l ≥ this (ext. E7: jump-down point).
   double free_amplitude() const { return coefficients_.free_amplitude(); }
-  const HbCoefficients& coefficients() const { return coefficients_; }
+  const HbCoefficients& coefficients() const& { return coefficients_; }
+  HbCoefficients coefficients() const&& { return coefficients_; }
 
  private:
   struct Node {

@@ -1,0 +1,18 @@
+#pragma once
+// A request's memory, checked before any work: a size option that would need more memory than the machine can
+// give is bad input (InvalidParameter, CLI exit 2) with the amount needed and available, never std::bad_alloc.
+#include <cstddef>
+#include <string>
+
+namespace afmkit::memory {
+
+/// Bytes of memory available to a new allocation now (MemAvailable of /proc/meminfo, or the physical memory
+/// when that is unreadable), capped by the address-space limit (ulimit -v) when one is set.
+std::size_t available_bytes();
+
+/// Throws InvalidParameter(parameter, …) when `bytes` (what a request of `value` for `parameter` needs, e.g.
+/// rows × bytes per row) exceeds `fraction` of available_bytes(); the message names the parameter, its value,
+/// the memory needed and the largest value that fits. `bytes_per_unit` (> 0) converts between the two.
+void require_fits(const std::string& parameter, double value, double bytes_per_unit, double fraction = 0.5);
+
+}  // namespace afmkit::memory

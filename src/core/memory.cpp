@@ -1,0 +1,50 @@
+#include "afmkit/core/memory.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <fmt/format.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "afmkit/core/error.hpp"
+
+namespace afmkit::memory {
+
+std::size_t available_bytes() {
+  std::size_t bytes = 0;
+  std::ifstream meminfo("/proc/meminfo");
+  for (std::string line; std::getline(meminfo, line);) {
+    std::istringstream in(line);
+    std::string key;
+    std::size_t kib = 0;
+    if (in >> key >> kib && key == "MemAvailable:") {
+      bytes = kib * 1024;
+      break;
+    }
+  }
+  if (bytes == 0) {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+    if (pages > 0 && page > 0) bytes = static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
+  }
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+    bytes = bytes == 0 ? limit.rlim_cur : std::min<std::size_t>(bytes, limit.rlim_cur);
+  return bytes;
+}
+
+void require_fits(const std::string& parameter, double value, double bytes_per_unit, double fraction) {
+  const double needed = value * bytes_per_unit;
+  const double usable = fraction * static_cast<double>(available_bytes());
+  if (!(needed <= usable)) {
+    const double gib = 1024.0 * 1024.0 * 1024.0;
+    throw InvalidParameter(
+        parameter, fmt::format("{} = {} needs about {:.2f} GiB of memory, more than the {:.2f} GiB this machine can "
+                               "give now: must be <= {:.0f}",
+                               parameter, value, needed / gib, usable / gib, std::floor(usable / bytes_per_unit)));
+  }
+}
+
+}  // namespace afmkit::memory

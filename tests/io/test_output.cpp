@@ -1,0 +1,136 @@
+// The streaming table writer: round-trip text, atomic placement, streaming (bounded memory), sidecars.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include <unistd.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
+
+namespace fs = std::filesystem;
+using afmkit::io::TableWriter;
+
+namespace {
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("afmkit_test_output_" + name + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  return dir;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+bool any_temporary(const fs::path& dir) {
+  for (const auto& f : fs::directory_iterator(dir))
+    if (f.path().string().find(".tmp.") != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST(TableWriter, DoublesRoundTripBitExactAndCellsHaveTheirText) {
+  const fs::path dir = fresh_dir("roundtrip");
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-300, 300);
+  std::vector<double> values;
+  for (int i = 0; i < 2000; ++i) values.push_back(std::ldexp(mantissa(rng), exponent(rng)));
+  values.push_back(0.1);
+  values.push_back(-0.0);
+  values.push_back(std::numeric_limits<double>::denorm_min());
+  {
+    TableWriter out((dir / "sub/t.csv").string(), {"x", "n", "flag", "name"});
+    for (std::size_t i = 0; i < values.size(); ++i) out.row(values[i], static_cast<long>(i) - 5, i % 2 == 0, "abc");
+    out.row(std::numeric_limits<double>::quiet_NaN(), 0L, false, "undefined");
+    EXPECT_EQ(out.size(), values.size() + 1);
+    out.commit(afmkit::io::make_sidecar("test", {{"x", 1}}, {{"rows", values.size() + 1}}));
+  }
+  std::ifstream in(dir / "sub/t.csv");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "x,n,flag,name");
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    ASSERT_TRUE(std::getline(in, line));
+    std::istringstream row(line);
+    std::string x, n, flag, name;
+    std::getline(row, x, ',');
+    std::getline(row, n, ',');
+    std::getline(row, flag, ',');
+    std::getline(row, name, ',');
+    const double back = std::strtod(x.c_str(), nullptr);
+    EXPECT_EQ(std::memcmp(&back, &values[i], sizeof back), 0) << x;
+    EXPECT_EQ(std::stol(n), static_cast<long>(i) - 5);
+    EXPECT_EQ(flag, i % 2 == 0 ? "1" : "0");
+    EXPECT_EQ(name, "abc");
+  }
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "nan,0,0,undefined");  // the one spelling of "undefined" (docs/conventions.md)
+  EXPECT_FALSE(std::getline(in, line));
+  const auto meta = nlohmann::json::parse(slurp(dir / "sub/t.csv.json"));
+  EXPECT_EQ(meta["results"]["rows"], values.size() + 1);
+  EXPECT_EQ(meta["command"], "test");
+  EXPECT_FALSE(any_temporary(dir / "sub"));
+  fs::remove_all(dir);
+}
+
+TEST(TableWriter, RowWidthIsChecked) {
+  const fs::path dir = fresh_dir("width");
+  TableWriter out((dir / "t.csv").string(), {"a", "b"});
+  EXPECT_THROW(out.row(1.0), std::logic_error);
+  EXPECT_THROW(out.row(1.0, 2.0, 3.0), std::logic_error);
+  fs::remove_all(dir);
+}
+
+TEST(TableWriter, AbandonedWriterLeavesNothingAndKeepsTheOldFile) {
+  const fs::path dir = fresh_dir("abandon");
+  fs::create_directories(dir);
+  { std::ofstream(dir / "t.csv") << "old\n"; }
+  try {
+    TableWriter out((dir / "t.csv").string(), {"a"});
+    for (int i = 0; i < 100000; ++i) out.row(i * 0.5);
+    throw std::runtime_error("interrupted");  // e.g. a numerical failure half way
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_EQ(slurp(dir / "t.csv"), "old\n");
+  EXPECT_FALSE(fs::exists(dir / "t.csv.json"));
+  EXPECT_FALSE(any_temporary(dir));
+  fs::remove_all(dir);
+}
+
+TEST(TableWriter, RowsAreStreamedToDiskNotHeldInMemory) {
+  // Before commit, all but the last buffer of the rows must already be in the temporary file.
+  const fs::path dir = fresh_dir("stream");
+  TableWriter out((dir / "t.csv").string(), {"a", "b", "c"});
+  std::size_t bytes = 6;  // header "a,b,c\n"
+  for (int i = 0; i < 200000; ++i) {
+    out.row(i + 0.25, i, true);
+    bytes += std::to_string(i + 0.25).size() - 4 /* "0000" of to_string */ + std::to_string(i).size() + 4;
+  }
+  fs::path temporary;
+  for (const auto& f : fs::directory_iterator(dir))
+    if (f.path().string().find(".tmp.") != std::string::npos) temporary = f.path();
+  ASSERT_FALSE(temporary.empty());
+  EXPECT_GE(fs::file_size(temporary) + (1u << 16), bytes);
+  EXPECT_FALSE(fs::exists(dir / "t.csv"));  // not in place before commit
+  out.commit(afmkit::io::make_sidecar("test", {}));
+  EXPECT_EQ(fs::file_size(dir / "t.csv"), bytes);
+  fs::remove_all(dir);
+}
+
+TEST(TableWriter, UnwritableTargetIsAnInputError) {
+  EXPECT_THROW(TableWriter("/proc/afmkit_cannot_write/t.csv", {"a"}), afmkit::InputError);
+}
