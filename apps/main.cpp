@@ -1,5 +1,8 @@
 // afmkit — command-line front end. Exit status: 0 success, 2 bad input (parameter, file, config),
 // 1 numerical failure (no convergence, budget exhausted) or any other error.
+#include <new>
+#include <string>
+
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
@@ -16,6 +19,23 @@ int main(int argc, char** argv) {
   afmkit::cli::register_impact(app);
   afmkit::cli::register_tapping(app);
   afmkit::cli::register_control(app);
+  // A word that names no command where one is expected (`afmkit frobnicate`, `afmkit tapping orbits`).
+  const CLI::App* level = &app;
+  for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {
+    const auto subcommands = level->get_subcommands([](const CLI::App*) { return true; });
+    if (subcommands.empty()) break;
+    const CLI::App* next = nullptr;
+    std::string names;
+    for (const CLI::App* sub : subcommands) {
+      if (sub->get_name() == argv[i]) next = sub;
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!next) {
+      fmt::print(stderr, "afmkit: unknown command '{}': must be one of {} (see afmkit --help)\n", argv[i], names);
+      return 2;
+    }
+    level = next;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -29,6 +49,10 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const afmkit::NumericalFailure& e) {
     fmt::print(stderr, "afmkit: numerical failure: {}\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {  // last resort: commands check their sizes against memory before work
+    fmt::print(stderr, "afmkit: out of memory: the request needs more memory than is available (reduce its sizes: "
+                       "points, harmonics, periods, grid points)\n");
     return 1;
   } catch (const std::exception& e) {
     fmt::print(stderr, "afmkit: error: {}\n", e.what());

@@ -81,7 +81,8 @@ void register_tapping_hb(CLI::App& tapping) {
   add_tapping_model_params(*params);
   params->real("q_min", -1.0, "smallest penetration parameter q = (A + l)/B of the curve", io::Range::any())
       .real("q_max", 1.5, "largest q (> q_min); q >= 1 is the free oscillation", io::Range::any())
-      .integer("points", 2000, "number of q samples (>= 2)", 2, 100000000)
+      .integer("points", 2000, "number of q samples (>= 2; the curve is held in memory, 96 bytes per sample)", 2,
+               10000000)
       .text("spacing", "refined", "q sampling: uniform, or refined (half the samples log-spaced in 1 - q near grazing)",
             {"uniform", "refined"})
       .real("min_gap", 1e-10, "smallest 1 - q of the refined samples", {0.0, 1.0, true, true})

@@ -1,6 +1,8 @@
 #include "afmkit/core/memory.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -12,6 +14,29 @@
 #include "afmkit/core/error.hpp"
 
 namespace afmkit::memory {
+
+namespace {
+/// AFMKIT_MEMORY_LIMIT: bytes, or a number with the suffix K, M, G or T (powers of 1024); 0 when unset.
+std::size_t limit_from_environment() {
+  const char* text = std::getenv("AFMKIT_MEMORY_LIMIT");
+  if (!text || !*text) return 0;
+  char* end = nullptr;
+  const double value = std::strtod(text, &end);
+  double scale = 1.0;
+  const std::string suffix(end);
+  if (suffix == "K" || suffix == "k") scale = 1024.0;
+  else if (suffix == "M") scale = 1024.0 * 1024.0;
+  else if (suffix == "G") scale = 1024.0 * 1024.0 * 1024.0;
+  else if (suffix == "T") scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+  else if (!suffix.empty()) scale = -1.0;
+  if (end == text || !(value > 0) || !(scale > 0) || !std::isfinite(value * scale) || value * scale > 1e18)
+    throw InvalidParameter("AFMKIT_MEMORY_LIMIT",
+                           fmt::format("AFMKIT_MEMORY_LIMIT = '{}' is out of range: must be a positive number of "
+                                       "bytes, optionally with the suffix K, M, G or T",
+                                       text));
+  return static_cast<std::size_t>(value * scale);
+}
+}  // namespace
 
 std::size_t available_bytes() {
   std::size_t bytes = 0;
@@ -32,6 +57,7 @@ std::size_t available_bytes() {
   rlimit limit{};
   if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
     bytes = bytes == 0 ? limit.rlim_cur : std::min<std::size_t>(bytes, limit.rlim_cur);
+  if (const std::size_t user = limit_from_environment()) bytes = bytes == 0 ? user : std::min(bytes, user);
   return bytes;
 }
 

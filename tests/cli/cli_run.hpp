@@ -58,4 +58,22 @@ inline RunResult run_cli(const std::string& args, const TempDir& dir) {
   return r;
 }
 
+/// Run a bash command line in `dir`, in which the word `afmkit` runs the built program (a shell function), so that
+/// command lines copied from the documentation run as written (environment prefixes, quoting, $'…').
+inline RunResult run_shell(const std::string& line, const TempDir& dir) {
+  const std::string script = dir.file(".command.sh"), out = dir.file(".stdout"), err = dir.file(".stderr");
+  std::ofstream(script) << "afmkit() { '" << AFMKIT_CLI << "' \"$@\"; }\n" << line << "\n";
+  const std::string cmd =
+      "cd '" + dir.path.string() + "' && bash '" + script + "' >'" + out + "' 2>'" + err + "' </dev/null";
+  const int raw = std::system(cmd.c_str());
+  RunResult r{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(out), slurp(err)};
+  for (const auto& f : {script, out, err}) std::filesystem::remove(f);
+  return r;
+}
+
+/// The text of a file of the source tree (AFMKIT_SOURCE_DIR from CMake), e.g. "docs/bad-input.md".
+inline std::string source_file(const std::string& relative) {
+  return slurp(std::filesystem::path(AFMKIT_SOURCE_DIR) / relative);
+}
+
 }  // namespace afmkit_test

@@ -7,7 +7,9 @@
 namespace afmkit::memory {
 
 /// Bytes of memory available to a new allocation now (MemAvailable of /proc/meminfo, or the physical memory
-/// when that is unreadable), capped by the address-space limit (ulimit -v) when one is set.
+/// when that is unreadable), capped by the address-space limit (ulimit -v) and by the environment variable
+/// AFMKIT_MEMORY_LIMIT (bytes, or with a suffix K, M, G, T; e.g. "2G" on a shared node) when they are set.
+/// A malformed AFMKIT_MEMORY_LIMIT -> InvalidParameter("AFMKIT_MEMORY_LIMIT").
 std::size_t available_bytes();
 
 /// Throws InvalidParameter(parameter, …) when `bytes` (what a request of `value` for `parameter` needs, e.g.

@@ -1,0 +1,75 @@
+// docs/bad-input.md, row by row: each documented bad input gives its exit status and message, and a rejected
+// command (exit 2) writes nothing. The page is the test's data, so documentation and behaviour cannot drift.
+#include <gtest/gtest.h>
+
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_run.hpp"
+
+using afmkit_test::run_shell;
+using afmkit_test::source_file;
+using afmkit_test::TempDir;
+
+namespace {
+
+struct Row {
+  std::string command;
+  int status;
+  std::string message;
+};
+// gtest prints parameters of failing tests.
+[[maybe_unused]] void PrintTo(const Row& row, std::ostream* os) { *os << row.command; }
+
+struct Page {
+  std::vector<std::pair<std::string, std::string>> files;  // name, content
+  std::vector<Row> rows;
+};
+
+// Backquoted cells may contain '|' only inside backquotes; split on " | " between cells.
+Page read_page() {
+  Page page;
+  std::istringstream in(source_file("docs/bad-input.md"));
+  const std::regex file_line(R"(^- `([^`]+)`: `(.*)`$)");
+  const std::regex row_line(R"(^\| `(.+)` \| (\d+) \| `(.+)` \|$)");
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (std::regex_match(line, m, file_line)) page.files.emplace_back(m[1], m[2]);
+    else if (std::regex_match(line, m, row_line)) page.rows.push_back({m[1], std::stoi(m[2]), m[3]});
+  }
+  return page;
+}
+
+}  // namespace
+
+TEST(BadInputPage, HasRowsForEveryCommand) {
+  const Page page = read_page();
+  ASSERT_GE(page.rows.size(), 20u);
+  for (const char* command : {"afmkit tapping hb", "afmkit tapping sweep", "afmkit tapping orbit", "afmkit demo",
+                              "afmkit impact", "afmkit control tf", "afmkit control roots", "afmkit control margin",
+                              "afmkit control chart", "afmkit control tune", "afmkit control simulate"}) {
+    bool found = false;
+    for (const Row& r : page.rows) found = found || r.command.find(command) != std::string::npos;
+    EXPECT_TRUE(found) << "docs/bad-input.md has no row for " << command;
+  }
+}
+
+class BadInputRow : public ::testing::TestWithParam<Row> {};
+
+TEST_P(BadInputRow, GivesItsStatusAndMessageAndWritesNothingWhenRejected) {
+  const Row& row = GetParam();
+  TempDir dir;
+  for (const auto& [name, content] : read_page().files) dir.write(name, content + "\n");
+  const std::size_t before = dir.count_files();
+  const auto r = run_shell(row.command, dir);
+  EXPECT_EQ(r.status, row.status) << row.command << "\n" << r.err;
+  EXPECT_NE(r.err.find(row.message), std::string::npos)
+      << row.command << "\nexpected in the message: " << row.message << "\ngot: " << r.err;
+  if (row.status == 2) EXPECT_EQ(dir.count_files(), before) << row.command << ": a file was written";
+}
+
+// One test per row of the page (named by its row number), so ctest runs and reports them one by one.
+INSTANTIATE_TEST_SUITE_P(Docs, BadInputRow, ::testing::ValuesIn(read_page().rows),
+                         [](const ::testing::TestParamInfo<Row>& info) { return "row" + std::to_string(info.index + 1); });

@@ -1,0 +1,85 @@
+// Every command example of the README and docs/ runs as written and succeeds (under the sanitizer build too,
+// where this is how the documented command lines are checked for memory errors and undefined behaviour).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_run.hpp"
+
+using afmkit_test::run_shell;
+using afmkit_test::source_file;
+using afmkit_test::TempDir;
+
+namespace {
+
+struct Example {
+  std::string origin;   // file:line
+  std::string command;  // with `afmkit` for build/bin/afmkit
+};
+[[maybe_unused]] void PrintTo(const Example& e, std::ostream* os) { *os << e.origin << ": " << e.command; }
+
+std::string trim(std::string s) {
+  s.erase(0, s.find_first_not_of(' '));
+  s.erase(s.find_last_not_of(' ') + 1);
+  return s;
+}
+
+// Indented code lines starting with build/bin/afmkit; '\' continues a line; a trailing '# …' is a comment;
+// a word "a|b|c" stands for one example per alternative.
+std::vector<Example> examples() {
+  std::vector<std::string> pages{"README.md"};
+  for (const auto& f : std::filesystem::directory_iterator(std::filesystem::path(AFMKIT_SOURCE_DIR) / "docs"))
+    if (f.path().extension() == ".md") pages.push_back("docs/" + f.path().filename().string());
+  std::vector<Example> out;
+  const std::string prefix = "    build/bin/afmkit";
+  for (const std::string& page : pages) {
+    std::istringstream in(source_file(page));
+    int number = 0;
+    for (std::string line; std::getline(in, line);) {
+      ++number;
+      if (line.rfind(prefix, 0) != 0) continue;
+      const int first = number;
+      std::string command = line;
+      while (!command.empty() && command.back() == '\\' && std::getline(in, line)) {
+        ++number;
+        command.pop_back();
+        command += " " + trim(line);
+      }
+      if (const auto hash = command.find(" #"); hash != std::string::npos) command.erase(hash);
+      command = "afmkit" + trim(command).substr(std::string("build/bin/afmkit").size());
+      std::vector<std::string> variants{command};
+      if (const auto bar = command.find('|'); bar != std::string::npos) {
+        variants.clear();
+        const auto start = command.rfind(' ', bar) + 1, end = command.find(' ', bar);
+        std::istringstream alternatives(command.substr(start, end - start));
+        for (std::string alt; std::getline(alternatives, alt, '|');)
+          variants.push_back(command.substr(0, start) + alt + command.substr(end));
+      }
+      for (const auto& v : variants) out.push_back({page + ":" + std::to_string(first), v});
+    }
+  }
+  return out;
+}
+
+class DocumentedExample : public ::testing::TestWithParam<Example> {};
+
+}  // namespace
+
+TEST(DocumentedExamples, AreFound) { EXPECT_GE(examples().size(), 20u); }
+
+TEST_P(DocumentedExample, RunsAndSucceeds) {
+  TempDir dir;
+  const auto r = run_shell(GetParam().command, dir);
+  EXPECT_EQ(r.status, 0) << GetParam().origin << ": " << GetParam().command << "\n" << r.err;
+}
+
+INSTANTIATE_TEST_SUITE_P(Docs, DocumentedExample, ::testing::ValuesIn(examples()),
+                         [](const ::testing::TestParamInfo<Example>& info) {
+                           std::string name = info.param.origin;
+                           for (char& c : name)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return name + "_" + std::to_string(info.index);
+                         });
