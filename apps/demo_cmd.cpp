@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/io/progress.hpp"
@@ -31,6 +32,8 @@ void run_demo(const io::ParamSet& p) {
   const TappingScales scales = tapping_scales_from(p);
   const std::string dir = p.text("output_dir");
   const int points = static_cast<int>(p.integer("points"));
+  // Both directions are held in memory (then streamed out).
+  memory::require_fits("points", static_cast<double>(points), 2.0 * sizeof(tapping::SweepPoint));
 
   // 1. Harmonic balance: the parametric curve and its folds (jump points).
   tapping::HbCurveOptions hb_options;

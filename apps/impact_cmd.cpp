@@ -6,7 +6,9 @@
 // nm (E* in GPa, R in nm, Hamaker in J); then masses in kg and speeds in nm/s give times in s
 // (1 nN / 1 kg = 1 nm/s²) and energies in nN·nm (1e-18 J).
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -27,6 +29,7 @@ using io::Range;
 
 const char* const linear_keys[] = {"approach_stiffness", "departure_stiffness", "approach_adhesion",
                                    "departure_adhesion", "restitution"};
+const char* const history_columns[] = {"t", "gap", "gap_rate", "force", "x1", "v1", "x2", "v2"};
 const char* const dmt_keys[] = {"effective_modulus", "departure_modulus", "tip_radius", "hamaker",
                                 "departure_hamaker", "intermolecular_distance"};
 
@@ -51,8 +54,13 @@ void add_impact_params(io::ParamSet& p) {
             Range::non_negative())
       .real("departure_adhesion", 0.0, "F_b >= F_a, attraction at the contact edge while departing (attractive)",
             Range::non_negative())
-      .real("restitution", 0.0, "if > 0: set K_b = e^2 K_a for restitution e (MATH.md ext. E0; hysteresis, attractive)",
-            Range::closed(0.0, 1.0))
+      .real("restitution", 0.0,
+            "if given: K_b = e^2 K_a for restitution e in (0, 1] (MATH.md ext. E0; hysteresis, attractive; "
+            "e > 1 needs allow_energy_gain)",
+            Range::non_negative())
+      .flag("allow_energy_gain", false,
+            "accept a law that creates energy (K_b > K_a, restitution > 1; dmt: departure_modulus > effective_modulus "
+            "or departure_hamaker < hamaker): e > 1 and a negative loss are then reported")
       .real("effective_modulus", 1.0, "[dmt] effective modulus E* while approaching (GPa)", Range::positive())
       .real("departure_modulus", 1.0, "[dmt] E* while departing (GPa; default: effective_modulus)", Range::positive())
       .real("tip_radius", 10.0, "[dmt] tip radius R (nm)", Range::positive())
@@ -86,7 +94,7 @@ void reject_foreign_keys(const io::ParamSet& p) {
         reject(k, "use law = attractive (eq. 26) for adhesion");
     }
   }
-  if (p.was_set("restitution") && p.was_set("departure_stiffness") && p.real("restitution") > 0)
+  if (p.was_set("restitution") && p.was_set("departure_stiffness"))
     throw InvalidParameter("restitution", "give either restitution or departure_stiffness, not both");
   if (p.was_set("velocity") && (p.was_set("v1") || p.was_set("v2")))
     throw InvalidParameter("velocity", "give either velocity (relative approach speed) or v1 and v2, not both");
@@ -99,21 +107,26 @@ impact::ForceLaw law_from(const io::ParamSet& p) {
     const double eb = p.was_set("departure_modulus") ? p.real("departure_modulus") : ea;
     const double ha = p.real("hamaker");
     const double hb = p.was_set("departure_hamaker") ? p.real("departure_hamaker") : ha;
-    return impact::DmtLaw(ea, eb, p.real("tip_radius"), ha, hb, p.real("intermolecular_distance"));
+    return impact::DmtLaw(ea, eb, p.real("tip_radius"), ha, hb, p.real("intermolecular_distance"),
+                          p.flag("allow_energy_gain"));
   }
   const double ka = p.real("approach_stiffness");
-  if (law == "linear") return impact::PiecewiseLinearLaw::linear_repulsive(ka);
-  const double e = p.real("restitution");
-  const double kb = e > 0 ? impact::PiecewiseLinearLaw::departure_stiffness_for_restitution(ka, e)
-                          : p.real("departure_stiffness");
-  if (law == "hysteresis") return impact::PiecewiseLinearLaw::linear_hysteresis(ka, kb);
-  return impact::PiecewiseLinearLaw::repulsive_attractive(ka, kb, p.real("approach_adhesion"),
-                                                          p.real("departure_adhesion"));
+  const bool gain = p.flag("allow_energy_gain");
+  if (law == "linear") return impact::PiecewiseLinearLaw(ka, ka, 0.0, 0.0, gain);  // eq. (10)
+  const double kb = p.was_set("restitution")
+                        ? impact::PiecewiseLinearLaw::departure_stiffness_for_restitution(ka, p.real("restitution"), gain)
+                        : p.real("departure_stiffness");
+  if (law == "hysteresis") return impact::PiecewiseLinearLaw(ka, kb, 0.0, 0.0, gain);  // eq. (11)
+  return impact::PiecewiseLinearLaw(ka, kb, p.real("approach_adhesion"), p.real("departure_adhesion"), gain);  // (26)
 }
 
 impact::ImpactProblem problem_from(const io::ParamSet& p) {
   reject_foreign_keys(p);
   const double m1 = p.real("mass1"), m2 = p.real("mass2"), total = m1 + m2, gap = p.real("gap");
+  if (!std::isfinite(total))
+    throw InvalidParameter("mass1", fmt::format("mass1 = {} is out of range: must be such that mass1 + mass2 is finite "
+                                                "(mass2 = {}); rescale the mass unit",
+                                                m1, m2));
   double v1 = 0, v2 = 0;
   if (p.was_set("v1") || p.was_set("v2")) {
     v1 = p.real("v1");
@@ -151,11 +164,13 @@ nlohmann::json result_json(const impact::ImpactResult& r, const impact::ForceLaw
                       {"approach_gap_rate", r.approach_gap_rate},
                       {"departure_gap_rate", r.departure_gap_rate},
                       {"restitution", r.restitution},
+                      {"restitution_deficit", r.restitution_deficit},
                       {"kinetic_energy_before", r.kinetic_energy_before},
                       {"kinetic_energy_after", r.kinetic_energy_after},
                       {"kinetic_energy_loss", r.kinetic_energy_loss},
                       {"energy_loss_restitution", r.energy_loss_restitution},
                       {"energy_loss_area", r.energy_loss_area},
+                      {"energy_balance_residual", r.energy_balance_residual},
                       {"peak_force", r.peak_force},
                       {"min_force", r.min_force},
                       {"body1_after", body_json(r.body1_after)},
@@ -166,6 +181,21 @@ nlohmann::json result_json(const impact::ImpactResult& r, const impact::ForceLaw
       lin && lin->approach_stiffness > 0 && lin->approach_adhesion == 0 && lin->departure_adhesion == 0)
     j["restitution_impulsive_limit"] = std::sqrt(lin->departure_stiffness / lin->approach_stiffness);  // ext. E0
   return j;  // NaN (undefined quantities) is written as null
+}
+
+/// Refuse (exit 2) before any work when the CSV would not fit on the disk: each row holds 8 numbers of at
+/// most 24 characters (shortest round-trip form) plus separators.
+void check_disk_space(const std::string& output, long points) {
+  namespace fs = std::filesystem;
+  const double need = (static_cast<double>(points) + 16.0) * 8.0 * 25.0;
+  fs::path dir = fs::absolute(fs::path(output)).parent_path();
+  while (!dir.empty() && !fs::exists(dir) && dir != dir.root_path()) dir = dir.parent_path();  // created later
+  std::error_code ec;
+  const fs::space_info space = fs::space(dir, ec);
+  if (!ec && need > static_cast<double>(space.available))
+    throw InvalidParameter("points", fmt::format("points = {} writes up to {:.3g} GB to '{}' but only {:.3g} GB are "
+                                                 "free there; use fewer points",
+                                                 points, need / 1e9, output, static_cast<double>(space.available) / 1e9));
 }
 
 void print_summary(const impact::ImpactResult& r, const impact::ForceLaw& law) {
@@ -182,7 +212,7 @@ void print_summary(const impact::ImpactResult& r, const impact::ForceLaw& law) {
   else
     fmt::print("  contact                    none\n");
   fmt::print("  gap rate before / after    {} / {}\n", num(r.approach_gap_rate), num(r.departure_gap_rate));
-  fmt::print("  restitution e (eq. 2)      {}\n", num(r.restitution));
+  fmt::print("  restitution e (eq. 2)      {} (1 - e = {})\n", num(r.restitution), num(r.restitution_deficit));
   fmt::print("  kinetic energy loss        {} (simulated)\n", num(r.kinetic_energy_loss));
   fmt::print("                             {} (eq. 3, from e)\n", num(r.energy_loss_restitution));
   fmt::print("                             {} (eq. 6, area between branches)\n", num(r.energy_loss_area));
@@ -201,20 +231,25 @@ void run_impact(const io::ParamSet& p) {
   options.absolute_tolerance = p.real("absolute_tolerance");
   const std::string output = p.text("output");
   options.history_points = output.empty() ? 0 : p.integer("points");
+  if (!output.empty()) check_disk_space(output, options.history_points);
+
+  // The history is streamed row by row into the CSV (memory does not grow with --points).
+  std::optional<io::TableWriter> table;
+  if (!output.empty()) {
+    table.emplace(output, std::vector<std::string>(std::begin(history_columns), std::end(history_columns)));
+    options.on_sample = [&table](const impact::ImpactSample& s) {
+      table->row(s.time, s.gap, s.gap_rate, s.force, s.position1, s.velocity1, s.position2, s.velocity2);
+    };
+  }
   const impact::ImpactResult r = impact::simulate_impact(problem, options);
   const nlohmann::json summary = result_json(r, problem.law());
+  if (table) table->commit(io::make_sidecar("impact", p.to_json(), summary));
 
-  if (!output.empty()) {
-    io::Table table({"t", "gap", "gap_rate", "force", "x1", "v1", "x2", "v2"});
-    for (const impact::ImpactSample& s : r.history)
-      table.add_row({s.time, s.gap, s.gap_rate, s.force, s.position1, s.velocity1, s.position2, s.velocity2});
-    io::write_table(output, table, io::make_sidecar("impact", p.to_json(), summary));
-  }
   if (p.flag("json")) {
     fmt::print("{}\n", summary.dump(2));
   } else {
     print_summary(r, problem.law());
-    if (!output.empty()) fmt::print("wrote {} rows to {} (summary in {}.json)\n", r.history.size(), output, output);
+    if (table) fmt::print("wrote {} rows to {} (summary in {}.json)\n", table->size(), output, output);
   }
 }
 

@@ -1,6 +1,8 @@
 // afmkit tapping orbit: every harmonic-balance solution and every periodic orbit found at one separation
-// (shooting from each HB solution, and transients from rest and from the free response), with Floquet
-// stability and the orbit observables. CSV: one row per orbit; JSON sidecar: HB solutions and transients.
+// (find_orbits: shooting from each HB solution, transients, a phase × amplitude grid, states in contact and the
+// branches continued through l), with Floquet stability and the orbit observables. CSV: one row per orbit;
+// JSON sidecar: HB solutions, transients and the search report (seeds per kind, which seeds found which orbit).
+#include <array>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -22,10 +24,51 @@ namespace {
 
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
-nlohmann::json orbit_json(const tapping::FoundOrbit& f, const TappingScales& s) {
+/// Seeds of each kind (tapping::SeedKind names) among `seeds` (indices into the search report).
+nlohmann::json seeds_by_kind(const std::vector<int>& seeds, const tapping::OrbitSearchReport& report) {
+  std::array<int, tapping::seed_kind_count> n{};
+  for (int i : seeds) ++n[static_cast<std::size_t>(report.seeds[i].kind)];
+  nlohmann::json j = nlohmann::json::object();
+  for (int k = 0; k < tapping::seed_kind_count; ++k) j[tapping::seed_kind_name(static_cast<tapping::SeedKind>(k))] = n[k];
+  return j;
+}
+
+/// How find_orbits searched: seeds per kind, converged per kind, the continuation bracket, every seed.
+nlohmann::json search_json(const tapping::OrbitSearchReport& r, const TappingScales& s) {
+  nlohmann::json by_kind = nlohmann::json::object(), converged = nlohmann::json::object();
+  for (int k = 0; k < tapping::seed_kind_count; ++k) {
+    const char* name = tapping::seed_kind_name(static_cast<tapping::SeedKind>(k));
+    by_kind[name] = r.seeds_by_kind[k];
+    converged[name] = r.converged_by_kind[k];
+  }
+  nlohmann::json seeds = nlohmann::json::array();
+  for (const tapping::SearchSeed& seed : r.seeds) {
+    nlohmann::json j = {{"kind", tapping::seed_kind_name(seed.kind)},
+                        {"initial_position", seed.start.position * s.length},
+                        {"initial_velocity", seed.start.velocity * s.length / s.time},
+                        {"orbits", seed.orbits}};
+    if (seed.kind == tapping::SeedKind::grid) {
+      j["grid_phase"] = seed.grid_phase;
+      j["grid_amplitude"] = seed.grid_amplitude * s.length;
+    }
+    seeds.push_back(j);
+  }
+  return {{"seeds_by_kind", by_kind},
+          {"converged_by_kind", converged},
+          {"seeds_total", r.seeds.size()},
+          {"continuation_runs", r.continuation_runs},
+          {"continuation_bracket", {r.bracket_min * s.length, r.bracket_max * s.length}},
+          {"seconds", r.seconds},
+          {"seeds", seeds}};
+}
+
+nlohmann::json orbit_json(const tapping::FoundOrbit& f, const tapping::OrbitSearchReport& report,
+                          const TappingScales& s) {
   const auto& m = f.metrics;
   const auto& o = f.orbit;
   return {{"source", tapping::orbit_source_name(f.source)},
+          {"found_by", seeds_by_kind(f.seeds, report)},
+          {"seeds", f.seeds},
           {"period_multiple", o.period_multiple},
           {"stable", o.stable},
           {"floquet_max", number(o.floquet_max)},
@@ -58,22 +101,8 @@ void run_orbit(const io::ParamSet& p) {
   options.transient = transient_options_from(p);
   const tapping::OrbitSearchResult r = tapping::find_orbits(model, options);
 
-  io::Table table({"source", "period_multiple", "stable", "amplitude", "offset", "phase", "harmonic_2", "harmonic_3",
-                   "harmonic_4", "harmonic_5", "contact_fraction", "peak_force", "min_gap", "energy_dissipated",
-                   "viscous_dissipation", "contact_dissipation", "floquet_max", "sticking_time", "initial_position",
-                   "initial_velocity"});
   nlohmann::json orbits = nlohmann::json::array();
-  for (const tapping::FoundOrbit& f : r.orbits) {
-    const auto& m = f.metrics;
-    const double l = scales.length;
-    table.add_row({std::string(tapping::orbit_source_name(f.source)), static_cast<long>(f.orbit.period_multiple),
-                   f.orbit.stable, m.amplitude * l, m.offset * l, m.phase, m.harmonics[0] * l, m.harmonics[1] * l,
-                   m.harmonics[2] * l, m.harmonics[3] * l, m.contact_fraction, m.peak_force * scales.force,
-                   m.min_gap * l, m.energy_dissipated() * scales.energy, m.viscous_dissipation * scales.energy,
-                   m.contact_dissipation * scales.energy, f.orbit.floquet_max, m.sticking_duration * scales.time,
-                   f.orbit.initial.position * l, f.orbit.initial.velocity * l / scales.time});
-    orbits.push_back(orbit_json(f, scales));
-  }
+  for (const tapping::FoundOrbit& f : r.orbits) orbits.push_back(orbit_json(f, r.report, scales));
   nlohmann::json hb = nlohmann::json::array();
   for (const tapping::HbPoint& h : r.harmonic_balance)
     hb.push_back({{"branch", tapping::branch_name(h.branch)},
@@ -92,9 +121,26 @@ void run_orbit(const io::ParamSet& p) {
                                   {"free_amplitude", model.free_amplitude() * scales.length},
                                   {"harmonic_balance", hb},
                                   {"orbits", orbits},
-                                  {"transients", transients}};
+                                  {"transients", transients},
+                                  {"search", search_json(r.report, scales)}};
   const std::string output = p.text("output");
-  if (!output.empty()) io::write_table(output, table, io::make_sidecar("tapping orbit", p.to_json(), summary));
+  if (!output.empty()) {
+    io::TableWriter table(output, {"source", "period_multiple", "stable", "amplitude", "offset", "phase", "harmonic_2",
+                                   "harmonic_3", "harmonic_4", "harmonic_5", "contact_fraction", "peak_force",
+                                   "min_gap", "energy_dissipated", "viscous_dissipation", "contact_dissipation",
+                                   "floquet_max", "sticking_time", "initial_position", "initial_velocity"});
+    for (const tapping::FoundOrbit& f : r.orbits) {
+      const auto& m = f.metrics;
+      const double l = scales.length;
+      table.row(tapping::orbit_source_name(f.source), f.orbit.period_multiple, f.orbit.stable, m.amplitude * l,
+                m.offset * l, m.phase, m.harmonics[0] * l, m.harmonics[1] * l, m.harmonics[2] * l,
+                m.harmonics[3] * l, m.contact_fraction, m.peak_force * scales.force, m.min_gap * l,
+                m.energy_dissipated() * scales.energy, m.viscous_dissipation * scales.energy,
+                m.contact_dissipation * scales.energy, f.orbit.floquet_max, m.sticking_duration * scales.time,
+                f.orbit.initial.position * l, f.orbit.initial.velocity * l / scales.time);
+    }
+    table.commit(io::make_sidecar("tapping orbit", p.to_json(), summary));
+  }
   if (p.flag("json")) {
     fmt::print("{}\n", summary.dump(2));
     return;
@@ -105,14 +151,30 @@ void run_orbit(const io::ParamSet& p) {
     fmt::print("  HB {:5s} amplitude {:.6g}  offset {:.6g}  phase {:.6g}\n", tapping::branch_name(h.branch),
                h.amplitude * scales.length, h.offset * scales.length, h.phase);
   for (const tapping::FoundOrbit& f : r.orbits)
-    fmt::print("  orbit ({}{}) amplitude {:.6g}  offset {:.6g}  phase {:.6g}  {}  |mu|max {:.4g}  contact {:.3g}\n",
+    fmt::print("  orbit ({}{}) amplitude {:.6g}  offset {:.6g}  phase {:.6g}  {}  |mu|max {:.4g}  contact {:.3g}  "
+               "found by {} seed(s)\n",
                tapping::orbit_source_name(f.source),
                f.orbit.period_multiple > 1 ? fmt::format(", period {}", f.orbit.period_multiple) : std::string(),
                f.metrics.amplitude * scales.length, f.metrics.offset * scales.length, f.metrics.phase,
-               f.orbit.stable ? "stable" : "unstable", f.orbit.floquet_max, f.metrics.contact_fraction);
+               f.orbit.stable ? "stable" : "unstable", f.orbit.floquet_max, f.metrics.contact_fraction,
+               f.seeds.size());
   for (const tapping::TransientOutcome& t : r.transients)
     if (t.kind != tapping::ResponseKind::periodic) fmt::print("  transient: {}\n", t.message);
-  if (!output.empty()) fmt::print("wrote {} rows to {} (details in {}.json)\n", table.size(), output, output);
+  {
+    const auto& rep = r.report;
+    std::string kinds;
+    int converged = 0;
+    for (int k = 0; k < tapping::seed_kind_count; ++k) {
+      kinds += fmt::format("{}{} {}/{}", k ? ", " : "", tapping::seed_kind_name(static_cast<tapping::SeedKind>(k)),
+                           rep.converged_by_kind[k], rep.seeds_by_kind[k]);
+      converged += rep.converged_by_kind[k];
+    }
+    fmt::print("  search: {} seeds, {} converged (converged/seeds: {}); {} branch continuations over l in [{:.6g}, "
+               "{:.6g}]; {:.3g} s\n",
+               rep.seeds.size(), converged, kinds, rep.continuation_runs, rep.bracket_min * scales.length,
+               rep.bracket_max * scales.length, rep.seconds);
+  }
+  if (!output.empty()) fmt::print("wrote {} rows to {} (details in {}.json)\n", r.orbits.size(), output, output);
 }
 
 }  // namespace
@@ -124,8 +186,8 @@ void register_tapping_orbit(CLI::App& tapping) {
   params->flag("json", false, "print the result as JSON instead of the summary")
       .text("output", "out/tapping_orbit.csv", "output CSV path (JSON sidecar next to it); empty: no file");
   auto* cmd = tapping.add_subcommand(
-      "orbit", "all periodic orbits at one separation: shooting from every HB solution and from transients, "
-               "Floquet stability, harmonics, contact, energy");
+      "orbit", "all periodic orbits at one separation: shooting from every HB solution, transients, a phase x "
+               "amplitude grid, contact states and branch continuation; Floquet stability, harmonics, contact, energy");
   params->add_options(*cmd);
   cmd->callback([params] {
     params->resolve();

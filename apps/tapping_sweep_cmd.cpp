@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/io/progress.hpp"
@@ -40,6 +41,8 @@ void run_sweep(const io::ParamSet& p) {
                                                          "separation_max = {}",
                                                          p.real("separation_min"), p.real("separation_max")));
   const int points = static_cast<int>(p.integer("points"));
+  // Both directions are held in memory (then streamed out).
+  memory::require_fits("points", static_cast<double>(points), 2.0 * sizeof(tapping::SweepPoint));
   const std::string& mode = p.text("mode");
   const bool instrument = mode == "instrument" || mode == "both";
   const bool continuation = mode == "continuation" || mode == "both";

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <fstream>
 #include <limits>
+#include <optional>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -30,11 +34,29 @@ ImpactProblem::ImpactProblem(Body body1, Body body2, ForceLaw law, ExternalForce
   // ḋ(t_s) < 0: the impact starts with an approach (seed-1 §II); e (eq. 2) needs ḋ(t_s) ≠ 0.
   validate::require(std::isfinite(rate) && rate < 0, "relative_velocity", rate,
                     "< 0 (v2 - v1: the bodies must approach each other at the start of the impact)");
+  // Scales must stay inside the double range (every later quantity is built from them).
+  constexpr double tiny = std::numeric_limits<double>::min();
+  const double total = total_mass(), mu = reduced_mass();
+  validate::require(std::isfinite(total), "mass1", body1_.mass,
+                    fmt::format("such that mass1 + mass2 is finite (mass2 = {}); rescale the mass unit", body2_.mass));
+  validate::require(mu >= tiny, "mass1", body1_.mass,
+                    fmt::format("such that the reduced mass m1 m2/(m1 + m2) >= {:g} (mass2 = {}); rescale the mass unit",
+                                tiny, body2_.mass));
+  const double kinetic = 0.5 * mu * rate * rate;
+  validate::require(std::isfinite(kinetic) && kinetic >= tiny && std::isfinite(body1_.mass * body1_.velocity) &&
+                        std::isfinite(body2_.mass * body2_.velocity),
+                    "relative_velocity", rate,
+                    fmt::format("such that the momenta and the relative kinetic energy ½ μ (v2 - v1)² (μ = {}) lie in "
+                                "[{:g}, {:g}]; rescale the units",
+                                mu, tiny, std::numeric_limits<double>::max()));
+  law_.require_dissipative();  // K_b <= K_a etc. unless the law opts in (seed-1 eq. 6: loss = area >= 0)
 }
 
 ImpactProblem ImpactProblem::head_on(double mass1, double mass2, double approach_speed, double gap, ForceLaw law) {
   validate::positive("mass1", mass1);
   validate::positive("mass2", mass2);
+  validate::require(std::isfinite(mass1 + mass2), "mass1", mass1,
+                    fmt::format("such that mass1 + mass2 is finite (mass2 = {}); rescale the mass unit", mass2));
   validate::positive("approach_speed", approach_speed);
   validate::finite("gap", gap);
   const double total = mass1 + mass2;
@@ -53,7 +75,8 @@ double restitution_energy_loss(double m1, double m2, double relative_velocity, d
   validate::positive("mass2", m2);
   validate::finite("relative_velocity", relative_velocity);
   validate::non_negative("restitution", e);
-  return (1.0 - e * e) * m1 * m2 / (2.0 * (m1 + m2)) * relative_velocity * relative_velocity;  // eq. (3)
+  // eq. (3); (1 − e)(1 + e) rather than 1 − e², exact factor 1 − e for e near 1
+  return (1.0 - e) * (1.0 + e) * (m1 * (m2 / (m1 + m2))) / 2.0 * relative_velocity * relative_velocity;
 }
 
 namespace detail {
@@ -63,20 +86,39 @@ double contact_gap_of(const ForceLaw& law) {
   return gaps.empty() ? nan : gaps.back();
 }
 
-std::vector<double> sample_times(double end_time, long points, const std::vector<double>& events) {
-  std::vector<double> t;
-  if (points <= 0) return t;
-  t.reserve(static_cast<std::size_t>(points) + events.size());
-  for (long k = 0; k < points; ++k) t.push_back(end_time * static_cast<double>(k) / static_cast<double>(points - 1));
-  t.back() = end_time;
+SampleClock::SampleClock(double end_time, long points, std::vector<double> events)
+    : end_time_(end_time), points_(points) {
+  if (points_ <= 0) return;
   for (double e : events)
-    if (e >= 0 && e <= end_time) t.push_back(e);
-  std::sort(t.begin(), t.end());
-  t.erase(std::unique(t.begin(), t.end()), t.end());
-  return t;
+    if (e >= 0 && e <= end_time) events_.push_back(e);
+  std::sort(events_.begin(), events_.end());
+  advance();
 }
 
-void complete_result(const ImpactProblem& problem, ImpactResult& r) {
+double SampleClock::uniform(long k) const {
+  return k + 1 == points_ ? end_time_ : end_time_ * static_cast<double>(k) / static_cast<double>(points_ - 1);
+}
+
+void SampleClock::advance() {
+  for (;;) {
+    const bool u = k_ < points_, e = j_ < events_.size();
+    if (!u && !e) {
+      has_next_ = false;
+      return;
+    }
+    double t = 0;
+    if (u && (!e || uniform(k_) <= events_[j_])) t = uniform(k_++);
+    else t = events_[j_++];
+    if (have_last_ && t == last_) continue;  // exact duplicate
+    next_ = last_ = t;
+    have_last_ = has_next_ = true;
+    return;
+  }
+}
+
+void SampleClock::pop() { advance(); }
+
+void complete_result(const ImpactProblem& problem, ImpactResult& r, double relative_loss) {
   const double m1 = problem.body1().mass, m2 = problem.body2().mass, total = m1 + m2;
   const double mu = problem.reduced_mass();
   r.reduced_mass = mu;
@@ -106,19 +148,62 @@ void complete_result(const ImpactProblem& problem, ImpactResult& r) {
     const double com_s = (m1 * s1.velocity + m2 * s2.velocity) / total;
     const double com_f = (m1 * r.body1_after.velocity + m2 * r.body2_after.velocity) / total;
     const double rel_s = r.approach_gap_rate, rel_f = r.body2_after.velocity - r.body1_after.velocity;
+    const double relative_ke = 0.5 * mu * rel_s * rel_s;
     r.departure_gap_rate = rel_f;
     r.restitution = -rel_f / rel_s;  // eq. (2)
-    r.kinetic_energy_loss =
-        0.5 * total * (com_s - com_f) * (com_s + com_f) + 0.5 * mu * (rel_s - rel_f) * (rel_s + rel_f);
-    r.energy_loss_restitution = (1.0 - r.restitution * r.restitution) * 0.5 * mu * rel_s * rel_s;  // eq. (3)
+    double rel_loss = 0.5 * mu * (rel_s - rel_f) * (rel_s + rel_f);
+    r.restitution_deficit = (rel_s + rel_f) / rel_s;  // 1 − e, as accurate as the state (integrator)
+    if (std::isfinite(relative_loss)) {
+      // 1 − e² = x = loss/(½ μ ḋ(t_s)²) known to relative accuracy: 1 − e = x/(1 + e) without cancellation
+      rel_loss = relative_loss;
+      r.restitution_deficit = relative_loss / relative_ke / (1.0 + r.restitution);
+    }
+    r.kinetic_energy_loss = 0.5 * total * (com_s - com_f) * (com_s + com_f) + rel_loss;
+    r.energy_loss_restitution = r.restitution_deficit * (1.0 + r.restitution) * relative_ke;  // eq. (3)
     r.energy_loss_area = hysteresis_energy_loss(problem.law(), r.minimum_gap, r.reference_gap);  // eq. (6)
   } else {
-    r.departure_gap_rate = r.restitution = nan;
+    r.departure_gap_rate = r.restitution = r.restitution_deficit = nan;
     r.kinetic_energy_loss = r.energy_loss_restitution = r.energy_loss_area = nan;
   }
 }
 
 }  // namespace detail
+
+namespace {
+
+/// MemAvailable from /proc/meminfo in bytes (nullopt where unreadable).
+std::optional<double> available_memory() {
+  std::ifstream in("/proc/meminfo");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("MemAvailable:", 0) != 0) continue;
+    std::istringstream fields(line.substr(13));
+    double kib = 0;
+    if (fields >> kib) return kib * 1024.0;
+  }
+  return std::nullopt;
+}
+
+/// The solved impact must be representable: non-finite times, gaps or speeds mean the input scales
+/// (gap / speed, stiffness / reduced mass, …) leave the double range.
+void require_finite_result(const ImpactResult& r) {
+  const bool separated = r.outcome == ImpactOutcome::separated;
+  for (auto [name, value] : {std::pair{"end_time", r.end_time}, std::pair{"minimum_time", r.minimum_time},
+                             std::pair{"minimum_gap", r.minimum_gap},
+                             std::pair{"kinetic_energy_before", r.kinetic_energy_before},
+                             std::pair{"restitution", separated ? r.restitution : 0.0},
+                             std::pair{"kinetic_energy_loss", separated ? r.kinetic_energy_loss : 0.0},
+                             std::pair{"energy_loss_area", separated ? r.energy_loss_area : 0.0},
+                             std::pair{"peak_force", r.peak_force}})
+    if (!std::isfinite(value))
+      throw InvalidParameter(
+          "parameters",
+          fmt::format("the impact leaves the double range ({} = {}): the combination of gap, velocity, masses and "
+                      "law coefficients is too extreme; rescale the units so that each lies within about 1e-150 .. "
+                      "1e150",
+                      name, value));
+}
+
+}  // namespace
 
 ImpactResult simulate_impact(const ImpactProblem& problem, const ImpactOptions& options) {
   validate::require(options.relative_tolerance > 0 && options.relative_tolerance <= 1e-2, "relative_tolerance",
@@ -126,23 +211,28 @@ ImpactResult simulate_impact(const ImpactProblem& problem, const ImpactOptions& 
   validate::positive("absolute_tolerance", options.absolute_tolerance);
   validate::in_range("max_steps", options.max_steps, 1L, 1'000'000'000L);
   validate::non_negative("max_time", options.max_time);
-  if (options.history_points != 0) validate::in_range("history_points", options.history_points, 2L, 100'000'000L);
+  if (options.history_points != 0) validate::in_range("history_points", options.history_points, 2L, 1'000'000'000L);
+  if (options.history_points > 0 && !options.on_sample) {
+    // Stored history: one ImpactSample per point (plus a few events). Refuse before any work when it would not fit.
+    const double need = static_cast<double>(options.history_points + 16) * sizeof(ImpactSample);
+    if (const auto avail = available_memory(); avail && need > *avail)
+      throw InvalidParameter("history_points",
+                             fmt::format("history_points = {} needs {:.3g} GB to store the history but only {:.3g} GB "
+                                         "are available (MemAvailable); use fewer points or ImpactOptions::on_sample "
+                                         "to stream the samples",
+                                         options.history_points, need / 1e9, *avail / 1e9));
+  }
 
   const bool closed_form_possible = problem.law().piecewise_linear() != nullptr && problem.external().constant();
-  switch (options.method) {
-    case ImpactMethod::closed_form:
-      if (!closed_form_possible)
-        throw InvalidParameter("method",
-                               "method = closed_form needs a piecewise-linear law (seed-1 eqs. 10, 11, 26) and "
-                               "constant external forces; use integrator or automatic");
-      return detail::closed_form_impact(problem, options);
-    case ImpactMethod::integrator:
-      return detail::integrated_impact(problem, options);
-    case ImpactMethod::automatic:
-    default:
-      return closed_form_possible ? detail::closed_form_impact(problem, options)
-                                  : detail::integrated_impact(problem, options);
-  }
+  if (options.method == ImpactMethod::closed_form && !closed_form_possible)
+    throw InvalidParameter("method",
+                           "method = closed_form needs a piecewise-linear law (seed-1 eqs. 10, 11, 26) and "
+                           "constant external forces; use integrator or automatic");
+  const bool closed = options.method == ImpactMethod::closed_form ||
+                      (options.method == ImpactMethod::automatic && closed_form_possible);
+  ImpactResult r = closed ? detail::closed_form_impact(problem, options) : detail::integrated_impact(problem, options);
+  require_finite_result(r);
+  return r;
 }
 
 }  // namespace afmkit::impact

@@ -160,6 +160,28 @@ ImpactResult closed_form_impact(const ImpactProblem& problem, const ImpactOption
     }
   }
   if (!finished) throw NumericalFailure("closed-form impact: too many arcs (internal error)");
+  for (const Arc& a : arcs)
+    if (!std::isfinite(a.w2) || !std::isfinite(a.accel))
+      throw InvalidParameter("approach_stiffness",
+                             fmt::format("stiffness / reduced mass = {} and (adhesion, external force) / mass = {} "
+                                         "must be finite (reduced mass {}): rescale the units",
+                                         a.w2, a.accel, mu));
+
+  // Departure speed from the energy balance (exact for this flow): each arc conserves ½ μ ḋ² + U(d) − μ g d
+  // (U' = −H), and the switch H_a -> H_b at t̄ removes the area between the branches, so
+  // ½ μ ḋ(t_f)² = ½ μ ḋ(t_s)² − ∫_{d(t̄)}^{d(t_s)} (H_a − H_b) dξ (seed-1 eqs. 3, 6). Writing ḋ(t_f) this way,
+  // with the area in closed form, keeps 1 − e and the loss relatively accurate as e → 1 (the arc-by-arc value
+  // carries an absolute rounding error ~ε|ḋ(t_s)|, i.e. a relative error ε/(1 − e) of the loss).
+  double relative_loss = nan;
+  if (r.outcome == ImpactOutcome::separated) {
+    const double v_s = problem.initial_gap_rate();
+    relative_loss = hysteresis_energy_loss(problem.law(), r.minimum_gap, d_ref);
+    r.energy_balance_residual = 0.5 * mu * (v_s - v) * (v_s + v) - relative_loss;  // arcs vs eq. (6)
+    const double x = relative_loss / (0.5 * mu * v_s * v_s);  // 1 − e²
+    if (x < 1) v = -v_s * std::sqrt(1.0 - x);
+  } else {
+    r.energy_balance_residual = nan;
+  }
 
   // Centre-of-mass motion (exact for constant forces) and body states.
   const double com_x0 = (m1 * problem.body1().position + m2 * problem.body2().position) / total;
@@ -198,23 +220,24 @@ ImpactResult closed_form_impact(const ImpactProblem& problem, const ImpactOption
   if (r.contact && std::isnan(r.contact_end) && r.outcome == ImpactOutcome::separated) r.contact_end = t;
   if (r.contact && r.outcome == ImpactOutcome::captured) r.contact_end = nan;
 
-  // History: uniform grid plus the arc boundaries; at t̄ one row per branch.
-  const auto times = sample_times(t, options.history_points, events);
-  r.history.reserve(times.size() + 2);
-  for (std::size_t i = 0, k = 0; i < arcs.size(); ++i) {
+  // History: uniform grid plus the arc boundaries; at t̄ one row per branch. Streamed to the sink one sample
+  // at a time.
+  SampleClock clock(t, options.history_points, events);
+  const HistorySink emit(options, r.history);
+  for (std::size_t i = 0; i < arcs.size(); ++i) {
     const Arc& a = arcs[i];
     const bool last = i + 1 == arcs.size();
     const bool turn = ended_at_turn && a.t1 == r.minimum_time && !a.departure;
-    for (; k < times.size() && (times[k] < a.t1 || (last && times[k] <= a.t1)); ++k) {
-      if (times[k] < a.t0) continue;
+    for (; !clock.done() && (clock.peek() < a.t1 || (last && clock.peek() <= a.t1)); clock.pop()) {
+      if (clock.peek() < a.t0) continue;
       ImpactSample s{};
-      s.time = times[k];
+      s.time = clock.peek();
       a.state(s.time, s.gap, s.gap_rate);
       s.force = a.departure ? problem.law().departure(s.gap) : problem.law().approach(s.gap);
       Body b1{}, b2{};
       bodies(s.time, s.gap, s.gap_rate, b1, b2);
       s.position1 = b1.position, s.velocity1 = b1.velocity, s.position2 = b2.position, s.velocity2 = b2.velocity;
-      r.history.push_back(s);
+      emit(s);
     }
     if (turn && options.history_points > 0) {
       // t̄: one row on the approach branch, one on the departure branch (the next arc's first row, or
@@ -226,16 +249,11 @@ ImpactResult closed_form_impact(const ImpactProblem& problem, const ImpactOption
       Body b1{}, b2{};
       bodies(s.time, s.gap, 0.0, b1, b2);
       s.position1 = b1.position, s.velocity1 = b1.velocity, s.position2 = b2.position, s.velocity2 = b2.velocity;
-      if (!last) {
-        s.force = problem.law().approach(s.gap);
-        r.history.push_back(s);
-      } else {
-        s.force = problem.law().departure(s.gap);
-        r.history.push_back(s);
-      }
+      s.force = last ? problem.law().departure(s.gap) : problem.law().approach(s.gap);
+      emit(s);
     }
   }
-  complete_result(problem, r);
+  complete_result(problem, r, relative_loss);
   return r;
 }
 

@@ -62,7 +62,8 @@ TEST(ImpactIntegrator, CustomLawFromLambdasReproducesLinearHysteresis) {
   const double mu = 2.0 / 3.0, delta = 1.5 * std::sqrt(mu / 9.0);
   EXPECT_NEAR(r.minimum_gap, -delta, 1e-9 * delta);
   EXPECT_NEAR(r.energy_loss_area, 0.5 * (9 - 4) * delta * delta, 1e-9 * r.energy_loss_area);  // via d(t̄)
-  EXPECT_NEAR(r.kinetic_energy_loss, r.energy_loss_area, 1e-9 * r.kinetic_energy_before);
+  // seed-1 eq. (6) checked on the integrated state itself (the reported loss uses the energy balance)
+  EXPECT_NEAR(r.energy_balance_residual, 0.0, 1e-9 * r.kinetic_energy_before);
 }
 
 TEST(ImpactIntegrator, DmtAreaQuadratureMatchesAnalyticIntegral) {
@@ -88,8 +89,9 @@ TEST(ImpactIntegrator, DmtImpactLosesTheAreaBetweenBranches) {
   EXPECT_EQ(r.method, "integrator");
   EXPECT_TRUE(r.contact);
   EXPECT_GT(r.max_penetration, 0.1);
-  // seed-1 eq. (6): kinetic-energy loss (simulated) = area between the branches (quadrature)
-  EXPECT_NEAR(r.kinetic_energy_loss, r.energy_loss_area, 1e-8 * r.kinetic_energy_before);
+  // seed-1 eq. (6): kinetic-energy loss of the integrated state = area between the branches (the reported
+  // ḋ(t_f) comes from the energy balance at the integrated d(t̄); the residual is the integration's own check)
+  EXPECT_NEAR(r.energy_balance_residual, 0.0, 1e-8 * r.kinetic_energy_before);
   // eq. (3) is an identity given e
   EXPECT_NEAR(r.energy_loss_restitution, r.kinetic_energy_loss, 1e-8 * r.kinetic_energy_before);
   EXPECT_GT(r.restitution, 0.0);

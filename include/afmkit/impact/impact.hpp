@@ -39,21 +39,28 @@ struct ExternalForces {
   double force2(double t) const { return varying2 ? on_body2 + varying2(t) : on_body2; }
 };
 
-/// A validated impact problem: m1, m2 > 0, finite initial state, approaching bodies (ḋ(t_s) = v2 − v1 < 0).
+/// A validated impact problem: m1, m2 > 0, finite initial state, approaching bodies (ḋ(t_s) = v2 − v1 < 0),
+/// a dissipative law (K_b ≤ K_a, …) unless the law sets allow_energy_gain, and scales inside the double
+/// range (m1 + m2, μ, ½ μ ḋ(t_s)² finite and normal).
 class ImpactProblem {
  public:
-  /// Throws InvalidParameter naming mass1/mass2/position1/…/relative_velocity/force1/force2.
+  /// Throws InvalidParameter naming mass1/mass2/position1/…/relative_velocity/force1/force2, or
+  /// departure_stiffness/departure_modulus/departure_hamaker for a law that creates energy.
   ImpactProblem(Body body1, Body body2, ForceLaw law, ExternalForces external = {});
   /// Isolated head-on impact with the centre of mass at rest at the origin: gap d(t_s) = `gap`,
   /// approach speed −ḋ(t_s) = `approach_speed` > 0.
   static ImpactProblem head_on(double mass1, double mass2, double approach_speed, double gap, ForceLaw law);
 
-  const Body& body1() const { return body1_; }
-  const Body& body2() const { return body2_; }
-  const ForceLaw& law() const { return law_; }
-  const ExternalForces& external() const { return external_; }
+  const Body& body1() const& { return body1_; }
+  Body body1() const&& { return body1_; }
+  const Body& body2() const& { return body2_; }
+  Body body2() const&& { return body2_; }
+  const ForceLaw& law() const& { return law_; }
+  ForceLaw law() const&& { return law_; }
+  const ExternalForces& external() const& { return external_; }
+  ExternalForces external() const&& { return external_; }
   double total_mass() const { return body1_.mass + body2_.mass; }
-  double reduced_mass() const { return body1_.mass * body2_.mass / total_mass(); }  // μ
+  double reduced_mass() const { return body1_.mass * (body2_.mass / total_mass()); }  // μ (no overflow of m1 m2)
   double initial_gap() const { return body2_.position - body1_.position; }            // d(t_s)
   double initial_gap_rate() const { return body2_.velocity - body1_.velocity; }       // ḋ(t_s) < 0
 
@@ -69,6 +76,15 @@ enum class ImpactMethod {
   integrator,   ///< always integrate eq. (1) numerically (any law)
 };
 
+/// One sample of the time history.
+struct ImpactSample {
+  double time;
+  double gap;       // d
+  double gap_rate;  // ḋ
+  double force;     // H on the branch in use (approach before t̄, departure after)
+  double position1, velocity1, position2, velocity2;
+};
+
 /// Numerical settings (validated by simulate_impact).
 struct ImpactOptions {
   ImpactMethod method = ImpactMethod::automatic;
@@ -82,20 +98,15 @@ struct ImpactOptions {
   /// Number of uniformly spaced samples of the time history on [t_s, t_f] (0 = none, else ≥ 2). The event
   /// instants (contact, minimum gap, separation) are added; at t̄ two rows give H_a and H_b.
   long history_points = 0;
+  /// If set, every history sample is passed here (in time order) instead of being stored in
+  /// ImpactResult::history, so memory does not grow with history_points. Without it the history is stored and
+  /// simulate_impact refuses (InvalidParameter "history_points") a history larger than the available memory.
+  std::function<void(const ImpactSample&)> on_sample{};
 };
 
 enum class ImpactOutcome {
   separated,  ///< the gap returned to d(t_s) with ḋ > 0: a complete impact
   captured,   ///< the bodies did not separate (attraction or external forces); no restitution defined
-};
-
-/// One sample of the time history.
-struct ImpactSample {
-  double time;
-  double gap;       // d
-  double gap_rate;  // ḋ
-  double force;     // H on the branch in use (approach before t̄, departure after)
-  double position1, velocity1, position2, velocity2;
 };
 
 struct ImpactResult {
@@ -119,11 +130,21 @@ struct ImpactResult {
   double approach_gap_rate = 0;   ///< ḋ(t_s) < 0
   double departure_gap_rate = 0;  ///< ḋ(t_f) (NaN if captured)
   double restitution = 0;         ///< e = −ḋ(t_f)/ḋ(t_s), seed-1 eq. (2) (NaN if captured)
+  /// 1 − e, computed without cancellation (closed form: from the energy balance), so nearly elastic impacts
+  /// keep relative accuracy (NaN if captured)
+  double restitution_deficit = 0;
   double kinetic_energy_before = 0;
   double kinetic_energy_after = 0;
-  double kinetic_energy_loss = 0;      ///< simulated: KE(t_s) − KE(t_f)
-  double energy_loss_restitution = 0;  ///< (1 − e²) μ/2 ḋ(t_s)², seed-1 eq. (3)
-  double energy_loss_area = 0;         ///< ∫_{d(t̄)}^{d(t_s)} (H_a − H_b) dξ by quadrature, seed-1 eq. (6)
+  double kinetic_energy_loss = 0;      ///< simulated: KE(t_s) − KE(t_f) (closed form: relative part exact, eq. 6)
+  double energy_loss_restitution = 0;  ///< (1 − e)(1 + e) μ/2 ḋ(t_s)², seed-1 eq. (3)
+  double energy_loss_area = 0;         ///< ∫_{d(t̄)}^{d(t_s)} (H_a − H_b) dξ, seed-1 eq. (6) (closed form or quadrature)
+  /// Check of the solution: kinetic-energy loss of the relative motion from the solver's own final state
+  /// (arcs, or the integrated state) minus the eq. (6) area. With constant external forces the reported
+  /// ḋ(t_f), e, 1 − e and losses come from the energy balance ½ μ ḋ(t_f)² = ½ μ ḋ(t_s)² − area at the solved
+  /// d(t̄), which stays relatively accurate as e → 1; this residual shows how far the raw state was from it
+  /// (~ε KE for the closed form, ~ the tolerance × KE for the integrator). NaN if captured or if the external
+  /// forces depend on time (then the integrated state is reported as is).
+  double energy_balance_residual = 0;
   double peak_force = 0;               ///< max H over the impact (repulsive peak); integrator: over steps and events
   double min_force = 0;                ///< min H over the impact (negative: strongest attraction)
 
@@ -137,8 +158,11 @@ struct ImpactResult {
 /// never stops (no repulsion) or a step/time budget is exhausted.
 ImpactResult simulate_impact(const ImpactProblem& problem, const ImpactOptions& options = {});
 
-/// Energy dissipated by the hysteresis, ∫_{minimum_gap}^{reference_gap} (H_a − H_b) dξ (seed-1 eq. 6),
-/// by adaptive Gauss–Kronrod quadrature split at the law's switching gaps.
+/// Energy dissipated by the hysteresis, ∫_{minimum_gap}^{reference_gap} (H_a − H_b) dξ (seed-1 eq. 6).
+/// Piecewise-linear and DMT laws: closed form written in the branch differences K_a − K_b, F_b − F_a,
+/// E*_a − E*_b, A_H,b − A_H,a (relative accuracy also when the branches nearly coincide, e → 1). Custom laws:
+/// adaptive Gauss–Kronrod quadrature of H_a − H_b split at the switching gaps, converged relative to the
+/// area itself or to the rounding floor ε ∫(|H_a| + |H_b|) of the branch values, whichever is larger.
 double hysteresis_energy_loss(const ForceLaw& law, double minimum_gap, double reference_gap);
 
 /// Kinetic-energy loss of an isolated impact with restitution e (seed-1 eq. 3, t_i -> t_s):

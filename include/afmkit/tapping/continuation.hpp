@@ -24,6 +24,7 @@ struct ContinuationOptions {
   double time_budget_seconds = 60.0;  // whole continuation -> stops with stop_reason "time budget"
   bool harmonic_balance = true;
   bool parallel = true;      // metrics and HB of the points on both cores
+  bool analyse_points = true;  // compute the metrics of every point (false: orbits only, metrics left zero)
   ShootingOptions shooting;  // integrator options; tolerance used for the starting orbit
   void validate() const;
 };

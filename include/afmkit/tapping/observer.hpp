@@ -4,6 +4,7 @@
 // event. Observers never influence the integration.
 #include <array>
 #include <complex>
+#include <utility>
 #include <vector>
 
 #include "afmkit/tapping/events.hpp"
@@ -19,7 +20,7 @@ class Segment {
   virtual ~Segment() = default;
   double t_begin() const { return t_begin_; }
   double t_end() const { return t_end_; }
-  const Mode& mode() const { return mode_; }
+  Mode mode() const { return mode_; }
   /// State at t ∈ [t_begin, t_end] (exact for the closed-form flow, dense output for the adaptive one).
   virtual TipState state(double t) const = 0;
 
@@ -44,9 +45,12 @@ class SampleRecorder : public TrajectoryObserver {
  public:
   explicit SampleRecorder(std::vector<double> times);
   void on_segment(const TappingSystem& system, const Segment& segment) override;
-  const std::vector<double>& times() const { return times_; }
-  const std::vector<TipState>& states() const { return states_; }
-  const std::vector<Mode>& modes() const { return modes_; }
+  const std::vector<double>& times() const& { return times_; }
+  std::vector<double> times() && { return std::move(times_); }
+  const std::vector<TipState>& states() const& { return states_; }
+  std::vector<TipState> states() && { return std::move(states_); }
+  const std::vector<Mode>& modes() const& { return modes_; }
+  std::vector<Mode> modes() && { return std::move(modes_); }
 
  private:
   std::vector<double> times_;
@@ -59,7 +63,8 @@ class SampleRecorder : public TrajectoryObserver {
 class EventRecorder : public TrajectoryObserver {
  public:
   void on_event(const TappingSystem& /*system*/, const Event& event) override { events_.push_back(event); }
-  const std::vector<Event>& events() const { return events_; }
+  const std::vector<Event>& events() const& { return events_; }
+  std::vector<Event> events() && { return std::move(events_); }
 
  private:
   std::vector<Event> events_;

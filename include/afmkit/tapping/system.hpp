@@ -4,6 +4,7 @@
 //   ẍ = Γ cos(ωt) − 2ξω_n ẋ − ω_n² x − h_branch(x),   h_branch(x) = −H_branch(x + l)   (seed-1 eq. 8)
 #include <array>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "afmkit/tapping/events.hpp"
@@ -11,19 +12,21 @@
 
 namespace afmkit::tapping {
 
-/// A view of a TappingModel: the model must outlive the system.
+/// The hybrid system of a TappingModel. Owns a copy of the model (no lifetime coupling to the caller's model;
+/// the copy costs about what the old switching-gap copy did, see bench/bench_tapping.cpp).
 class TappingSystem {
  public:
-  explicit TappingSystem(const TappingModel& model);
+  explicit TappingSystem(TappingModel model);
 
-  const TappingModel& model() const { return *model_; }
+  const TappingModel& model() const& { return model_; }
+  TappingModel model() && { return std::move(model_); }
   double separation() const { return separation_; }
   double gap(double x) const { return x + separation_; }  // d = x + l
   /// Number of gap regions (switching gaps + 1). Region r: s_{r−1} ≤ gap < s_r.
-  int region_count() const { return static_cast<int>(switching_.size()) + 1; }
+  int region_count() const { return static_cast<int>(switching().size()) + 1; }
   int region_of(double gap) const;
   /// Lowest switching gap (0 when the law has none): x + l below it counts as contact.
-  double contact_gap() const { return switching_.empty() ? 0.0 : switching_.front(); }
+  double contact_gap() const { return switching().empty() ? 0.0 : switching().front(); }
   /// Whether approach and departure branches differ in `region` (else no velocity guard there).
   bool branch_dependent(int region) const { return region < 64 && ((dependent_mask_ >> region) & 1u); }
 
@@ -65,9 +68,9 @@ class TappingSystem {
                         double& time_partial) const;
 
  private:
-  const TappingModel* model_;
+  TappingModel model_;
   double separation_;
-  std::vector<double> switching_;
+  const std::vector<double>& switching() const& { return model_.law.switching_gaps(); }
   unsigned long dependent_mask_ = 0;
   std::optional<impact::PiecewiseLinearLaw> linear_;  // scaled coefficients when piecewise linear
   double damping_;    // 2ξω_n

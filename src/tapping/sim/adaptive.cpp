@@ -1,6 +1,7 @@
 // Adaptive stepper: Dormand–Prince 5(4) with dense output (Boost.Odeint runge_kutta_dopri5) on the smooth
 // vector field of the current mode, guards scanned on the dense output inside every accepted step and
 // isolated on it. With sensitivities, the variational equations are integrated alongside (8 states).
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -85,6 +86,9 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
       return TipState{tmp[0], tmp[1]};
     };
     sample_guards(sys, mode, guards, n, rs.t, rs.y, a);
+    start_on_pre_side(guards, n,
+                      std::max({1.0, std::abs(rs.y.position), std::abs(rs.y.velocity), std::abs(sys.separation())}),
+                      a);
     std::optional<Crossing> hit;
     double t_stop = t_end;
     for (;;) {

@@ -183,6 +183,9 @@ void run_closed_form(const TappingSystem& sys, RunState& rs, double t_end, const
       };
       FlowSampler sampler(flow, t0, h0, h);
       fill_samples(sys, guards, n, sampler, a);
+      start_on_pre_side(guards, n,
+                        std::max({1.0, std::abs(rs.y.position), std::abs(rs.y.velocity), std::abs(sys.separation())}),
+                        a);
       double ta = t0;
       while (ta < t_end) {
         sampler.advance(safe_steps(a));

@@ -215,7 +215,8 @@ ContinuationResult continue_orbits(const TappingModel& base, const PeriodicOrbit
       break;
     case Stop::none: break;
   }
-  detail::finish_points(base, out.points, options.shooting.simulation, options.harmonic_balance, options.parallel);
+  if (options.analyse_points)
+    detail::finish_points(base, out.points, options.shooting.simulation, options.harmonic_balance, options.parallel);
   return out;
 }
 

@@ -40,6 +40,23 @@ inline void sample_guards(const TappingSystem& sys, const Mode& mode, const std:
   }
 }
 
+/// At the start of a segment (just after an event) the witness of the guard that ends the new mode is zero up to
+/// the rounding of the event location, possibly on its post-crossing side (e.g. entering contact with the gap
+/// at +1e-16: the exit guard "gap rising through 0" then looks already crossed). When the witness rate points
+/// into the pre-crossing side, the state is on the pre side an instant later: record it as such, so a short
+/// excursion (a grazing contact shorter than one scan step) is not missed by the sign test of first_crossing.
+inline void start_on_pre_side(const std::array<Guard, 3>& guards, int n, double scale, GuardSamples& a) {
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  for (int i = 0; i < n; ++i) {
+    const bool falling = guards[i].direction == CrossingDirection::falling;
+    const double v = a.value[i], r = a.rate[i];
+    const bool post_or_zero = falling ? v <= 0.0 : v >= 0.0;
+    const bool into_pre = falling ? r > 0.0 : r < 0.0;
+    if (post_or_zero && into_pre && std::abs(v) <= 1e3 * eps * scale)
+      a.value[i] = falling ? std::numeric_limits<double>::denorm_min() : -std::numeric_limits<double>::denorm_min();
+  }
+}
+
 struct Crossing {
   double time;
   int guard;

@@ -1,6 +1,7 @@
 #include "afmkit/tapping/orbit.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <numbers>
@@ -10,6 +11,8 @@
 #include <Eigen/LU>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/validate.hpp"
+#include "afmkit/tapping/continuation.hpp"
 #include "afmkit/tapping/observer.hpp"
 
 namespace afmkit::tapping {
@@ -22,8 +25,38 @@ const char* orbit_source_name(OrbitSource source) {
     case OrbitSource::transient: return "transient";
     case OrbitSource::previous: return "previous";
     case OrbitSource::continuation: return "continuation";
+    case OrbitSource::grid: return "grid";
+    case OrbitSource::contact: return "contact";
   }
   return "?";
+}
+
+const char* seed_kind_name(SeedKind kind) {
+  switch (kind) {
+    case SeedKind::harmonic_balance: return "harmonic_balance";
+    case SeedKind::transient: return "transient";
+    case SeedKind::grid: return "grid";
+    case SeedKind::contact: return "contact";
+    case SeedKind::continuation: return "continuation";
+  }
+  return "?";
+}
+
+void OrbitSearchOptions::validate() const {
+  shooting.validate();
+  transient.validate();
+  validate::require(grid_phases >= 1 && grid_phases <= 360, "grid_phases", grid_phases, "in [1, 360]");
+  for (double f : grid_amplitudes)
+    validate::require(std::isfinite(f) && f >= 0.0 && f <= 100.0, "grid_amplitudes", f, "in [0, 100] (factors of max(A_free, |l|))");
+  for (std::size_t k = 0; k < grid_transient_periods.size(); ++k)
+    validate::require(grid_transient_periods[k] >= 1 && grid_transient_periods[k] <= 1000000 &&
+                          (k == 0 || grid_transient_periods[k] > grid_transient_periods[k - 1]),
+                      "grid_transient_periods", grid_transient_periods[k], "increasing, in [1, 1000000]");
+  validate::require(std::isfinite(bracket_fraction) && bracket_fraction >= 0.0 && bracket_fraction <= 10.0,
+                    "bracket_fraction", bracket_fraction, "in [0, 10]");
+  validate::require(continuation_max_points >= 2, "continuation_max_points", continuation_max_points, ">= 2");
+  validate::require(duplicate_tolerance > 0.0 && duplicate_tolerance <= 1e-2, "duplicate_tolerance",
+                    duplicate_tolerance, "in (0, 1e-2]");
 }
 
 namespace {
@@ -66,13 +99,6 @@ OrbitMetrics analyse_orbit(const TappingModel& model, const PeriodicOrbit& orbit
 
 namespace {
 
-struct Task {
-  OrbitSource source;
-  TipState guess;
-  bool transient;                // settle first, then the outcome's orbit
-  std::optional<HbPoint> hb{};   // the HB solution the guess comes from
-};
-
 double distance(TipState a, TipState b, double omega) {
   return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
 }
@@ -86,7 +112,7 @@ bool same_orbit(const TappingModel& model, const PeriodicOrbit& a, const Periodi
   TipState p = a.initial;
   for (int j = 0; j < a.period_multiple; ++j) {
     if (distance(p, b.initial, omega) <= tol * scale) return true;
-    p = simulate(model, 0.0, p, model.period(), sim).state;
+    if (j + 1 < a.period_multiple) p = simulate(model, 0.0, p, model.period(), sim).state;
   }
   return false;
 }
@@ -155,12 +181,64 @@ std::optional<TipState> impact_section_guess(const TappingModel& model, const Hb
 
 }  // namespace
 
+namespace {
+
+/// One seed of the search (SearchSeed plus what to do with it).
+struct Task {
+  SeedKind kind;
+  OrbitSource source;
+  TipState start;
+  std::optional<HbPoint> hb{};  // harmonic_balance seeds: the HB solution the guess comes from
+  double phase = 0.0, amplitude = 0.0;
+};
+
+/// Newton from an HB solution; when HB predicts contact but Newton slid onto a contact-free orbit (a grazing
+/// contact orbit missed by the guess), seed again on the impact section.
+std::optional<PeriodicOrbit> shoot_from_hb(const TappingModel& model, const Task& task, const ShootingOptions& shooting) {
+  auto found = try_shoot(model, task.start, 1, shooting);
+  if (task.hb && task.hb->q < 1.0 && (!found || found->stats.impacts == 0)) {
+    if (auto guess = impact_section_guess(model, *task.hb, shooting.simulation)) {
+      auto again = try_shoot(model, *guess, 1, shooting);
+      if (again && again->stats.impacts > 0) found = again;
+    }
+  }
+  return found;
+}
+
+/// Grid / contact seed: Newton from the state, then after each cumulative number of drive periods of transient.
+std::vector<PeriodicOrbit> shoot_with_short_transients(const TappingModel& model, TipState y,
+                                                       const std::vector<int>& periods, const ShootingOptions& quick,
+                                                       const SimulationOptions& sim) {
+  std::vector<PeriodicOrbit> found;
+  auto attempt = [&](TipState s) {
+    try {
+      if (auto o = try_shoot(model, s, 1, quick)) found.push_back(*o);
+    } catch (const NumericalFailure&) {
+    }
+  };
+  attempt(y);
+  int done = 0;
+  for (int k : periods) {
+    // every period restarts at t = 0: the drive is T-periodic, so the phase stays exact
+    for (; done < k; ++done) y = simulate(model, 0.0, y, model.period(), sim).state;
+    attempt(y);
+  }
+  return found;
+}
+
+double elapsed_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
 OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOptions& options) {
-  options.shooting.validate();
-  options.transient.validate();
+  options.validate();
+  const auto t_start = std::chrono::steady_clock::now();
   OrbitSearchResult out;
   std::vector<Task> tasks;
-  const double omega = model.drive.frequency;
+  const double omega = model.drive.frequency, l = model.separation;
+  const double free_amplitude = model.free_amplitude();
   if (options.from_harmonic_balance && model.law.piecewise_linear()) {
     out.harmonic_balance = harmonic_balance_solutions(model);
     for (const HbPoint& p : out.harmonic_balance) {
@@ -169,50 +247,151 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
       const OrbitSource src = p.branch == HbBranch::Free   ? OrbitSource::hb_free
                               : p.branch == HbBranch::Plus ? OrbitSource::hb_plus
                                                            : OrbitSource::hb_minus;
-      tasks.push_back({src, guess, false, p});
+      tasks.push_back({SeedKind::harmonic_balance, src, guess, p});
       // HB is accurate to ~1 %: when two orbits lie closer than that, Newton from the HB guess may pick the
       // wrong one; a transient from the same guess finds the attractor of that neighbourhood.
-      if (options.from_transient && src != OrbitSource::hb_free) tasks.push_back({OrbitSource::transient, guess, true});
+      if (options.from_transient && src != OrbitSource::hb_free)
+        tasks.push_back({SeedKind::transient, OrbitSource::transient, guess});
     }
   }
   if (options.from_transient) {
-    tasks.push_back({OrbitSource::transient, free_response_state(model), true});
-    tasks.push_back({OrbitSource::transient, TipState{0.0, 0.0}, true});
+    tasks.push_back({SeedKind::transient, OrbitSource::transient, free_response_state(model)});
+    tasks.push_back({SeedKind::transient, OrbitSource::transient, TipState{0.0, 0.0}});
   }
-  std::vector<std::optional<PeriodicOrbit>> found(tasks.size());
-  std::vector<std::optional<TransientOutcome>> outcomes(tasks.size());
+  if (options.from_grid) {
+    // phase × energy of the motion: x(t) ≈ a cos(ωt − θ), from near rest to beyond the free amplitude and the
+    // separation (amplitudes above l reach the sample)
+    const double a_ref = std::max(free_amplitude, std::abs(l));
+    for (double f : options.grid_amplitudes) {
+      const int phases = f == 0.0 ? 1 : options.grid_phases;
+      for (int j = 0; j < phases; ++j) {
+        const double theta = 2.0 * std::numbers::pi * j / phases, a = f * a_ref;
+        tasks.push_back({SeedKind::grid, OrbitSource::grid, {a * std::cos(theta), a * omega * std::sin(theta)},
+                         std::nullopt, theta, a});
+      }
+    }
+    // in contact: just below the contact edge (2 % of a_ref deep), moving in, at rest, moving out
+    const double edge = model.law.switching_gaps().empty() ? 0.0 : model.law.switching_gaps().front();
+    const double x_in = edge - l - 0.02 * a_ref;
+    for (double v : {-1.0, -0.3, 0.0, 0.3, 1.0})
+      tasks.push_back({SeedKind::contact, OrbitSource::contact, {x_in, v * omega * a_ref}});
+  }
+
   SimulationOptions sim = options.shooting.simulation;
   sim.sensitivity = false;
+  ShootingOptions quick = options.shooting;
+  quick.max_iterations = std::min(quick.max_iterations, 10);
+  std::vector<std::vector<PeriodicOrbit>> found(tasks.size());
+  std::vector<std::optional<TransientOutcome>> outcomes(tasks.size());
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     try {
-      if (tasks[i].transient) {
-        outcomes[i] = settle(model, tasks[i].guess, options.transient, options.shooting);
-        if (outcomes[i]->orbit) found[i] = outcomes[i]->orbit;
-      } else {
-        found[i] = try_shoot(model, tasks[i].guess, 1, options.shooting);
-        // HB predicts contact but Newton slid onto a contact-free orbit (a grazing contact orbit missed by the
-        // guess): seed again on the impact section
-        if (tasks[i].hb && tasks[i].hb->q < 1.0 && (!found[i] || found[i]->stats.impacts == 0)) {
-          if (auto guess = impact_section_guess(model, *tasks[i].hb, options.shooting.simulation)) {
-            auto again = try_shoot(model, *guess, 1, options.shooting);
-            if (again && again->stats.impacts > 0) found[i] = again;
-          }
-        }
+      switch (tasks[i].kind) {
+        case SeedKind::transient:
+          outcomes[i] = settle(model, tasks[i].start, options.transient, options.shooting);
+          if (outcomes[i]->orbit) found[i].push_back(*outcomes[i]->orbit);
+          break;
+        case SeedKind::harmonic_balance:
+          if (auto o = shoot_from_hb(model, tasks[i], options.shooting)) found[i].push_back(*o);
+          break;
+        default: found[i] = shoot_with_short_transients(model, tasks[i].start, options.grid_transient_periods, quick, sim);
       }
     } catch (const NumericalFailure&) {
-      found[i].reset();  // this candidate failed; others may succeed
+      // this candidate failed (time or event budget); others may succeed
     }
   }
   for (auto& o : outcomes)
     if (o) out.transients.push_back(std::move(*o));
+
+  OrbitSearchReport& report = out.report;
+  auto add_seed = [&](const Task& t) {
+    SearchSeed s;
+    s.kind = t.kind;
+    s.start = t.start;
+    s.grid_phase = t.phase;
+    s.grid_amplitude = t.amplitude;
+    report.seeds.push_back(s);
+  };
+  // merge: each converged orbit is either one already listed (record the seed) or a new one
+  auto merge = [&](int seed, OrbitSource source, const PeriodicOrbit& orbit) {
+    int index = -1;
+    for (std::size_t k = 0; k < out.orbits.size() && index < 0; ++k)
+      if (same_orbit(model, out.orbits[k].orbit, orbit, options.duplicate_tolerance, sim)) index = static_cast<int>(k);
+    if (index < 0) {
+      index = static_cast<int>(out.orbits.size());
+      out.orbits.push_back({source, orbit, {}, {}});
+    }
+    auto& orbit_seeds = out.orbits[index].seeds;
+    if (orbit_seeds.empty() || orbit_seeds.back() != seed) orbit_seeds.push_back(seed);
+    auto& seed_orbits = report.seeds[seed].orbits;
+    if (std::find(seed_orbits.begin(), seed_orbits.end(), index) == seed_orbits.end()) seed_orbits.push_back(index);
+  };
   for (std::size_t i = 0; i < tasks.size(); ++i) {
-    if (!found[i]) continue;
-    bool duplicate = false;
-    for (const FoundOrbit& f : out.orbits)
-      duplicate = duplicate || same_orbit(model, f.orbit, *found[i], options.duplicate_tolerance, sim);
-    if (!duplicate) out.orbits.push_back({tasks[i].source, *found[i], {}});
+    add_seed(tasks[i]);
+    for (const PeriodicOrbit& o : found[i]) merge(static_cast<int>(i), tasks[i].source, o);
   }
+
+  // Continuation: follow the branch of every period-1 orbit found through l ± w in both directions (through
+  // folds, so the unstable orbit between two stable ones is reached from either of them); each point where a
+  // branch crosses l again seeds Newton at l.
+  if (options.from_continuation && options.bracket_fraction > 0.0) {
+    const double w = options.bracket_fraction * free_amplitude;
+    report.bracket_min = l - w;
+    report.bracket_max = l + w;
+    ContinuationOptions copt;
+    copt.shooting = options.shooting;
+    copt.harmonic_balance = false;
+    copt.analyse_points = false;
+    copt.parallel = false;
+    copt.max_points = options.continuation_max_points;
+    copt.max_step = std::max(copt.max_step, 0.02 * free_amplitude);
+    copt.min_step = 1e-6 * std::max(1.0, free_amplitude);
+    copt.initial_step = std::clamp(0.1 * w, copt.min_step, copt.max_step);
+    copt.time_budget_seconds = options.shooting.time_budget_seconds;
+    std::vector<std::pair<PeriodicOrbit, bool>> runs;
+    for (const FoundOrbit& f : out.orbits)
+      if (f.orbit.period_multiple == 1)
+        for (bool up : {true, false}) runs.push_back({f.orbit, up});
+    report.continuation_runs = static_cast<int>(runs.size());
+    std::vector<std::vector<TipState>> crossings(runs.size());
+#pragma omp parallel for schedule(dynamic) if (options.parallel)
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      try {
+        const ContinuationResult c = continue_orbits(model, runs[r].first, l - w, l + w, runs[r].second, copt);
+        for (std::size_t k = 1; k < c.points.size(); ++k) {
+          const SweepPoint &a = c.points[k - 1], &b = c.points[k];
+          const double da = a.separation - l, db = b.separation - l;
+          if (db == 0.0) {
+            crossings[r].push_back(b.orbit.initial);
+          } else if (da != 0.0 && (da < 0) != (db < 0)) {
+            const double u = da / (da - db);
+            crossings[r].push_back({a.orbit.initial.position + u * (b.orbit.initial.position - a.orbit.initial.position),
+                                    a.orbit.initial.velocity + u * (b.orbit.initial.velocity - a.orbit.initial.velocity)});
+          }
+        }
+      } catch (const NumericalFailure&) {
+        // a continuation that cannot start or proceed contributes no seeds
+      }
+    }
+    std::vector<Task> more;
+    for (const auto& list : crossings)
+      for (const TipState& s : list) more.push_back({SeedKind::continuation, OrbitSource::continuation, s});
+    std::vector<std::optional<PeriodicOrbit>> shot(more.size());
+#pragma omp parallel for schedule(dynamic) if (options.parallel)
+    for (std::size_t i = 0; i < more.size(); ++i) {
+      try {
+        shot[i] = try_shoot(model, more[i].start, 1, options.shooting);
+      } catch (const NumericalFailure&) {
+        shot[i].reset();
+      }
+    }
+    for (std::size_t i = 0; i < more.size(); ++i) {
+      const int seed = static_cast<int>(report.seeds.size());
+      add_seed(more[i]);
+      if (shot[i]) merge(seed, OrbitSource::continuation, *shot[i]);
+    }
+  }
+
   std::exception_ptr error;
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
   for (std::size_t i = 0; i < out.orbits.size(); ++i) {
@@ -224,8 +403,27 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
     }
   }
   if (error) std::rethrow_exception(error);
-  std::sort(out.orbits.begin(), out.orbits.end(),
-            [](const FoundOrbit& a, const FoundOrbit& b) { return a.metrics.amplitude < b.metrics.amplitude; });
+  // by increasing amplitude; renumber the seeds' orbit indices
+  std::vector<int> order(out.orbits.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return out.orbits[a].metrics.amplitude < out.orbits[b].metrics.amplitude;
+  });
+  std::vector<int> rank(order.size());
+  std::vector<FoundOrbit> sorted;
+  sorted.reserve(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    rank[order[k]] = static_cast<int>(k);
+    sorted.push_back(std::move(out.orbits[order[k]]));
+  }
+  out.orbits = std::move(sorted);
+  for (SearchSeed& s : report.seeds) {
+    for (int& index : s.orbits) index = rank[index];
+    const auto kind = static_cast<std::size_t>(s.kind);
+    ++report.seeds_by_kind[kind];
+    if (s.converged()) ++report.converged_by_kind[kind];
+  }
+  report.seconds = elapsed_since(t_start);
   return out;
 }
 

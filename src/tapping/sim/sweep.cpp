@@ -3,6 +3,9 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <optional>
+
+#include <Eigen/LU>
 
 #include <fmt/format.h>
 
@@ -24,7 +27,7 @@ const char* direction_name(SweepDirection direction) {
 void SweepOptions::validate() const {
   shooting.validate();
   transient.validate();
-  validate::require(jump_check_distance > 0, "jump_check_distance", jump_check_distance, "> 0");
+  validate::require(max_substeps >= 1, "max_substeps", max_substeps, ">= 1");
 }
 
 namespace {
@@ -83,27 +86,97 @@ SweepPoint from_transient(const TappingModel& model, TipState state, SweepDirect
   return p;
 }
 
-/// One instrument step: continue `previous` (at the previous separation) to the model's separation.
-SweepPoint continue_point(const TappingModel& model, const SweepPoint& previous, const SweepPoint* before_previous,
-                          SweepDirection direction, const SweepOptions& options) {
-  const double omega = model.drive.frequency;
-  TipState guess = previous.orbit.initial;
-  if (previous.periodic && before_previous && before_previous->periodic && !previous.jumped &&
-      before_previous->orbit.period_multiple == previous.orbit.period_multiple) {
-    // secant predictor along the branch
-    const double r = (model.separation - previous.separation) / (previous.separation - before_previous->separation);
-    guess.position += r * (previous.orbit.initial.position - before_previous->orbit.initial.position);
-    guess.velocity += r * (previous.orbit.initial.velocity - before_previous->orbit.initial.velocity);
-  }
-  if (previous.periodic) {
-    std::optional<PeriodicOrbit> orbit;
+/// Scaled state z = (x, ẋ/ω) of an orbit and the slope dz/dl of its branch, −(M − I)⁻¹ ∂P/∂l (implicit
+/// function theorem on P_l(z) = z); nullopt at a fold (M − I singular).
+Eigen::Vector2d scaled(TipState s, double omega) { return {s.position, s.velocity / omega}; }
+std::optional<Eigen::Vector2d> branch_slope(const PeriodicOrbit& orbit, double omega) {
+  const Eigen::Matrix2d j = orbit.monodromy - Eigen::Matrix2d::Identity();
+  const Eigen::FullPivLU<Eigen::Matrix2d> lu(j);
+  if (!lu.isInvertible()) return std::nullopt;
+  const Eigen::Vector2d dydl = -lu.solve(orbit.separation_sensitivity);  // d(x, ẋ)/dl
+  if (!dydl.allFinite()) return std::nullopt;
+  return Eigen::Vector2d(dydl.x(), dydl.y() / omega);
+}
+
+}  // namespace
+
+std::optional<PeriodicOrbit> follow_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
+                                           const ShootingOptions& shooting, int max_substeps) {
+  validate::finite("separation", l_to);
+  validate::require(max_substeps >= 1, "max_substeps", max_substeps, ">= 1");
+  const double omega = base.drive.frequency;
+  const int n = from.period_multiple;
+  const double span = l_to - from.separation;
+  if (span == 0.0) return from.stable ? std::optional<PeriodicOrbit>(from) : std::nullopt;
+  const double scale = std::max(1.0, scaled(from.initial, omega).norm());
+  // below this sub-step the branch is taken to end (fold, or a corner into another branch)
+  const double h_min = 1e-5 * std::max(1.0, std::abs(span));
+  // from the tangent prediction Newton converges in a few iterations; a slow start means the step is too long
+  ShootingOptions quick = shooting;
+  quick.max_iterations = std::min(quick.max_iterations, 8);
+  const double closeness = 1e-8 * scale;  // Newton-level agreement
+  PeriodicOrbit current = from;
+  if (!current.stable) return std::nullopt;
+  double h = span;  // try the whole step first
+  for (int k = 0; k < max_substeps; ++k) {
+    const double remaining = l_to - current.separation;
+    if (remaining == 0.0) return current;
+    if (std::abs(h) > std::abs(remaining)) h = remaining;
+    const auto slope = branch_slope(current, omega);
+    if (!slope) return std::nullopt;
+    const double l_next = std::abs(remaining - h) <= 1e-14 * std::max(1.0, std::abs(l_to)) ? l_to : current.separation + h;
+    const Eigen::Vector2d z = scaled(current.initial, omega);
+    const Eigen::Vector2d predicted = z + (l_next - current.separation) * *slope;
+    std::optional<PeriodicOrbit> next;
     try {
-      orbit = try_shoot(model, guess, previous.orbit.period_multiple, options.shooting);
+      next = try_shoot(base.with_separation(l_next), {predicted.x(), predicted.y() * omega}, n, quick);
     } catch (const NumericalFailure&) {
-      orbit.reset();
+      next.reset();
     }
-    const double scale = std::max(1e-9, magnitude(previous.orbit.initial, omega));
-    if (orbit && orbit->stable && distance(orbit->initial, guess, omega) <= options.jump_check_distance * scale) {
+    bool accepted = false;
+    if (next && next->stable && next->period_multiple == n) {
+      // continuity, both ways: (1) the corrector moves the prediction by at most |Δl| times the larger of the two
+      // branch slopes (O(Δl²) on a smooth branch, O(Δl) at a corner where the slope changes, e.g. grazing; another
+      // branch stays a finite distance away however small Δl is); (2) the step taken back from the new orbit
+      // returns to the current one (after a jump, Newton from the new orbit's tangent prediction lands on the
+      // other branch's continuation instead — this catches a jump hidden inside a long step)
+      const double dl = l_next - current.separation;
+      const auto slope_next = branch_slope(*next, omega);
+      const double bound = std::abs(dl) * std::max(slope->norm(), slope_next ? slope_next->norm() : 0.0) + closeness;
+      accepted = slope_next && (scaled(next->initial, omega) - predicted).norm() <= bound;
+      if (accepted) {
+        const Eigen::Vector2d back_guess = scaled(next->initial, omega) - dl * *slope_next;
+        std::optional<PeriodicOrbit> back;
+        try {
+          back = try_shoot(base.with_separation(current.separation), {back_guess.x(), back_guess.y() * omega}, n,
+                           quick);
+        } catch (const NumericalFailure&) {
+          back.reset();
+        }
+        accepted = back && (scaled(back->initial, omega) - z).norm() <= 1e-6 * scale;
+      }
+    }
+    if (accepted) {
+      current = *next;
+      current.separation = l_next;
+      h *= 2.0;  // grow again after a successful sub-step
+      continue;
+    }
+    h *= 0.5;
+    if (std::abs(h) < h_min) return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+/// One instrument step: continue `previous` (at the previous separation) to the model's separation.
+SweepPoint continue_point(const TappingModel& model, const SweepPoint& previous, SweepDirection direction,
+                          const SweepOptions& options) {
+  const double omega = model.drive.frequency;
+  if (previous.periodic) {
+    // follow the branch of the previous orbit to the new separation (sub-stepping when needed)
+    if (auto orbit = follow_branch(model, previous.orbit, model.separation, options.shooting, options.max_substeps)) {
       SweepPoint p;
       p.separation = model.separation;
       p.direction = direction;
@@ -111,20 +184,15 @@ SweepPoint continue_point(const TappingModel& model, const SweepPoint& previous,
       return p;
     }
   }
-  // Newton failed, found an unstable orbit or moved far: do what the instrument does — the tip keeps moving
-  // from where it was and settles on whatever attracts it.
+  // The branch ends (fold, stability loss, or a corner into another branch) before the new separation: do what
+  // the instrument does — the tip keeps moving from where it was and settles on whatever attracts it.
   SweepPoint p = from_transient(model, previous.orbit.initial, direction, options);
   if (p.periodic && previous.periodic) {
-    // Not a jump if the new orbit continues the previous branch: Newton from it at the previous separation
-    // returns to the previous orbit (a long step on a steep branch, not the end of the branch).
-    std::optional<PeriodicOrbit> back;
-    try {
-      back = try_shoot(model.with_separation(previous.separation), p.orbit.initial, p.orbit.period_multiple,
-                       options.shooting);
-    } catch (const NumericalFailure&) {
-      back.reset();
-    }
-    const double scale = std::max(1e-9, magnitude(previous.orbit.initial, omega));
+    // Not a jump if the branch of the new orbit, followed back to the previous separation through stable orbits
+    // without a fold, arrives at the previous orbit (the forward follow can fail where the backward one does
+    // not, e.g. through a grazing corner entered from the other side).
+    const auto back = follow_branch(model, p.orbit, previous.separation, options.shooting, options.max_substeps);
+    const double scale = std::max(1.0, magnitude(previous.orbit.initial, omega));
     if (back && back->period_multiple == previous.orbit.period_multiple &&
         distance(back->initial, previous.orbit.initial, omega) <= 1e-6 * scale)
       p.jumped = false;
@@ -141,8 +209,7 @@ std::vector<SweepPoint> run_direction(const TappingModel& base, const std::vecto
   out.push_back(first);
   if (options.progress) options.progress(1);
   for (std::size_t k = 1; k < ls.size(); ++k) {
-    const SweepPoint* before = k >= 2 ? &out[k - 2] : nullptr;
-    out.push_back(continue_point(base.with_separation(ls[k]), out[k - 1], before, direction, options));
+    out.push_back(continue_point(base.with_separation(ls[k]), out[k - 1], direction, options));
     if (out.back().jumped) jumps.push_back(ls[k]);
     if (options.progress) options.progress(1);
   }

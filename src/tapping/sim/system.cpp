@@ -10,20 +10,19 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 }
 
-TappingSystem::TappingSystem(const TappingModel& model)
-    : model_(&model),
-      separation_(model.separation),
-      switching_(model.law.switching_gaps()),
-      damping_(2.0 * model.cantilever.damping_ratio() * model.cantilever.natural_frequency),
-      stiffness_(model.cantilever.natural_frequency * model.cantilever.natural_frequency),
-      omega_(model.drive.frequency),
-      gamma_(model.drive.amplitude) {
-  if (const auto* p = model.law.piecewise_linear()) {
+TappingSystem::TappingSystem(TappingModel model)
+    : model_(std::move(model)),
+      separation_(model_.separation),
+      damping_(2.0 * model_.cantilever.damping_ratio() * model_.cantilever.natural_frequency),
+      stiffness_(model_.cantilever.natural_frequency * model_.cantilever.natural_frequency),
+      omega_(model_.drive.frequency),
+      gamma_(model_.drive.amplitude) {
+  if (const auto* p = model_.law.piecewise_linear()) {
     linear_ = *p;
     const bool hysteretic = p->approach_stiffness != p->departure_stiffness ||
                             p->approach_adhesion != p->departure_adhesion;
     dependent_mask_ = hysteretic ? 1u : 0u;  // only the contact region can depend on the branch
-  } else if (const auto* d = std::get_if<impact::DmtLaw>(&model.law.kind())) {
+  } else if (const auto* d = std::get_if<impact::DmtLaw>(&model_.law.kind())) {
     const bool moduli = d->effective_modulus_approach != d->effective_modulus_departure;
     const bool hamaker = d->hamaker_approach != d->hamaker_departure;
     dependent_mask_ = ((moduli || hamaker) ? 1u : 0u) | (hamaker ? 2u : 0u);
@@ -33,12 +32,12 @@ TappingSystem::TappingSystem(const TappingModel& model)
 }
 
 int TappingSystem::region_of(double gap) const {
-  return static_cast<int>(std::upper_bound(switching_.begin(), switching_.end(), gap) - switching_.begin());
+  return static_cast<int>(std::upper_bound(switching().begin(), switching().end(), gap) - switching().begin());
 }
 
-double TappingSystem::region_lo(int region) const { return region == 0 ? -kInf : switching_[region - 1]; }
+double TappingSystem::region_lo(int region) const { return region == 0 ? -kInf : switching()[region - 1]; }
 double TappingSystem::region_hi(int region) const {
-  return region >= static_cast<int>(switching_.size()) ? kInf : switching_[region];
+  return region >= static_cast<int>(switching().size()) ? kInf : switching()[region];
 }
 
 double TappingSystem::drive(double t) const { return gamma_ * std::cos(omega_ * t); }
@@ -62,9 +61,9 @@ double TappingSystem::interaction(ContactBranch branch, double x, int region) co
   const double hi = region_hi(region);
   if (dc >= hi) dc = std::nextafter(hi, -kInf);
   switch (branch) {
-    case ContactBranch::approach: return -model_->law.approach(dc);
-    case ContactBranch::departure: return -model_->law.departure(dc);
-    case ContactBranch::sticking: return -0.5 * (model_->law.approach(dc) + model_->law.departure(dc));
+    case ContactBranch::approach: return -model_.law.approach(dc);
+    case ContactBranch::departure: return -model_.law.departure(dc);
+    case ContactBranch::sticking: return -0.5 * (model_.law.approach(dc) + model_.law.departure(dc));
   }
   return 0.0;
 }
@@ -99,7 +98,7 @@ double TappingSystem::acceleration(const Mode& mode, double t, TipState s) const
 Mode TappingSystem::initial_mode(double t, TipState& s) const {
   int region = region_of(gap(s.position));
   // exactly on a switching gap and moving down: the motion continues in the region below
-  if (region > 0 && gap(s.position) == switching_[region - 1] && s.velocity < 0) --region;
+  if (region > 0 && gap(s.position) == switching()[region - 1] && s.velocity < 0) --region;
   return enter_region(region, t, s);
 }
 
@@ -162,9 +161,9 @@ int TappingSystem::guards(const Mode& mode, std::array<Guard, 3>& out) const {
     out[n++] = {GuardKind::release_approach, CrossingDirection::falling, 0.0};
     return n;
   }
-  if (mode.region > 0) out[n++] = {GuardKind::gap, CrossingDirection::falling, switching_[mode.region - 1]};
-  if (mode.region < static_cast<int>(switching_.size()))
-    out[n++] = {GuardKind::gap, CrossingDirection::rising, switching_[mode.region]};
+  if (mode.region > 0) out[n++] = {GuardKind::gap, CrossingDirection::falling, switching()[mode.region - 1]};
+  if (mode.region < static_cast<int>(switching().size()))
+    out[n++] = {GuardKind::gap, CrossingDirection::rising, switching()[mode.region]};
   if (branch_dependent(mode.region)) {
     out[n++] = {GuardKind::velocity,
                 mode.branch == ContactBranch::approach ? CrossingDirection::rising : CrossingDirection::falling, 0.0};
