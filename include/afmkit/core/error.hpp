@@ -12,7 +12,8 @@ class InvalidParameter : public std::invalid_argument {
  public:
   InvalidParameter(std::string parameter, const std::string& message)
       : std::invalid_argument(message), parameter_(std::move(parameter)) {}
-  const std::string& parameter() const noexcept { return parameter_; }
+  const std::string& parameter() const& noexcept { return parameter_; }
+  std::string parameter() const&& { return parameter_; }
 
  private:
   std::string parameter_;
