@@ -63,17 +63,6 @@ void run_roots(const io::ParamSet& p) {
   o.collocation_nodes = static_cast<int>(p.integer("nodes"));
   const control::Spectrum sp = control::rightmost_roots(loop, o);
 
-  io::Table t({"real", "imag", "multiplicity", "certified", "correction", "kind"});
-  for (const auto& r : sp.roots)
-    t.add_row({r.value.real() / w, r.value.imag() / w, static_cast<long>(r.multiplicity), r.certified,
-               r.correction / w, std::string("root")});
-  for (const auto& s : sp.near_chain) {
-    t.add_row({s.real() / w, s.imag() / w, 1L, false, 0.0, std::string("near_chain")});
-    if (s.imag() != 0.0) t.add_row({s.real() / w, -s.imag() / w, 1L, false, 0.0, std::string("near_chain")});
-  }
-  for (const auto& s : sp.structural)
-    t.add_row({s.value.real() / w, s.value.imag() / w, static_cast<long>(s.multiplicity), true, 0.0,
-               std::string("structural")});
   nlohmann::json res;
   res["loop"] = loop.describe();
   res["delay_exceeds_period"] = loop.delay >= loop.period();
@@ -108,7 +97,17 @@ void run_roots(const io::ParamSet& p) {
     return;
   }
   const std::string out = p.text("output");
-  io::write_table(out, t, io::make_sidecar("control roots", p.to_json(), res));
+  io::TableWriter t(out, {"real", "imag", "multiplicity", "certified", "correction", "kind"});
+  for (const auto& r : sp.roots)
+    t.row(r.value.real() / w, r.value.imag() / w, static_cast<long>(r.multiplicity), r.certified, r.correction / w,
+          "root");
+  for (const auto& s : sp.near_chain) {
+    t.row(s.real() / w, s.imag() / w, 1L, false, 0.0, "near_chain");
+    if (s.imag() != 0.0) t.row(s.real() / w, -s.imag() / w, 1L, false, 0.0, "near_chain");
+  }
+  for (const auto& s : sp.structural)
+    t.row(s.value.real() / w, s.value.imag() / w, static_cast<long>(s.multiplicity), true, 0.0, "structural");
+  t.commit(io::make_sidecar("control roots", p.to_json(), res));
   fmt::print("{} roots in the box (argument principle: {}{}); spectral abscissa {:.10g} Omega, {} unstable -> {}\n",
              sp.roots.size(), sp.box_count, sp.complete ? ", complete" : ", INCOMPLETE", sp.spectral_abscissa / w,
              sp.unstable_count, out);
@@ -133,11 +132,16 @@ nlohmann::json margin_json(const control::DelayMargin& m, double w, double perio
 // τ_c of variants of the loop (beyond the paper): other rejected harmonics, N = ∞, Smith predictor.
 void run_margin_compare(const io::ParamSet& p, const ControlSettings& base) {
   const double w = base.rotation_frequency, period = base.period;
-  io::Table t({"variant", "critical_delay", "crossing_frequency", "lower_delay", "stable_at_reference"});
+  struct Row {
+    std::string name;
+    double upper, frequency, lower;
+    bool stable;
+  };
+  std::vector<Row> table;
   nlohmann::json rows = nlohmann::json::array();
   const auto add = [&](const std::string& name, const ControlSettings& c) {
     const control::DelayMargin m = control::delay_margin(control_loop_from(c));
-    t.add_row({name, m.upper / period, m.upper_frequency / w, m.lower / period, m.stable_at_reference});
+    table.push_back({name, m.upper / period, m.upper_frequency / w, m.lower / period, m.stable_at_reference});
     nlohmann::json j = margin_json(m, w, period);
     j["variant"] = name;
     rows.push_back(j);
@@ -179,8 +183,10 @@ void run_margin_compare(const io::ParamSet& p, const ControlSettings& base) {
     return;
   }
   const std::string out = p.text("output");
-  io::write_table(out, t, io::make_sidecar("control margin --compare", p.to_json(), res));
-  fmt::print("wrote {} variants to {}\n", t.size(), out);
+  io::TableWriter t(out, {"variant", "critical_delay", "crossing_frequency", "lower_delay", "stable_at_reference"});
+  for (const Row& r : table) t.row(r.name, r.upper, r.frequency, r.lower, r.stable);
+  t.commit(io::make_sidecar("control margin --compare", p.to_json(), res));
+  fmt::print("wrote {} variants to {}\n", table.size(), out);
 }
 
 void run_margin(const io::ParamSet& p) {
@@ -199,13 +205,13 @@ void run_margin(const io::ParamSet& p) {
     fmt::print("{}\n", res.dump(2));
     return;
   }
-  io::Table t({"frequency", "first_delay", "delay_period"});
-  for (const auto& x : m.crossings) t.add_row({x.frequency / w, x.first_delay / period, x.delay_period / period});
   res["columns"] = {{"frequency", "crossing frequency nu / Omega (roots at +-i nu)"},
                     {"first_delay", "smallest delay with these roots on the axis / T"},
                     {"delay_period", "2 pi / nu / T (crossings repeat)"}};
   const std::string out = p.text("output");
-  io::write_table(out, t, io::make_sidecar("control margin", p.to_json(), res));
+  io::TableWriter t(out, {"frequency", "first_delay", "delay_period"});
+  for (const auto& x : m.crossings) t.row(x.frequency / w, x.first_delay / period, x.delay_period / period);
+  t.commit(io::make_sidecar("control margin", p.to_json(), res));
   if (m.stable_at_reference)
     fmt::print("critical delay tau_c = {:.6g} T (crossing at {:.6g} Omega, method {}) -> {}\n", m.upper / period,
                m.upper_frequency / w, m.method, out);
@@ -231,6 +237,20 @@ Window window_from(const io::ParamSet& p, const control::LoopFamily& f, double w
   return r;
 }
 
+// The parameters as run: the window bounds replaced by the values actually used (the family defaults apply when
+// x_min … y_max are not given), in units of Ω like the flags.
+nlohmann::json params_as_run(const io::ParamSet& p, const Window& win, double w) {
+  nlohmann::json j = p.to_json();
+  j["x_min"] = win.x_min / w;
+  j["x_max"] = win.x_max / w;
+  j["y_min"] = win.y_min / w;
+  j["y_max"] = win.y_max / w;
+  return j;
+}
+nlohmann::json window_json(const Window& win, double w) {
+  return {{"x_min", win.x_min / w}, {"x_max", win.x_max / w}, {"y_min", win.y_min / w}, {"y_max", win.y_max / w}};
+}
+
 void run_chart(const io::ParamSet& p) {
   const ControlSettings c = control_settings_from(p);
   const control::LoopSpec loop = control_loop_from(c);
@@ -240,6 +260,8 @@ void run_chart(const io::ParamSet& p) {
   const int nx = static_cast<int>(p.integer("x_points")), ny = static_cast<int>(p.integer("y_points"));
   const int threads = static_cast<int>(p.integer("threads"));
   const std::string out = p.text("output");
+  // memory of the grid (values, counts, labels and the tracked roots of each point), before any work
+  require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * 64.0);
   io::Progress progress("control chart (grid points)", static_cast<long>(nx) * ny, p.flag("progress"));
   const auto tick = [&progress](long n, long) { progress.advance(n); };
   nlohmann::json res;
@@ -247,20 +269,24 @@ void run_chart(const io::ParamSet& p) {
   res["x"] = family.x_name();
   res["y"] = family.y_name();
   res["delay_exceeds_period"] = loop.delay >= loop.period();
+  res["window"] = window_json(win, w);
+  res["x_points"] = nx;
+  res["y_points"] = ny;
+  const nlohmann::json params = params_as_run(p, win, w);
   if (p.text("quantity") == "margin") {
     const control::MarginMap m = control::delay_margin_map(family, win.x_min, win.x_max, nx, win.y_min, win.y_max, ny,
                                                            threads, tick);
     progress.finish();
-    io::Table t({"x", "y", "critical_delay", "crossing_frequency"});
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const std::size_t k = static_cast<std::size_t>(j) * nx + i;
-        t.add_row({m.x[i] / w, m.y[j] / w, m.critical_delay[k] / period, m.crossing_frequency[k] / w});
-      }
     res["columns"] = {{"x", std::string(family.x_name()) + " / Omega"}, {"y", std::string(family.y_name()) + " / Omega"},
                       {"critical_delay", "tau_c / T (inf: no crossing, nan: unstable at tau = 0)"},
                       {"crossing_frequency", "nu at tau_c / Omega"}};
-    io::write_table(out, t, io::make_sidecar("control chart --quantity margin", p.to_json(), res));
+    io::TableWriter t(out, {"x", "y", "critical_delay", "crossing_frequency"});
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const std::size_t k = static_cast<std::size_t>(j) * nx + i;
+        t.row(m.x[i] / w, m.y[j] / w, m.critical_delay[k] / period, m.crossing_frequency[k] / w);
+      }
+    t.commit(io::make_sidecar("control chart --quantity margin", params, res));
     fmt::print("wrote the {}x{} delay-margin map to {}\n", nx, ny, out);
     return;
   }
@@ -275,17 +301,6 @@ void run_chart(const io::ParamSet& p) {
   spec.threads = threads;
   const control::StabilityChart chart = control::stability_chart(spec, tick);
   progress.finish();
-  io::Table t({"x", "y", "spectral_abscissa", "unstable_roots", "region"});
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j) * nx + i;
-      t.add_row({chart.x[i] / w, chart.y[j] / w, chart.abscissa[k] / w, static_cast<long>(chart.unstable_roots[k]),
-                 static_cast<long>(chart.region[k])});
-    }
-  io::Table b({"curve", "frequency", "x", "y"});
-  for (std::size_t ci = 0; ci < chart.boundaries.size(); ++ci)
-    for (const auto& q : chart.boundaries[ci])
-      b.add_row({static_cast<long>(ci), q.frequency / w, q.x / w, q.y / w});
   nlohmann::json regions = nlohmann::json::array();
   for (const auto& r : chart.regions)
     regions.push_back({{"id", r.id}, {"unstable_roots", r.unstable_roots}, {"tracked_roots", r.tracked_roots},
@@ -299,12 +314,23 @@ void run_chart(const io::ParamSet& p) {
                     {"spectral_abscissa", "max Re s / Omega (= -decay rate)"},
                     {"unstable_roots", "roots with Re s > 0 (region label, argument-principle count; -1: infinitely many)"},
                     {"region", "region id (connected set of equal counts)"}};
-  io::write_table(out, t, io::make_sidecar("control chart", p.to_json(), res));
+  io::TableWriter t(out, {"x", "y", "spectral_abscissa", "unstable_roots", "region"});
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * nx + i;
+      t.row(chart.x[i] / w, chart.y[j] / w, chart.abscissa[k] / w, static_cast<long>(chart.unstable_roots[k]),
+            static_cast<long>(chart.region[k]));
+    }
+  t.commit(io::make_sidecar("control chart", params, res));
   nlohmann::json bres;
   bres["family"] = family.describe();
   bres["columns"] = {{"curve", "polyline id"}, {"frequency", "crossing frequency nu / Omega (0: root at s = 0)"},
                      {"x", std::string(family.x_name()) + " / Omega"}, {"y", std::string(family.y_name()) + " / Omega"}};
-  io::write_table(bout, b, io::make_sidecar("control chart (D-subdivision boundaries)", p.to_json(), bres));
+  bres["window"] = window_json(win, w);
+  io::TableWriter b(bout, {"curve", "frequency", "x", "y"});
+  for (std::size_t ci = 0; ci < chart.boundaries.size(); ++ci)
+    for (const auto& q : chart.boundaries[ci]) b.row(static_cast<long>(ci), q.frequency / w, q.x / w, q.y / w);
+  b.commit(io::make_sidecar("control chart (D-subdivision boundaries)", params, bres));
   fmt::print("wrote the {}x{} chart ({} regions) to {} and {} boundary curves to {}\n", nx, ny, chart.regions.size(), out,
              chart.boundaries.size(), bout);
 }
@@ -332,6 +358,7 @@ void run_tune(const io::ParamSet& p) {
   s.coarse_points = static_cast<int>(p.integer("coarse_points"));
   s.max_evaluations = static_cast<int>(p.integer("max_evaluations"));
   s.threads = static_cast<int>(p.integer("threads"));
+  require_memory("coarse_points", static_cast<double>(s.coarse_points), s.coarse_points * 32.0);
   io::Progress progress("control tune (objective evaluations)",
                         static_cast<long>(s.coarse_points) * s.coarse_points + s.max_evaluations, p.flag("progress"));
   const control::RobustTuning r = control::robust_tuning(s, [&progress](long n, long) { progress.advance(n); });
@@ -350,6 +377,7 @@ void run_tune(const io::ParamSet& p) {
     ms.push_back({{"gain_ratio", m.gain_ratio}, {"critical_delay", num(m.critical_delay / period)},
                   {"crossing_frequency", num(m.crossing_frequency / w)}});
   res["margins"] = ms;
+  res["window"] = window_json(win, w);
   res["evaluations"] = r.evaluations;
   res["converged"] = r.converged;
   res["objective"] = "max over (x, y) of min over tau in [0, delay_max], rho in [gain_ratio_min, gain_ratio_max] "
@@ -358,15 +386,15 @@ void run_tune(const io::ParamSet& p) {
     fmt::print("{}\n", res.dump(2));
     return;
   }
-  io::Table t({"x", "y", "worst_decay_rate"});
-  const int n = s.coarse_points;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      t.add_row({r.coarse_x[i] / w, r.coarse_y[j] / w, r.coarse_worst_decay[static_cast<std::size_t>(j) * n + i] / w});
   res["columns"] = {{"x", std::string(s.family.x_name()) + " / Omega"}, {"y", std::string(s.family.y_name()) + " / Omega"},
                     {"worst_decay_rate", "coarse-grid objective / Omega"}};
   const std::string out = p.text("output");
-  io::write_table(out, t, io::make_sidecar("control tune", p.to_json(), res));
+  io::TableWriter t(out, {"x", "y", "worst_decay_rate"});
+  const int n = s.coarse_points;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      t.row(r.coarse_x[i] / w, r.coarse_y[j] / w, r.coarse_worst_decay[static_cast<std::size_t>(j) * n + i] / w);
+  t.commit(io::make_sidecar("control tune", params_as_run(p, win, w), res));
   fmt::print("robust optimum {} = {:.5g} Omega, {} = {:.5g} Omega: worst-case decay rate {:.5g} Omega (certified {:.5g}) -> {}\n",
              s.family.x_name(), r.x / w, s.family.y_name(), r.y / w, r.worst_decay / w, r.certified_worst_decay / w, out);
 }
@@ -390,7 +418,9 @@ void register_control_analysis(CLI::App& control) {
   add_command(
       control, "roots",
       "rightmost closed-loop roots under delay (Newton on the exact characteristic function, certified by the "
-      "argument principle; N = inf: neutral chain bound and the MATH.md B.8 diagnosis)",
+      "argument principle; N = inf: neutral chain bound and the MATH.md B.8 diagnosis). Cost: O(N) per evaluation "
+      "of the characteristic function; initial guesses by collocation (dense, N <= 40) or from the delay-free poles "
+      "(Aberth, O(N^2)); certification O(N) evaluations along the box: O(N^2) in all",
       [](io::ParamSet& p) {
         p.real("min_real", 0.0, "left edge of the search box [units of Omega] (default: automatic)")
             .real("max_imag", 1.0, "half-height of the search box [units of Omega] (default: proven bound)",
@@ -403,7 +433,8 @@ void register_control_analysis(CLI::App& control) {
       run_roots);
   add_command(
       control, "margin",
-      "delay margin tau_c (largest delay keeping the loop stable; crossing formulas MATH.md B.9, ext. E1/E2)",
+      "delay margin tau_c (largest delay keeping the loop stable; crossing formulas MATH.md B.9, ext. E1/E2). Cost: "
+      "O(N) per crossing-function evaluation on points_per_omega x (N + 1) frequencies, O(N^2) stability check",
       [](io::ParamSet& p) {
         p.real("reference_delay", 0.0, "delay where stability is required [units of T] (default: 0, Smith: "
                                        "model_delay)", Range::non_negative())
@@ -417,7 +448,8 @@ void register_control_analysis(CLI::App& control) {
   add_command(
       control, "chart",
       "stability chart in the coupling plane (a, b) or (alpha, beta): spectral abscissa grid, certified region "
-      "labels, exact D-subdivision boundaries (paper Figs. 2, 4)",
+      "labels, exact D-subdivision boundaries (paper Figs. 2, 4). Cost: O(N) per Newton step of each tracked root per "
+      "grid point, O(N^2) per fresh spectrum and per certified region",
       [](io::ParamSet& p) {
         p.text("quantity", "abscissa", "abscissa: spectral abscissa + unstable roots; margin: tau_c map",
                {"abscissa", "margin"})
@@ -436,7 +468,8 @@ void register_control_analysis(CLI::App& control) {
   add_command(
       control, "tune",
       "robust couplings: maximise the worst-case decay rate over delays [0, delay_max] and gain errors "
-      "rho = K/gamma in [gain_ratio_min, gain_ratio_max] (coarse grid + Nelder-Mead)",
+      "rho = K/gamma in [gain_ratio_min, gain_ratio_max] (coarse grid + Nelder-Mead). Cost: per objective evaluation "
+      "O(N^2) per gain ratio (fresh spectrum) plus O(N) per tracked-root Newton step",
       [](io::ParamSet& p) {
         p.real("delay_max", 0.25, "largest delay [units of T]", Range::non_negative())
             .integer("delay_points", 6, "delay grid points on [0, delay_max]", 1, 10000)

@@ -6,24 +6,30 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/memory.hpp"
 
 namespace afmkit::cli {
 
 using io::Range;
 
-void add_control_params(io::ParamSet& p) {
+void add_control_params(io::ParamSet& p, long max_harmonics) {
   p.text("controller", "bank", "controller: single oscillator (eqs. 5-6), bank of N oscillators (eq. 15), "
                                "infinite bank (eq. 31) or Smith predictor around a bank",
          {"single", "bank", "infinite", "smith"})
       .real("rotation_frequency", 1.0, "rotation angular frequency Omega [rad/s]; rates below are in units of "
                                        "Omega, delays in units of T = 2 pi/Omega", Range::positive())
-      .integer("harmonics", 10, "number N of oscillators of the bank (eq. 15)", 1, 100000)
+      .integer("harmonics", 10,
+               max_harmonics == kMaxHarmonicsTf
+                   ? "number N of oscillators of the bank (eq. 15); cost O(N) per frequency"
+                   : "number N of oscillators of the bank (eq. 15); cost O(N) per characteristic evaluation, "
+                     "O(N^2) per spectrum / per simulated period",
+               1, max_harmonics)
       .real("alpha", 0.1, "coupling alpha of eq. (20) [units of Omega]")
       .real("beta", -0.1, "coupling beta of eq. (20) [units of Omega]")
       .real("a", 0.5, "coupling a of the single oscillator (eq. 5) [units of Omega]")
       .real("b", 0.0, "coupling b of the single oscillator (eq. 5) [units of Omega]")
       .reals("rejected", {1.0}, "harmonics removed from the output (bank controller), e.g. 1,3",
-             Range::closed(1, 100000))
+             Range::closed(1, static_cast<double>(max_harmonics)))
       .real("gain", 20.0, "controller gain K [units of Omega] (default: equal to plant_rate, design rule K = gamma)",
             Range::positive())
       .text("plant", "static", "plant: static y = f + u/gamma (eq. 3) or first order (eq. 1)", {"static", "first_order"})
@@ -37,6 +43,10 @@ void add_control_params(io::ParamSet& p) {
             Range::positive())
       .real("model_delay", 0.1, "Smith model delay tau_hat [units of T] (default: equal to delay)",
             Range::non_negative());
+}
+
+void require_memory(const std::string& parameter, double value, double bytes_per_unit) {
+  memory::require_fits(parameter, value, bytes_per_unit);
 }
 
 namespace {

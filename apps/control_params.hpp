@@ -7,7 +7,7 @@
 // delay = 0.1 means τ = 0.1 T. Physical run: rotation_frequency = 314.159 (50 Hz), plant_rate = 20 (γ = 20Ω).
 //
 //   controller      single | bank | infinite | smith          (default bank)
-//   harmonics       N of the bank (eq. 15)                      (default 10)
+//   harmonics       N of the bank (eq. 15)                      (default 10; range per command: kMaxHarmonics*)
 //   alpha, beta     couplings (20) in units of Ω                (default 0.1, −0.1: the "universal" setting)
 //   a, b            couplings of the single oscillator (5)      (default 0.5, 0)
 //   rejected        harmonics removed from the output (bank)    (default 1; e.g. "1,3")
@@ -52,8 +52,18 @@ struct ControlSettings {
   nlohmann::json to_json() const;  // resolved values (physical units) for sidecars
 };
 
-/// Adds the parameters listed above to `params`.
-void add_control_params(io::ParamSet& params);
+/// Largest `harmonics` of each command (docs/commands.md states the costs behind them):
+///   tf: O(N) per frequency (transfer function as a sum over the oscillators);
+///   roots, margin, chart, tune: O(N) per characteristic evaluation, O(N) evaluations per spectrum → O(N²);
+///   simulate: O(N²) set-up (controller modes), O(N) per step with more than 2N steps per period.
+inline constexpr long kMaxHarmonicsTf = 100000;
+inline constexpr long kMaxHarmonicsSpectra = 1000;
+
+/// Adds the parameters listed above to `params`; `max_harmonics` bounds `harmonics` (and `rejected`).
+void add_control_params(io::ParamSet& params, long max_harmonics = kMaxHarmonicsSpectra);
+/// Throws InvalidParameter(parameter, …) when a request of `rows` rows of `bytes_per_row` bytes held in memory
+/// does not fit in half of the available memory (MemAvailable), before any work.
+void require_memory(const std::string& parameter, double value, double bytes_per_unit);
 /// Resolves the parameters (after params.resolve()); throws InvalidParameter naming the parameter.
 ControlSettings control_settings_from(const io::ParamSet& params);
 /// The controller described by the settings (bank / infinite / single / Smith predictor).

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -112,10 +113,22 @@ void run_simulate(const io::ParamSet& p) {
   o.stepping = stepping_from(p.text("method"));
   const bool json = p.flag("json");
   o.record_every = json ? 0 : static_cast<int>(p.integer("record_every"));
+  // memory: the per-period tables of the run (about 14 doubles per step of a period) and the controller's modes
+  require_memory("steps_per_period", static_cast<double>(o.steps_per_period), 14.0 * sizeof(double));
+  // the measurement delay line holds (delay + delay_variation)/h samples (rounded up to a power of two)
+  require_memory("delay", p.real("delay") + p.real("delay_variation"),
+                 2.0 * sizeof(double) * static_cast<double>(o.steps_per_period));
   const control::ClosedLoopSimulation sim(plant, bank, o);
-
+  const std::string output = p.text("output");
+  // the time series is streamed to the CSV as it is computed (memory bounded by a row, not by the run)
+  std::optional<io::TableWriter> table;
+  if (!json) table.emplace(output, std::vector<std::string>{"t", "y", "u", "m", "target", "f_minus_f1"});
   io::Progress progress("control simulate (periods)", o.periods, true, 1.0);
-  const auto res = sim.run([&](long, long) { progress.advance(); });
+  const auto sink = [&table](const control::TimeSample& r) {
+    table->row(r.t, r.y, r.u, r.m, r.target, r.f_minus_first);
+  };
+  const auto res = json ? sim.run([&](long, long) { progress.advance(); })
+                        : sim.run([&](long, long) { progress.advance(); }, sink);
   progress.finish();
   nlohmann::json report = report_json(res.report, sim);
   report["settings"] = c.to_json();
@@ -128,21 +141,18 @@ void run_simulate(const io::ParamSet& p) {
     fmt::print("{}\n", report.dump(2));
     return;
   }
-  const auto& s = res.series;
-  io::Table table({"t", "y", "u", "m", "target", "f_minus_f1"});
-  for (std::size_t i = 0; i < s.t.size(); ++i) table.add_row({s.t[i], s.y[i], s.u[i], s.m[i], s.target[i], s.f_minus_first[i]});
   report["columns"] = {{"t", "time [s]"},
                        {"y", "plant output"},
                        {"u", "control"},
                        {"m", "measurement y(t - tau)"},
                        {"target", "steady state to reach: uncontrolled output without the rejected harmonics"},
                        {"f_minus_f1", "disturbance without its first harmonic"}};
-  report["rows"] = table.size();
-  const std::string output = p.text("output");
-  io::write_table(output, table, io::make_sidecar("control simulate", p.to_json(), report));
+  report["rows"] = table->size();
+  const std::size_t rows = table->size();
+  table->commit(io::make_sidecar("control simulate", p.to_json(), report));
   fmt::print("wrote {} rows to {}: |y_1| over the last period = {:.3e}, max harmonic error = {:.3e}, growth rate = "
              "{:.4g} 1/s\n",
-             table.size(), output, res.report.residual_first_harmonic, res.report.max_harmonic_error,
+             rows, output, res.report.residual_first_harmonic, res.report.max_harmonic_error,
              res.report.growth_rate);
 }
 

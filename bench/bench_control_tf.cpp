@@ -63,6 +63,30 @@ static void BM_ControllerResponseVsStateSpace(benchmark::State& st) {
 }
 BENCHMARK(BM_ControllerResponseVsStateSpace)->Args({10, 0})->Args({10, 1})->Args({40, 0})->Args({40, 1});
 
+// Cost per frequency of every `afmkit control tf` system vs N (issue 6): O(N) — time/N is flat (BigO fit "N").
+static void BM_LoopResponsePerFrequency(benchmark::State& st) {
+  const LoopSpec loop = bank_loop(static_cast<int>(st.range(0)));
+  std::complex<double> s(0.0, 0.7);
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(evaluate(loop, LoopSystem::ClosedLoop, s));
+    s += std::complex<double>(0.0, 1e-9);
+  }
+  st.SetComplexityN(st.range(0));
+}
+BENCHMARK(BM_LoopResponsePerFrequency)->RangeMultiplier(10)->Range(10, 100000)->Complexity(benchmark::oN);
+
+// Δ and Δ' per evaluation vs N (the unit of the spectra's cost, docs/commands.md): O(N).
+static void BM_CharacteristicPerEvaluation(benchmark::State& st) {
+  const LoopSpec loop = bank_loop(static_cast<int>(st.range(0)));
+  std::complex<double> s(-0.05, 0.7);
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(characteristic_scaled(loop, s));
+    s += std::complex<double>(0.0, 1e-9);
+  }
+  st.SetComplexityN(st.range(0));
+}
+BENCHMARK(BM_CharacteristicPerEvaluation)->RangeMultiplier(10)->Range(10, 100000)->Complexity(benchmark::oN);
+
 static void BM_FrequencyResponse1000(benchmark::State& st) {
   const LoopSpec loop = bank_loop(10);
   const auto w = frequency_grid(0.01, 10.0, 1000, true);

@@ -17,28 +17,37 @@ std::vector<double> frequency_grid(double lo, double hi, int points, bool log_sp
   validate::in_range("points", static_cast<long>(points), 2L, 100000000L);
   if (log_spacing) validate::positive("omega_min", lo);
   std::vector<double> w(points);
-  for (int i = 0; i < points; ++i) {
-    const double t = static_cast<double>(i) / (points - 1);
-    w[i] = log_spacing ? lo * std::pow(hi / lo, t) : lo + (hi - lo) * t;
-  }
-  w.front() = lo;
-  w.back() = hi;
+  for (int i = 0; i < points; ++i) w[i] = frequency_grid_point(lo, hi, points, log_spacing, i);
   return w;
 }
 
-std::vector<double> unwrap_phase(std::vector<double> p) {
-  const double two_pi = 2.0 * std::numbers::pi;
-  double offset = 0.0, last = std::nan("");
-  for (double& x : p) {
-    if (!std::isfinite(x)) continue;
-    if (std::isfinite(last)) {
-      const double raw = x + offset;
-      const double jump = raw - last;
-      if (std::abs(jump) > std::numbers::pi) offset -= two_pi * std::round(jump / two_pi);
-    }
-    x += offset;
-    last = x;
+double frequency_grid_point(double lo, double hi, long points, bool log_spacing, long i) {
+  if (i <= 0) return lo;
+  if (i >= points - 1) return hi;
+  const double t = static_cast<double>(i) / static_cast<double>(points - 1);
+  return log_spacing ? lo * std::pow(hi / lo, t) : lo + (hi - lo) * t;
+}
+
+double PhaseUnwrapper::operator()(double x) {
+  if (!std::isfinite(x)) return x;
+  if (std::isfinite(last_)) {
+    const double two_pi = 2.0 * std::numbers::pi;
+    const double jump = x + offset_ - last_;
+    if (std::abs(jump) > std::numbers::pi) offset_ -= two_pi * std::round(jump / two_pi);
   }
+  last_ = x + offset_;
+  return last_;
+}
+
+void magnitude_phase(std::complex<double> v, double& magnitude, double& raw_phase) {
+  const bool infinite = std::isinf(v.real()) || std::isinf(v.imag());
+  magnitude = infinite ? INFINITY : std::abs(v);
+  raw_phase = infinite || std::isnan(v.real()) || std::isnan(v.imag()) ? std::nan("") : std::arg(v);
+}
+
+std::vector<double> unwrap_phase(std::vector<double> p) {
+  PhaseUnwrapper unwrap;
+  for (double& x : p) x = unwrap(x);
   return p;
 }
 
@@ -52,9 +61,7 @@ FrequencyResponse frequency_response(const FrequencyFunction& g, std::span<const
     validate::finite("omega", omegas[i]);
     const std::complex<double> v = g({0.0, omegas[i]});
     r.response[i] = v;
-    const bool infinite = std::isinf(v.real()) || std::isinf(v.imag());
-    r.magnitude[i] = infinite ? INFINITY : std::abs(v);
-    r.phase[i] = infinite || std::isnan(v.real()) || std::isnan(v.imag()) ? std::nan("") : std::arg(v);
+    magnitude_phase(v, r.magnitude[i], r.phase[i]);
   }
   r.phase = unwrap_phase(std::move(r.phase));
   return r;

@@ -16,22 +16,6 @@ using detail::Dual;
 using detail::Scaled;
 
 namespace {
-double bank_omega(const Bank& b) {
-  return std::visit(
-      [](const auto& x) {
-        if constexpr (std::is_same_v<std::decay_t<decltype(x)>, OscillatorBank>) return x.rotation_frequency();
-        else return x.rotation_frequency;
-      },
-      b);
-}
-double bank_gain(const Bank& b) {
-  return std::visit(
-      [](const auto& x) {
-        if constexpr (std::is_same_v<std::decay_t<decltype(x)>, OscillatorBank>) return x.gain();
-        else return x.gain;
-      },
-      b);
-}
 std::string describe_bank(const Bank& b) {
   if (const auto* o = std::get_if<OscillatorBank>(&b)) {
     std::string rej;
@@ -42,6 +26,12 @@ std::string describe_bank(const Bank& b) {
   const auto& i = std::get<InfiniteBank>(b);
   return fmt::format("infinite bank alpha={:g} beta={:g} K={:g} Omega={:g}", i.alpha, i.beta, i.gain,
                      i.rotation_frequency);
+}
+// Bank parts of a plain (non-Smith) controller without copying the bank (O(N) per call, no allocation).
+detail::BankParts plain_parts(const Controller& c, cplx s) {
+  if (const auto* o = std::get_if<OscillatorBank>(&c)) return detail::bank_parts(*o, s);
+  if (const auto* i = std::get_if<InfiniteBank>(&c)) return detail::bank_parts(*i, s);
+  return detail::bank_parts(std::get<SmithPredictor>(c).bank, s);
 }
 const char* plant_name(PlantKind k) { return k == PlantKind::FirstOrder ? "first-order" : "static"; }
 
@@ -63,7 +53,8 @@ double LoopSpec::rotation_frequency() const {
       [](const auto& c) {
         using T = std::decay_t<decltype(c)>;
         if constexpr (std::is_same_v<T, SmithPredictor>) return c.rotation_frequency();
-        else return bank_omega(Bank(c));
+        else if constexpr (std::is_same_v<T, OscillatorBank>) return c.rotation_frequency();
+        else return c.rotation_frequency;
       },
       controller);
 }
@@ -73,7 +64,8 @@ double LoopSpec::gain() const {
       [](const auto& c) {
         using T = std::decay_t<decltype(c)>;
         if constexpr (std::is_same_v<T, SmithPredictor>) return c.gain();
-        else return bank_gain(Bank(c));
+        else if constexpr (std::is_same_v<T, OscillatorBank>) return c.gain();
+        else return c.gain;
       },
       controller);
 }
@@ -109,13 +101,7 @@ ScaledCharacteristic characteristic_scaled(const LoopSpec& loop, std::complex<do
     const Scaled bracket = corr + Scaled{Dual(-1.0), 0.0} * (corr * e_c) + Scaled{(1.0 / loop.plant_rate) * mh, 0.0} * e_m;
     delta = Scaled{m * mh * parts.d, parts.ls} + parts.scaled_kn() * bracket;
   } else {
-    const Bank bank = std::visit(
-        [](const auto& c) -> Bank {
-          if constexpr (std::is_same_v<std::decay_t<decltype(c)>, SmithPredictor>) return c.bank;  // unreachable
-          else return c;
-        },
-        loop.controller);
-    const detail::BankParts parts = detail::bank_parts(bank, s);
+    const detail::BankParts parts = plain_parts(loop.controller, s);
     // Δ = M d + Kn e^{−sτ}/γ
     delta = Scaled{m * parts.d, parts.ls} +
             Scaled{(1.0 / loop.plant_rate) * parts.kn, parts.ls} * detail::delay_factor(s, loop.delay);
@@ -166,13 +152,7 @@ std::complex<double> controller_response(const Controller& controller, std::comp
     const SmithTerms t = smith_terms(*sp, s);
     return safe_ratio(t.kn * t.a_m, t.d + t.kn * t.pi_corr);
   }
-  const Bank bank = std::visit(
-      [](const auto& c) -> Bank {
-        if constexpr (std::is_same_v<std::decay_t<decltype(c)>, SmithPredictor>) return c.bank;
-        else return c;
-      },
-      controller);
-  const detail::BankParts parts = detail::bank_parts(bank, s);
+  const detail::BankParts parts = plain_parts(controller, s);
   return detail::ratio(parts.kn, parts.d);
 }
 
@@ -198,13 +178,7 @@ std::complex<double> sensitivity(const LoopSpec& loop, std::complex<double> s) {
     const cplx open = t.d + t.kn * t.pi_corr;  // S = (d + KnΠ)/(d + KnΠ + Kn A_m P)
     return safe_ratio(open, open + t.kn * t.a_m * p);
   }
-  const Bank bank = std::visit(
-      [](const auto& c) -> Bank {
-        if constexpr (std::is_same_v<std::decay_t<decltype(c)>, SmithPredictor>) return c.bank;
-        else return c;
-      },
-      loop.controller);
-  const detail::BankParts parts = detail::bank_parts(bank, s);
+  const detail::BankParts parts = plain_parts(loop.controller, s);
   return safe_ratio(parts.d.v, parts.d.v + parts.kn.v * p);  // S = d/(d + Kn P)
 }
 

@@ -105,6 +105,14 @@ bool infinite_bank_stable_tau0(double omega, double alpha, double beta) {
 }
 
 std::vector<std::complex<double>> undelayed_poles(const LoopSpec& loop) {
+  try {
+    return undelayed_poles_secular(loop);
+  } catch (const NumericalFailure&) {
+    const Bank* inner = nullptr;
+    if (const auto* sp = std::get_if<SmithPredictor>(&loop.controller)) inner = &sp->bank;
+    const auto* b = inner ? std::get_if<OscillatorBank>(inner) : std::get_if<OscillatorBank>(&loop.controller);
+    if (!b || b->harmonics() > 50) throw;
+  }
   const Eigen::MatrixXd a = closed_loop_dde(loop).undelayed_matrix();
   const Eigen::VectorXcd ev = Eigen::EigenSolver<Eigen::MatrixXd>(a, false).eigenvalues();
   return {ev.data(), ev.data() + ev.size()};

@@ -8,8 +8,9 @@
 // Fixed step h = T/M (M = steps_per_period, T = 2π/Ω of the plant). The controller is stepped either by
 //   * AdamsBashforth3 — as in the paper (AB1, AB2 for the first two steps), with its dense output (the
 //     integrated interpolation polynomial of the derivatives) giving u as a cubic in t over each step; or
-//   * ZeroOrderHold  — the exact discretisation for a held sample m_n (Φ = e^{Ah}, Γ, zero_order_hold()),
-//     output u_n = −K c_rᵀ z_n held over the step (a DAC); finite banks only;
+//   * ZeroOrderHold  — the exact discretisation for a held sample m_n (Φ = e^{Ah}, Γ; computed in the modal
+//     coordinates of A from bank_eigenvalues(), O(N) per step, no N×N matrix), output u_n = −K c_rᵀ z_n held over
+//     the step (a DAC); finite banks only;
 //   * BlockZeroOrderHold — each oscillator exact for the held error e_n (discretisation.hpp: SampledForm), u held;
 //     finite banks only. The two ZOH forms are what RealtimeFilter runs (computed there independently).
 // The first-order plant is integrated exactly over each step for the polynomial u and the trigonometric f
@@ -76,6 +77,13 @@ struct SimulationResult {
 /// progress(done_periods, total_periods), called once per period.
 using SimulationProgress = std::function<void(long, long)>;
 
+/// One recorded step of the time series (the columns of TimeSeries).
+struct TimeSample {
+  double t, y, u, m, target, f_minus_first;
+};
+/// Receives every recorded step in time order (streaming: the series is then not kept in memory).
+using SampleSink = std::function<void(const TimeSample&)>;
+
 class ClosedLoopSimulation {
  public:
   /// Validates (InvalidParameter naming the parameter and the allowed range): periods ≥ 1;
@@ -84,11 +92,17 @@ class ClosedLoopSimulation {
   /// modes are mirrored, −λ̄); N = ∞: AB3 only, α > 0 (|B4/A4| < 1), controller Ω = plant Ω.
   ClosedLoopSimulation(Plant plant, Bank controller, SimulationOptions options = {});
 
-  SimulationResult run(const SimulationProgress& progress = {}) const;
+  /// Runs the loop. With a `sink`, every recorded step (record_every) is passed to it as it is computed and
+  /// `series` stays empty (memory independent of the run length); without one, `series` holds them.
+  /// Cost: O(N) per step for every stepping (ZOH in modal coordinates), O(N²) set-up (controller modes).
+  SimulationResult run(const SimulationProgress& progress = {}, const SampleSink& sink = {}) const;
 
-  const Plant& plant() const { return plant_; }
-  const Bank& controller() const { return controller_; }
-  const SimulationOptions& options() const { return options_; }
+  const Plant& plant() const& { return plant_; }
+  const Plant& plant() const&& = delete;
+  const Bank& controller() const& { return controller_; }
+  const Bank& controller() const&& = delete;
+  const SimulationOptions& options() const& { return options_; }
+  const SimulationOptions& options() const&& = delete;
   double step() const;  // h = T/M
   /// Harmonics rejected by the controller ({1} for N = ∞).
   std::vector<int> rejected() const;

@@ -4,6 +4,7 @@
 // Exactly at a pole on the grid the magnitude is +inf and the phase NaN (the unwrapping skips it).
 #include <complex>
 #include <functional>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -24,6 +25,23 @@ struct FrequencyResponse {
 /// Grid of `points` angular frequencies in [omega_min, omega_max] (log spacing needs omega_min > 0).
 /// Validated: 0 ≤ omega_min < omega_max finite, points ≥ 2.
 std::vector<double> frequency_grid(double omega_min, double omega_max, int points, bool log_spacing);
+
+/// Point i (0 ≤ i < points) of frequency_grid(omega_min, omega_max, points, log_spacing), computed alone (for
+/// streaming a grid of any length in O(1) memory). Same values as the vector form.
+double frequency_grid_point(double omega_min, double omega_max, long points, bool log_spacing, long i);
+
+/// Streaming form of unwrap_phase: feed the raw phases in grid order, get the unwrapped ones (NaN passed through).
+class PhaseUnwrapper {
+ public:
+  double operator()(double raw_phase);
+
+ private:
+  double offset_ = 0.0;
+  double last_ = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// The frequency-response row of a value G(iω): magnitude (+inf at a pole) and raw phase (NaN at a pole).
+void magnitude_phase(std::complex<double> value, double& magnitude, double& raw_phase);
 
 /// np.unwrap: adds multiples of 2π so that consecutive finite entries differ by at most π; NaN kept.
 std::vector<double> unwrap_phase(std::vector<double> phase);

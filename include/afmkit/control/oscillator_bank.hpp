@@ -8,6 +8,7 @@
 // Conventions (MATH.md B.0): negative feedback U(s) = −C(s) M(s); K = γ̂ (estimate of the plant rate γ) is
 // the design rule; couplings (20): a0 = α, a_k = 2α, b_k = −2β/k.
 // State ordering: (x0, x1, z1, x2, z2, …, xN, zN) ∈ ℝ^{2N+1}.
+#include <complex>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -33,7 +34,8 @@ class OscillatorBank {
   double a(int k) const { return a_.at(k - 1); }
   double b(int k) const { return b_.at(k - 1); }
   double gain() const { return gain_; }  // K
-  const std::vector<int>& rejected() const { return rejected_; }
+  const std::vector<int>& rejected() const& { return rejected_; }
+  const std::vector<int>& rejected() const&& = delete;
   bool is_rejected(int k) const;
   int state_size() const { return 2 * harmonics() + 1; }
 
@@ -52,5 +54,10 @@ class OscillatorBank {
   std::vector<int> rejected_;
   std::vector<char> rejected_mask_;  // index k (0..N)
 };
+
+/// Eigenvalues of state_matrix() without forming it: ±ikΩ for each rejected k (exact), and the roots of the
+/// bank's denominator d(s) (loop.hpp) by the Aberth–Ehrlich iteration from ikΩ − g_k (eq. 34), O(N) per
+/// evaluation, O(N²) in total. Throws NumericalFailure if the iteration does not converge.
+std::vector<std::complex<double>> bank_eigenvalues(const OscillatorBank& bank);
 
 }  // namespace afmkit::control

@@ -46,7 +46,8 @@ struct SpectrumOptions {
   double min_real = std::numeric_limits<double>::quiet_NaN();
   /// Half-height of the box [rad/s]. NaN: the proven root-free bound (capped at `max_imag_cap`).
   double max_imag = std::numeric_limits<double>::quiet_NaN();
-  double max_imag_cap_periods = 60.0;  ///< cap of the automatic half-height, in units of Ω
+  double max_imag_cap_periods = 60.0;  ///< cap of the automatic half-height, in units of Ω (finite banks: at
+                                       ///< least 2(N + 1), above every oscillator frequency)
   int count = 12;                  ///< automatic box: aim at about this many rightmost roots
   int collocation_nodes = 0;       ///< Chebyshev nodes per delay (0: automatic)
   double tolerance = 1e-12;        ///< Newton: stop when |Δ/Δ'| ≤ tolerance·max(Ω, |s|)

@@ -46,9 +46,14 @@ bool couplings_stable_tau0(int harmonics, double rotation_frequency, double alph
 /// Eq. (24): α > 0 and β > −Ω/4 (N = ∞, K = γ, τ = 0).
 bool infinite_bank_stable_tau0(double rotation_frequency, double alpha, double beta);
 
-/// Eigenvalues of the closed loop with every delay set to 0 (closed_loop_dde(loop).undelayed_matrix()):
+/// Eigenvalues of the closed loop with every delay set to 0 (those of closed_loop_dde(loop).undelayed_matrix()):
 /// any finite bank / Smith predictor, any K, γ, plant kind. InvalidParameter("controller") for N = ∞.
+/// Computed as the roots of the delay-free characteristic polynomial (Aberth–Ehrlich from the first-order
+/// positions ikΩ − g_k, eq. 45), O(N) per evaluation and O(N²) in total; dense eigenvalues only as a fallback
+/// for N ≤ 50.
 std::vector<std::complex<double>> undelayed_poles(const LoopSpec& loop);
+/// The Aberth form alone (no fallback); NumericalFailure if it does not converge.
+std::vector<std::complex<double>> undelayed_poles_secular(const LoopSpec& loop);
 /// max Re of undelayed_poles.
 double undelayed_spectral_abscissa(const LoopSpec& loop);
 

@@ -37,7 +37,8 @@ int max_disturbance_order(const Disturbance& f) {
 Eigen::VectorXcd controller_modes(const Bank& bank) {
   Eigen::VectorXcd ev;
   if (const auto* ob = std::get_if<OscillatorBank>(&bank)) {
-    ev = Eigen::EigenSolver<Eigen::MatrixXd>(ob->state_matrix(), false).eigenvalues();
+    const std::vector<std::complex<double>> e = bank_eigenvalues(*ob);  // O(N²), no dense matrix
+    ev = Eigen::Map<const Eigen::VectorXcd>(e.data(), static_cast<Eigen::Index>(e.size()));
   } else {
     const auto a = std::get<InfiniteBank>(bank).a_coefficients();
     Eigen::Matrix4d comp = Eigen::Matrix4d::Zero();
@@ -103,7 +104,7 @@ struct LastPeriod {
 
 template <class Stepper>
 void run_loop(Stepper& ctrl, const LoopContext& cx, SimulationResult& res, LastPeriod& last,
-              const SimulationProgress& progress) {
+              const SimulationProgress& progress, const SampleSink& sink) {
   const Plant& plant = *cx.plant;
   const int M = cx.M;
   const double h = cx.h, gamma = plant.rate;
@@ -114,7 +115,7 @@ void run_loop(Stepper& ctrl, const LoopContext& cx, SimulationResult& res, LastP
   auto& rep = res.report;
   auto& ser = res.series;
   std::vector<double> last_y(M), last_u(M);
-  if (cx.record_every > 0) {
+  if (cx.record_every > 0 && !sink) {
     const std::size_t n_rec = static_cast<std::size_t>(cx.total / cx.record_every + 1);
     for (auto* v : {&ser.t, &ser.y, &ser.u, &ser.m, &ser.target, &ser.f_minus_first}) v->reserve(n_rec);
   }
@@ -153,7 +154,9 @@ void run_loop(Stepper& ctrl, const LoopContext& cx, SimulationResult& res, LastP
       }
     }
     ctrl.step(m, cx.first_order ? &poly : nullptr);
-    if (cx.record_every > 0 && n % cx.record_every == 0) {
+    if (cx.record_every > 0 && n % cx.record_every == 0 && sink) {
+      sink(TimeSample{t, y, u, m, cx.target[i], cx.f_minus_first[i]});
+    } else if (cx.record_every > 0 && n % cx.record_every == 0) {
       ser.t.push_back(t);
       ser.y.push_back(y);
       ser.u.push_back(u);
@@ -320,7 +323,7 @@ std::vector<int> ClosedLoopSimulation::rejected() const {
   return {1};
 }
 
-SimulationResult ClosedLoopSimulation::run(const SimulationProgress& progress) const {
+SimulationResult ClosedLoopSimulation::run(const SimulationProgress& progress, const SampleSink& sink) const {
   const std::vector<int> rej = rejected();
   const LoopContext cx = make_context(plant_, options_, rej);
   SimulationResult res;
@@ -332,17 +335,17 @@ SimulationResult ClosedLoopSimulation::run(const SimulationProgress& progress) c
   if (const auto* ob = std::get_if<OscillatorBank>(&controller_)) {
     if (options_.stepping == ControllerStepping::ZeroOrderHold) {
       detail::BankZoh c(*ob, cx.h);
-      run_loop(c, cx, res, last, progress);
+      run_loop(c, cx, res, last, progress, sink);
     } else if (options_.stepping == ControllerStepping::BlockZeroOrderHold) {
       detail::BankBlockZoh c(*ob, cx.h);
-      run_loop(c, cx, res, last, progress);
+      run_loop(c, cx, res, last, progress, sink);
     } else {
       detail::BankAb3 c(*ob, cx.h);
-      run_loop(c, cx, res, last, progress);
+      run_loop(c, cx, res, last, progress, sink);
     }
   } else {
     detail::NeutralAb3 c(std::get<InfiniteBank>(controller_), cx.M, cx.h);
-    run_loop(c, cx, res, last, progress);
+    run_loop(c, cx, res, last, progress, sink);
   }
   const EnvelopeFit fit = fit_log_envelope(rep.envelope, plant_.period());
   rep.growth_rate = fit.growth_rate;

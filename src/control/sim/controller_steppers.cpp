@@ -74,19 +74,66 @@ void BankAb3::step(double m, OutputPolynomial* poly) {
 // ---- BankZoh -------------------------------------------------------------------------------------------------
 
 BankZoh::BankZoh(const OscillatorBank& bank, double step) {
-  const ZeroOrderHold zoh = zero_order_hold(bank.state_matrix(), bank.input_vector(), step);
-  phi_ = zoh.transition;
-  gamma_ = zoh.input.col(0);
-  c_ = -bank.output_vector();
-  z_ = Eigen::VectorXd::Zero(bank.state_size());
-  tmp_ = z_;
+  using cplx = std::complex<double>;
+  const double omega = bank.rotation_frequency(), gain = bank.gain();
+  const std::vector<cplx> lambda = bank_eigenvalues(bank);
+  // D(s) = 1 + a0/s + Σ_kept G_k, D', N(s) = Σ_rejected G_k at s (eq. 18), O(N)
+  const auto terms = [&](cplx s, cplx& d, cplx& dd, cplx& n) {
+    d = 1.0 + bank.a0() / s;
+    dd = -bank.a0() / (s * s);
+    n = 0.0;
+    for (int k = 1; k <= bank.harmonics(); ++k) {
+      const double kw = k * omega;
+      const cplx den = s * s + kw * kw;
+      const cplx g = (bank.a(k) * s - bank.b(k) * kw) / den;
+      if (bank.is_rejected(k)) {
+        n += g;
+      } else {
+        d += g;
+        dd += (bank.a(k) - 2.0 * s * g) / den;
+      }
+    }
+  };
+  for (const cplx l : lambda) {
+    cplx beta, out;
+    int rejected = 0;
+    for (int k : bank.rejected())
+      if (std::abs(std::abs(l.imag()) - k * omega) == 0.0 && l.real() == 0.0) rejected = k;
+    cplx d, dd, n;
+    if (rejected) {
+      const cplx l_safe = l;
+      d = 1.0 + bank.a0() / l_safe;
+      for (int k = 1; k <= bank.harmonics(); ++k)
+        if (!bank.is_rejected(k)) {
+          const double kw = k * omega;
+          d += (bank.a(k) * l - bank.b(k) * kw) / (l * l + kw * kw);
+        }
+      const double sign = l.imag() > 0.0 ? 1.0 : -1.0;
+      beta = cplx(bank.a(rejected), sign * bank.b(rejected)) / (2.0 * d);
+      out = -gain;
+    } else {
+      terms(l, d, dd, n);
+      beta = 1.0 / dd;
+      out = -gain * n;
+    }
+    const cplx z = l * step;
+    const cplx e = std::exp(z);
+    decay_.push_back(e);
+    input_.push_back(beta * step * phi_function(1, z));  // β (e^{λh} − 1)/λ
+    out_.push_back(out);
+  }
+  q_.assign(decay_.size(), 0.0);
+}
+
+double BankZoh::output() const {
+  std::complex<double> u = 0.0;
+  for (std::size_t j = 0; j < q_.size(); ++j) u += out_[j] * q_[j];
+  return u.real();
 }
 
 void BankZoh::step(double m, OutputPolynomial* poly) {
   if (poly) *poly = {output(), 0.0, 0.0, 0.0};
-  tmp_.noalias() = phi_ * z_;
-  tmp_ += gamma_ * m;
-  z_.swap(tmp_);
+  for (std::size_t j = 0; j < q_.size(); ++j) q_[j] = decay_[j] * q_[j] + input_[j] * m;
 }
 
 // ---- BankBlockZoh --------------------------------------------------------------------------------------------

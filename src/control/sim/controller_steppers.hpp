@@ -4,6 +4,7 @@
 // describing u over [t_n, t_{n+1}] as a cubic u(t_n + s) = c0 + c1 s + c2 s² + c3 s³ (for the exact plant step).
 // No allocation in step().
 #include <array>
+#include <complex>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -35,17 +36,20 @@ class BankAb3 {
   long count_ = 0;
 };
 
-/// Finite bank discretised exactly for a held sample (ZOH, dense Φ, Γ from zero_order_hold()); u held.
+/// Finite bank discretised exactly for a held sample (ZOH) in modal coordinates; u held. With the eigenvalues
+/// λ_j of A (bank_eigenvalues) the modes are q_j' = λ_j q_j + β_j m, u = Re Σ_j o_j q_j, stepped exactly:
+/// q_j ← e^{λ_j h} q_j + β_j (e^{λ_j h} − 1)/λ_j m. O(N) per step and O(N²) set-up, no N×N matrix:
+///   kept-subsystem modes (D(λ_j) = 0, D the curly bracket of eq. 18): β_j = 1/D'(λ_j), o_j = −K N(λ_j)
+///   (the residues of −C = −K N/D), N = Σ_rejected G_k;
+///   rejected oscillator r at λ = ±ik_rΩ: β = (a_r ± i b_r)/(2 D(λ)), o = −K.
 class BankZoh {
  public:
   BankZoh(const OscillatorBank& bank, double step);
-  double output() const { return c_.dot(z_); }
+  double output() const;
   void step(double measured, OutputPolynomial* poly);
 
  private:
-  Eigen::MatrixXd phi_;
-  Eigen::VectorXd gamma_, z_, tmp_;
-  Eigen::RowVectorXd c_;  // −K c_rᵀ
+  std::vector<std::complex<double>> decay_, input_, out_, q_;
 };
 
 /// Finite bank, block scheme sampled: e_n = m_n − c_eᵀ z_n held, each oscillator advanced by its own exact ZOH

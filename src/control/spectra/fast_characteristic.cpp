@@ -72,6 +72,9 @@ void FastCharacteristic::bank(cplx s, cplx& d, cplx& dd, cplx& n, cplx& dn, cplx
       const cplx dg = (a_[k] - 2.0 * s * g) * inv;  // G_k'
       log_dq += 2.0 * s * inv;
       q *= 1.0 + s2 / kw2_[k];
+      // Q grows like Π k⁻²|s|² for |s| ≫ kΩ: divide by a positive power of two before it overflows (a common
+      // positive factor of Δ and Δ'; exact where Δ is representable, see the header)
+      if (std::abs(q.real()) + std::abs(q.imag()) > 1e150) q *= 0x1p-500;
       if (rejected_[k]) {
         n += g;
         dn += dg;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <variant>
 
+#include "afmkit/control/stability_tau0.hpp"
 #include "spectra_detail.hpp"
 
 namespace afmkit::control::spectra_detail {
@@ -51,6 +52,38 @@ NewtonResult newton(const Evaluator& f, cplx guess, double tolerance, int max_it
   // Rounding floor: accept a stagnating iteration whose corrections are already tiny.
   if (!r.converged && last <= 1e-9 * std::max(omega, std::abs(s))) r.converged = true;
   return r;
+}
+
+std::vector<cplx> delay_free_continuation(const Evaluator& f, double tolerance, std::size_t limit) {
+  const double omega = f.omega();
+  std::vector<cplx> poles = undelayed_poles(f.loop());
+  std::erase_if(poles, [omega](cplx e) { return e.imag() < -1e-9 * omega; });
+  if (poles.size() > limit) {
+    std::partial_sort(poles.begin(), poles.begin() + static_cast<std::ptrdiff_t>(limit), poles.end(),
+                      [](cplx a, cplx b) { return a.real() > b.real(); });
+    poles.resize(limit);
+  }
+  std::vector<cplx> out;
+  for (cplx e : poles) {
+    const NewtonResult r = newton(f, e, tolerance, 60);
+    if (!r.converged) continue;
+    cplx s = r.root;
+    if (std::abs(s.imag()) < 1e-10 * std::max(omega, std::abs(s))) s = s.real();
+    if (s.imag() < 0) s = std::conj(s);
+    out.push_back(s);
+  }
+  // distinct (sorted by imaginary part, neighbours compared: O(N log N))
+  std::sort(out.begin(), out.end(), [](cplx a, cplx b) { return a.imag() < b.imag(); });
+  std::vector<cplx> uniq;
+  for (cplx s : out) {
+    bool dup = false;
+    for (std::size_t i = uniq.size(); i-- > 0;) {
+      if (s.imag() - uniq[i].imag() > 1e-8 * std::max(omega, std::abs(s))) break;
+      if (std::abs(uniq[i] - s) <= 1e-8 * std::max(omega, std::abs(s))) dup = true;
+    }
+    if (!dup) uniq.push_back(s);
+  }
+  return uniq;
 }
 
 bool add_unique(std::vector<cplx>& roots, cplx s, double radius) {

@@ -133,6 +133,16 @@ void subdivision_search(const Evaluator& f, const Box& box, int count, double to
 /// boundary; `box` is updated to the box actually used. Returns false if every attempt failed.
 bool robust_count(const Evaluator& f, Box& box, int& count);
 
+/// Banks with more oscillators than this get their initial root guesses from the delay-free poles (Aberth,
+/// O(N²)) instead of the dense Chebyshev collocation (O((2N + nodes)³)).
+inline constexpr int kCollocationMaxHarmonics = 40;
+/// Initial guesses for a finite bank without dense matrices: the delay-free closed-loop poles
+/// (undelayed_poles, stability_tau0.hpp), each continued by Newton on Δ of the delayed loop; upper half-plane
+/// and real axis, distinct. O(N) per evaluation, O(N) starts: O(N²).
+/// `limit`: continue only the `limit` rightmost delay-free poles (root tracking keeps a few rightmost roots).
+std::vector<cplx> delay_free_continuation(const Evaluator& f, double tolerance,
+                                          std::size_t limit = static_cast<std::size_t>(-1));
+
 /// Merge `s` into `roots` unless a root within `radius` is already present.
 bool add_unique(std::vector<cplx>& roots, cplx s, double radius);
 

@@ -35,6 +35,8 @@ bool in_box(const Box& b, cplx s) {
 std::vector<cplx> collocation_candidates(const LoopSpec& loop, const SpectrumOptions& o) {
   const auto v = spectra_detail::view(loop);
   const double omega = v.omega;
+  if (v.bank->harmonics() > spectra_detail::kCollocationMaxHarmonics)
+    return spectra_detail::delay_free_continuation(spectra_detail::Evaluator(loop), o.tolerance);
   const double scale = (v.bank->harmonics() + 3) * omega;
   const DelayDifferentialSystem sys = closed_loop_dde(loop);
   const auto ev = collocation_eigenvalues(sys, o.collocation_nodes, scale);
@@ -88,7 +90,10 @@ Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
   out.neutral_bound = neutral_spectrum_bound(loop);
   if (v.infinite) out.structural = neutral_realisation_roots(loop);
   const double bound = out.neutral_bound.value_or(-INFINITY);
-  const double cap = o.max_imag_cap_periods * omega;
+  // finite banks: every oscillator frequency kΩ ≤ NΩ carries roots, so the proven box height exceeds NΩ; the cap
+  // is raised to 2(N + 1)Ω (the winding along the box is then O(N) evaluations of O(N) each)
+  const double cap =
+      (v.bank ? std::max(o.max_imag_cap_periods, 2.0 * (v.bank->harmonics() + 1)) : o.max_imag_cap_periods) * omega;
   const spectra_detail::Evaluator f(loop);
 
   // 1. candidates (finite banks: collocation + Newton)

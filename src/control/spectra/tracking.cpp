@@ -103,7 +103,11 @@ TrackedSpectrum RootTracker::merge(const TrackedSpectrum& a, const TrackedSpectr
 TrackedSpectrum RootTracker::initial(const LoopSpec& loop) const {
   const LoopView v = view(loop);
   TrackedSpectrum start;
-  if (v.bank) {
+  if (v.bank && v.bank->harmonics() > kCollocationMaxHarmonics) {
+    start.roots = delay_free_continuation(Evaluator(loop), tolerance_, static_cast<std::size_t>(4 * keep_));
+    std::sort(start.roots.begin(), start.roots.end(), [](cplx a, cplx b) { return a.real() > b.real(); });
+    if (start.roots.size() > static_cast<std::size_t>(3 * keep_)) start.roots.resize(3 * keep_);
+  } else if (v.bank) {
     const double scale = (v.bank->harmonics() + 3) * v.omega;
     const auto ev = collocation_eigenvalues(closed_loop_dde(loop), 0, scale);
     for (cplx e : ev)

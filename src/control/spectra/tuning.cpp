@@ -54,6 +54,7 @@ class Objective {
     // τ continuation sub-steps of at most T/50
     const double period = 2.0 * std::numbers::pi / spec.family.rotation_frequency;
     substeps_ = std::max(1, static_cast<int>(std::ceil(spec.delay_max / std::max(1, n - 1) / (period / 50.0))));
+    small_bank_ = spec.family.harmonics <= spectra_detail::kCollocationMaxHarmonics;
   }
   double operator()(double x, double y, std::vector<TrackedSpectrum>& warm, double* wd, double* wr) const {
     if (warm.size() != rhos_.size()) warm.assign(rhos_.size(), TrackedSpectrum{});
@@ -68,7 +69,8 @@ class Objective {
         if (tau > 0.0) {
           s = advance(x, y, rhos_[j], s, prev, tau);
           // finite banks: merge a fresh collocation spectrum at the largest delay (chain roots from −∞)
-          if (!spec_.family.neutral() && tau == taus_.back())
+          // (large banks start from the delay-free poles, which hold no chain roots: nothing to merge)
+          if (!spec_.family.neutral() && tau == taus_.back() && small_bank_)
             s = tracker_.merge(s, tracker_.initial(spec_.family.at(x, y, tau, rhos_[j])));
         }
         prev = tau;
@@ -113,6 +115,7 @@ class Objective {
   const RobustTuningSpec& spec_;
   std::vector<double> rhos_, taus_;
   int substeps_ = 1;
+  bool small_bank_ = true;
   RootTracker tracker_{24};
 };
 }  // namespace
