@@ -87,7 +87,8 @@ class RealtimeFilter {
   std::uint64_t skipped_samples() const noexcept { return skipped_; }
   std::uint64_t samples() const noexcept { return samples_; }
   double last_output() const noexcept { return held_; }
-  const OscillatorBank& controller() const noexcept { return bank_; }
+  const OscillatorBank& controller() const& noexcept { return bank_; }
+  OscillatorBank controller() const&& { return bank_; }
   double sample_rate() const noexcept { return sample_rate_; }
   SampledForm form() const noexcept { return form_; }
   /// ZeroOrderHold form running in modal coordinates (O(N)); false for the dense fallback and for the block form.

@@ -24,7 +24,8 @@ class Polynomial {
   int degree() const { return static_cast<int>(c_.size()) - 1; }  // −1 for the zero polynomial
   bool is_zero() const { return c_.empty(); }
   double coefficient(int power) const;  // 0 beyond the degree
-  const std::vector<double>& ascending() const { return c_; }
+  const std::vector<double>& ascending() const& { return c_; }
+  std::vector<double> ascending() const&& { return c_; }
   std::vector<double> descending() const;
   double leading() const;
 
@@ -47,8 +48,10 @@ class TransferFunction {
  public:
   /// Validated: denominator not the zero polynomial ("den").
   TransferFunction(Polynomial num, Polynomial den);
-  const Polynomial& num() const { return num_; }
-  const Polynomial& den() const { return den_; }
+  const Polynomial& num() const& { return num_; }
+  Polynomial num() const&& { return num_; }
+  const Polynomial& den() const& { return den_; }
+  Polynomial den() const&& { return den_; }
 
   /// num(s)/den(s); exactly at a pole (den = 0, num ≠ 0) returns complex(inf, 0).
   std::complex<double> operator()(std::complex<double> s) const;
