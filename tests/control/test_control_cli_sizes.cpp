@@ -126,42 +126,66 @@ TEST_F(ControlCliSizes, RootsMarginChartTuneSimulateAnswerAtN1000) {
 
 // ---- the chart sidecar records the computed window (defect 2) -------------------------------------------------
 
-TEST_F(ControlCliSizes, ChartSidecarRecordsTheComputedWindow) {
-  // default window of the coupling family (docs: alpha in [-0.1, 1], beta in [-0.4, 1])
-  const CliResult r = run("control chart --harmonics 3 --x-points 3 --y-points 3 --progress false --output c.csv "
-                    "--boundaries-output b.csv");
-  ASSERT_EQ(r.status, 0) << r.err;
-  std::ifstream in(dir_ / "c.csv");
-  std::string line;
-  std::getline(in, line);
+// The grid actually written: min/max of the first two CSV columns (x, y) and the row count.
+struct GridExtent {
   double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
   int rows = 0;
+};
+GridExtent grid_extent(const std::filesystem::path& csv) {
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  GridExtent e;
   while (std::getline(in, line)) {
     double x, y;
     char c;
     std::stringstream ss(line);
     ss >> x >> c >> y;
-    xmin = std::min(xmin, x);
-    xmax = std::max(xmax, x);
-    ymin = std::min(ymin, y);
-    ymax = std::max(ymax, y);
-    ++rows;
+    e.xmin = std::min(e.xmin, x);
+    e.xmax = std::max(e.xmax, x);
+    e.ymin = std::min(e.ymin, y);
+    e.ymax = std::max(e.ymax, y);
+    ++e.rows;
   }
-  EXPECT_EQ(rows, 9);
-  EXPECT_DOUBLE_EQ(xmin, -0.1);
-  EXPECT_DOUBLE_EQ(xmax, 1.0);
-  EXPECT_DOUBLE_EQ(ymin, -0.4);
-  EXPECT_DOUBLE_EQ(ymax, 1.0);
-  const auto j = nlohmann::json::parse(slurp(dir_ / "c.csv.json"));
+  return e;
+}
+// The sidecar's window, in the parameters as run and in the results, is the grid written.
+void expect_window(const nlohmann::json& sidecar, const GridExtent& e) {
   for (const auto* sec : {"parameters", "results"}) {
-    const auto& w = std::string(sec) == "results" ? j[sec]["window"] : j[sec];
-    EXPECT_DOUBLE_EQ(w["x_min"].get<double>(), xmin) << sec;
-    EXPECT_DOUBLE_EQ(w["x_max"].get<double>(), xmax) << sec;
-    EXPECT_DOUBLE_EQ(w["y_min"].get<double>(), ymin) << sec;
-    EXPECT_DOUBLE_EQ(w["y_max"].get<double>(), ymax) << sec;
+    const auto& w = std::string(sec) == "results" ? sidecar[sec]["window"] : sidecar[sec];
+    EXPECT_DOUBLE_EQ(w["x_min"].get<double>(), e.xmin) << sec;
+    EXPECT_DOUBLE_EQ(w["x_max"].get<double>(), e.xmax) << sec;
+    EXPECT_DOUBLE_EQ(w["y_min"].get<double>(), e.ymin) << sec;
+    EXPECT_DOUBLE_EQ(w["y_max"].get<double>(), e.ymax) << sec;
   }
+}
+
+TEST_F(ControlCliSizes, ChartSidecarRecordsTheComputedWindow) {
+  // default window of the coupling family (docs: alpha in [-0.1, 1], beta in [-0.4, 1])
+  const CliResult r = run("control chart --harmonics 3 --x-points 3 --y-points 3 --progress false --output c.csv "
+                    "--boundaries-output b.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const GridExtent e = grid_extent(dir_ / "c.csv");
+  EXPECT_EQ(e.rows, 9);
+  EXPECT_DOUBLE_EQ(e.xmin, -0.1);
+  EXPECT_DOUBLE_EQ(e.xmax, 1.0);
+  EXPECT_DOUBLE_EQ(e.ymin, -0.4);
+  EXPECT_DOUBLE_EQ(e.ymax, 1.0);
+  const auto j = nlohmann::json::parse(slurp(dir_ / "c.csv.json"));
+  expect_window(j, e);
   EXPECT_EQ(j["results"]["x_points"].get<int>(), 3);
   EXPECT_EQ(j["results"]["y_points"].get<int>(), 3);
+}
+
+TEST_F(ControlCliSizes, TuneSidecarRecordsTheComputedWindow) {
+  // default window of the tuning search (coupling family): the coarse grid's corners are the window's
+  const CliResult r = run("control tune --harmonics 3 --coarse-points 3 --max-evaluations 2 --delay-points 1 "
+                          "--gain-points 1 --progress false --output t.csv");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const GridExtent e = grid_extent(dir_ / "t.csv");
+  EXPECT_EQ(e.rows, 9);
+  const auto j = nlohmann::json::parse(slurp(dir_ / "t.csv.json"));
+  expect_window(j, e);
 }
 
 }  // namespace
