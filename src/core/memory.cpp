@@ -67,9 +67,10 @@ void require_fits(const std::string& parameter, double value, double bytes_per_u
   if (!(needed <= usable)) {
     const double gib = 1024.0 * 1024.0 * 1024.0;
     throw InvalidParameter(
-        parameter, fmt::format("{} = {} needs about {:.2f} GiB of memory, more than the {:.2f} GiB this machine can "
-                               "give now: must be <= {:.0f}",
-                               parameter, value, needed / gib, usable / gib, std::floor(usable / bytes_per_unit)));
+        parameter, fmt::format("{} = {} needs about {:.2f} GiB of memory, more than the {:.2f} GiB usable now ({:.0f} % "
+                               "of MemAvailable, capped by ulimit -v and AFMKIT_MEMORY_LIMIT): must be <= {:.0f}",
+                               parameter, value, needed / gib, usable / gib, 100.0 * fraction,
+                               std::floor(usable / bytes_per_unit)));
   }
 }
 

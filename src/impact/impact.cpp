@@ -3,14 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
 #include <limits>
-#include <optional>
-#include <sstream>
 
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/memory.hpp"
 #include "afmkit/core/validate.hpp"
 #include "impact_detail.hpp"
 
@@ -171,18 +169,6 @@ void complete_result(const ImpactProblem& problem, ImpactResult& r, double relat
 
 namespace {
 
-/// MemAvailable from /proc/meminfo in bytes (nullopt where unreadable).
-std::optional<double> available_memory() {
-  std::ifstream in("/proc/meminfo");
-  for (std::string line; std::getline(in, line);) {
-    if (line.rfind("MemAvailable:", 0) != 0) continue;
-    std::istringstream fields(line.substr(13));
-    double kib = 0;
-    if (fields >> kib) return kib * 1024.0;
-  }
-  return std::nullopt;
-}
-
 /// The solved impact must be representable: non-finite times, gaps or speeds mean the input scales
 /// (gap / speed, stiffness / reduced mass, …) leave the double range.
 void require_finite_result(const ImpactResult& r) {
@@ -214,13 +200,7 @@ ImpactResult simulate_impact(const ImpactProblem& problem, const ImpactOptions& 
   if (options.history_points != 0) validate::in_range("history_points", options.history_points, 2L, 1'000'000'000L);
   if (options.history_points > 0 && !options.on_sample) {
     // Stored history: one ImpactSample per point (plus a few events). Refuse before any work when it would not fit.
-    const double need = static_cast<double>(options.history_points + 16) * sizeof(ImpactSample);
-    if (const auto avail = available_memory(); avail && need > *avail)
-      throw InvalidParameter("history_points",
-                             fmt::format("history_points = {} needs {:.3g} GB to store the history but only {:.3g} GB "
-                                         "are available (MemAvailable); use fewer points or ImpactOptions::on_sample "
-                                         "to stream the samples",
-                                         options.history_points, need / 1e9, *avail / 1e9));
+    memory::require_fits("history_points", static_cast<double>(options.history_points), sizeof(ImpactSample), 1.0);
   }
 
   const bool closed_form_possible = problem.law().piecewise_linear() != nullptr && problem.external().constant();
