@@ -13,6 +13,7 @@
 #include "afmkit/control/oscillator_bank.hpp"
 #include "afmkit/control/stability_tau0.hpp"
 #include "afmkit/core/error.hpp"
+#include "bank_sums.hpp"
 
 namespace afmkit::control {
 
@@ -31,18 +32,20 @@ template <class LogDerivative>
 bool aberth(LogDerivative&& logd, std::vector<cplx>& z, double scale, int max_sweeps = 100) {
   const std::size_t n = z.size();
   std::vector<char> done(n, 0);
-  std::vector<double> last(n, INFINITY);
+  std::vector<double> last(n, INFINITY), re(n), im(n);
+  for (std::size_t j = 0; j < n; ++j) re[j] = z[j].real(), im[j] = z[j].imag();
   for (int sweep = 0; sweep < max_sweeps; ++sweep) {
     bool all = true;
     for (std::size_t j = 0; j < n; ++j) {
       if (done[j]) continue;
       const cplx ld = logd(z[j]);
-      cplx sum = 0.0;
-      for (std::size_t k = 0; k < n; ++k)
-        if (k != j) sum += reciprocal(z[j] - z[k]);
+      const cplx sum = detail::inverse_distance_sum(re.data(), im.data(), j, z[j]) +
+                       detail::inverse_distance_sum(re.data() + j + 1, im.data() + j + 1, n - j - 1, z[j]);
       cplx w = reciprocal(ld - sum);
       if (!finite(w)) w = cplx(1e-7 * scale, 1.3e-7 * scale);  // exactly on a pole of p'/p: nudge
       z[j] -= w;
+      re[j] = z[j].real();
+      im[j] = z[j].imag();
       const double size = std::abs(w), floor = 1e-14 * std::max(scale, std::abs(z[j]));
       // converged: below the rounding floor, or no longer decreasing once small
       if (size <= floor || (size <= 1e-10 * std::max(scale, std::abs(z[j])) && size >= 0.5 * last[j])) done[j] = 1;
@@ -68,29 +71,16 @@ struct BankTerms {
   cplx lq_all;  // Σ_all 2s/(s² + k²Ω²)
   cplx lq_kept; // Σ_kept 2s/(s² + k²Ω²)
 };
-BankTerms bank_terms(const OscillatorBank& b, cplx s) {
-  const double omega = b.rotation_frequency();
+BankTerms bank_terms(const detail::SplitBank& b, cplx s) {
   BankTerms t{};
   const cplx inv_s = reciprocal(s);
-  t.d = 1.0 + b.a0() * inv_s;
-  t.dd = -b.a0() * inv_s * inv_s;
-  const cplx s2 = s * s;
-  for (int k = 1; k <= b.harmonics(); ++k) {
-    const double kw = k * omega;
-    const cplx inv = reciprocal(s2 + kw * kw);
-    const cplx g = (b.a(k) * s - b.b(k) * kw) * inv;  // G_k (eq. 18)
-    const cplx dg = (b.a(k) - 2.0 * s * g) * inv;
-    const cplx lq = 2.0 * s * inv;
-    t.lq_all += lq;
-    if (b.is_rejected(k)) {
-      t.n += g;
-      t.dn += dg;
-    } else {
-      t.d += g;
-      t.dd += dg;
-      t.lq_kept += lq;
-    }
-  }
+  const detail::BankSums kept = detail::bank_sums(b.kept, s), rej = detail::bank_sums(b.rejected, s);
+  t.d = 1.0 + b.a0 * inv_s + kept.g;  // G_k: eq. (18)
+  t.dd = -b.a0 * inv_s * inv_s + kept.a_inv - 2.0 * s * kept.g_inv;
+  t.n = rej.g;
+  t.dn = rej.a_inv - 2.0 * s * rej.g_inv;
+  t.lq_kept = 2.0 * s * kept.inv;
+  t.lq_all = t.lq_kept + 2.0 * s * rej.inv;
   return t;
 }
 
@@ -120,9 +110,10 @@ std::vector<std::complex<double>> bank_eigenvalues(const OscillatorBank& b) {
     z.push_back(-ikw - std::conj(g));
   }
   nudge(z, omega);
+  const detail::SplitBank split = detail::split_bank(b);
   // d / Π_rejected q_r = [s] Π_kept q_k · D:  log-derivative [1/s] + Σ_kept 2s/(s² + k²Ω²) + D'/D
   const auto logd = [&](cplx s) {
-    const BankTerms t = bank_terms(b, s);
+    const BankTerms t = bank_terms(split, s);
     return (integrator ? reciprocal(s) : cplx(0.0)) + t.lq_kept + t.dd * reciprocal(t.d);
   };
   if (!aberth(logd, z, omega * (b.harmonics() + 1)))
@@ -152,9 +143,10 @@ std::vector<std::complex<double>> undelayed_poles_secular(const LoopSpec& loop) 
     z.push_back(-ikw - std::conj(g));
   }
   nudge(z, omega);
+  const detail::SplitBank split = detail::split_bank(*b);
   // Δ(τ = 0) ∝ [s] Π_all q_k · (M D + ρ N), M = 1 or 1 + s/γ
   const auto logd = [&](cplx s) {
-    const BankTerms t = bank_terms(*b, s);
+    const BankTerms t = bank_terms(split, s);
     const cplx m = first_order ? 1.0 + s / loop.plant_rate : cplx(1.0);
     const double dm = first_order ? 1.0 / loop.plant_rate : 0.0;
     const cplx f = m * t.d + rho * t.n, df = dm * t.d + m * t.dd + rho * t.dn;

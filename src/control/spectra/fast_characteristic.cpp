@@ -18,18 +18,7 @@ inline cplx reciprocal(cplx z) {
 FastCharacteristic::FastCharacteristic(const LoopSpec& loop) : omega_(loop.rotation_frequency()) {
   const auto set_bank = [this](const Bank& b) {
     if (const auto* o = std::get_if<OscillatorBank>(&b)) {
-      a0_ = o->a0();
-      const int n = o->harmonics();
-      a_.resize(n);
-      bkw_.resize(n);
-      kw2_.resize(n);
-      rejected_.resize(n);
-      for (int k = 1; k <= n; ++k) {
-        a_[k - 1] = o->a(k);
-        bkw_[k - 1] = o->b(k) * k * omega_;
-        kw2_[k - 1] = (k * omega_) * (k * omega_);
-        rejected_[k - 1] = o->is_rejected(k) ? 1 : 0;
-      }
+      bank_ = detail::split_bank(*o);
     } else {
       const auto& i = std::get<InfiniteBank>(b);
       infinite_ = true;
@@ -57,32 +46,18 @@ FastCharacteristic::FastCharacteristic(const LoopSpec& loop) : omega_(loop.rotat
   }
 }
 
-void FastCharacteristic::bank(cplx s, cplx& d, cplx& dd, cplx& n, cplx& dn, cplx& log_dq, cplx& q) const {
+void FastCharacteristic::bank(cplx s, cplx& d, cplx& dd, cplx& n, cplx& dn, cplx& log_dq, cplx* q) const {
   if (!infinite_) {
     const cplx inv_s = reciprocal(s);
-    d = 1.0 + a0_ * inv_s;
-    dd = -a0_ * inv_s * inv_s;
-    n = dn = 0.0;
-    log_dq = a0_ != 0.0 ? inv_s : cplx(0.0);  // Q'/Q, Q = [s] Π (1 + s²/(k²Ω²))
-    q = a0_ != 0.0 ? s : cplx(1.0);
     const cplx s2 = s * s;
-    for (std::size_t k = 0; k < a_.size(); ++k) {
-      const cplx inv = reciprocal(s2 + kw2_[k]);
-      const cplx g = (a_[k] * s - bkw_[k]) * inv;  // G_k
-      const cplx dg = (a_[k] - 2.0 * s * g) * inv;  // G_k'
-      log_dq += 2.0 * s * inv;
-      q *= 1.0 + s2 / kw2_[k];
-      // Q grows like Π k⁻²|s|² for |s| ≫ kΩ: divide by a positive power of two before it overflows (a common
-      // positive factor of Δ and Δ'; exact where Δ is representable, see the header)
-      if (std::abs(q.real()) + std::abs(q.imag()) > 1e150) q *= 0x1p-500;
-      if (rejected_[k]) {
-        n += g;
-        dn += dg;
-      } else {
-        d += g;
-        dd += dg;
-      }
-    }
+    const detail::BankSums kept = detail::bank_sums(bank_.kept, s), rej = detail::bank_sums(bank_.rejected, s);
+    d = 1.0 + bank_.a0 * inv_s + kept.g;
+    dd = -bank_.a0 * inv_s * inv_s + kept.a_inv - 2.0 * s * kept.g_inv;
+    n = rej.g;
+    dn = rej.a_inv - 2.0 * s * rej.g_inv;
+    // Q'/Q, Q = [s] Π (1 + s²/(k²Ω²))
+    log_dq = (bank_.a0 != 0.0 ? inv_s : cplx(0.0)) + 2.0 * s * (kept.inv + rej.inv);
+    if (q) *q = detail::normaliser_product(bank_.inv_kw2, s2, bank_.a0 != 0.0 ? s : cplx(1.0));
     return;
   }
   // N = ∞: coth(u), u = πs/Ω, via e^{−2u} (or e^{2u}) to avoid overflow
@@ -98,7 +73,7 @@ void FastCharacteristic::bank(cplx s, cplx& d, cplx& dd, cplx& n, cplx& dn, cplx
   }
   const cplx dcoth = c * (1.0 - coth * coth);
   log_dq = c * coth;  // Q∞'/Q∞
-  q = std::sinh(u) / c;  // Q∞ = (Ω/π) sinh(πs/Ω)
+  if (q) *q = std::sinh(u) / c;  // Q∞ = (Ω/π) sinh(πs/Ω)
   const cplx inv_s = reciprocal(s);
   const cplx lin = c * (alpha_ + beta_ * omega_ * inv_s);  // (π/Ω)(α + βΩ/s)
   const cplx dlin = -c * beta_ * omega_ * inv_s * inv_s;
@@ -112,21 +87,21 @@ void FastCharacteristic::bank(cplx s, cplx& d, cplx& dd, cplx& n, cplx& dn, cplx
 }
 
 void FastCharacteristic::evaluate(cplx s, cplx& f, cplx& df) const {
-  cplx lq, q;
-  evaluate(s, f, df, lq, q);
+  cplx lq;
+  evaluate(s, f, df, lq, nullptr);
 }
 
 void FastCharacteristic::entire(cplx s, cplx& delta, cplx& ddelta) const {
   cplx f, df, lq, q;
-  evaluate(s, f, df, lq, q);
+  evaluate(s, f, df, lq, &q);
   delta = q * f;
   ddelta = q * (lq * f + df);
 }
 
 void FastCharacteristic::crossing_parts(double nu, cplx& x, cplx& y) const {
   const cplx s(0.0, nu);
-  cplx d, dd, n, dn, lq, q;
-  bank(s, d, dd, n, dn, lq, q);
+  cplx d, dd, n, dn, lq;
+  bank(s, d, dd, n, dn, lq, nullptr);
   const cplx m = first_order_ ? 1.0 + s / rate_ : cplx(1.0);
   if (!smith_) {
     x = m * d;
@@ -138,7 +113,7 @@ void FastCharacteristic::crossing_parts(double nu, cplx& x, cplx& y) const {
   y = rho_ * mh * std::exp(-s * measurement_delay_) * n;
 }
 
-void FastCharacteristic::evaluate(cplx s, cplx& f, cplx& df, cplx& log_dq, cplx& q) const {
+void FastCharacteristic::evaluate(cplx s, cplx& f, cplx& df, cplx& log_dq, cplx* q) const {
   cplx d, dd, n, dn;
   bank(s, d, dd, n, dn, log_dq, q);
   const cplx m = first_order_ ? 1.0 + s / rate_ : cplx(1.0);
@@ -166,8 +141,8 @@ void FastCharacteristic::evaluate(cplx s, cplx& f, cplx& df, cplx& log_dq, cplx&
 }
 
 cplx FastCharacteristic::newton_step(cplx s) const {
-  cplx f, df, lq, q;
-  evaluate(s, f, df, lq, q);
+  cplx f, df, lq;
+  evaluate(s, f, df, lq, nullptr);
   return 1.0 / (lq + df / f);
 }
 

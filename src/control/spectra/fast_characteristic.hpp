@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "afmkit/control/loop.hpp"
+#include "../bank_sums.hpp"
 
 namespace afmkit::control::spectra_detail {
 
@@ -33,16 +34,15 @@ class FastCharacteristic {
   double rotation_frequency() const { return omega_; }
 
  private:
+  /// D, D', N, N', Q'/Q and (if `q` is not null) Q at s.
   void bank(std::complex<double> s, std::complex<double>& d, std::complex<double>& dd, std::complex<double>& n,
-            std::complex<double>& dn, std::complex<double>& log_dq, std::complex<double>& q) const;
+            std::complex<double>& dn, std::complex<double>& log_dq, std::complex<double>* q) const;
   void evaluate(std::complex<double> s, std::complex<double>& f, std::complex<double>& df,
-                std::complex<double>& log_dq, std::complex<double>& q) const;
+                std::complex<double>& log_dq, std::complex<double>* q) const;
   double omega_;
   bool infinite_ = false;
-  // finite bank: per harmonic a_k, b_k kΩ, k²Ω², rejected flag
-  double a0_ = 0.0;
-  std::vector<double> a_, bkw_, kw2_;
-  std::vector<char> rejected_;
+  detail::SplitBank bank_;  // finite bank: kept (D) and rejected (N) harmonics
+
   double alpha_ = 0.0, beta_ = 0.0;  // N = ∞
   // loop
   bool first_order_ = false, smith_ = false, model_first_order_ = false;
