@@ -41,8 +41,12 @@ bool aberth(LogDerivative&& logd, std::vector<cplx>& z, double scale, int max_sw
       const cplx ld = logd(z[j]);
       const cplx sum = detail::inverse_distance_sum(re.data(), im.data(), j, z[j]) +
                        detail::inverse_distance_sum(re.data() + j + 1, im.data() + j + 1, n - j - 1, z[j]);
-      cplx w = reciprocal(ld - sum);
-      if (!finite(w)) w = cplx(1e-7 * scale, 1.3e-7 * scale);  // exactly on a pole of p'/p: nudge
+      cplx w;
+      if (std::isinf(ld.real())) w = 0.0;  // p(z_j) = 0 exactly: a root (p'/p has a pole there)
+      else w = reciprocal(ld - sum);
+      // not finite: exactly on a pole of one of the partial sums (s = ±ikΩ), where p'/p is finite but its parts
+      // are not: nudge
+      if (!finite(w)) w = cplx(1e-7 * scale, 1.3e-7 * scale);
       z[j] -= w;
       re[j] = z[j].real();
       im[j] = z[j].imag();
@@ -114,6 +118,7 @@ std::vector<std::complex<double>> bank_eigenvalues(const OscillatorBank& b) {
   // d / Π_rejected q_r = [s] Π_kept q_k · D:  log-derivative [1/s] + Σ_kept 2s/(s² + k²Ω²) + D'/D
   const auto logd = [&](cplx s) {
     const BankTerms t = bank_terms(split, s);
+    if (t.d == 0.0) return cplx(INFINITY, 0.0);  // exactly at a root
     return (integrator ? reciprocal(s) : cplx(0.0)) + t.lq_kept + t.dd * reciprocal(t.d);
   };
   if (!aberth(logd, z, omega * (b.harmonics() + 1)))
@@ -150,6 +155,7 @@ std::vector<std::complex<double>> undelayed_poles_secular(const LoopSpec& loop) 
     const cplx m = first_order ? 1.0 + s / loop.plant_rate : cplx(1.0);
     const double dm = first_order ? 1.0 / loop.plant_rate : 0.0;
     const cplx f = m * t.d + rho * t.n, df = dm * t.d + m * t.dd + rho * t.dn;
+    if (f == 0.0) return cplx(INFINITY, 0.0);  // exactly at a root
     return (integrator ? reciprocal(s) : cplx(0.0)) + t.lq_all + df * reciprocal(f);
   };
   if (!aberth(logd, z, omega * (b->harmonics() + 1)))

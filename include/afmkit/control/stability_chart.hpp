@@ -55,7 +55,8 @@ struct StabilityChart {
   std::vector<int> region;            ///< region id per grid point
   std::vector<ChartRegion> regions;
   std::vector<BoundaryCurve> boundaries;
-  long mismatched_points = 0;         ///< tracked count ≠ certified region count
+  long mismatched_points = 0;         ///< tracked count ≠ certified region count (not counted where every
+                                      ///< tracked root is unstable and the region has more: a lower bound)
   long recomputed_points = 0;         ///< of those, abscissa recomputed with rightmost_roots()
   double at(int ix, int iy) const { return abscissa[static_cast<std::size_t>(iy) * x.size() + ix]; }
 };

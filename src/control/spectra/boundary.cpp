@@ -5,6 +5,7 @@
 #include "afmkit/control/spectrum.hpp"
 #include "afmkit/control/stability_chart.hpp"
 #include "afmkit/core/validate.hpp"
+#include "fast_characteristic.hpp"
 
 namespace afmkit::control {
 
@@ -20,23 +21,40 @@ void check_window(double x_min, double x_max, double y_min, double y_max) {
   validate::require(y_max > y_min, "y_max", y_max, "> y_min");
 }
 
-// Δ(s; x, y) = e0 + x ex + y ey from three members of the family (Δ is affine in the couplings).
+// Δ(s; x, y) = e0 + x ex + y ey from three members of the family (Δ is affine in the couplings). The members share
+// the normaliser Q (same N, a0 ≠ 0), so the fast O(N) evaluation keeps them on one scale; the scaled evaluation of
+// loop.hpp where the fast one is not finite (exactly at s = ±ikΩ).
 class AffineCharacteristic {
  public:
   explicit AffineCharacteristic(const LoopFamily& f)
-      : w_(f.rotation_frequency), p0_(f.at(w_, 0.0)), p1_(f.at(2.0 * w_, 0.0)), p2_(f.at(w_, w_)) {}
+      : w_(f.rotation_frequency),
+        p0_(f.at(w_, 0.0)),
+        p1_(f.at(2.0 * w_, 0.0)),
+        p2_(f.at(w_, w_)),
+        f0_(p0_),
+        f1_(p1_),
+        f2_(p2_) {}
   void parts(cplx s, cplx& e0, cplx& ex, cplx& ey) const {
-    const auto a = characteristic_scaled(p0_, s), b = characteristic_scaled(p1_, s), c = characteristic_scaled(p2_, s);
-    const cplx v0 = a.value, v1 = b.value * std::exp(b.log_scale - a.log_scale),
-               v2 = c.value * std::exp(c.log_scale - a.log_scale);
+    cplx v0, v1, v2, d;
+    f0_.entire(s, v0, d);
+    f1_.entire(s, v1, d);
+    f2_.entire(s, v2, d);
+    if (!(finite(v0) && finite(v1) && finite(v2))) {
+      const auto a = characteristic_scaled(p0_, s), b = characteristic_scaled(p1_, s), c = characteristic_scaled(p2_, s);
+      v0 = a.value;
+      v1 = b.value * std::exp(b.log_scale - a.log_scale);
+      v2 = c.value * std::exp(c.log_scale - a.log_scale);
+    }
     ex = (v1 - v0) / w_;
     ey = (v2 - v0) / w_;
     e0 = v0 - w_ * ex;
   }
 
  private:
+  static bool finite(cplx z) { return std::isfinite(z.real()) && std::isfinite(z.imag()); }
   double w_;
   LoopSpec p0_, p1_, p2_;
+  spectra_detail::FastCharacteristic f0_, f1_, f2_;
 };
 }  // namespace
 

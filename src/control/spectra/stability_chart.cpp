@@ -56,7 +56,9 @@ void parallel_for(long n, int threads, F&& body) {
 }
 
 // Connected components of equal tracked counts; each labelled by a certified count at its most interior point.
-void label_regions(const ChartSpec& spec, StabilityChart& c, const std::vector<int>& tracked) {
+// `saturated`: the tracked count is only a lower bound there (every tracked root unstable).
+void label_regions(const ChartSpec& spec, const RootTracker& tracker, StabilityChart& c,
+                   const std::vector<int>& tracked, const std::vector<char>& saturated) {
   const int nx = spec.x_points, ny = spec.y_points;
   c.region.assign(static_cast<std::size_t>(nx) * ny, -1);
   const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
@@ -133,16 +135,23 @@ void label_regions(const ChartSpec& spec, StabilityChart& c, const std::vector<i
   for (std::size_t p = 0; p < c.region.size(); ++p) {
     const ChartRegion& r = c.regions[c.region[p]];
     c.unstable_roots[p] = r.unstable_roots;
-    if (r.unstable_roots != tracked[p]) {
+    const bool agrees = r.unstable_roots == tracked[p] || (saturated[p] && r.unstable_roots > tracked[p]);
+    if (!agrees) {
       ++c.mismatched_points;
       redo.push_back(static_cast<long>(p));
     }
   }
-  // tracking lost roots there: recompute those points with the certified spectrum (bounded effort)
+  // tracking lost roots there: a fresh tracked spectrum (delay-free poles continued, O(N²) with a small constant)
+  // merged with the point's abscissa; if its count still disagrees, the certified spectrum (bounded effort)
   if (static_cast<long>(redo.size()) <= spec.max_recomputed_points) {
     parallel_for(static_cast<long>(redo.size()), spec.threads, [&](long i) {
       const long p = redo[i];
-      c.abscissa[p] = rightmost_roots(spec.family.at(c.x[p % nx], c.y[p / nx])).spectral_abscissa;
+      const LoopSpec loop = spec.family.at(c.x[p % nx], c.y[p / nx]);
+      const TrackedSpectrum fresh = tracker.initial(loop);
+      const int region_count = c.unstable_roots[p];
+      const bool agrees = fresh.unstable() == region_count ||
+                          (fresh.saturated(tracker.keep()) && region_count > fresh.unstable());
+      c.abscissa[p] = agrees ? std::max(c.abscissa[p], fresh.abscissa()) : rightmost_roots(loop).spectral_abscissa;
     });
     c.recomputed_points = static_cast<long>(redo.size());
   }
@@ -157,6 +166,7 @@ StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(l
   c.y = linspace(spec.y_min, spec.y_max, ny);
   c.abscissa.assign(static_cast<std::size_t>(nx) * ny, 0.0);
   std::vector<int> tracked(c.abscissa.size(), 0);
+  std::vector<char> saturated(c.abscissa.size(), 0);
   const RootTracker tracker(spec.tracked_roots);
   const long total = static_cast<long>(nx) * ny;
 
@@ -177,10 +187,11 @@ StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(l
       const std::size_t p = static_cast<std::size_t>(j) * nx + i;
       c.abscissa[p] = s.abscissa();
       tracked[p] = s.unstable();
+      saturated[p] = s.saturated(tracker.keep()) ? 1 : 0;
     }
     if (progress) progress(static_cast<long>(nx), total);
   });
-  label_regions(spec, c, tracked);
+  label_regions(spec, tracker, c, tracked, saturated);
   if (spec.boundaries) c.boundaries = stability_boundaries(spec.family, spec.x_min, spec.x_max, spec.y_min, spec.y_max);
   return c;
 }

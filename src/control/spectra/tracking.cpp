@@ -65,7 +65,11 @@ void RootTracker::add_seeds(const LoopSpec& loop, std::vector<cplx>& starts) con
   } else {
     const double shift = 0.02 * omega;
     if (v.bank->a0() != 0.0) starts.emplace_back(-shift, 0.0);
-    for (int k = 1; k <= std::min(v.bank->harmonics(), 16); ++k) starts.emplace_back(-shift, k * omega);
+    // both ends of the bank: the low harmonics meet the plant and the delay, the top ones are the least damped
+    // at large N (the edge of the coupling sum; e.g. N = 1000: Re s ≈ −0.03Ω at k = N, ≈ −α in the middle)
+    const int n = v.bank->harmonics();
+    for (int k = 1; k <= std::min(n, 16); ++k) starts.emplace_back(-shift, k * omega);
+    for (int k = std::max(17, n - 15); k <= n; ++k) starts.emplace_back(-shift, k * omega);
   }
 }
 

@@ -18,11 +18,20 @@ struct TrackedSpectrum {
   double abscissa() const;
   /// roots with Re s > 0 (conjugate pairs count 2); −1 if the neutral chain lies in Re s ≥ 0
   int unstable() const;
+  /// `keep` roots tracked and at most one of them stable: unstable() is then only a lower bound (more roots
+  /// may lie in Re s > 0 beyond the tracked ones, e.g. the whole bank for α < 0)
+  bool saturated(std::size_t keep) const {
+    if (roots.size() < keep) return false;
+    std::size_t stable = 0;
+    for (const auto& r : roots) stable += r.real() <= 0.0 ? 1 : 0;
+    return stable <= 1;
+  }
 };
 
 class RootTracker {
  public:
   explicit RootTracker(int keep = 16, double tolerance = 1e-11) : keep_(keep), tolerance_(tolerance) {}
+  std::size_t keep() const { return static_cast<std::size_t>(keep_); }
 
   /// Full initialisation: collocation (finite banks) or certified rightmost roots (N = ∞), plus seeds.
   TrackedSpectrum initial(const LoopSpec& loop) const;
