@@ -45,7 +45,14 @@ std::vector<double> gain_grid(const RobustTuningSpec& s) {
   return r;
 }
 
-// J(x, y) with warm starts at τ = 0 (one tracked spectrum per ρ, updated in place).
+// The τ = 0 spectra of the last evaluated point (one per ρ) and where it was.
+struct WarmStart {
+  std::vector<TrackedSpectrum> spectra;
+  double x = 0.0, y = 0.0;
+};
+
+// J(x, y) with warm starts at τ = 0 from the previous point when it is near (within a tenth of the window; always
+// for N = ∞, whose τ = 0 spectrum has no finite list to start from), else a fresh tracked spectrum.
 class Objective {
  public:
   explicit Objective(const RobustTuningSpec& spec) : spec_(spec), rhos_(gain_grid(spec)) {
@@ -56,14 +63,18 @@ class Objective {
     substeps_ = std::max(1, static_cast<int>(std::ceil(spec.delay_max / std::max(1, n - 1) / (period / 50.0))));
     small_bank_ = spec.family.harmonics <= spectra_detail::kCollocationMaxHarmonics;
   }
-  double operator()(double x, double y, std::vector<TrackedSpectrum>& warm, double* wd, double* wr) const {
-    if (warm.size() != rhos_.size()) warm.assign(rhos_.size(), TrackedSpectrum{});
+  double operator()(double x, double y, WarmStart& warm, double* wd, double* wr) const {
+    if (warm.spectra.size() != rhos_.size()) warm.spectra.assign(rhos_.size(), TrackedSpectrum{});
+    const bool near = spec_.family.neutral() || std::hypot((x - warm.x) / (spec_.x_max - spec_.x_min),
+                                                           (y - warm.y) / (spec_.y_max - spec_.y_min)) <= 0.1;
+    warm.x = x;
+    warm.y = y;
     double worst = INFINITY;
     for (std::size_t j = 0; j < rhos_.size(); ++j) {
       const LoopSpec l0 = spec_.family.at(x, y, 0.0, rhos_[j]);
-      TrackedSpectrum s = (warm[j].roots.empty() || !spec_.family.neutral()) ? tracker_.initial(l0)
-                                                                              : tracker_.update(l0, warm[j], true);
-      warm[j] = s;
+      TrackedSpectrum s = (warm.spectra[j].roots.empty() || !near) ? tracker_.initial(l0)
+                                                                   : tracker_.update(l0, warm.spectra[j], true);
+      warm.spectra[j] = s;
       double prev = 0.0;
       for (double tau : taus_) {
         if (tau > 0.0) {
@@ -123,7 +134,7 @@ class Objective {
 double worst_case_decay(const RobustTuningSpec& spec, double x, double y, double* worst_delay,
                         double* worst_gain_ratio) {
   check(spec);
-  std::vector<TrackedSpectrum> warm;
+  WarmStart warm;
   return Objective(spec)(x, y, warm, worst_delay, worst_gain_ratio);
 }
 
@@ -144,7 +155,7 @@ RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<voi
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
   for (int j = 0; j < n; ++j) {
     try {
-      std::vector<TrackedSpectrum> warm;
+      WarmStart warm;
       for (int i = 0; i < n; ++i) {
         out.coarse_worst_decay[static_cast<std::size_t>(j) * n + i] =
             objective(out.coarse_x[i], out.coarse_y[j], warm, nullptr, nullptr);
@@ -162,7 +173,7 @@ RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<voi
   double bx = out.coarse_x[best % n], by = out.coarse_y[best / n];
 
   // Nelder–Mead on −J, clamped to the window
-  std::vector<TrackedSpectrum> warm;
+  WarmStart warm;
   const auto clamp = [&](std::array<double, 2> p) {
     p[0] = std::clamp(p[0], spec.x_min, spec.x_max);
     p[1] = std::clamp(p[1], spec.y_min, spec.y_max);
@@ -224,14 +235,24 @@ RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<voi
   out.evaluations += used;
   out.x = bx;
   out.y = by;
-  warm.clear();
+  warm = WarmStart{};
   out.worst_decay = objective(bx, by, warm, &out.worst_delay, &out.worst_gain_ratio);
 
   // certified re-evaluation and margins at the optimum
-  double cert = INFINITY;
-  for (double rho : objective.rhos())
-    for (double tau : objective.taus()) cert = std::min(cert, -rightmost_roots(spec.family.at(bx, by, tau, rho)).spectral_abscissa);
-  out.certified_worst_decay = cert;
+  const std::size_t nt_tau = objective.taus().size(), n_cert = objective.rhos().size() * nt_tau;
+  std::vector<double> cert(n_cert);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
+  for (std::size_t i = 0; i < n_cert; ++i) {
+    try {
+      const LoopSpec loop = spec.family.at(bx, by, objective.taus()[i % nt_tau], objective.rhos()[i / nt_tau]);
+      cert[i] = -rightmost_roots(loop).spectral_abscissa;
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(m);
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  out.certified_worst_decay = *std::min_element(cert.begin(), cert.end());
   std::vector<double> rs{spec.gain_ratio_min};
   if (spec.gain_ratio_min < 1.0 && spec.gain_ratio_max > 1.0) rs.push_back(1.0);
   if (spec.gain_ratio_max != spec.gain_ratio_min) rs.push_back(spec.gain_ratio_max);
