@@ -85,9 +85,13 @@ std::complex<double> normaliser_product(const std::vector<double>& inv_kw2, std:
     mul(qr, qi, tr, ti, pr, pi);
     qr = pr;
     qi = pi;
-    if (std::abs(qr) + std::abs(qi) > 1e150) {
+    const double size = std::abs(qr) + std::abs(qi);
+    if (size > 1e150) {
       qr *= 0x1p-500;
       qi *= 0x1p-500;
+    } else if (size < 1e-150 && size > 0.0) {  // the factors k > |s|/Ω are below 1: no underflow either
+      qr *= 0x1p500;
+      qi *= 0x1p500;
     }
   }
   for (; k < n; ++k) {

@@ -31,8 +31,8 @@ struct BankSums {
 };
 BankSums bank_sums(const BankArrays& terms, std::complex<double> s);
 
-/// q Π_k (1 + s² inv_kw2_k), rescaled by powers of two (0x1p-500) whenever it exceeds 1e150: a common positive
-/// factor of Δ and Δ' (only phases and ratios are used); exact for |s| < 1e6 Ω between checks (every 4 factors).
+/// q Π_k (1 + s² inv_kw2_k), rescaled by powers of two (2^∓500) whenever it leaves [1e-150, 1e150]: a common
+/// positive factor of Δ and Δ' (only phases and ratios are used); checked every 4 factors (exact for |s| < 1e6 Ω).
 std::complex<double> normaliser_product(const std::vector<double>& inv_kw2, std::complex<double> s2,
                                         std::complex<double> q);
 

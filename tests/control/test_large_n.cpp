@@ -139,3 +139,24 @@ TEST(LargeBank, DelayFreePolesAtN1000AgreeWithCriticalBeta) {
 }
 
 }  // namespace
+
+// An Aberth step that lands exactly on a delay-free pole (Δ = 0 in floating point) used to be nudged off it every
+// sweep until the sweep limit ("did not converge", chart grids at N = 1000 hit it at about 1 point in 400).
+// This grid point of the default chart does it; the poles must satisfy the trace identity tr A_cl = −(α + 2Nα)
+// (A_cl = A0 − b 1ᵀ as above, K = γ) and each be a root of the independently evaluated Δ(s) at τ = 0.
+TEST(LargeBank, DelayFreePolesWhenAnIterateHitsAPoleExactly) {
+  const int n = 1000;
+  const double alpha = -0.1, beta = -0.4 + 1.4 * 97 / 199;
+  const auto bank = OscillatorBank::with_couplings(1.0, n, alpha, beta, 20.0);
+  const LoopSpec loop(Controller(bank), PlantKind::Static, 20.0, 0.0);
+  const auto poles = undelayed_poles(loop);
+  ASSERT_EQ(static_cast<int>(poles.size()), 2 * n + 1);
+  cplx sum = 0.0;
+  for (cplx p : poles) sum += p;
+  EXPECT_NEAR(sum.real(), -(alpha + 2.0 * n * alpha), 1e-8 * n);
+  EXPECT_NEAR(sum.imag(), 0.0, 1e-8 * n);
+  for (cplx p : poles) {
+    const auto c = characteristic_scaled(loop, p);
+    EXPECT_LT(std::abs(c.value / c.derivative), 1e-9 * std::max(1.0, std::abs(p))) << p;
+  }
+}

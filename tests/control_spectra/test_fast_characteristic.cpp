@@ -51,3 +51,22 @@ TEST(FastCharacteristic, EqualsLoopCharacteristicAndDerivative) {
     }
   }
 }
+
+// Large banks high on the imaginary axis: the product Q = Π (1 + s²/(k²Ω²)) first grows (k < |s|/Ω) and then
+// shrinks (k > |s|/Ω); it used to be rescaled only downwards and underflowed to a denormal at N = 1500,
+// s = 1412.85i (every count of `control roots` above N ≈ 1400 failed "root on the boundary"). Phase and
+// logarithmic derivative against the scaled evaluation of loop.hpp.
+TEST(FastCharacteristic, NoUnderflowOfTheNormaliserAtLargeN) {
+  const int n = 1500;
+  const LoopSpec loop(OscillatorBank::with_couplings(1.0, n, 0.1, -0.1, 20.0), PlantKind::Static, 20.0,
+                      0.1 * 2.0 * std::numbers::pi);
+  const spectra_detail::FastCharacteristic f(loop);
+  for (const cplx s : {cplx(0.0, 1412.85), cplx(-0.06, 1499.3), cplx(0.0, 1700.2), cplx(150.0, -1805.0)}) {
+    cplx v, d;
+    f.entire(s, v, d);
+    ASSERT_TRUE(std::isnormal(std::abs(v))) << s << " " << v;
+    const ScaledCharacteristic ref = characteristic_scaled(loop, s);
+    EXPECT_LT(std::abs(std::arg(v / ref.value)), 1e-9) << s;
+    EXPECT_LT(std::abs(d / v - ref.derivative / ref.value), 1e-9 * std::abs(ref.derivative / ref.value)) << s;
+  }
+}

@@ -25,8 +25,8 @@ class FastCharacteristic {
   /// Newton step Δ/Δ' = 1/(Q'/Q + f'/f) of the entire Δ = Q f (robust next to the poles of f).
   std::complex<double> newton_step(std::complex<double> s) const;
   /// The entire Δ = Q f and Δ' (Q = [s] Π_k (1 + s²/(k²Ω²)) or (Ω/π) sinh(πs/Ω)); same zeros and scale as
-  /// characteristic() of loop.hpp while the partial products of Q stay below 1e150; beyond (large N, |s| ≫ Ω)
-  /// both are divided by a common power of two (phases and ratios exact: all the callers need). May be
+  /// characteristic() of loop.hpp while the partial products of Q stay within [1e-150, 1e150]; beyond (large N,
+  /// |s| ≫ Ω) both are scaled by a common power of two (phases and ratios exact: all the callers need). May be
   /// non-finite exactly at a pole of f or where sinh overflows (N = ∞).
   void entire(std::complex<double> s, std::complex<double>& delta, std::complex<double>& ddelta) const;
   /// Δ/Q at s = iν split as X + Y e^{−iντ} (τ the loop delay): X, Y independent of τ (delay_margin.hpp).
