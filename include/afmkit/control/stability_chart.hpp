@@ -22,7 +22,7 @@ struct BoundaryPoint {
 using BoundaryCurve = std::vector<BoundaryPoint>;
 
 /// D-subdivision curves inside the window (polylines, split where they leave it). `max_frequency` NaN: from the
-/// proven root-free bounds at the window corners (capped at 200 Ω).
+/// proven root-free bounds at the window corners (capped at 200 Ω, or (N + 20) Ω for a larger bank).
 std::vector<BoundaryCurve> stability_boundaries(const LoopFamily& family, double x_min, double x_max, double y_min,
                                                 double y_max,
                                                 double max_frequency = std::numeric_limits<double>::quiet_NaN());
@@ -57,7 +57,8 @@ struct StabilityChart {
   std::vector<BoundaryCurve> boundaries;
   long mismatched_points = 0;         ///< tracked count ≠ certified region count (not counted where every
                                       ///< tracked root is unstable and the region has more: a lower bound)
-  long recomputed_points = 0;         ///< of those, abscissa recomputed with rightmost_roots()
+  long recomputed_points = 0;         ///< of those, abscissa recomputed (a fresh tracked spectrum; the certified
+                                      ///< rightmost_roots() where that still disagrees)
   double at(int ix, int iy) const { return abscissa[static_cast<std::size_t>(iy) * x.size() + ix]; }
 };
 

@@ -70,7 +70,9 @@ std::vector<BoundaryCurve> stability_boundaries(const LoopFamily& family, double
         const RootBounds rb = root_bounds(family.at(x, y), 0.0);
         max_frequency = std::max(max_frequency, rb.proven ? rb.imag_max : (family.harmonics + 20) * omega);
       }
-    max_frequency = std::min(std::max(max_frequency, 4.0 * omega), 200.0 * omega);
+    // cap: 200 Ω, or above the top oscillator of a larger bank (its crossings are near kΩ, k ≤ N)
+    const double cap = family.kind == LoopFamily::Kind::Bank ? std::max(200.0, family.harmonics + 20.0) : 200.0;
+    max_frequency = std::min(std::max(max_frequency, 4.0 * omega), cap * omega);
   } else {
     validate::positive("max_frequency", max_frequency);
   }
