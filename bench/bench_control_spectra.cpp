@@ -135,28 +135,10 @@ void BM_CharacteristicBank1000Scaled(benchmark::State& st) {
 BENCHMARK(BM_CharacteristicBank1000Fast)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_CharacteristicBank1000Scaled)->Unit(benchmark::kMicrosecond);
 
-void BM_RobustTuningInfinite(benchmark::State& st) {
+// robust tuning with the window and ranges of `control tune`'s defaults
+void tuning(benchmark::State& st, const LoopSpec& loop) {
   RobustTuningSpec s;
-  s.family = LoopFamily::from_loop(infinite_loop(0.0));
-  s.delay_max = 0.25 * kT;
-  s.gain_ratio_min = 0.5;
-  s.gain_ratio_max = 2.0;
-  s.x_min = 0.01;
-  s.x_max = 0.6;
-  s.y_min = -0.24;
-  s.y_max = 0.3;
-  s.threads = 2;
-  RobustTuning r;
-  for (auto _ : st) r = robust_tuning(s);
-  st.counters["alpha"] = r.x;
-  st.counters["beta"] = r.y;
-  st.counters["worst_decay"] = r.worst_decay;
-}
-BENCHMARK(BM_RobustTuningInfinite)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
-
-void BM_RobustTuningBank1000(benchmark::State& st) {
-  RobustTuningSpec s;
-  s.family = LoopFamily::from_loop(bank1000_loop(0.0));
+  s.family = LoopFamily::from_loop(loop);
   s.delay_max = 0.25 * kT;
   s.gain_ratio_min = 0.5;
   s.gain_ratio_max = 2.0;
@@ -172,6 +154,9 @@ void BM_RobustTuningBank1000(benchmark::State& st) {
   st.counters["worst_decay"] = r.worst_decay;
   st.counters["certified_worst_decay"] = r.certified_worst_decay;
 }
+void BM_RobustTuningInfinite(benchmark::State& st) { tuning(st, infinite_loop(0.0)); }
+void BM_RobustTuningBank1000(benchmark::State& st) { tuning(st, bank1000_loop(0.0)); }
+BENCHMARK(BM_RobustTuningInfinite)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_RobustTuningBank1000)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 }  // namespace
 
