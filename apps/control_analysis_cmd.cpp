@@ -308,6 +308,7 @@ void run_chart(const io::ParamSet& p) {
   res["regions"] = regions;
   res["mismatched_points"] = chart.mismatched_points;
   res["recomputed_points"] = chart.recomputed_points;
+  res["lower_bound_points"] = chart.lower_bound_points;
   const std::string bout = p.text("boundaries_output");
   res["boundaries_file"] = bout;
   res["columns"] = {{"x", std::string(family.x_name()) + " / Omega"}, {"y", std::string(family.y_name()) + " / Omega"},

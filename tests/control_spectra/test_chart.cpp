@@ -209,3 +209,26 @@ TEST(StabilityChart, BadInput) {
   EXPECT_THROW(stability_boundaries(s.family, 0.0, 1.0, 0.0, std::nan("")), InvalidParameter);
   EXPECT_THROW(s.family.at(std::nan(""), 0.0), InvalidParameter);
 }
+
+// A large bank (N = 300 > the collocation limit) over a window that reaches α < 0, where nearly every root of the
+// bank is unstable: the tracked counts there are lower bounds (lower_bound_points, not mismatches), and the grid
+// abscissa equals the certified rightmost root of rightmost_roots() at points on both sides of α = 0 — including
+// α > 0, where the rightmost stable roots sit at the top of the bank (k ≈ N), not at the low harmonics.
+TEST(StabilityChart, LargeBankAbscissaAndLowerBoundCounts) {
+  ChartSpec s;
+  s.family = LoopFamily::from_loop(
+      LoopSpec(OscillatorBank::with_couplings(kOmega, 300, 0.1, -0.1, kGamma), PlantKind::Static, kGamma, 0.1 * kT));
+  s.x_min = -0.1;
+  s.x_max = 0.5;
+  s.y_min = -0.2;
+  s.y_max = 0.4;
+  s.x_points = s.y_points = 7;
+  s.boundaries = false;
+  const StabilityChart c = stability_chart(s);
+  EXPECT_GT(c.lower_bound_points, 0);
+  EXPECT_EQ(c.recomputed_points, c.mismatched_points);  // a coarse grid: tracking loses roots, recomputed
+  for (const auto& [ix, iy] : {std::pair{0, 0}, std::pair{0, 6}, std::pair{4, 3}, std::pair{6, 6}}) {
+    const Spectrum sp = rightmost_roots(s.family.at(c.x[ix], c.y[iy]));
+    EXPECT_NEAR(c.at(ix, iy), sp.spectral_abscissa, 1e-8) << "alpha " << c.x[ix] << " beta " << c.y[iy];
+  }
+}

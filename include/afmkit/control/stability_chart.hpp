@@ -57,6 +57,8 @@ struct StabilityChart {
   std::vector<BoundaryCurve> boundaries;
   long mismatched_points = 0;         ///< tracked count ≠ certified region count (not counted where every
                                       ///< tracked root is unstable and the region has more: a lower bound)
+  long lower_bound_points = 0;        ///< every tracked root unstable and the region has more: the abscissa there
+                                      ///< is the largest tracked real part (e.g. α < 0 at large N)
   long recomputed_points = 0;         ///< of those, abscissa recomputed (a fresh tracked spectrum; the certified
                                       ///< rightmost_roots() where that still disagrees)
   double at(int ix, int iy) const { return abscissa[static_cast<std::size_t>(iy) * x.size() + ix]; }

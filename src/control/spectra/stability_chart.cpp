@@ -135,8 +135,9 @@ void label_regions(const ChartSpec& spec, const RootTracker& tracker, StabilityC
   for (std::size_t p = 0; p < c.region.size(); ++p) {
     const ChartRegion& r = c.regions[c.region[p]];
     c.unstable_roots[p] = r.unstable_roots;
-    const bool agrees = r.unstable_roots == tracked[p] || (saturated[p] && r.unstable_roots > tracked[p]);
-    if (!agrees) {
+    const bool lower_bound = saturated[p] && r.unstable_roots > tracked[p];
+    if (lower_bound) ++c.lower_bound_points;
+    if (r.unstable_roots != tracked[p] && !lower_bound) {
       ++c.mismatched_points;
       redo.push_back(static_cast<long>(p));
     }
