@@ -222,8 +222,16 @@ void ParamSet::load_toml_text(const std::string& text, const std::string& origin
             if (auto d = node.value<double>()) v = *d;
             else type_error("a number");
           } else if constexpr (std::is_same_v<T, long>) {
-            if (auto i = node.value<int64_t>(); i && node.is_integer()) v = static_cast<long>(*i);
-            else type_error("an integer");
+            // an integer node, or a float with an exact integer value below 2^63 (as "1e7" on the command line);
+            // toml++'s own float-to-integer conversion casts before it checks the range (UB, found by fuzzing)
+            if (const auto* i = node.as_integer()) {
+              v = static_cast<long>(i->get());
+            } else if (const auto* f = node.as_floating_point();
+                       f && std::isfinite(f->get()) && std::trunc(f->get()) == f->get() && std::abs(f->get()) < 0x1p63) {
+              v = static_cast<long>(f->get());
+            } else {
+              type_error("an integer");
+            }
           } else if constexpr (std::is_same_v<T, std::string>) {
             if (auto s = node.value<std::string>()) v = *s;
             else type_error("a string");

@@ -75,3 +75,23 @@ TEST(ParamSet, OutOfRangeNamesParameterAndRange) {
   EXPECT_THROW(p.load_toml_text("quality_factor = nan\n", "t.toml"), InvalidParameter);
 }
 
+
+// Found by fuzz_io_params: a huge float for an integer key made toml++ cast it to an integer before checking its
+// range (undefined behaviour). A float with an exact integer value is accepted (as "1e7" on the command line);
+// any other float, or one beyond 2^63, is "must be an integer" naming the key.
+TEST(ParamSet, FloatForAnIntegerKey) {
+  auto p = make();
+  p.load_toml_text("points = 1e2\n", "t.toml");
+  EXPECT_EQ(p.integer("points"), 100);
+  for (const char* text : {"points = 7.77e113\n", "points = 3.5\n", "points = nan\n", "points = -inf\n",
+                           "points = 9.3e18\n"}) {
+    auto q = make();
+    try {
+      q.load_toml_text(text, "t.toml");
+      FAIL() << text;
+    } catch (const InvalidParameter& e) {
+      EXPECT_NE(std::string(e.what()).find("points"), std::string::npos) << text;
+      EXPECT_NE(std::string(e.what()).find("integer"), std::string::npos) << text;
+    }
+  }
+}
