@@ -6,20 +6,12 @@
 #include "afmkit/control/stability_chart.hpp"
 #include "afmkit/core/validate.hpp"
 #include "fast_characteristic.hpp"
+#include "spectra_detail.hpp"
 
 namespace afmkit::control {
 
 namespace {
 using cplx = std::complex<double>;
-
-void check_window(double x_min, double x_max, double y_min, double y_max) {
-  validate::finite("x_min", x_min);
-  validate::finite("y_min", y_min);
-  validate::finite("x_max", x_max);
-  validate::finite("y_max", y_max);
-  validate::require(x_max > x_min, "x_max", x_max, "> x_min");
-  validate::require(y_max > y_min, "y_max", y_max, "> y_min");
-}
 
 // Δ(s; x, y) = e0 + x ex + y ey from three members of the family (Δ is affine in the couplings). The members share
 // the normaliser Q (same N, a0 ≠ 0), so the fast O(N) evaluation keeps them on one scale; the scaled evaluation of
@@ -60,7 +52,7 @@ class AffineCharacteristic {
 
 std::vector<BoundaryCurve> stability_boundaries(const LoopFamily& family, double x_min, double x_max, double y_min,
                                                 double y_max, double max_frequency) {
-  check_window(x_min, x_max, y_min, y_max);
+  spectra_detail::validate_window(x_min, x_max, y_min, y_max);
   const double omega = family.rotation_frequency;
   if (std::isnan(max_frequency)) {
     max_frequency = 0.0;

@@ -199,12 +199,7 @@ StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(l
 
 MarginMap delay_margin_map(const LoopFamily& family, double x_min, double x_max, int x_points, double y_min,
                            double y_max, int y_points, int threads, const std::function<void(long, long)>& progress) {
-  validate::finite("x_min", x_min);
-  validate::finite("x_max", x_max);
-  validate::finite("y_min", y_min);
-  validate::finite("y_max", y_max);
-  validate::require(x_max > x_min, "x_max", x_max, "> x_min");
-  validate::require(y_max > y_min, "y_max", y_max, "> y_min");
+  spectra_detail::validate_window(x_min, x_max, y_min, y_max);
   validate::in_range("x_points", static_cast<long>(x_points), 2L, 100000L);
   validate::in_range("y_points", static_cast<long>(y_points), 2L, 100000L);
   MarginMap m;
