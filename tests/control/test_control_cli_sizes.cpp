@@ -18,6 +18,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "test_helpers.hpp"
+
 namespace {
 namespace fs = std::filesystem;
 
@@ -69,27 +71,19 @@ TEST_F(ControlCliSizes, TfAtN1000MatchesStateSpaceAndN100000Answers) {
   ASSERT_EQ(r.status, 0) << r.err;
   // independent: C(iω) = K c_1ᵀ (iωI − A)⁻¹ b with 2×2 blocks and Sherman–Morrison (MATH.md B.3), α = 0.1,
   // β = −0.1, K = 20, Ω = 1: x-component of block k: (a_k s − kΩ b_k)/(s² + k²)
-  std::ifstream in(dir_ / "tf.csv");
-  std::string line;
-  std::getline(in, line);
-  int rows = 0;
-  while (std::getline(in, line)) {
-    double f, mag, ph, re, im;
-    char c;
-    std::stringstream ss(line);
-    ss >> f >> c >> mag >> c >> ph >> c >> re >> c >> im;
-    const std::complex<double> s(0.0, f);
+  const auto rows = afmkit::control::testing::read_tf_csv(dir_ / "tf.csv");
+  for (const auto& row : rows) {
+    const std::complex<double> s(0.0, row.frequency);
     std::complex<double> ce_y = 0.1 / s, c1_y = 0.0;
     for (int k = 1; k <= 1000; ++k) {
       const std::complex<double> y = (0.2 * s - 0.2) / (s * s + double(k) * k);
       (k == 1 ? c1_y : ce_y) += y;
     }
     const std::complex<double> expected = 20.0 * c1_y / (1.0 + ce_y);
-    EXPECT_NEAR(re, expected.real(), 1e-9 * std::abs(expected)) << line;
-    EXPECT_NEAR(im, expected.imag(), 1e-9 * std::abs(expected)) << line;
-    ++rows;
+    EXPECT_NEAR(row.real, expected.real(), 1e-9 * std::abs(expected)) << row.line;
+    EXPECT_NEAR(row.imag, expected.imag(), 1e-9 * std::abs(expected)) << row.line;
   }
-  EXPECT_EQ(rows, 5);
+  EXPECT_EQ(rows.size(), 5u);
   // the documented maximum
   const CliResult big = run("control tf --harmonics 100000 --points 3 --output big.csv");
   EXPECT_EQ(big.status, 0) << big.err;

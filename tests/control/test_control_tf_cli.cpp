@@ -13,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "test_helpers.hpp"
+
 namespace {
 namespace fs = std::filesystem;
 
@@ -52,25 +54,18 @@ TEST_F(ControlTfCli, SingleOscillatorCsvMatchesEq10) {
   const CliRun r = run("--controller single --a 0.5 --b 0.2 --gain 3 --points 7 --frequency-min 0.1 --frequency-max 3 "
                     "--output " + out.string(), dir_);
   ASSERT_EQ(r.status, 0) << r.err;
-  std::ifstream in(out);
   std::string header;
-  std::getline(in, header);
+  const auto rows = afmkit::control::testing::read_tf_csv(out, &header);
   EXPECT_EQ(header, "frequency,magnitude,phase,real,imag");
-  std::string line;
-  int rows = 0;
-  while (std::getline(in, line)) {
-    double f, mag, ph, re, im;
-    char c;
-    std::stringstream ss(line);
-    ss >> f >> c >> mag >> c >> ph >> c >> re >> c >> im;
+  for (const auto& row : rows) {
+    const double f = row.frequency;
     // eq. (10) with Ω = 1 (units of Ω): C(iω) = K (a iω − b)/(1 − ω²)
     const std::complex<double> expected = 3.0 * std::complex<double>(-0.2, 0.5 * f) / (1.0 - f * f);
-    EXPECT_NEAR(re, expected.real(), 1e-12 * std::abs(expected));
-    EXPECT_NEAR(im, expected.imag(), 1e-12 * std::abs(expected));
-    EXPECT_NEAR(mag, std::abs(expected), 1e-12 * std::abs(expected));
-    ++rows;
+    EXPECT_NEAR(row.real, expected.real(), 1e-12 * std::abs(expected));
+    EXPECT_NEAR(row.imag, expected.imag(), 1e-12 * std::abs(expected));
+    EXPECT_NEAR(row.magnitude, std::abs(expected), 1e-12 * std::abs(expected));
   }
-  EXPECT_EQ(rows, 7);
+  EXPECT_EQ(rows.size(), 7u);
   std::ifstream side(out.string() + ".json");
   const auto j = nlohmann::json::parse(side);
   EXPECT_EQ(j["command"], "control tf");
