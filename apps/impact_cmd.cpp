@@ -20,6 +20,7 @@
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "commands.hpp"
+#include "law_params.hpp"
 
 namespace afmkit::cli {
 
@@ -27,11 +28,7 @@ namespace {
 
 using io::Range;
 
-const char* const linear_keys[] = {"approach_stiffness", "departure_stiffness", "approach_adhesion",
-                                   "departure_adhesion", "restitution"};
 const char* const history_columns[] = {"t", "gap", "gap_rate", "force", "x1", "v1", "x2", "v2"};
-const char* const dmt_keys[] = {"effective_modulus", "departure_modulus", "tip_radius", "hamaker",
-                                "departure_hamaker", "intermolecular_distance"};
 
 void add_impact_params(io::ParamSet& p) {
   p.real("mass1", 1.0, "mass m1 of the lower body (kg for law = dmt)", Range::positive())
@@ -44,30 +41,6 @@ void add_impact_params(io::ParamSet& p) {
       .real("gap", 1.0, "initial gap d(t_s) = x2 - x1 (nm for law = dmt); contact for d < 0 (a0 for dmt)", Range::any())
       .real("force1", 0.0, "constant external force F1 on body 1 (seed-1 eq. 1; nN for dmt)", Range::any())
       .real("force2", 0.0, "constant external force F2 on body 2", Range::any())
-      .text("law", "hysteresis",
-            "interaction H(d, d'): linear (eq. 10), hysteresis (eq. 11), attractive (eq. 26), dmt (Hertz + van der Waals)",
-            {"linear", "hysteresis", "attractive", "dmt"})
-      .real("approach_stiffness", 10.0, "K_a, contact stiffness while approaching", Range::non_negative())
-      .real("departure_stiffness", 8.0, "K_b, contact stiffness while departing (hysteresis, attractive)",
-            Range::non_negative())
-      .real("approach_adhesion", 0.0, "F_a >= 0, attraction at the contact edge while approaching (attractive)",
-            Range::non_negative())
-      .real("departure_adhesion", 0.0, "F_b >= F_a, attraction at the contact edge while departing (attractive)",
-            Range::non_negative())
-      .real("restitution", 0.0,
-            "if given: K_b = e^2 K_a for restitution e in (0, 1] (MATH.md ext. E0; hysteresis, attractive; "
-            "e > 1 needs allow_energy_gain)",
-            Range::non_negative())
-      .flag("allow_energy_gain", false,
-            "accept a law that creates energy (K_b > K_a, restitution > 1; dmt: departure_modulus > effective_modulus "
-            "or departure_hamaker < hamaker): e > 1 and a negative loss are then reported")
-      .real("effective_modulus", 1.0, "[dmt] effective modulus E* while approaching (GPa)", Range::positive())
-      .real("departure_modulus", 1.0, "[dmt] E* while departing (GPa; default: effective_modulus)", Range::positive())
-      .real("tip_radius", 10.0, "[dmt] tip radius R (nm)", Range::positive())
-      .real("hamaker", 6.4e-20, "[dmt] Hamaker constant while approaching (J)", Range::non_negative())
-      .real("departure_hamaker", 6.4e-20, "[dmt] Hamaker constant while departing (J; default: hamaker)",
-            Range::non_negative())
-      .real("intermolecular_distance", 0.165, "[dmt] intermolecular distance a0 (nm)", Range::positive())
       .text("method", "automatic", "solver: automatic (closed form for linear laws), closed_form, integrator",
             {"automatic", "closed_form", "integrator"})
       .real("relative_tolerance", 1e-11, "integrator relative tolerance", {0.0, 1e-2, true, false})
@@ -75,49 +48,12 @@ void add_impact_params(io::ParamSet& p) {
       .integer("points", 400, "time-history samples written with --output (>= 2; events are added)", 2, 10000000)
       .flag("json", false, "print the result as JSON instead of the summary")
       .text("output", "", "CSV file for the time history (JSON sidecar written next to it); empty: none");
+  add_law_params(p, impact::LawRegistry::builtin(), "hysteresis");
 }
 
 void reject_foreign_keys(const io::ParamSet& p) {
-  const std::string& law = p.text("law");
-  auto reject = [&](const char* key, const std::string& why) {
-    if (p.was_set(key)) throw InvalidParameter(key, fmt::format("{} does not apply to law = {}: {}", key, law, why));
-  };
-  if (law == "dmt") {
-    for (const char* k : linear_keys) reject(k, "it is a parameter of the piecewise-linear laws");
-  } else {
-    for (const char* k : dmt_keys) reject(k, "it is a parameter of law = dmt");
-    if (law == "linear") {
-      for (const char* k : {"departure_stiffness", "approach_adhesion", "departure_adhesion", "restitution"})
-        reject(k, "the linear law (eq. 10) has one stiffness and no adhesion; use hysteresis or attractive");
-    } else if (law == "hysteresis") {
-      for (const char* k : {"approach_adhesion", "departure_adhesion"})
-        reject(k, "use law = attractive (eq. 26) for adhesion");
-    }
-  }
-  if (p.was_set("restitution") && p.was_set("departure_stiffness"))
-    throw InvalidParameter("restitution", "give either restitution or departure_stiffness, not both");
   if (p.was_set("velocity") && (p.was_set("v1") || p.was_set("v2")))
     throw InvalidParameter("velocity", "give either velocity (relative approach speed) or v1 and v2, not both");
-}
-
-impact::ForceLaw law_from(const io::ParamSet& p) {
-  const std::string& law = p.text("law");
-  if (law == "dmt") {
-    const double ea = p.real("effective_modulus");
-    const double eb = p.was_set("departure_modulus") ? p.real("departure_modulus") : ea;
-    const double ha = p.real("hamaker");
-    const double hb = p.was_set("departure_hamaker") ? p.real("departure_hamaker") : ha;
-    return impact::DmtLaw(ea, eb, p.real("tip_radius"), ha, hb, p.real("intermolecular_distance"),
-                          p.flag("allow_energy_gain"));
-  }
-  const double ka = p.real("approach_stiffness");
-  const bool gain = p.flag("allow_energy_gain");
-  if (law == "linear") return impact::PiecewiseLinearLaw(ka, ka, 0.0, 0.0, gain);  // eq. (10)
-  const double kb = p.was_set("restitution")
-                        ? impact::PiecewiseLinearLaw::departure_stiffness_for_restitution(ka, p.real("restitution"), gain)
-                        : p.real("departure_stiffness");
-  if (law == "hysteresis") return impact::PiecewiseLinearLaw(ka, kb, 0.0, 0.0, gain);  // eq. (11)
-  return impact::PiecewiseLinearLaw(ka, kb, p.real("approach_adhesion"), p.real("departure_adhesion"), gain);  // (26)
 }
 
 impact::ImpactProblem problem_from(const io::ParamSet& p) {
@@ -138,7 +74,7 @@ impact::ImpactProblem problem_from(const io::ParamSet& p) {
   impact::ExternalForces ext;
   ext.on_body1 = p.real("force1");
   ext.on_body2 = p.real("force2");
-  return {{m1, -m2 / total * gap, v1}, {m2, m1 / total * gap, v2}, law_from(p), ext};
+  return {{m1, -m2 / total * gap, v1}, {m2, m1 / total * gap, v2}, law_from_params(p, impact::LawRegistry::builtin()), ext};
 }
 
 nlohmann::json body_json(const impact::Body& b) {

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "law_params.hpp"
 
 namespace afmkit::cli {
 
@@ -12,42 +13,55 @@ namespace {
 using io::Range;
 const std::vector<const char*> normalised_keys = {"natural_frequency", "drive_amplitude", "approach_stiffness",
                                        "departure_stiffness", "approach_adhesion", "departure_adhesion"};
-const std::vector<const char*> physical_keys = {"spring_constant", "resonance_frequency", "free_amplitude",
-                                     "sample_stiffness_approach", "sample_stiffness_departure", "adhesion_approach",
-                                     "adhesion_departure", "effective_modulus", "departure_modulus", "tip_radius",
-                                     "hamaker", "departure_hamaker", "intermolecular_distance"};
+const std::vector<const char*> physical_cantilever_keys = {"spring_constant", "resonance_frequency", "free_amplitude",
+                                                           "sample_stiffness_approach", "sample_stiffness_departure",
+                                                           "adhesion_approach", "adhesion_departure"};
+
+/// Keys that exist only in physical units: the cantilever's and those of the laws that need physical units.
+std::vector<std::string> physical_keys() {
+  const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  std::vector<std::string> keys(physical_cantilever_keys.begin(), physical_cantilever_keys.end());
+  for (const auto& k : registry.keys()) {
+    bool piecewise = false;
+    for (const auto& law : registry.laws_using(k.key)) piecewise = piecewise || registry.find(law).piecewise_linear;
+    if (!piecewise) keys.push_back(k.key);
+  }
+  keys.push_back("force_curve");
+  return keys;
+}
 
 bool physical(const io::ParamSet& p) { return p.text("units") == "physical"; }
 
 void reject_foreign_keys(const io::ParamSet& p) {
   const bool phys = physical(p);
-  for (const char* k : phys ? normalised_keys : physical_keys) {
+  std::vector<std::string> foreign;
+  if (phys) foreign.assign(normalised_keys.begin(), normalised_keys.end());
+  else foreign = physical_keys();
+  for (const std::string& k : foreign) {
     if (p.was_set(k))
       throw InvalidParameter(k, fmt::format("{} applies only with units = {}; this run uses units = {}", k,
                                             phys ? "normalised" : "physical", p.text("units")));
   }
 }
 
+// The tapping command's own keys for the piecewise-linear laws in physical units (N/m, nN); the registry keys
+// of the same laws (approach_stiffness, …) are the normalised ones here (units of ω_n², nm·ω_n²).
+const LawKeyAliases physical_aliases = {{"sample_stiffness_approach", "approach_stiffness"},
+                                        {"sample_stiffness_departure", "departure_stiffness"},
+                                        {"adhesion_approach", "approach_adhesion"},
+                                        {"adhesion_departure", "departure_adhesion"}};
+
 impact::ForceLaw law_from(const io::ParamSet& p, const tapping::PhysicalCantilever* pc) {
-  const std::string& law = p.text("law");
+  const impact::LawRegistry registry = impact::LawRegistry::builtin();
   if (!pc) {
-    const double ka = p.real("approach_stiffness"), kb = p.real("departure_stiffness");
-    const double fa = p.real("approach_adhesion"), fb = p.real("departure_adhesion");
-    if (law == "linear") return impact::PiecewiseLinearLaw::linear_repulsive(ka);
-    if (law == "hysteresis") return impact::PiecewiseLinearLaw::linear_hysteresis(ka, kb);
-    if (law == "attractive") return impact::PiecewiseLinearLaw::repulsive_attractive(ka, kb, fa, fb);
-    throw InvalidParameter("law", "law = dmt needs physical units (units = physical): its parameters are in GPa, nm, J");
+    if (!registry.find(p.text("law")).piecewise_linear)
+      throw InvalidParameter("law", fmt::format("law = {} needs physical units (units = physical): its parameters are "
+                                                "in GPa, nm, J (docs/force-laws.md)",
+                                                p.text("law")));
+    return law_from_params(p, registry);
   }
-  const double ka = pc->normalised_stiffness(p.real("sample_stiffness_approach"));
-  const double kb = pc->normalised_stiffness(p.real("sample_stiffness_departure"));
-  const double fa = pc->normalised_force(p.real("adhesion_approach"));
-  const double fb = pc->normalised_force(p.real("adhesion_departure"));
-  if (law == "linear") return impact::PiecewiseLinearLaw::linear_repulsive(ka);
-  if (law == "hysteresis") return impact::PiecewiseLinearLaw::linear_hysteresis(ka, kb);
-  if (law == "attractive") return impact::PiecewiseLinearLaw::repulsive_attractive(ka, kb, fa, fb);
-  impact::DmtLaw dmt(p.real("effective_modulus"), p.real("departure_modulus"), p.real("tip_radius"), p.real("hamaker"),
-                     p.real("departure_hamaker"), p.real("intermolecular_distance"));
-  return impact::ForceLaw(dmt).scaled(1.0 / pc->spring_constant);  // nN -> nm·ω_n² per unit mass
+  // physical law (nm, nN, nm/s) -> per unit mass (nm·ω_n²) in normalised time (1/ω_n)
+  return pc->normalised_law(law_from_params(p, registry, physical_aliases));
 }
 
 tapping::PhysicalCantilever physical_cantilever(const io::ParamSet& p) {
@@ -60,8 +74,6 @@ void add_tapping_model_params(io::ParamSet& p) {
   p.text("units", "normalised", "unit system of the model parameters and results", {"normalised", "physical"})
       .real("quality_factor", 100.0, "quality factor Q = 1/(2ξ)", Range::positive())
       .real("frequency_ratio", 1.0, "drive frequency over natural frequency ω/ω_n", Range::positive())
-      .text("law", "hysteresis", "tip-sample force law: linear (eq. 10), hysteresis (eq. 11), attractive (eq. 26), dmt",
-            {"linear", "hysteresis", "attractive", "dmt"})
       .real("separation", 10.0, "separation l (nm): sample surface at x = -l", Range::any())
       // normalised units (ω_n, lengths in nm, per-unit-mass forces in nm·ω_n²)
       .real("natural_frequency", 1.0, "[normalised] natural frequency ω_n", Range::positive())
@@ -81,12 +93,9 @@ void add_tapping_model_params(io::ParamSet& p) {
       .real("sample_stiffness_departure", 320.0, "[physical] contact stiffness while departing (N/m)", Range::non_negative())
       .real("adhesion_approach", 0.0, "[physical] attraction at contact while approaching (nN)", Range::non_negative())
       .real("adhesion_departure", 0.0, "[physical] attraction at contact while departing (nN)", Range::non_negative())
-      .real("effective_modulus", 1.0, "[physical, dmt] effective modulus E* while approaching (GPa)", Range::positive())
-      .real("departure_modulus", 1.0, "[physical, dmt] effective modulus E* while departing (GPa)", Range::positive())
-      .real("tip_radius", 10.0, "[physical, dmt] tip radius R (nm)", Range::positive())
-      .real("hamaker", 6.4e-20, "[physical, dmt] Hamaker constant while approaching (J)", Range::non_negative())
-      .real("departure_hamaker", 6.4e-20, "[physical, dmt] Hamaker constant while departing (J)", Range::non_negative())
-      .real("intermolecular_distance", 0.165, "[physical, dmt] intermolecular distance a0 (nm)", Range::positive());
+      ;
+  add_law_params(p, impact::LawRegistry::builtin(), "hysteresis",
+                 {"approach_stiffness", "departure_stiffness", "approach_adhesion", "departure_adhesion"});
 }
 
 tapping::TappingModel tapping_model_from(const io::ParamSet& p) {

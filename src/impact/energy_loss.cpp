@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <variant>
 #include <vector>
 
 #include <boost/math/quadrature/gauss_kronrod.hpp>
@@ -18,42 +17,7 @@ namespace afmkit::impact {
 
 namespace {
 
-/// ∫_lo^hi (H_a − H_b) dξ for H_X = −(F_X + K_X ξ) (ξ < 0), 0 (ξ ≥ 0), seed-1 eqs. (10), (11), (26):
-/// on [lo, min(hi, 0)] the integrand is (F_b − F_a) − (K_a − K_b) ξ, so the area is
-/// w·((F_b − F_a) − ½(K_a − K_b)(lo + hi')) with w = hi' − lo: a sum of non-negative terms for a dissipative law.
-double piecewise_linear_area(const PiecewiseLinearLaw& p, double lo, double hi) {
-  const double top = std::min(hi, 0.0);
-  if (!(lo < top)) return 0.0;
-  const double dk = p.approach_stiffness - p.departure_stiffness;  // exact when K_b is near K_a (Sterbenz)
-  const double df = p.departure_adhesion - p.approach_adhesion;
-  return (top - lo) * (df - 0.5 * dk * (lo + top));
-}
-
-/// The same for DMT (docs/units.md), in nN·nm, times `scale`: with ΔA = A_H,b − A_H,a, ΔE = E*_a − E*_b,
-///   ξ ≥ a0: H_a − H_b = ΔA R/(6ξ²)                    -> ΔA R/6 · (hi − l)/(l hi), l = max(lo, a0)
-///   ξ < a0: H_a − H_b = ΔA R/(6a0²) + (4/3) ΔE √R (a0 − ξ)^{3/2}
-///                                                      -> ΔA R/(6a0²)(u − lo) + (8/15) ΔE √R ((a0−lo)^{5/2} − (a0−u)^{5/2})
-///           with u = min(hi, a0).
-double dmt_area(const DmtLaw& m, double lo, double hi) {
-  constexpr double joule_per_nm_in_nN = 1e18;
-  const double a0 = m.intermolecular_distance, r = m.tip_radius;
-  const double da = (m.hamaker_departure - m.hamaker_approach) * joule_per_nm_in_nN;
-  const double de = m.effective_modulus_approach - m.effective_modulus_departure;
-  double area = 0.0;
-  if (hi > a0) {
-    const double l = std::max(lo, a0);
-    area += da * r / 6.0 * ((hi - l) / (l * hi));
-  }
-  if (lo < a0) {
-    const double u = std::min(hi, a0);
-    const double p = a0 - lo, q = a0 - u;
-    area += da * r / (6.0 * a0 * a0) * (u - lo) +
-            8.0 / 15.0 * de * std::sqrt(r) * (p * p * std::sqrt(p) - q * q * std::sqrt(q));
-  }
-  return area;
-}
-
-/// Custom laws: adaptive Gauss–Kronrod of H_a − H_b split at the switching gaps.
+/// Laws without a closed form: adaptive Gauss–Kronrod of H_a − H_b split at the switching gaps.
 double quadrature_area(const ForceLaw& law, double minimum_gap, double reference_gap) {
   // Split at the switching gaps so that every piece is smooth inside, then map each piece with the
   // smoothstep ξ = lo + (hi − lo)(3t² − 2t³): the Jacobian 6t(1 − t) vanishes at both ends, which smooths
@@ -102,9 +66,8 @@ double hysteresis_energy_loss(const ForceLaw& law, double minimum_gap, double re
   validate::finite("reference_gap", reference_gap);
   validate::require(minimum_gap <= reference_gap, "minimum_gap", minimum_gap,
                     fmt::format("<= reference_gap = {}", reference_gap));
-  if (const auto* p = law.piecewise_linear()) return piecewise_linear_area(*p, minimum_gap, reference_gap);  // scaled
-  if (const auto* d = std::get_if<DmtLaw>(&law.kind()))
-    return law.scale() * dmt_area(*d, minimum_gap, reference_gap);
+  const double closed_form = law.hysteresis_area(minimum_gap, reference_gap);
+  if (!std::isnan(closed_form)) return closed_form;
   return quadrature_area(law, minimum_gap, reference_gap);
 }
 

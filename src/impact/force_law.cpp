@@ -51,111 +51,97 @@ double PiecewiseLinearLaw::departure_stiffness_for_restitution(double ka, double
   return kb;
 }
 
-DmtLaw::DmtLaw(double ea, double eb, double r, double ha, double hb, double a0, bool allow_gain)
-    : effective_modulus_approach(validate::positive("effective_modulus_approach", ea)),
-      effective_modulus_departure(validate::positive("effective_modulus_departure", eb)),
-      tip_radius(validate::positive("tip_radius", r)),
-      hamaker_approach(validate::non_negative("hamaker_approach", ha)),
-      hamaker_departure(validate::non_negative("hamaker_departure", hb)),
-      intermolecular_distance(validate::positive("intermolecular_distance", a0)),
-      allow_energy_gain(allow_gain) {}
-
-void DmtLaw::require_dissipative() const {
-  // H_a − H_b = (A_H,b − A_H,a) R/(6 max(d, a0)²) + (4/3)(E*_a − E*_b) √R (a0 − d)₊^{3/2} ≥ 0 for all d
-  // iff E*_b ≤ E*_a and A_H,b ≥ A_H,a (seed-1 eq. 6: the loss is the area between the branches).
-  if (allow_energy_gain) return;
-  if (effective_modulus_departure > effective_modulus_approach)
-    throw InvalidParameter("departure_modulus",
-                           fmt::format("departure_modulus = {} must be <= effective_modulus = {} (a hysteresis law "
-                                       "dissipates energy; set allow_energy_gain = true to allow a gain)",
-                                       effective_modulus_departure, effective_modulus_approach));
-  if (hamaker_departure < hamaker_approach)
-    throw InvalidParameter("departure_hamaker",
-                           fmt::format("departure_hamaker = {} must be >= hamaker = {} (a hysteresis law "
-                                       "dissipates energy; set allow_energy_gain = true to allow a gain)",
-                                       hamaker_departure, hamaker_approach));
-}
-
 namespace {
-// force in nN for gap d [nm], modulus [GPa], radius [nm], Hamaker [J]: J/nm = 1e18 nN
-double dmt(double d, double modulus, double radius, double hamaker, double a0) {
-  constexpr double joule_per_nm_in_nN = 1e18;
-  if (d >= a0) return -hamaker * joule_per_nm_in_nN * radius / (6.0 * d * d);
-  const double delta = a0 - d;
-  return -hamaker * joule_per_nm_in_nN * radius / (6.0 * a0 * a0) +
-         4.0 / 3.0 * modulus * std::sqrt(radius) * delta * std::sqrt(delta);
+
+/// ∫_lo^hi (H_a − H_b) dξ for H_X = −(F_X + K_X ξ) (ξ < 0), 0 (ξ ≥ 0), seed-1 eqs. (10), (11), (26):
+/// on [lo, min(hi, 0)] the integrand is (F_b − F_a) − (K_a − K_b) ξ, so the area is
+/// w·((F_b − F_a) − ½(K_a − K_b)(lo + hi')) with w = hi' − lo: a sum of non-negative terms for a dissipative law.
+double piecewise_linear_area(const PiecewiseLinearLaw& p, double lo, double hi) {
+  const double top = std::min(hi, 0.0);
+  if (!(lo < top)) return 0.0;
+  const double dk = p.approach_stiffness - p.departure_stiffness;  // exact when K_b is near K_a (Sterbenz)
+  const double df = p.departure_adhesion - p.approach_adhesion;
+  return (top - lo) * (df - 0.5 * dk * (lo + top));
 }
+
+class PiecewiseLinearModel final : public ForceLawModel {
+ public:
+  explicit PiecewiseLinearModel(const PiecewiseLinearLaw& law) : law_(law) {}
+  std::string name() const override {
+    if (law_.approach_adhesion == 0 && law_.departure_adhesion == 0)
+      return law_.approach_stiffness == law_.departure_stiffness ? "linear" : "hysteresis";
+    return "attractive";
+  }
+  double approach(double gap) const override { return law_.approach(gap); }
+  double departure(double gap) const override { return law_.departure(gap); }
+  std::vector<double> switching_gaps() const override { return {0.0}; }
+  bool branch_dependent(int region) const override {
+    return region == 0 && (law_.approach_stiffness != law_.departure_stiffness ||
+                           law_.approach_adhesion != law_.departure_adhesion);
+  }
+  const PiecewiseLinearLaw* piecewise_linear() const override { return &law_; }
+  void require_dissipative() const override { law_.require_dissipative(); }
+  double hysteresis_area(double lo, double hi) const override { return piecewise_linear_area(law_, lo, hi); }
+
+ private:
+  PiecewiseLinearLaw law_;
+};
+
+class CustomModel final : public ForceLawModel {
+ public:
+  explicit CustomModel(CustomLaw law) : law_(std::move(law)) {
+    if (!law_.approach || !law_.departure)
+      throw InvalidParameter("force_law", "custom force law: both branches must be set");
+    for (double g : law_.switching_gaps) validate::finite("switching_gaps", g);
+  }
+  std::string name() const override { return law_.name; }
+  double approach(double gap) const override { return law_.approach(gap); }
+  double departure(double gap) const override { return law_.departure(gap); }
+  std::vector<double> switching_gaps() const override { return law_.switching_gaps; }
+
+ private:
+  CustomLaw law_;
+};
+
 }  // namespace
 
-double DmtLaw::approach(double d) const {
-  return dmt(d, effective_modulus_approach, tip_radius, hamaker_approach, intermolecular_distance);
-}
-double DmtLaw::departure(double d) const {
-  return dmt(d, effective_modulus_departure, tip_radius, hamaker_departure, intermolecular_distance);
-}
-
-ForceLaw::ForceLaw(PiecewiseLinearLaw law) : kind_(law) { refresh(); }
-ForceLaw::ForceLaw(DmtLaw law) : kind_(law) { refresh(); }
-ForceLaw::ForceLaw(CustomLaw law) : kind_(std::move(law)) {
-  const auto& c = std::get<CustomLaw>(kind_);
-  if (!c.approach || !c.departure) throw InvalidParameter("force_law", "custom force law: both branches must be set");
+ForceLaw::ForceLaw(std::shared_ptr<const ForceLawModel> model) : model_(std::move(model)) {
+  if (!model_) throw InvalidParameter("force_law", "force law: no model given (null pointer)");
   refresh();
 }
+ForceLaw::ForceLaw(PiecewiseLinearLaw law) : ForceLaw(std::make_shared<PiecewiseLinearModel>(law)) {}
+ForceLaw::ForceLaw(CustomLaw law) : ForceLaw(std::make_shared<CustomModel>(std::move(law))) {}
 
 void ForceLaw::refresh() {
-  switching_gaps_.clear();
+  switching_gaps_ = model_->switching_gaps();
+  for (double g : switching_gaps_) validate::finite("switching_gaps", g);
+  std::sort(switching_gaps_.begin(), switching_gaps_.end());
+  switching_gaps_.erase(std::unique(switching_gaps_.begin(), switching_gaps_.end()), switching_gaps_.end());
+  has_damping_ = model_->has_damping();
   scaled_linear_.reset();
-  if (auto* p = std::get_if<PiecewiseLinearLaw>(&kind_)) {
-    switching_gaps_ = {0.0};
+  if (const auto* p = model_->piecewise_linear())
     scaled_linear_ = std::make_shared<PiecewiseLinearLaw>(p->approach_stiffness * scale_, p->departure_stiffness * scale_,
                                                           p->approach_adhesion * scale_, p->departure_adhesion * scale_,
                                                           p->allow_energy_gain);
-  } else if (auto* d = std::get_if<DmtLaw>(&kind_)) {
-    switching_gaps_ = {d->intermolecular_distance};
-  } else {
-    switching_gaps_ = std::get<CustomLaw>(kind_).switching_gaps;
-    std::sort(switching_gaps_.begin(), switching_gaps_.end());
-  }
 }
 
-double ForceLaw::approach(double gap) const {
-  return scale_ * std::visit([gap](const auto& k) { return k.approach(gap); }, kind_);
-}
-double ForceLaw::departure(double gap) const {
-  return scale_ * std::visit([gap](const auto& k) { return k.departure(gap); }, kind_);
-}
 double ForceLaw::force(double gap, double rate) const {
-  if (rate < 0) return approach(gap);
-  if (rate > 0) return departure(gap);
+  const double viscous = has_damping_ ? -damping(gap) * rate : 0.0;
+  if (rate < 0) return approach(gap) + viscous;
+  if (rate > 0) return departure(gap) + viscous;
   return 0.5 * (approach(gap) + departure(gap));
 }
 
 const PiecewiseLinearLaw* ForceLaw::piecewise_linear() const& { return scaled_linear_.get(); }
 
-void ForceLaw::require_dissipative() const {
-  if (const auto* p = std::get_if<PiecewiseLinearLaw>(&kind_)) p->require_dissipative();  // user's units
-  else if (const auto* d = std::get_if<DmtLaw>(&kind_)) d->require_dissipative();
-}
-
-ForceLaw ForceLaw::scaled(double factor) const {
-  validate::positive("force_scale", factor);
+ForceLaw ForceLaw::scaled(double force_factor, double rate_factor) const {
+  validate::positive("force_scale", force_factor);
+  validate::positive("rate_scale", rate_factor);
   ForceLaw out = *this;
-  out.scale_ = scale_ * factor;
+  out.scale_ = scale_ * force_factor;
+  out.damping_scale_ = damping_scale_ * force_factor * rate_factor;
   out.refresh();
   return out;
-}
-
-std::string ForceLaw::name() const {
-  struct V {
-    std::string operator()(const PiecewiseLinearLaw& p) const {
-      if (p.approach_adhesion == 0 && p.departure_adhesion == 0)
-        return p.approach_stiffness == p.departure_stiffness ? "linear_repulsive" : "linear_hysteresis";
-      return "repulsive_attractive";
-    }
-    std::string operator()(const DmtLaw&) const { return "dmt"; }
-    std::string operator()(const CustomLaw& c) const { return c.name; }
-  };
-  return std::visit(V{}, kind_);
 }
 
 }  // namespace afmkit::impact

@@ -79,7 +79,7 @@ class ImpactIntegrator {
       }
     };
     auto track_force = [&](const State& z) {
-      const double f = branch(gap(z));
+      const double f = force_at(z);
       r.peak_force = std::max(r.peak_force, f);
       r.min_force = std::min(r.min_force, f);
     };
@@ -244,10 +244,15 @@ class ImpactIntegrator {
   double gap(const State& z) const { return length_ * (z[2] - z[0]); }
   double rate(const State& z) const { return speed_ * (z[3] - z[1]); }
   double branch(double d) const { return departure_ ? law_.departure(d) : law_.approach(d); }
+  /// H of the current phase with the Kelvin–Voigt term −c(d)ḋ of laws that have one.
+  double force_at(const State& z) const {
+    const double d = gap(z);
+    return law_.has_damping() ? branch(d) - law_.damping(d) * rate(z) : branch(d);
+  }
 
   void rhs(const State& z, State& dz, double s) const {
     const double d = gap(z);
-    const double force = branch(d);
+    const double force = force_at(z);
     if (!std::isfinite(force))
       throw NumericalFailure(fmt::format("force law '{}' returned {} at gap {}", law_.name(), force, d));
     const double t = s * time_;
@@ -262,7 +267,7 @@ class ImpactIntegrator {
     out.time = t;
     out.gap = gap(z);
     out.gap_rate = rate(z);
-    out.force = branch(out.gap);
+    out.force = force_at(z);
     out.position1 = com_x0_ + com_v0_ * t + length_ * z[0];
     out.velocity1 = com_v0_ + speed_ * z[1];
     out.position2 = com_x0_ + com_v0_ * t + length_ * z[2];
@@ -298,7 +303,9 @@ ImpactResult integrated_impact(const ImpactProblem& problem, const ImpactOptions
   // tolerance/(1 − e) of the loss. The centre-of-mass velocity is kept from the integration.
   double relative_loss = std::numeric_limits<double>::quiet_NaN();
   r.energy_balance_residual = relative_loss;
-  if (r.outcome == ImpactOutcome::separated && problem.external().constant()) {
+  // A Kelvin–Voigt term dissipates ∫ c(d) ḋ² dt on top of the area (eq. 6): no closed balance, the integrated
+  // state is reported as is.
+  if (r.outcome == ImpactOutcome::separated && problem.external().constant() && !problem.law().has_damping()) {
     const double m1 = problem.body1().mass, m2 = problem.body2().mass, total = m1 + m2;
     const double mu = problem.reduced_mass(), v_s = problem.initial_gap_rate();
     const double v_raw = r.body2_after.velocity - r.body1_after.velocity;

@@ -20,6 +20,10 @@ Drive PhysicalCantilever::drive() const {
   return {free_amplitude / gain, frequency_ratio};
 }
 
+impact::ForceLaw PhysicalCantilever::normalised_law(const impact::ForceLaw& physical) const {
+  return physical.scaled(1.0 / spring_constant, 2.0 * std::numbers::pi * resonance_frequency * 1e3);
+}
+
 UnitScales PhysicalCantilever::scales() const {
   UnitScales s;
   s.length = 1.0;

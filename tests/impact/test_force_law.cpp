@@ -25,7 +25,7 @@ TEST(ForceLaw, Eq4SelectsBranchBySignOfGapRate) {
   EXPECT_DOUBLE_EQ(law.force(-1.0, -1.0), 10.0);  // approaching: H_a
   EXPECT_DOUBLE_EQ(law.force(-1.0, +1.0), 4.0);   // departing: H_b
   EXPECT_DOUBLE_EQ(law.force(-1.0, 0.0), 7.0);    // ḋ = 0: mean
-  EXPECT_EQ(law.name(), "linear_hysteresis");
+  EXPECT_EQ(law.name(), "hysteresis");
   EXPECT_EQ(law.switching_gaps(), std::vector<double>{0.0});
 }
 

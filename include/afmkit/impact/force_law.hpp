@@ -4,9 +4,9 @@
 // Sign convention: H > 0 is repulsive (pushes the two bodies apart). d is the gap between the bodies.
 // In the tapping model (seed-1 eq. 8) d = x + l and h(x, ẋ) = −H(x + l, ẋ) (per unit mass).
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
-#include <variant>
 #include <vector>
 
 namespace afmkit::impact {
@@ -78,38 +78,77 @@ struct CustomLaw {
   std::string name = "custom";
 };
 
-/// A hysteresis force law as a value: one of the kinds above, times a scale factor (used to convert a
-/// physical law into the normalised per-unit-mass units of the tapping model).
+/// What every force law is (the one interface that impact, simulation, shooting, harmonic balance, continuation
+/// and sweeps take; docs/force-laws.md shows how to add one). Forces H > 0 are repulsive, in the law's own units.
+///   H(d, ḋ) = H_a(d) − c(d)·ḋ while approaching (ḋ < 0), H_b(d) − c(d)·ḋ while departing (ḋ > 0),
+///   ½(H_a + H_b) at ḋ = 0   (seed-1 eq. 4 with an optional Kelvin–Voigt term c(d) ≥ 0).
+/// Between consecutive switching gaps every branch (and c) must be smooth; crossings of the switching gaps are
+/// events located by the integrators and switching angles of the harmonic-balance quadrature.
+class ForceLawModel {
+ public:
+  virtual ~ForceLawModel() = default;
+  virtual std::string name() const = 0;
+  virtual double approach(double gap) const = 0;   // H_a(d)
+  virtual double departure(double gap) const = 0;  // H_b(d)
+  /// Kelvin–Voigt coefficient c(d) ≥ 0 (force per unit gap rate); 0 unless has_damping().
+  virtual double damping(double /*gap*/) const { return 0.0; }
+  virtual bool has_damping() const { return false; }
+  /// Gaps at which a branch or c(d) is not smooth (any order; the ForceLaw sorts them).
+  virtual std::vector<double> switching_gaps() const = 0;
+  /// Whether H_a and H_b may differ in region r (gaps between switching gap r−1 and r; region 0 lies below
+  /// the lowest). Default: everywhere. A tighter answer saves velocity-zero guards.
+  virtual bool branch_dependent(int /*region*/) const { return true; }
+  /// The coefficients when the law is piecewise linear (eqs. 10, 11, 26): closed-form fast paths use them.
+  virtual const PiecewiseLinearLaw* piecewise_linear() const { return nullptr; }
+  /// Throws InvalidParameter naming the parameter when the law creates energy without its opt-in.
+  virtual void require_dissipative() const {}
+  /// ∫_lo^hi (H_a − H_b) dd in closed form when the law has one (seed-1 eq. 6); NaN: use quadrature.
+  virtual double hysteresis_area(double /*lo*/, double /*hi*/) const { return std::numeric_limits<double>::quiet_NaN(); }
+};
+
+/// A hysteresis force law as a value: a shared immutable ForceLawModel, times a force scale factor (used to
+/// convert a physical law into the normalised per-unit-mass units of the tapping model) and a rate scale for the
+/// Kelvin–Voigt term. Copying is cheap.
 class ForceLaw {
  public:
-  using Kind = std::variant<PiecewiseLinearLaw, DmtLaw, CustomLaw>;
+  explicit ForceLaw(std::shared_ptr<const ForceLawModel> model);
   ForceLaw(PiecewiseLinearLaw law);  // NOLINT(google-explicit-constructor)
   ForceLaw(DmtLaw law);              // NOLINT(google-explicit-constructor)
   ForceLaw(CustomLaw law);           // NOLINT(google-explicit-constructor)
 
-  double approach(double gap) const;                   // scale · H_a(d)
-  double departure(double gap) const;                  // scale · H_b(d)
-  double force(double gap, double gap_rate) const;     // eq. (4)
-  /// Gaps at which a branch is non-smooth (sorted); crossings are events for the integrators.
+  double approach(double gap) const { return scale_ * model_->approach(gap); }    // scale · H_a(d)
+  double departure(double gap) const { return scale_ * model_->departure(gap); }  // scale · H_b(d)
+  /// scale · rate scale · c(d): the Kelvin–Voigt coefficient in the scaled units (0 for laws without one).
+  double damping(double gap) const { return has_damping_ ? damping_scale_ * model_->damping(gap) : 0.0; }
+  bool has_damping() const { return has_damping_; }
+  double force(double gap, double gap_rate) const;     // eq. (4) with the Kelvin–Voigt term
+  /// Gaps at which a branch is non-smooth (sorted, distinct); crossings are events for the integrators.
   const std::vector<double>& switching_gaps() const& { return switching_gaps_; }
   std::vector<double> switching_gaps() const&& { return switching_gaps_; }
+  /// Whether the branches may differ between switching gaps region−1 and region (see ForceLawModel).
+  bool branch_dependent(int region) const { return model_->branch_dependent(region); }
   /// Non-null iff the law is piecewise linear (eqs. 10, 11, 26) — then the flow has a closed form.
   /// The returned coefficients already include the scale factor.
   const PiecewiseLinearLaw* piecewise_linear() const&;
   const PiecewiseLinearLaw* piecewise_linear() const&& = delete;  // would point into a temporary
-  /// The same law with forces multiplied by `factor` (> 0).
-  ForceLaw scaled(double factor) const;
+  /// The same law with forces multiplied by `force_factor` (> 0) and gap rates by `rate_factor` (> 0): a rate
+  /// ḋ in the new units is ḋ·rate_factor in the old ones (the Kelvin–Voigt term scales by the product).
+  ForceLaw scaled(double force_factor, double rate_factor = 1.0) const;
   double scale() const { return scale_; }
-  const Kind& kind() const& { return kind_; }
-  Kind kind() const&& { return kind_; }
+  const ForceLawModel& model() const& { return *model_; }
+  const ForceLawModel& model() const&& = delete;  // would refer into a temporary
   /// Throws InvalidParameter when the law creates energy (area between the branches < 0 at some penetration)
   /// without its allow_energy_gain opt-in. Custom laws are not checked.
-  void require_dissipative() const;
-  std::string name() const;
+  void require_dissipative() const { model_->require_dissipative(); }
+  /// scale · ∫_lo^hi (H_a − H_b) dd in closed form, NaN when the law has none.
+  double hysteresis_area(double lo, double hi) const { return scale_ * model_->hysteresis_area(lo, hi); }
+  std::string name() const { return model_->name(); }
 
  private:
-  Kind kind_;
+  std::shared_ptr<const ForceLawModel> model_;
   double scale_ = 1.0;
+  double damping_scale_ = 1.0;
+  bool has_damping_ = false;
   std::vector<double> switching_gaps_;
   std::shared_ptr<const PiecewiseLinearLaw> scaled_linear_;  // cached scaled copy for piecewise_linear()
   void refresh();

@@ -28,7 +28,9 @@ class TappingSystem {
   /// Lowest switching gap (0 when the law has none): x + l below it counts as contact.
   double contact_gap() const { return switching().empty() ? 0.0 : switching().front(); }
   /// Whether approach and departure branches differ in `region` (else no velocity guard there).
-  bool branch_dependent(int region) const { return region < 64 && ((dependent_mask_ >> region) & 1u); }
+  bool branch_dependent(int region) const {
+    return region < 64 ? ((dependent_mask_ >> region) & 1u) != 0 : model_.law.branch_dependent(region);
+  }
 
   double drive(double t) const;       // Γ cos ωt
   double drive_rate(double t) const;  // d/dt Γ cos ωt
@@ -37,9 +39,12 @@ class TappingSystem {
 
   /// h of the given (fixed) branch at position x, extended smoothly (piecewise-linear laws) or continuously
   /// (clamped gap, other laws) beyond the bounds of `region`; sticking uses the mean of the branches (eq. 4).
-  double interaction(ContactBranch branch, double x, int region) const;
+  /// With a Kelvin–Voigt law h also has the term c(d)·ẋ (c evaluated at the clamped gap); none while sticking.
+  double interaction(ContactBranch branch, double x, double velocity, int region) const;
   /// ∂h/∂x of the same extension: exact for piecewise-linear laws, one-sided differences inside `region` else.
-  double interaction_slope(ContactBranch branch, double x, int region) const;
+  double interaction_slope(ContactBranch branch, double x, double velocity, int region) const;
+  /// ∂h/∂ẋ = c(d) (0 unless the law has a Kelvin–Voigt term).
+  double interaction_rate_slope(ContactBranch branch, double x, int region) const;
   /// ẍ in `mode` at (t, x, ẋ) (0 while sticking).
   double acceleration(const Mode& mode, double t, TipState s) const;
   /// ẍ with the given branch's force in `region`.
@@ -72,7 +77,10 @@ class TappingSystem {
   double separation_;
   const std::vector<double>& switching() const& { return model_.law.switching_gaps(); }
   unsigned long dependent_mask_ = 0;
-  std::optional<impact::PiecewiseLinearLaw> linear_;  // scaled coefficients when piecewise linear
+  std::optional<impact::PiecewiseLinearLaw> linear_;
+  bool has_damping_ = false;
+  double elastic_interaction(ContactBranch branch, double x, int region) const;
+  double clamp_gap(double gap, int region) const;  // scaled coefficients when piecewise linear
   double damping_;    // 2ξω_n
   double stiffness_;  // ω_n²
   double omega_;      // ω

@@ -35,6 +35,9 @@ struct PhysicalCantilever {
   UnitScales scales() const;
   double normalised_stiffness(double stiffness_n_per_m) const { return stiffness_n_per_m / spring_constant; }
   double normalised_force(double force_nN) const { return force_nN / spring_constant; }
+  /// A force law in physical units (gap nm, force nN, gap rate nm/s) as the model's per-unit-mass law
+  /// (force / k; a model rate is 2π f0 times a physical one, which scales a Kelvin–Voigt term).
+  impact::ForceLaw normalised_law(const impact::ForceLaw& physical) const;
 };
 
 }  // namespace afmkit::tapping

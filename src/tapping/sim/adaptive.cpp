@@ -27,9 +27,10 @@ struct ModeField {
     dy[0] = y[1];
     dy[1] = sys->acceleration(mode, t, s);
     if constexpr (N == 8) {
-      // J_f = [[0, 1], [−ω_n² − h'(x), −2ξω_n]],  ∂f/∂l = (0, −h'(x))
-      const double slope = sys->interaction_slope(mode.branch, y[0], mode.region);
-      const double j10 = -sys->stiffness() - slope, j11 = -sys->damping();
+      // J_f = [[0, 1], [−ω_n² − h_x, −2ξω_n − h_ẋ]],  ∂f/∂l = (0, −h_x)
+      const double slope = sys->interaction_slope(mode.branch, y[0], y[1], mode.region);
+      const double j10 = -sys->stiffness() - slope;
+      const double j11 = -sys->damping() - sys->interaction_rate_slope(mode.branch, y[0], mode.region);
       for (int c = 0; c < 3; ++c) {
         const double px = y[2 + 2 * c], pv = y[3 + 2 * c];
         dy[2 + 2 * c] = pv;

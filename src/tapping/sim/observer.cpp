@@ -39,7 +39,7 @@ void OrbitIntegrals::extremum(const TappingSystem& system, const Segment& segmen
   const double tm = isolate_crossing(rate, a, b, CrossingDirection::rising, 1e-15 * std::max(1.0, std::abs(b)));
   const TipState sm = segment.state(tm);
   min_gap = std::min(min_gap, system.gap(sm.position));
-  peak_force = std::max(peak_force, 0.0 - system.interaction(segment.mode().branch, sm.position, segment.mode().region));
+  peak_force = std::max(peak_force, 0.0 - system.interaction(segment.mode().branch, sm.position, sm.velocity, segment.mode().region));
 }
 
 void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segment) {
@@ -64,12 +64,12 @@ void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segm
       fourier[k] += w * x * ek;
       ek *= e1;
     }
-    const double h = mode.branch == ContactBranch::sticking ? 0.0 : system.interaction(mode.branch, x, mode.region);
+    const double h = mode.branch == ContactBranch::sticking ? 0.0 : system.interaction(mode.branch, x, v, mode.region);
     drive_work += w * system.drive(t) * v;
     viscous_dissipation += w * system.damping() * v * v;
     contact_dissipation += w * h * v;
     if (system.region_count() == 1 && system.gap(x) < 0) contact_time += w;
-    peak_force = std::max(peak_force, 0.0 - system.interaction(mode.branch, x, mode.region));
+    peak_force = std::max(peak_force, 0.0 - system.interaction(mode.branch, x, v, mode.region));
     min_gap = std::min(min_gap, system.gap(x));
   };
   for (int p = 0; p < panels; ++p) {
@@ -88,7 +88,7 @@ void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segm
   for (double t : {t0, t1}) {
     const TipState s = segment.state(t);
     min_gap = std::min(min_gap, system.gap(s.position));
-    peak_force = std::max(peak_force, 0.0 - system.interaction(mode.branch, s.position, mode.region));
+    peak_force = std::max(peak_force, 0.0 - system.interaction(mode.branch, s.position, s.velocity, mode.region));
   }
 }
 

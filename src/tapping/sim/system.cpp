@@ -17,18 +17,11 @@ TappingSystem::TappingSystem(TappingModel model)
       stiffness_(model_.cantilever.natural_frequency * model_.cantilever.natural_frequency),
       omega_(model_.drive.frequency),
       gamma_(model_.drive.amplitude) {
-  if (const auto* p = model_.law.piecewise_linear()) {
-    linear_ = *p;
-    const bool hysteretic = p->approach_stiffness != p->departure_stiffness ||
-                            p->approach_adhesion != p->departure_adhesion;
-    dependent_mask_ = hysteretic ? 1u : 0u;  // only the contact region can depend on the branch
-  } else if (const auto* d = std::get_if<impact::DmtLaw>(&model_.law.kind())) {
-    const bool moduli = d->effective_modulus_approach != d->effective_modulus_departure;
-    const bool hamaker = d->hamaker_approach != d->hamaker_departure;
-    dependent_mask_ = ((moduli || hamaker) ? 1u : 0u) | (hamaker ? 2u : 0u);
-  } else {
-    dependent_mask_ = ~0ul;  // custom law: assume branches differ everywhere
-  }
+  if (const auto* p = model_.law.piecewise_linear()) linear_ = *p;
+  const int regions = region_count();
+  for (int r = 0; r < regions && r < 64; ++r)
+    if (model_.law.branch_dependent(r)) dependent_mask_ |= 1ul << r;
+  has_damping_ = model_.law.has_damping();
 }
 
 int TappingSystem::region_of(double gap) const {
@@ -43,7 +36,25 @@ double TappingSystem::region_hi(int region) const {
 double TappingSystem::drive(double t) const { return gamma_ * std::cos(omega_ * t); }
 double TappingSystem::drive_rate(double t) const { return -gamma_ * omega_ * std::sin(omega_ * t); }
 
-double TappingSystem::interaction(ContactBranch branch, double x, int region) const {
+double TappingSystem::interaction(ContactBranch branch, double x, double velocity, int region) const {
+  const double elastic = elastic_interaction(branch, x, region);
+  if (!has_damping_ || branch == ContactBranch::sticking) return elastic;
+  return elastic + model_.law.damping(clamp_gap(gap(x), region)) * velocity;  // h = −H, H ∋ −c(d)ḋ, ḋ = ẋ
+}
+
+double TappingSystem::clamp_gap(double d, int region) const {
+  double dc = std::max(d, region_lo(region));
+  const double hi = region_hi(region);
+  if (dc >= hi) dc = std::nextafter(hi, -kInf);
+  return dc;
+}
+
+double TappingSystem::interaction_rate_slope(ContactBranch branch, double x, int region) const {
+  if (!has_damping_ || branch == ContactBranch::sticking) return 0.0;
+  return model_.law.damping(clamp_gap(gap(x), region));
+}
+
+double TappingSystem::elastic_interaction(ContactBranch branch, double x, int region) const {
   const double d = gap(x);
   if (linear_) {
     if (region != 0) return 0.0;
@@ -57,9 +68,7 @@ double TappingSystem::interaction(ContactBranch branch, double x, int region) co
     }
   }
   // continuous extension: clamp the gap into the region (open upper end: stay just below the switching gap)
-  double dc = std::max(d, region_lo(region));
-  const double hi = region_hi(region);
-  if (dc >= hi) dc = std::nextafter(hi, -kInf);
+  const double dc = clamp_gap(d, region);
   switch (branch) {
     case ContactBranch::approach: return -model_.law.approach(dc);
     case ContactBranch::departure: return -model_.law.departure(dc);
@@ -68,7 +77,7 @@ double TappingSystem::interaction(ContactBranch branch, double x, int region) co
   return 0.0;
 }
 
-double TappingSystem::interaction_slope(ContactBranch branch, double x, int region) const {
+double TappingSystem::interaction_slope(ContactBranch branch, double x, double velocity, int region) const {
   if (linear_) {
     if (region != 0) return 0.0;
     switch (branch) {
@@ -80,14 +89,14 @@ double TappingSystem::interaction_slope(ContactBranch branch, double x, int regi
   const double d = gap(x);
   const double step = 1e-6 * std::max(1.0, std::abs(d));
   const double lo = region_lo(region), hi = region_hi(region);
-  auto h = [&](double dd) { return interaction(branch, dd - separation_, region); };
+  auto h = [&](double dd) { return interaction(branch, dd - separation_, velocity, region); };
   if (d - step >= lo && d + step < hi) return (h(d + step) - h(d - step)) / (2.0 * step);
   if (d + 2 * step < hi) return (-3.0 * h(d) + 4.0 * h(d + step) - h(d + 2 * step)) / (2.0 * step);
   return (3.0 * h(d) - 4.0 * h(d - step) + h(d - 2 * step)) / (2.0 * step);
 }
 
 double TappingSystem::acceleration(ContactBranch branch, int region, double t, TipState s) const {
-  return drive(t) - damping_ * s.velocity - stiffness_ * s.position - interaction(branch, s.position, region);
+  return drive(t) - damping_ * s.velocity - stiffness_ * s.position - interaction(branch, s.position, s.velocity, region);
 }
 
 double TappingSystem::acceleration(const Mode& mode, double t, TipState s) const {
@@ -198,9 +207,10 @@ double TappingSystem::witness_rate_derivative(const Guard& guard, const Mode& mo
     case GuardKind::gap: return acceleration(mode, t, s);
     case GuardKind::velocity: {
       if (mode.branch == ContactBranch::sticking) return 0.0;
-      // jerk: d/dt (Γ cos ωt − cẋ − ω_n² x − h(x)) = −Γω sin ωt − c ẍ − (ω_n² + h'(x)) ẋ
+      // jerk: d/dt (Γ cos ωt − cẋ − ω_n² x − h(x, ẋ)) = −Γω sin ωt − (c + h_ẋ) ẍ − (ω_n² + h_x) ẋ
       const double a = acceleration(mode, t, s);
-      return drive_rate(t) - damping_ * a - (stiffness_ + interaction_slope(mode.branch, s.position, mode.region)) * s.velocity;
+      return drive_rate(t) - (damping_ + interaction_rate_slope(mode.branch, s.position, mode.region)) * a -
+             (stiffness_ + interaction_slope(mode.branch, s.position, s.velocity, mode.region)) * s.velocity;
     }
     case GuardKind::release_departure:
     case GuardKind::release_approach: return -omega_ * omega_ * drive(t);
@@ -222,8 +232,10 @@ void TappingSystem::witness_gradient(const Guard& guard, const Mode& mode, doubl
     case GuardKind::release_approach: {
       const ContactBranch b =
           guard.kind == GuardKind::release_departure ? ContactBranch::departure : ContactBranch::approach;
-      const double slope = interaction_slope(b, s.position, mode.region);  // g = Γcos ωt − ω_n² x − h(x + l)
-      grad[0] = -stiffness_ - slope, grad[1] = -damping_, grad[2] = -slope;
+      // g = Γcos ωt − ω_n² x − cẋ − h(x + l, ẋ)
+      const double slope = interaction_slope(b, s.position, s.velocity, mode.region);
+      grad[0] = -stiffness_ - slope, grad[1] = -damping_ - interaction_rate_slope(b, s.position, mode.region),
+      grad[2] = -slope;
       time_partial = drive_rate(t);
       return;
     }

@@ -1,0 +1,69 @@
+#include "law_params.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "afmkit/core/error.hpp"
+
+namespace afmkit::cli {
+
+void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& default_law,
+                    const std::vector<std::string>& skip) {
+  std::vector<std::string> summaries;
+  for (const auto& name : registry.names()) summaries.push_back(fmt::format("{}: {}", name, registry.find(name).summary));
+  p.text("law", default_law, fmt::format("tip-sample force law (docs/force-laws.md): {}", fmt::join(summaries, "; ")),
+         registry.names())
+      .text("force_curve", "",
+            "[table] force-curve file: approach and retract force vs distance, units in the header "
+            "(docs/force-laws.md)")
+      .flag("allow_energy_gain", false,
+            "accept a law that creates energy (retract branch above the approach branch somewhere: K_b > K_a, "
+            "restitution > 1, departure_modulus > effective_modulus, ...)");
+  for (const auto& k : registry.keys()) {
+    if (std::find(skip.begin(), skip.end(), k.key) != skip.end()) continue;
+    const std::string unit = k.unit.empty() ? std::string() : fmt::format(" ({})", k.unit);
+    const std::string laws = fmt::format("[{}] ", fmt::join(registry.laws_using(k.key), ", "));
+    io::Range range{k.lower, std::min(k.upper, 1e308), k.lower_open, false};
+    p.real(k.key, k.default_value, laws + k.help + unit, range);
+  }
+}
+
+impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistry& registry,
+                                 const LawKeyAliases& aliases) {
+  const std::string& name = p.text("law");
+  const impact::LawSpec& spec = registry.find(name);
+  impact::LawArguments args;
+  args.allow_energy_gain = p.flag("allow_energy_gain");
+  args.force_curve = p.text("force_curve");
+  auto reads = [&](const std::string& key) { return std::find(spec.keys.begin(), spec.keys.end(), key) != spec.keys.end(); };
+  for (const auto& [command_key, registry_key] : aliases) {
+    // always pass an alias the law reads (its default is the command's); a given alias of another law is
+    // passed too, so that the registry names it as foreign
+    if (reads(registry_key) || p.was_set(command_key)) args.values[registry_key] = p.real(command_key);
+  }
+  // every key the law reads, with the command's value (given, or its default — a command may change defaults);
+  // keys that follow another key or count only when given are passed only when given; given keys of other laws
+  // are passed so that the registry names them
+  std::vector<std::string> replaced;  // keys a given alternative stands for (restitution -> departure_stiffness)
+  for (const auto& k : registry.keys())
+    if (!k.replaces.empty() && p.was_set(k.key)) replaced.push_back(k.replaces);
+  for (const auto& k : registry.keys()) {
+    if (args.values.count(k.key)) continue;
+    const bool is_replaced = std::find(replaced.begin(), replaced.end(), k.key) != replaced.end();
+    const bool pass = p.was_set(k.key) || (reads(k.key) && k.follows.empty() && !k.only_if_given && !is_replaced);
+    if (pass) args.values[k.key] = p.real(k.key);
+  }
+  try {
+    return registry.build(name, args);
+  } catch (const InvalidParameter& e) {
+    // name the command's key, not the registry key it stands for
+    for (const auto& [command_key, registry_key] : aliases)
+      if (e.parameter() == registry_key && command_key != registry_key)
+        throw InvalidParameter(command_key, fmt::format("{} (given as {})", e.what(), command_key));
+    throw;
+  }
+}
+
+}  // namespace afmkit::cli

@@ -1,0 +1,26 @@
+#pragma once
+// The force-law parameters of every command, declared and read in one place from impact::LawRegistry
+// (docs/force-laws.md): `law`, `force_curve`, `allow_energy_gain` and every law parameter with its unit.
+#include <map>
+#include <string>
+
+#include "afmkit/impact/law_registry.hpp"
+#include "afmkit/io/params.hpp"
+
+namespace afmkit::cli {
+
+/// Keys that a command declares itself (other unit or default than the registry's) and maps onto registry keys:
+/// command key -> registry key. The command key's value (given or default) is passed whenever the chosen law
+/// reads the registry key.
+using LawKeyAliases = std::map<std::string, std::string>;
+
+/// Declares `law` (default `default_law`), `force_curve`, `allow_energy_gain` and every registry key not in
+/// `skip` (keys the command declares itself).
+void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& default_law,
+                    const std::vector<std::string>& skip = {});
+/// The law the parameters describe (InvalidParameter naming the key for a key of another law, a value out of
+/// range or an unknown law). `aliases`: command keys whose values stand for registry keys.
+impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistry& registry,
+                                 const LawKeyAliases& aliases = {});
+
+}  // namespace afmkit::cli
