@@ -118,6 +118,7 @@ void ForceLaw::refresh() {
   std::sort(switching_gaps_.begin(), switching_gaps_.end());
   switching_gaps_.erase(std::unique(switching_gaps_.begin(), switching_gaps_.end()), switching_gaps_.end());
   has_damping_ = model_->has_damping();
+  contact_gap_ = model_->contact_gap();
   scaled_linear_.reset();
   if (const auto* p = model_->piecewise_linear())
     scaled_linear_ = std::make_shared<PiecewiseLinearLaw>(p->approach_stiffness * scale_, p->departure_stiffness * scale_,

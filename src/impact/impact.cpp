@@ -79,10 +79,7 @@ double restitution_energy_loss(double m1, double m2, double relative_velocity, d
 
 namespace detail {
 
-double contact_gap_of(const ForceLaw& law) {
-  const auto& gaps = law.switching_gaps();
-  return gaps.empty() ? nan : gaps.back();
-}
+double contact_gap_of(const ForceLaw& law) { return law.contact_gap(); }
 
 SampleClock::SampleClock(double end_time, long points, std::vector<double> events)
     : end_time_(end_time), points_(points) {

@@ -43,11 +43,14 @@ class ImpactIntegrator {
     d_ref_ = problem.initial_gap();
     length_ = std::abs(d_ref_);
     for (double g : law_.switching_gaps()) length_ = std::max(length_, std::abs(g));
+    if (std::isfinite(law_.contact_gap())) length_ = std::max(length_, std::abs(law_.contact_gap()));
     if (!(length_ > 0)) length_ = 1.0;
     speed_ = -problem.initial_gap_rate();
     time_ = length_ / speed_;
     accel_scale_ = length_ / (speed_ * speed_);
     levels_ = law_.switching_gaps();
+    if (const double c = law_.contact_gap(); std::isfinite(c)) levels_.push_back(c);  // contact start/end events
+    std::sort(levels_.begin(), levels_.end());
     levels_.erase(std::unique(levels_.begin(), levels_.end()), levels_.end());
     max_time_ = options.max_time > 0 ? options.max_time : 1e9 * time_;
   }

@@ -17,10 +17,10 @@ namespace {
 constexpr double inf = std::numeric_limits<double>::infinity();
 
 LawKey positive(std::string key, std::string unit, double def, std::string help, std::string follows = {}) {
-  return {std::move(key), std::move(unit), def, std::move(help), 0.0, inf, true, std::move(follows)};
+  return {std::move(key), std::move(unit), def, std::move(help), 0.0, inf, true, std::move(follows), false, ""};
 }
 LawKey non_negative(std::string key, std::string unit, double def, std::string help, std::string follows = {}) {
-  return {std::move(key), std::move(unit), def, std::move(help), 0.0, inf, false, std::move(follows)};
+  return {std::move(key), std::move(unit), def, std::move(help), 0.0, inf, false, std::move(follows), false, ""};
 }
 
 std::string range_text(const LawKey& k) {

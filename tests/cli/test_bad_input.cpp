@@ -36,7 +36,11 @@ Page read_page() {
   const std::regex row_line(R"(^\| `(.+)` \| (\d+) \| `(.+)` \|$)");
   for (std::string line; std::getline(in, line);) {
     std::smatch m;
-    if (std::regex_match(line, m, file_line)) page.files.emplace_back(m[1], m[2]);
+    if (std::regex_match(line, m, file_line)) {
+      std::string content = m[2];  // "\n" in a fixture stands for a line break (multi-line files on one line)
+      for (std::size_t at; (at = content.find("\\n")) != std::string::npos;) content.replace(at, 2, "\n");
+      page.files.emplace_back(m[1], content);
+    }
     else if (std::regex_match(line, m, row_line)) page.rows.push_back({m[1], std::stoi(m[2]), m[3]});
   }
   return page;

@@ -495,3 +495,27 @@ TEST(TableLaw, HysteresisAreaOfASampledDmtCurve) {
   custom.switching_gaps = model->switching_gaps();
   EXPECT_NEAR(hysteresis_energy_loss(ForceLaw(custom), -5.0, -1.0), part, 1e-12 * part);
 }
+
+TEST(TableLaw, ContactGapIsTheBottomOfTheAdhesionWell) {
+  // DMT's approach force is most negative at the contact edge a0: a table through a0 puts its contact there
+  const afmkit::impact::DmtLaw dmt(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165);
+  afmkit::impact::ForceCurve c;
+  for (int i = 0; i <= 40; ++i) {
+    const double d = -1.835 + 0.05 * i;  // a0 = 0.165 is the 41st-but-one … sample: -1.835 + 0.05·40 = 0.165
+    c.approach_gap.push_back(d);
+    c.approach_force.push_back(dmt.approach(d));
+  }
+  for (int i = 1; i <= 20; ++i) {
+    c.approach_gap.push_back(0.165 + 0.25 * i);
+    c.approach_force.push_back(dmt.approach(0.165 + 0.25 * i));
+  }
+  c.retract_gap = c.approach_gap;
+  c.retract_force = c.approach_force;
+  const afmkit::impact::TableLaw law(c);
+  EXPECT_NEAR(law.contact_gap(), 0.165, 1e-12);
+  // purely repulsive: the largest distance with a positive force
+  afmkit::impact::ForceCurve r;
+  r.approach_gap = r.retract_gap = {-2.0, -1.0, 0.0, 1.0};
+  r.approach_force = r.retract_force = {4.0, 1.0, 0.0, 0.0};
+  EXPECT_EQ(afmkit::impact::TableLaw(r).contact_gap(), -1.0);
+}

@@ -3,6 +3,7 @@
 // converged orbits (drive work = viscous + contact dissipation, exact for a periodic orbit).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -10,9 +11,12 @@
 #include <vector>
 
 #include "afmkit/impact/law_registry.hpp"
+#include "afmkit/impact/laws/contact_laws.hpp"
+#include "afmkit/impact/laws/table_law.hpp"
 #include "afmkit/tapping/orbit.hpp"
 #include "afmkit/tapping/shooting.hpp"
 #include "afmkit/tapping/simulation.hpp"
+#include "afmkit/tapping/sweep.hpp"
 #include "afmkit/tapping/units.hpp"
 #include "reference_hybrid.hpp"
 
@@ -103,4 +107,38 @@ TEST(LawFidelity, EnergyBalanceOfConvergedOrbitsForEveryLaw) {
       else EXPECT_GT(m.contact_dissipation, 0.0);
     }
   }
+}
+
+TEST(LawFidelity, TableSampledFromDmtAt200PointsReproducesItsSweep) {
+  // the DMT + vdW law (with hysteresis) sampled at 200 gaps as a measured curve: the contact edge a0 is a
+  // sample, spacing quadratic in the penetration inside (F ~ δ^{3/2}) and geometric in d − a0 outside (F ~ 1/d²)
+  const impact::DmtLaw dmt(1.0, 0.8, 10.0, 6.4e-20, 1.0e-19, 0.165);
+  impact::ForceCurve curve;
+  curve.origin = "sampled dmt";
+  std::vector<double> gaps;
+  for (int k = 99; k >= 0; --k) gaps.push_back(0.165 - 3.0 * (k / 99.0) * (k / 99.0));  // −2.835 … a0
+  for (int k = 0; k < 100; ++k) gaps.push_back(0.165 + 1e-3 * std::pow(3e4, k / 99.0));  // … 30.2 nm
+  for (double d : gaps) {
+    curve.approach_gap.push_back(d);
+    curve.approach_force.push_back(dmt.approach(d));
+  }
+  curve.retract_gap = curve.approach_gap;
+  for (double d : curve.retract_gap) curve.retract_force.push_back(dmt.departure(d));
+  const tapping::PhysicalCantilever pc(40.0, 300.0, 400.0, 10.0, 1.0);
+  const auto analytic = tapping::TappingModel(pc.cantilever(), pc.drive(), pc.normalised_law(dmt), 9.0);
+  const auto table = tapping::TappingModel(pc.cantilever(), pc.drive(),
+                                           pc.normalised_law(impact::make_law<impact::TableLaw>(curve)), 9.0);
+  const auto a = tapping::sweep_instrument(analytic, 6.0, 9.5, 8, {});
+  const auto t = tapping::sweep_instrument(table, 6.0, 9.5, 8, {});
+  ASSERT_EQ(a.approach.size(), t.approach.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.approach.size(); ++i)
+    worst = std::max(worst, std::abs(t.approach[i].metrics.amplitude / a.approach[i].metrics.amplitude - 1.0));
+  std::printf("table vs analytic DMT sweep: max relative difference of B %.3g\n", worst);
+  for (std::size_t i = 0; i < a.approach.size(); ++i) {
+    SCOPED_TRACE(a.approach[i].separation);
+    EXPECT_NEAR(t.approach[i].metrics.amplitude, a.approach[i].metrics.amplitude, 1e-4 * a.approach[i].metrics.amplitude);
+  }
+  for (std::size_t i = 0; i < a.retract.size(); ++i)
+    EXPECT_NEAR(t.retract[i].metrics.amplitude, a.retract[i].metrics.amplitude, 1e-4 * a.retract[i].metrics.amplitude);
 }

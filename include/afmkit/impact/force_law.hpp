@@ -3,6 +3,7 @@
 //   H(d, ḋ) = H_a(d) while approaching (ḋ < 0), H_b(d) while departing (ḋ > 0), ½(H_a + H_b) at ḋ = 0.
 // Sign convention: H > 0 is repulsive (pushes the two bodies apart). d is the gap between the bodies.
 // In the tapping model (seed-1 eq. 8) d = x + l and h(x, ẋ) = −H(x + l, ẋ) (per unit mass).
+#include <algorithm>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -95,6 +96,12 @@ class ForceLawModel {
   virtual bool has_damping() const { return false; }
   /// Gaps at which a branch or c(d) is not smooth (any order; the ForceLaw sorts them).
   virtual std::vector<double> switching_gaps() const = 0;
+  /// The gap below which tip and sample count as in contact (contact time, penetration, impacts): by default
+  /// the lowest switching gap (0 for eqs. 10, 11, 26; a0 for DMT), NaN for a law without switching gaps.
+  virtual double contact_gap() const {
+    const auto g = switching_gaps();
+    return g.empty() ? std::numeric_limits<double>::quiet_NaN() : *std::min_element(g.begin(), g.end());
+  }
   /// Whether H_a and H_b may differ in region r (gaps between switching gap r−1 and r; region 0 lies below
   /// the lowest). Default: everywhere. A tighter answer saves velocity-zero guards.
   virtual bool branch_dependent(int /*region*/) const { return true; }
@@ -125,6 +132,8 @@ class ForceLaw {
   /// Gaps at which a branch is non-smooth (sorted, distinct); crossings are events for the integrators.
   const std::vector<double>& switching_gaps() const& { return switching_gaps_; }
   std::vector<double> switching_gaps() const&& { return switching_gaps_; }
+  /// The contact gap of the law (see ForceLawModel::contact_gap; NaN when the law has none).
+  double contact_gap() const { return contact_gap_; }
   /// Whether the branches may differ between switching gaps region−1 and region (see ForceLawModel).
   bool branch_dependent(int region) const { return model_->branch_dependent(region); }
   /// Non-null iff the law is piecewise linear (eqs. 10, 11, 26) — then the flow has a closed form.
@@ -149,6 +158,7 @@ class ForceLaw {
   double scale_ = 1.0;
   double damping_scale_ = 1.0;
   bool has_damping_ = false;
+  double contact_gap_ = 0.0;
   std::vector<double> switching_gaps_;
   std::shared_ptr<const PiecewiseLinearLaw> scaled_linear_;  // cached scaled copy for piecewise_linear()
   void refresh();

@@ -120,7 +120,7 @@ struct ImpactResult {
   double end_time = 0;         ///< t_f (gap back to d(t_s)); for a capture, the instant it was detected
   double reference_gap = 0;    ///< d(t_s) = d(t_f)
   double minimum_gap = 0;      ///< d(t̄)
-  double contact_gap = 0;      ///< largest switching gap of the law (0 piecewise-linear, a0 DMT); NaN if none
+  double contact_gap = 0;      ///< ForceLaw::contact_gap (0 piecewise-linear and Hertz, a0 DMT/LJ); NaN if none
   double max_penetration = 0;  ///< contact_gap − minimum_gap (NaN if the law has no switching gap)
   bool contact = false;        ///< the gap went below contact_gap (always true if the law has no switching gap)
   double contact_start = 0;    ///< first crossing of contact_gap (t_s if started inside); NaN without contact

@@ -22,7 +22,7 @@ struct OrbitMetrics {
   double offset = 0.0;     // A: mean of x
   double phase = 0.0;      // φ [rad] in (−π, π]
   std::array<double, 4> harmonics{};  // amplitudes of harmonics 2, 3, 4, 5 (|c_k|, same normalisation as B)
-  double contact_fraction = 0.0;  // fraction of time with x + l below the lowest switching gap
+  double contact_fraction = 0.0;  // fraction of time with x + l below the law's contact gap (ForceLaw::contact_gap)
   double peak_force = 0.0;        // max over the orbit of H (tip–sample force, positive = repulsive)
   double min_gap = 0.0;           // min over the orbit of x + l
   double drive_work = 0.0;            // per drive period

@@ -3,6 +3,7 @@
 // vector field of each mode, the guards that end a mode and the rules that pick the next mode at an event.
 //   ẍ = Γ cos(ωt) − 2ξω_n ẋ − ω_n² x − h_branch(x),   h_branch(x) = −H_branch(x + l)   (seed-1 eq. 8)
 #include <array>
+#include <cmath>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -25,8 +26,10 @@ class TappingSystem {
   /// Number of gap regions (switching gaps + 1). Region r: s_{r−1} ≤ gap < s_r.
   int region_count() const { return static_cast<int>(switching().size()) + 1; }
   int region_of(double gap) const;
-  /// Lowest switching gap (0 when the law has none): x + l below it counts as contact.
-  double contact_gap() const { return switching().empty() ? 0.0 : switching().front(); }
+  /// The law's contact gap (0 when it has none): x + l below it counts as contact.
+  double contact_gap() const { return std::isnan(model_.law.contact_gap()) ? 0.0 : model_.law.contact_gap(); }
+  /// Whether the contact gap is a switching gap, i.e. the contact region is region 0 exactly.
+  bool contact_is_region_zero() const { return !switching().empty() && switching().front() == contact_gap(); }
   /// Whether approach and departure branches differ in `region` (else no velocity guard there).
   bool branch_dependent(int region) const {
     return region < 64 ? ((dependent_mask_ >> region) & 1u) != 0 : model_.law.branch_dependent(region);

@@ -650,4 +650,14 @@ void TableLaw::require_dissipative() const {
   }
 }
 
+double TableLaw::contact_gap() const {
+  const auto& d = curve_.approach_gap;
+  const auto& f = curve_.approach_force;
+  const auto lowest = std::min_element(f.begin(), f.end());
+  if (*lowest < 0) return d[static_cast<std::size_t>(lowest - f.begin())];
+  for (std::size_t i = f.size(); i-- > 0;)
+    if (f[i] > 0) return d[i];
+  return d.front();
+}
+
 }  // namespace afmkit::impact

@@ -50,7 +50,8 @@ void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segm
   if (!(t1 > t0)) return;
   const Mode mode = segment.mode();
   const double omega = system.model().drive.frequency;
-  const bool in_contact_region = mode.region == 0 && system.region_count() > 1;
+  const bool exact_contact = system.contact_is_region_zero();  // else: counted at the quadrature nodes
+  const bool in_contact_region = exact_contact && mode.region == 0;
   duration += t1 - t0;
   if (in_contact_region) contact_time += t1 - t0;
   const int panels = std::max(1, static_cast<int>(std::ceil((t1 - t0) / max_panel_)));
@@ -68,7 +69,7 @@ void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segm
     drive_work += w * system.drive(t) * v;
     viscous_dissipation += w * system.damping() * v * v;
     contact_dissipation += w * h * v;
-    if (system.region_count() == 1 && system.gap(x) < 0) contact_time += w;
+    if (!exact_contact && system.gap(x) < system.contact_gap()) contact_time += w;
     peak_force = std::max(peak_force, 0.0 - system.interaction(mode.branch, x, v, mode.region));
     min_gap = std::min(min_gap, system.gap(x));
   };

@@ -69,6 +69,7 @@ class LennardJonesLaw final : public ForceLawModel {
   double approach(double gap) const override;
   double departure(double gap) const override { return approach(gap); }
   std::vector<double> switching_gaps() const override { return {0.5 * a0_}; }
+  double contact_gap() const override { return a0_; }  // where the force turns repulsive
   bool branch_dependent(int) const override { return false; }
   double hysteresis_area(double, double) const override { return 0.0; }
 

