@@ -164,4 +164,10 @@ class ForceLaw {
   void refresh();
 };
 
+/// A ForceLaw from a ForceLawModel type and its constructor arguments: make_law<HertzLaw>(1.0, 0.8, 10.0).
+template <class Model, class... Args>
+ForceLaw make_law(Args&&... args) {
+  return ForceLaw(std::make_shared<const Model>(std::forward<Args>(args)...));
+}
+
 }  // namespace afmkit::impact

@@ -11,12 +11,6 @@
 
 namespace afmkit::impact {
 
-/// A ForceLaw from a model type and its constructor arguments.
-template <class Model, class... Args>
-ForceLaw make_law(Args&&... args) {
-  return ForceLaw(std::make_shared<const Model>(std::forward<Args>(args)...));
-}
-
 /// Hertz contact without attraction:  H(d) = (4/3) E* √R (−d)^{3/2} for d < 0, 0 for d ≥ 0.
 /// Approach and departure moduli may differ (dissipative iff E*_b ≤ E*_a).
 class HertzLaw final : public ForceLawModel {
