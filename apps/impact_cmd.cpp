@@ -2,8 +2,8 @@
 // Prints a summary (or the result as JSON with --json); --output FILE writes the time history as CSV
 // (t, gap, gap_rate, force, x1, v1, x2, v2) with a JSON sidecar holding the parameters and the summary.
 //
-// Units: any consistent set for the piecewise-linear laws. For law = dmt the force law is in nN for gaps in
-// nm (E* in GPa, R in nm, Hamaker in J); then masses in kg and speeds in nm/s give times in s
+// Units: any consistent set for the piecewise-linear laws. The other laws (docs/force-laws.md) are in nN for gaps
+// in nm (E* in GPa, R in nm, Hamaker in J); then masses in kg and speeds in nm/s give times in s
 // (1 nN / 1 kg = 1 nm/s²) and energies in nN·nm (1e-18 J).
 #include <cmath>
 #include <filesystem>
@@ -31,15 +31,15 @@ using io::Range;
 const char* const history_columns[] = {"t", "gap", "gap_rate", "force", "x1", "v1", "x2", "v2"};
 
 void add_impact_params(io::ParamSet& p) {
-  p.real("mass1", 1.0, "mass m1 of the lower body (kg for law = dmt)", Range::positive())
-      .real("mass2", 1.0, "mass m2 of the upper body (kg for law = dmt)", Range::positive())
+  p.real("mass1", 1.0, "mass m1 of the lower body (kg for the physical laws, docs/force-laws.md)", Range::positive())
+      .real("mass2", 1.0, "mass m2 of the upper body (kg for the physical laws, docs/force-laws.md)", Range::positive())
       .real("velocity", 1.0,
-            "relative approach speed -(v2 - v1) > 0, centre of mass at rest (nm/s for law = dmt); or give v1, v2",
+            "relative approach speed -(v2 - v1) > 0, centre of mass at rest (nm/s for the physical laws); or give v1, v2",
             Range::positive())
       .real("v1", 0.0, "initial velocity of body 1 (instead of velocity; needs v2 - v1 < 0)", Range::any())
       .real("v2", 0.0, "initial velocity of body 2 (instead of velocity)", Range::any())
-      .real("gap", 1.0, "initial gap d(t_s) = x2 - x1 (nm for law = dmt); contact for d < 0 (a0 for dmt)", Range::any())
-      .real("force1", 0.0, "constant external force F1 on body 1 (seed-1 eq. 1; nN for dmt)", Range::any())
+      .real("gap", 1.0, "initial gap d(t_s) = x2 - x1 (nm for the physical laws); contact below the law's contact gap (0, or a0)", Range::any())
+      .real("force1", 0.0, "constant external force F1 on body 1 (seed-1 eq. 1; nN for the physical laws)", Range::any())
       .real("force2", 0.0, "constant external force F2 on body 2", Range::any())
       .text("method", "automatic", "solver: automatic (closed form for linear laws), closed_form, integrator",
             {"automatic", "closed_form", "integrator"})
