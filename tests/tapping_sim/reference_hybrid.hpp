@@ -69,10 +69,14 @@ class ReferenceHybrid {
   double lo(int r) const { return r == 0 ? -INFINITY : gaps_[r - 1]; }
   double hi(int r) const { return r == static_cast<int>(gaps_.size()) ? INFINITY : gaps_[r]; }
   int region(double d) const { return static_cast<int>(std::upper_bound(gaps_.begin(), gaps_.end(), d) - gaps_.begin()); }
+  // whether the branches differ somewhere in region r (sampled; an unbounded side is sampled over 50 nm)
   bool differs(int r) const {
-    const double a = r == 0 ? gaps_.front() - 1.0 : (r == static_cast<int>(gaps_.size()) ? gaps_.back() + 1.0
-                                                                                         : 0.5 * (lo(r) + hi(r)));
-    return m_.law.approach(a) != m_.law.departure(a);
+    const double a = std::isfinite(lo(r)) ? lo(r) : hi(r) - 50.0, b = std::isfinite(hi(r)) ? hi(r) : lo(r) + 50.0;
+    for (int i = 1; i < 2000; ++i) {
+      const double d = a + (b - a) * i / 2000.0;
+      if (m_.law.approach(d) != m_.law.departure(d)) return true;
+    }
+    return false;
   }
 
   double accel(const Mode& mode, double t, double x, double v) const {
