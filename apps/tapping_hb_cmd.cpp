@@ -1,6 +1,6 @@
-// afmkit tapping hb: the harmonic-balance separation–amplitude curve (seed-1 eqs. 18–19, 32–33, MATH.md A.7)
-// sampled over the penetration parameter q, as CSV (q, separation, amplitude, offset, phase, branch) with a
-// JSON sidecar holding the folds (jump points), the free amplitude and the solutions at `separation`.
+// afmkit tapping hb: the harmonic-balance separation–amplitude curve (seed-1 eqs. 18–19, 32–33, MATH.md A.7; any
+// force law, issue 7.2) sampled over the penetration parameter q, as CSV (q, separation, amplitude, offset, phase,
+// branch) with a JSON sidecar holding the folds (jump points), the free amplitude and the solutions at `separation`.
 #include <memory>
 #include <string>
 
@@ -67,8 +67,10 @@ void run_hb(const io::ParamSet& p) {
                             {"free_amplitude", hb.free_amplitude() * scales.length},
                             {"solutions_at_separation", solutions},
                             {"rows", table.size()}};
-  if (const auto limit = tapping::minimum_separation_limit(model))
-    results["minimum_separation_limit"] = *limit * scales.length;  // ext. E8 (−∞ written as null)
+  if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
+    if (const auto limit = tapping::minimum_separation_limit(model))
+      results["minimum_separation_limit"] = *limit * scales.length;  // (−∞ written as null)
+  }
   table.commit(io::make_sidecar("tapping hb", p.to_json(), results));
   fmt::print("wrote {} rows to {} ({} fold(s), {} solution(s) at separation {})\n", table.size(), output,
              folds.size(), solutions.size(), p.real("separation"));
@@ -89,7 +91,8 @@ void register_tapping_hb(CLI::App& tapping) {
       .flag("minus_branch", true, "also write the '-' root of the quadratic (MATH.md E2) where it exists")
       .text("output", "out/tapping_hb.csv", "output CSV path (JSON sidecar written next to it)");
   auto* cmd = tapping.add_subcommand(
-      "hb", "harmonic-balance separation-amplitude curve over q (piecewise-linear laws), with folds (jump points)");
+      "hb", "harmonic-balance separation-amplitude curve over q (closed form for piecewise-linear laws, numerical "
+            "describing functions for the others), with folds (jump points)");
   params->add_options(*cmd);
   cmd->callback([params] {
     params->resolve();

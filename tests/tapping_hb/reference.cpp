@@ -6,38 +6,73 @@
 
 #include <Eigen/Dense>
 #include <boost/math/quadrature/gauss_kronrod.hpp>
+#include <boost/math/quadrature/tanh_sinh.hpp>
 
 namespace afmkit::tapping::test {
 
 namespace {
 constexpr double pi = std::numbers::pi;
 
+// Piecewise-linear pieces are polynomial in cos θ: GK31 is exact to rounding at depth 0–1 (depth 3 caps the work
+// when 1e-14 is below the rounding of a large integrand); other laws get a deeper bisection.
 template <class F>
-double integrate(F f, double a, double b) {
-  return boost::math::quadrature::gauss_kronrod<double, 31>::integrate(f, a, b, 3, 1e-14);  // pieces are smooth: GK31 is exact to rounding at depth 0–1
+double integrate(F f, double a, double b, unsigned depth = 3) {
+  return boost::math::quadrature::gauss_kronrod<double, 31>::integrate(f, a, b, depth, 1e-14);
 }
 }  // namespace
 
-QuadratureDf quadrature_df(const TappingModel& model, double offset, double amplitude) {
-  const double q = (offset + model.separation) / amplitude;
+// Angles in (0, 2π) where g + B cos θ crosses a switching gap of the law, found by bisection (independent of the
+// library's closed-form switching angles).
+std::vector<double> switching_cuts(const impact::ForceLaw& law, double g, double b) {
   std::vector<double> cuts{0.0, pi, 2.0 * pi};
-  if (std::abs(q) < 1.0) {
-    const double a = std::acos(q);
-    cuts.push_back(pi - a);
-    cuts.push_back(pi + a);
+  for (const double s : law.switching_gaps()) {
+    if (!(s > g - b && s < g + b)) continue;
+    double lo = 0.0, hi = pi;  // d(θ) decreasing on [0, π]
+    for (int it = 0; it < 200 && hi - lo > 0.0; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      if (mid == lo || mid == hi) break;
+      (g + b * std::cos(mid) > s ? lo : hi) = mid;
+    }
+    const double t = 0.5 * (lo + hi);
+    cuts.push_back(t);
+    cuts.push_back(2.0 * pi - t);
   }
   std::sort(cuts.begin(), cuts.end());
+  return cuts;
+}
+
+QuadratureDf quadrature_df(const TappingModel& model, double offset, double amplitude) {
+  const std::vector<double> cuts = switching_cuts(model.law, offset + model.separation, amplitude);
   auto h = [&](double theta) {
     const double x = offset + amplitude * std::cos(theta);
     const double velocity = -amplitude * model.drive.frequency * std::sin(theta);
     return model.interaction(x, velocity);
   };
+  const unsigned depth = model.law.piecewise_linear() != nullptr ? 3 : 15;
   double m = 0, c = 0, s = 0;
   for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
     if (cuts[k + 1] <= cuts[k]) continue;
-    m += integrate(h, cuts[k], cuts[k + 1]);
-    c += integrate([&](double t) { return h(t) * std::cos(t); }, cuts[k], cuts[k + 1]);
-    s += integrate([&](double t) { return h(t) * std::sin(t); }, cuts[k], cuts[k + 1]);
+    m += integrate(h, cuts[k], cuts[k + 1], depth);
+    c += integrate([&](double t) { return h(t) * std::cos(t); }, cuts[k], cuts[k + 1], depth);
+    s += integrate([&](double t) { return h(t) * std::sin(t); }, cuts[k], cuts[k + 1], depth);
+  }
+  return {m / (2.0 * pi), std::complex<double>(c, -s) / (pi * amplitude)};
+}
+
+QuadratureDf tanh_sinh_df(const impact::ForceLaw& law, double mean_gap, double amplitude, double frequency) {
+  const std::vector<double> cuts = switching_cuts(law, mean_gap, amplitude);
+  auto h = [&](double theta) {
+    return -law.force(mean_gap + amplitude * std::cos(theta), -amplitude * frequency * std::sin(theta));
+  };
+  static thread_local boost::math::quadrature::tanh_sinh<double> ts(15);
+  double m = 0, c = 0, s = 0;
+  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double a = cuts[k], b = cuts[k + 1];
+    if (!(b > a)) continue;
+    // on the open interval (a, b): the rate never vanishes inside a piece, so the branch is the piece's own
+    m += ts.integrate(h, a, b, 1e-15);
+    c += ts.integrate([&](double t) { return h(t) * std::cos(t); }, a, b, 1e-15);
+    s += ts.integrate([&](double t) { return h(t) * std::sin(t); }, a, b, 1e-15);
   }
   return {m / (2.0 * pi), std::complex<double>(c, -s) / (pi * amplitude)};
 }

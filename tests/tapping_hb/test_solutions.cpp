@@ -129,9 +129,19 @@ TEST(Solutions, CountMatchesIndependentDenseScan) {
 TEST(Solutions, BadInput) {
   const HarmonicBalance hb(example(1.0));
   EXPECT_THROW(hb.solutions(std::nan("")), InvalidParameter);
+  // any other law has harmonic balance too (test_general_hb.cpp), but no closed-form coefficients
   const TappingModel dmt(Cantilever(1.0, 100.0), Drive(0.2, 1.0),
                          impact::ForceLaw(impact::DmtLaw(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165)), 3.0);
-  EXPECT_THROW(HarmonicBalance{dmt}, InvalidParameter);
+  const HarmonicBalance general(dmt);
+  EXPECT_FALSE(general.closed_form());
+  EXPECT_TRUE(hb.closed_form());
+  try {
+    (void)general.coefficients();
+    FAIL() << "expected InvalidParameter";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "law");
+  }
+  EXPECT_THROW(general.solutions(std::nan("")), InvalidParameter);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #pragma once
-// Describing functions of the piecewise-linear hysteresis law (seed-1 eqs. 12–15, 26–31; MATH.md A.3, A.6).
+// Describing functions of the piecewise-linear hysteresis law (seed-1 eqs. 12–15, 26–31; MATH.md A.3, A.6) —
+// the closed-form fast path; any other law: numerical_describing_functions.hpp (the ForceLaw overloads dispatch).
 //
 // Ansatz x(t) = A + B cos ωt (B > 0) with penetration parameter q = (A + l)/B (eq. 15):
 //   N0·A = ⟨h⟩ = Σ_F χ̄(q) − Σ_K Ω̄(q) B                                   (eq. 29, the mean of h)
@@ -63,11 +64,16 @@ struct DescribingFunctions {
 
 /// q finite, amplitude B > 0 (finite) -> else InvalidParameter("q" / "amplitude").
 DescribingFunctions describing_functions(const impact::PiecewiseLinearLaw& law, double q, double amplitude);
-/// Same for a ForceLaw; InvalidParameter("law", …) unless law.piecewise_linear() is non-null.
+/// Same for any ForceLaw: the closed forms when law.piecewise_linear() is non-null, else adaptive quadrature
+/// (numerical_describing_functions.hpp, mean gap qB). A law with a velocity term (has_damping) needs the drive
+/// frequency: InvalidParameter("frequency") here — use the overload with frequency.
 DescribingFunctions describing_functions(const impact::ForceLaw& law, double q, double amplitude);
 /// Same, from the ansatz x = A + B cos ωt and the separation l: q = (A + l)/B.
 DescribingFunctions describing_functions(const impact::ForceLaw& law, double offset, double amplitude,
                                          double separation);
+/// Same at drive frequency ω > 0 (enters only through the velocity term of a law with damping).
+DescribingFunctions describing_functions(const impact::ForceLaw& law, double offset, double amplitude,
+                                         double separation, double frequency);
 
 /// The piecewise-linear coefficients of a ForceLaw, or InvalidParameter("law", …) if it is not piecewise linear.
 const impact::PiecewiseLinearLaw& require_piecewise_linear(const impact::ForceLaw& law);

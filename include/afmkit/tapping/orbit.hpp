@@ -43,7 +43,7 @@ const char* orbit_source_name(OrbitSource source);
 
 /// Kinds of starting point of the orbit search.
 enum class SeedKind {
-  harmonic_balance,  // Newton from an HB solution (piecewise-linear laws)
+  harmonic_balance,  // Newton from an HB solution (any law: closed forms or numerical describing functions)
   transient,         // full transient (settle): from each HB contact solution, the free response and rest
   grid,              // phase × amplitude grid: Newton from the state, and after short transients
   contact,           // states in contact (at the contact edge, penetrating, moving in or out or at rest)
@@ -82,7 +82,7 @@ struct FoundOrbit {
 struct OrbitSearchOptions {
   ShootingOptions shooting;
   TransientOptions transient;
-  bool from_harmonic_balance = true;  // shoot from each HB solution (piecewise-linear laws only)
+  bool from_harmonic_balance = true;  // shoot from each HB solution
   bool from_transient = true;         // full transients from each HB contact solution, the free response, rest
   bool from_grid = true;              // grid and contact seeds
   bool from_continuation = true;      // continue every period-1 orbit found through the bracket around l
@@ -102,7 +102,7 @@ struct OrbitSearchOptions {
 };
 
 struct OrbitSearchResult {
-  std::vector<HbPoint> harmonic_balance;  // every HB solution (empty for non piecewise-linear laws)
+  std::vector<HbPoint> harmonic_balance;  // every HB solution at the separation
   std::vector<FoundOrbit> orbits;         // distinct orbits, by increasing amplitude
   std::vector<TransientOutcome> transients;  // what each full transient settled to (incl. non-periodic)
   OrbitSearchReport report;               // how the search went

@@ -15,7 +15,7 @@
 //
 // sweep_grid: independent points (all orbits at each l, via find_orbits), in parallel (OpenMP).
 //
-// Each point carries the harmonic-balance value nearest to it (piecewise-linear laws; NaN otherwise).
+// Each point carries the harmonic-balance value nearest to it (NaN where HB has no solution).
 #include <functional>
 #include <limits>
 #include <optional>
@@ -31,7 +31,7 @@ const char* direction_name(SweepDirection direction);  // "approach", "retract",
 struct SweepOptions {
   ShootingOptions shooting;
   TransientOptions transient;
-  bool harmonic_balance = true;  // put the nearest HB solution beside each point (piecewise-linear laws)
+  bool harmonic_balance = true;  // put the nearest HB solution beside each point (any law)
   /// Sub-step budget of follow_branch per separation step (halving / doubling the step in l).
   int max_substeps = 200;
   bool parallel = true;  // OpenMP where points are independent (HB evaluation, grid sweeps, both directions)
@@ -88,7 +88,8 @@ std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::v
                                           const OrbitSearchOptions& options = {},
                                           const std::function<void(long)>& progress = {});
 
-/// Fill the hb_* fields of `point` with the HB solution nearest in amplitude at point.separation.
+/// Fill the hb_* fields of `point` with the HB solution nearest in amplitude at point.separation (any law; for
+/// laws without closed forms each call traces the HB curve, ~10 ms: sweeps use one HarmonicBalance instead).
 void attach_harmonic_balance(const TappingModel& base, SweepPoint& point);
 
 }  // namespace afmkit::tapping

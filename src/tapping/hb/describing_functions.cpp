@@ -7,6 +7,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
+#include "afmkit/tapping/numerical_describing_functions.hpp"
 
 namespace afmkit::tapping {
 
@@ -145,7 +146,16 @@ const impact::PiecewiseLinearLaw& require_piecewise_linear(const impact::ForceLa
 }
 
 DescribingFunctions describing_functions(const impact::ForceLaw& law, double q, double amplitude) {
-  return describing_functions(require_piecewise_linear(law), q, amplitude);
+  if (const impact::PiecewiseLinearLaw* linear = law.piecewise_linear())
+    return describing_functions(*linear, q, amplitude);  // closed form (fast path)
+  if (!std::isfinite(q)) validate::finite("q", q);
+  if (!(amplitude > 0.0 && std::isfinite(amplitude))) validate::positive("amplitude", amplitude);
+  if (law.has_damping())
+    throw InvalidParameter("frequency", fmt::format("law = {} has a velocity (Kelvin–Voigt) term: its describing "
+                                                    "functions depend on the drive frequency; use the overload "
+                                                    "with the frequency",
+                                                    law.name()));
+  return DescribingFunctionQuadrature(law, 1.0).at_gap(q * amplitude, amplitude);  // (ω irrelevant)
 }
 
 DescribingFunctions describing_functions(const impact::ForceLaw& law, double offset, double amplitude,
@@ -154,6 +164,17 @@ DescribingFunctions describing_functions(const impact::ForceLaw& law, double off
   validate::positive("amplitude", amplitude);
   validate::finite("separation", separation);
   return describing_functions(law, (offset + separation) / amplitude, amplitude);
+}
+
+DescribingFunctions describing_functions(const impact::ForceLaw& law, double offset, double amplitude,
+                                         double separation, double frequency) {
+  validate::finite("offset", offset);
+  validate::positive("amplitude", amplitude);
+  validate::finite("separation", separation);
+  validate::positive("frequency", frequency);
+  if (const impact::PiecewiseLinearLaw* linear = law.piecewise_linear())
+    return describing_functions(*linear, (offset + separation) / amplitude, amplitude);
+  return DescribingFunctionQuadrature(law, frequency).at_gap(offset + separation, amplitude);
 }
 
 }  // namespace afmkit::tapping

@@ -12,6 +12,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
+#include "general_harmonic_balance.hpp"
 
 namespace afmkit::tapping {
 
@@ -97,14 +98,46 @@ const char* branch_name(HbBranch branch) {
 }
 
 HbBranchEvaluation HarmonicBalance::evaluate(const Node& like, double parameter, int sign) const {
-  return like.permanent ? evaluate_branch_permanent(coefficients_, parameter, sign)
-                        : evaluate_branch_at_angle(coefficients_, parameter, sign);
+  return like.permanent ? evaluate_branch_permanent(*coefficients_, parameter, sign)
+                        : evaluate_branch_at_angle(*coefficients_, parameter, sign);
 }
 
-HarmonicBalance::HarmonicBalance(const TappingModel& model) : coefficients_(model) {
+HarmonicBalance::HarmonicBalance(const TappingModel& model) : free_amplitude_(model.free_amplitude()) {
+  if (model.law.piecewise_linear() == nullptr) {
+    general_ = std::make_shared<const detail::GeneralHarmonicBalance>(model);
+    folds_ = general_->folds();
+    free_amplitude_ = general_->free_amplitude();
+    return;
+  }
+  coefficients_.emplace(model);
+  free_amplitude_ = coefficients_->free_amplitude();
   scan_branch(+1);
   scan_branch(-1);
   std::sort(folds_.begin(), folds_.end(), [](const HbFold& a, const HbFold& b) { return a.point.q < b.point.q; });
+}
+
+const HbCoefficients& HarmonicBalance::coefficients() const& {
+  if (!coefficients_) require_piecewise_linear_model();
+  return *coefficients_;
+}
+
+HbCoefficients HarmonicBalance::coefficients() const&& {
+  if (!coefficients_) require_piecewise_linear_model();
+  return *coefficients_;
+}
+
+void HarmonicBalance::require_piecewise_linear_model() const {
+  throw InvalidParameter("law", "harmonic balance: the closed-form coefficients exist only for the piecewise-linear "
+                                "laws of seed-1 eqs. (10), (11), (26)");
+}
+
+std::vector<HbPoint> HarmonicBalance::points_at_q(double q) const {
+  if (general_) return general_->points_at_q(q);
+  std::vector<HbPoint> out;
+  for (const HbBranch b : {HbBranch::Minus, HbBranch::Plus})
+    if (const auto p = point_at_q(*coefficients_, q, b)) out.push_back(*p);
+  std::sort(out.begin(), out.end(), [](const HbPoint& a, const HbPoint& b) { return a.amplitude < b.amplitude; });
+  return out;
 }
 
 void HarmonicBalance::scan_branch(int sign) {
@@ -195,10 +228,11 @@ void HarmonicBalance::scan_branch(int sign) {
 }
 
 std::vector<HbPoint> HarmonicBalance::solutions(double separation) const {
+  if (general_) return general_->solutions(separation);
   validate::finite("separation", separation);
   std::vector<HbPoint> out;
-  const double b_free = coefficients_.free_amplitude();
-  if (separation >= b_free) out.push_back(free_point(coefficients_, separation / b_free));
+  const double b_free = coefficients_->free_amplitude();
+  if (separation >= b_free) out.push_back(free_point(*coefficients_, separation / b_free));
   for (const int sign : {+1, -1}) {
     for (const Run& run : runs_[sign > 0 ? 0 : 1]) {
       auto add = [&](const Node& like, double p) {
@@ -237,7 +271,15 @@ std::vector<HbPoint> HarmonicBalance::solutions(double separation) const {
 }
 
 std::optional<HbPoint> HarmonicBalance::at_q(double q, HbBranch branch) const {
-  return point_at_q(coefficients_, q, branch);
+  if (!general_) return point_at_q(*coefficients_, q, branch);
+  std::optional<HbPoint> best;
+  for (const HbPoint& p : general_->points_at_q(q)) {  // by increasing amplitude: the last match is the largest
+    const bool match = branch == HbBranch::Minus  ? p.branch == HbBranch::Minus
+                       : branch == HbBranch::Free ? p.branch == HbBranch::Free
+                                                  : p.branch != HbBranch::Minus;
+    if (match) best = p;
+  }
+  return best;
 }
 
 std::vector<HbPoint> harmonic_balance_solutions(const TappingModel& model) {
@@ -245,6 +287,10 @@ std::vector<HbPoint> harmonic_balance_solutions(const TappingModel& model) {
 }
 
 std::optional<HbPoint> harmonic_balance_at_q(const TappingModel& model, double q, HbBranch branch) {
+  if (model.law.piecewise_linear() == nullptr) {
+    validate::finite("q", q);
+    return HarmonicBalance(model).at_q(q, branch);
+  }
   return point_at_q(HbCoefficients(model), q, branch);
 }
 

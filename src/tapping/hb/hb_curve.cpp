@@ -4,6 +4,7 @@
 
 #include "afmkit/core/validate.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
+#include "general_harmonic_balance.hpp"
 
 namespace afmkit::tapping {
 
@@ -57,10 +58,26 @@ HbPoint to_point(const HbBranchEvaluation& e, HbBranch branch) {
   return {e.q, e.separation, e.amplitude, e.offset, e.phase, branch};
 }
 
+// Any other law: every point at each sample from the traced curve (general_harmonic_balance.hpp).
+void general_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out) {
+  std::vector<double> qs;
+  qs.reserve(options.points);
+  for_each_sample(options, [&](double q, double) { qs.push_back(q); });
+  const detail::GeneralHarmonicBalance hb(model);
+  std::vector<HbPoint> lower;
+  out.clear();
+  hb.sample(qs, options.include_minus, out, lower);
+  out.insert(out.end(), lower.begin(), lower.end());
+}
+
 }  // namespace
 
 void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out) {
   validate_options(options);
+  if (model.law.piecewise_linear() == nullptr) {
+    general_curve(model, options, out);
+    return;
+  }
   const HbCoefficients c(model);
   const std::size_t n = options.points;
   // One pass: Plus/Free points fill out[0, …), Minus points out[n, …); then the Minus block is moved down.

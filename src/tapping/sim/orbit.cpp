@@ -239,7 +239,7 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
   std::vector<Task> tasks;
   const double omega = model.drive.frequency, l = model.separation;
   const double free_amplitude = model.free_amplitude();
-  if (options.from_harmonic_balance && model.law.piecewise_linear()) {
+  if (options.from_harmonic_balance) {  // any law (closed form for piecewise-linear ones)
     out.harmonic_balance = harmonic_balance_solutions(model);
     for (const HbPoint& p : out.harmonic_balance) {
       // x ≈ A + B cos(ωt − φ): x(0) = A + B cos φ, ẋ(0) = Bω sin φ

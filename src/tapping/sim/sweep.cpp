@@ -47,7 +47,6 @@ void attach_from(const std::vector<HbPoint>& solutions, SweepPoint& point) {
 }  // namespace
 
 void attach_harmonic_balance(const TappingModel& base, SweepPoint& point) {
-  if (!base.law.piecewise_linear()) return;
   attach_from(harmonic_balance_solutions(base.with_separation(point.separation)), point);
 }
 
@@ -223,7 +222,7 @@ namespace detail {
 void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
                    bool harmonic_balance, bool parallel) {
   std::optional<HarmonicBalance> hb;  // branch scan once, cheap queries
-  if (harmonic_balance && base.law.piecewise_linear()) hb.emplace(base);
+  if (harmonic_balance) hb.emplace(base);  // any law (closed form for piecewise-linear ones)
   std::exception_ptr error;
 #pragma omp parallel for schedule(dynamic) if (parallel)
   for (std::size_t i = 0; i < points.size(); ++i) {
