@@ -141,6 +141,15 @@ bool secant(F f, double f0, double& slope, double limit, double& root, int& iter
   return false;
 }
 
+// (tu, tv) scaled to unit length (left as is when zero).
+void normalise(double& tu, double& tv) {
+  const double n = std::hypot(tu, tv);
+  if (n > 0.0) {
+    tu /= n;
+    tv /= n;
+  }
+}
+
 // Tangent at x2 from three consecutive points (quadratic through them, non-uniform spacing), normalised.
 void three_point_tangent(double u0, double v0, double u1, double v1, double u2, double v2, double& tu, double& tv) {
   const double s1 = std::hypot(u1 - u0, v1 - v0), s2 = std::hypot(u2 - u1, v2 - v1);
@@ -152,11 +161,7 @@ void three_point_tangent(double u0, double v0, double u1, double v1, double u2, 
     tu = a * u0 + b * u1 + c * u2;
     tv = a * v0 + b * v1 + c * v2;
   }
-  const double n = std::hypot(tu, tv);
-  if (n > 0.0) {
-    tu /= n;
-    tv /= n;
-  }
+  normalise(tu, tv);
 }
 // Central tangent at x1 from its two neighbours (quadratic through the three points), normalised.
 void central_tangent(double u0, double v0, double u1, double v1, double u2, double v2, double& tu, double& tv) {
@@ -165,11 +170,7 @@ void central_tangent(double u0, double v0, double u1, double v1, double u2, doub
   const double a = -s2 / (s1 * (s1 + s2)), b = (s2 - s1) / (s1 * s2), c = s1 / (s2 * (s1 + s2));
   tu = a * u0 + b * u1 + c * u2;
   tv = a * v0 + b * v1 + c * v2;
-  const double n = std::hypot(tu, tv);
-  if (n > 0.0) {
-    tu /= n;
-    tv /= n;
-  }
+  normalise(tu, tv);
 }
 
 }  // namespace
