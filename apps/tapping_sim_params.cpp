@@ -4,8 +4,8 @@ namespace afmkit::cli {
 
 void add_tapping_sim_params(io::ParamSet& p) {
   p.text("integrator", "automatic",
-         "time integration: closed_form (exact, piecewise-linear laws), adaptive (Dormand-Prince 5(4) with event "
-         "location, any law) or automatic",
+         "time integration: closed_form (exact, piecewise-linear laws), adaptive (DOP853, order 8, events located on "
+         "its dense output; any law) or automatic",
          {"automatic", "closed_form", "adaptive"})
       .real("relative_tolerance", 1e-10, "adaptive integrator relative tolerance", {0.0, 1.0, true, true})
       .real("absolute_tolerance", 1e-12, "adaptive integrator absolute tolerance (model length units)",

@@ -1,8 +1,12 @@
 // Speed of the tapping model with the open force laws (docs/force-laws.md), in the physical case users compare
 // with pyDAMPF: k = 40 N/m, f0 = 300 kHz, Q = 400, free amplitude 10 nm at resonance, R = 10 nm, E* = 1 GPa,
 // A_H = 6.4e-20 J, a0 = 0.165 nm. Targets (issue 7): one converged orbit with a table law at Q = 400 ≤ 5 ms;
-// a DMT + vdW approach sweep ≤ 0.5 ms per separation point at amplitude accuracy 1e-8.
+// a DMT + vdW approach sweep ≤ 0.5 ms per separation point at amplitude accuracy 1e-8 (counter amplitude_error:
+// the largest relative amplitude error of the sweep against the same sweep at tolerance 1e-13).
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -59,15 +63,38 @@ void BM_ConvergedOrbit(benchmark::State& state, bool table) {
 BENCHMARK_CAPTURE(BM_ConvergedOrbit, dmt, false)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ConvergedOrbit, table, true)->Unit(benchmark::kMillisecond);
 
+SweepOptions sweep_options(double tolerance) {
+  SweepOptions o;
+  o.parallel = false;
+  o.harmonic_balance = false;
+  o.shooting.tolerance = tolerance;
+  o.shooting.simulation.relative_tolerance = tolerance;
+  o.shooting.simulation.absolute_tolerance = 0.1 * tolerance;
+  return o;
+}
+
+double max_relative_amplitude_error(const SweepResult& r, const SweepResult& reference) {
+  double worst = 0.0;
+  auto compare = [&](const std::vector<SweepPoint>& a, const std::vector<SweepPoint>& b) {
+    if (a.size() != b.size()) worst = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i)
+      worst = std::max(worst, std::abs(a[i].metrics.amplitude / b[i].metrics.amplitude - 1.0));
+  };
+  compare(r.approach, reference.approach);
+  compare(r.retract, reference.retract);
+  return worst;
+}
+
+// Approach and retract over l = 2…10 nm, 50 points each way; state.range(1) = −log10 of the integrator and
+// Newton tolerance. The amplitude accuracy is measured against the same sweep at tolerance 1e-13.
 void BM_DmtApproachSweepPerPoint(benchmark::State& state) {
   const TappingModel model = model_with(impact::ForceLaw(dmt), 10.0);
-  SweepOptions options;
-  options.parallel = false;
-  options.harmonic_balance = false;
-  options.shooting = accurate();
+  const int points = static_cast<int>(state.range(0));
+  const double tolerance = std::pow(10.0, -static_cast<double>(state.range(1)));
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);
-  const int points = static_cast<int>(state.range(0));
+  const SweepResult reference = sweep_instrument(model, 2.0, 10.0, points, sweep_options(1e-13));
+  const SweepOptions options = sweep_options(tolerance);
   SweepResult r;
   for (auto _ : state) {
     r = sweep_instrument(model, 2.0, 10.0, points, options);
@@ -76,10 +103,11 @@ void BM_DmtApproachSweepPerPoint(benchmark::State& state) {
   omp_set_num_threads(threads);
   const double per_sweep_points = static_cast<double>(r.approach.size() + r.retract.size());
   state.counters["points"] = per_sweep_points;
+  state.counters["amplitude_error"] = max_relative_amplitude_error(r, reference);
   state.counters["time_per_point"] =
       benchmark::Counter(per_sweep_points, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_DmtApproachSweepPerPoint)->Arg(50)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DmtApproachSweepPerPoint)->Args({50, 9})->Args({50, 10})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

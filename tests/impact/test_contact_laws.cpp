@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/impact/impact.hpp"
@@ -115,4 +116,29 @@ TEST(KelvinVoigtLaw, ImpactLosesExactlyTheViscousWork) {
   }
   EXPECT_NEAR(res.kinetic_energy_loss, work, 1e-5 * work);
   EXPECT_GT(work, 0.0);
+}
+
+// Closed-form slopes dH/dd (used by the variational equations) against a fourth-order central difference of the
+// force itself, on both sides of every switching gap.
+TEST(ContactLawSlopes, EqualTheDerivativeOfTheForceAwayFromSwitchingGaps) {
+  const std::vector<ForceLaw> laws = {
+      ForceLaw(DmtLaw(1.3, 0.9, 10.0, 6.4e-20, 8e-20, 0.165)),
+      make_law<HertzLaw>(1.3, 0.9, 10.0),
+      make_law<AdhesionHysteresisLaw>(1.0, 10.0, 6.4e-20, 0.165, 0.05),
+      make_law<LennardJonesLaw>(10.0, 6.4e-20, 0.3),
+  };
+  for (const ForceLaw& law : laws) {
+    ASSERT_TRUE(law.has_slopes()) << law.name();
+    for (double d = -1.5; d <= 3.0; d += 0.0173) {
+      const double h = 1e-4;
+      bool near_switch = false;
+      for (double g : law.switching_gaps()) near_switch |= std::abs(d - g) < 3 * h;
+      if (near_switch) continue;
+      auto diff = [&](auto&& f) { return (-f(d + 2 * h) + 8 * f(d + h) - 8 * f(d - h) + f(d - 2 * h)) / (12 * h); };
+      const double da = diff([&](double x) { return law.approach(x); });
+      const double db = diff([&](double x) { return law.departure(x); });
+      EXPECT_NEAR(law.approach_slope(d), da, 1e-6 * std::max(1.0, std::abs(da))) << law.name() << " d = " << d;
+      EXPECT_NEAR(law.departure_slope(d), db, 1e-6 * std::max(1.0, std::abs(db))) << law.name() << " d = " << d;
+    }
+  }
 }

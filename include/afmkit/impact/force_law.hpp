@@ -91,9 +91,17 @@ class ForceLawModel {
   virtual std::string name() const = 0;
   virtual double approach(double gap) const = 0;   // H_a(d)
   virtual double departure(double gap) const = 0;  // H_b(d)
+  /// dH_a/dd and dH_b/dd in closed form, when has_slopes() (else the integrators difference H within its region).
+  /// Used by the variational equations and the witness rates: a law with slopes integrates faster.
+  virtual bool has_slopes() const { return false; }
+  virtual double approach_slope(double /*gap*/) const { return std::numeric_limits<double>::quiet_NaN(); }
+  virtual double departure_slope(double /*gap*/) const { return std::numeric_limits<double>::quiet_NaN(); }
   /// Kelvin–Voigt coefficient c(d) ≥ 0 (force per unit gap rate); 0 unless has_damping().
   virtual double damping(double /*gap*/) const { return 0.0; }
   virtual bool has_damping() const { return false; }
+  /// Whether the branches are smooth (C^∞) between switching gaps, as the 8th-order adaptive integrator assumes;
+  /// false for laws only C¹ there (a monotone cubic through a measured table): integrated at 5th order instead.
+  virtual bool smooth() const { return true; }
   /// Gaps at which a branch or c(d) is not smooth (any order; the ForceLaw sorts them).
   virtual std::vector<double> switching_gaps() const = 0;
   /// The gap below which tip and sample count as in contact (contact time, penetration, impacts): by default
@@ -125,6 +133,10 @@ class ForceLaw {
 
   double approach(double gap) const { return scale_ * model_->approach(gap); }    // scale · H_a(d)
   double departure(double gap) const { return scale_ * model_->departure(gap); }  // scale · H_b(d)
+  bool has_slopes() const { return model_->has_slopes(); }
+  bool smooth() const { return model_->smooth(); }
+  double approach_slope(double gap) const { return scale_ * model_->approach_slope(gap); }    // scale · dH_a/dd
+  double departure_slope(double gap) const { return scale_ * model_->departure_slope(gap); }  // scale · dH_b/dd
   /// scale · rate scale · c(d): the Kelvin–Voigt coefficient in the scaled units (0 for laws without one).
   double damping(double gap) const { return has_damping_ ? damping_scale_ * model_->damping(gap) : 0.0; }
   bool has_damping() const { return has_damping_; }

@@ -23,7 +23,7 @@ class TrajectoryObserver;
 enum class Integrator {
   automatic,    // closed_form for piecewise-linear laws, adaptive otherwise
   closed_form,  // exact (to rounding) flow of the linear modes; piecewise-linear laws only
-  adaptive,     // Dormand–Prince 5(4) (Boost.Odeint runge_kutta_dopri5, dense output) + event isolation
+  adaptive,     // DOP853 (order 8, 7th-order dense output) + event isolation on the dense output
 };
 const char* integrator_name(Integrator integrator);
 

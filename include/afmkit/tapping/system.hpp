@@ -50,6 +50,11 @@ class TappingSystem {
   double interaction_rate_slope(ContactBranch branch, double x, int region) const;
   /// ẍ in `mode` at (t, x, ẋ) (0 while sticking).
   double acceleration(const Mode& mode, double t, TipState s) const;
+  /// h(x, ẋ) and ∂h/∂x together (one region lookup; the law's closed-form slopes when it has them).
+  double interaction_with_slope(ContactBranch branch, double x, double velocity, int region, double& slope) const;
+  /// The same with the drive term Γ cos ωt given (integrators that advance the drive phase themselves).
+  double acceleration_given_drive(const Mode& mode, double drive_term, TipState s) const;
+  double drive_frequency() const { return omega_; }
   /// ẍ with the given branch's force in `region`.
   double acceleration(ContactBranch branch, int region, double t, TipState s) const;
 

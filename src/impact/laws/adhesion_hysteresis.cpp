@@ -38,6 +38,11 @@ double AdhesionHysteresisLaw::departure(double d) const {
   const double delta = a0_ - d;
   return -pull_off_ + 4.0 / 3.0 * modulus_ * std::sqrt(radius_) * delta * std::sqrt(delta);
 }
+double AdhesionHysteresisLaw::approach_slope(double d) const {
+  if (d >= a0_) return hamaker_ * radius_ / (3.0 * d * d * d);
+  return -2.0 * modulus_ * std::sqrt(radius_ * (a0_ - d));
+}
+double AdhesionHysteresisLaw::departure_slope(double d) const { return approach_slope(d); }  // same shape, shifted
 
 void AdhesionHysteresisLaw::require_dissipative() const {
   // H_a − H_b = F_pull − A_H R/(6 a0²) in contact (d < a0), 0 outside: ≥ 0 iff F_pull ≥ A_H R/(6 a0²)

@@ -71,12 +71,27 @@ double dmt_area(const DmtLaw& m, double lo, double hi) {
   return area;
 }
 
+// dH/dd [nN/nm]: A_H R/(3d³) for d ≥ a0, −2E*√R (a0 − d)^{1/2} below
+double dmt_slope(double d, double modulus, double radius, double hamaker, double a0) {
+  if (d >= a0) return hamaker * joule_per_nm_in_nN * radius / (3.0 * d * d * d);
+  return -2.0 * modulus * std::sqrt(radius * (a0 - d));
+}
+
 class DmtModel final : public ForceLawModel {
  public:
   explicit DmtModel(const DmtLaw& law) : law_(law) {}
   std::string name() const override { return "dmt"; }
   double approach(double gap) const override { return law_.approach(gap); }
   double departure(double gap) const override { return law_.departure(gap); }
+  bool has_slopes() const override { return true; }
+  double approach_slope(double gap) const override {
+    return dmt_slope(gap, law_.effective_modulus_approach, law_.tip_radius, law_.hamaker_approach,
+                     law_.intermolecular_distance);
+  }
+  double departure_slope(double gap) const override {
+    return dmt_slope(gap, law_.effective_modulus_departure, law_.tip_radius, law_.hamaker_departure,
+                     law_.intermolecular_distance);
+  }
   std::vector<double> switching_gaps() const override { return {law_.intermolecular_distance}; }
   bool branch_dependent(int region) const override {
     const bool moduli = law_.effective_modulus_approach != law_.effective_modulus_departure;

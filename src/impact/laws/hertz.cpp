@@ -24,6 +24,8 @@ double HertzLaw::departure(double d) const {
   if (d >= 0) return 0.0;
   return 4.0 / 3.0 * modulus_b_ * std::sqrt(radius_) * (-d) * std::sqrt(-d);
 }
+double HertzLaw::approach_slope(double d) const { return d >= 0 ? 0.0 : -2.0 * modulus_a_ * std::sqrt(-radius_ * d); }
+double HertzLaw::departure_slope(double d) const { return d >= 0 ? 0.0 : -2.0 * modulus_b_ * std::sqrt(-radius_ * d); }
 
 void HertzLaw::require_dissipative() const {
   if (allow_gain_ || modulus_b_ <= modulus_a_) return;

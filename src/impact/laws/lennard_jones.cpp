@@ -1,4 +1,5 @@
 // Lennard-Jones sphere–plane interaction (docs/force-laws.md).
+#include <algorithm>
 #include <cmath>
 
 #include "afmkit/core/validate.hpp"
@@ -15,6 +16,12 @@ LennardJonesLaw::LennardJonesLaw(double r, double hamaker, double a0)
 double LennardJonesLaw::force_at(double d) const {
   const double r2 = a0_ * a0_ / (d * d), r6 = r2 * r2 * r2;
   return coefficient_ / (d * d) * (r6 - 1.0);  // (A_H R/6)(−1/d² + a0⁶/d⁸)
+}
+
+double LennardJonesLaw::approach_slope(double d) const {
+  const double x = std::max(d, 0.5 * a0_);  // the tangent below a0/2 has the slope at a0/2
+  const double r2 = a0_ * a0_ / (x * x), r6 = r2 * r2 * r2;
+  return coefficient_ / (x * x * x) * (2.0 - 8.0 * r6);
 }
 
 double LennardJonesLaw::approach(double d) const {

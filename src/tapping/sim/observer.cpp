@@ -50,6 +50,7 @@ void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segm
   if (!(t1 > t0)) return;
   const Mode mode = segment.mode();
   const double omega = system.model().drive.frequency;
+  const double drive_amplitude = system.model().drive.amplitude;
   const bool exact_contact = system.contact_is_region_zero();  // else: counted at the quadrature nodes
   const bool in_contact_region = exact_contact && mode.region == 0;
   duration += t1 - t0;
@@ -65,12 +66,12 @@ void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segm
       fourier[k] += w * x * ek;
       ek *= e1;
     }
-    const double h = mode.branch == ContactBranch::sticking ? 0.0 : system.interaction(mode.branch, x, v, mode.region);
-    drive_work += w * system.drive(t) * v;
+    const double h = system.interaction(mode.branch, x, v, mode.region);
+    drive_work += w * drive_amplitude * e1.real() * v;  // Γ cos ωt = Γ Re e^{−iωt}
     viscous_dissipation += w * system.damping() * v * v;
-    contact_dissipation += w * h * v;
+    if (mode.branch != ContactBranch::sticking) contact_dissipation += w * h * v;
     if (!exact_contact && system.gap(x) < system.contact_gap()) contact_time += w;
-    peak_force = std::max(peak_force, 0.0 - system.interaction(mode.branch, x, v, mode.region));
+    peak_force = std::max(peak_force, 0.0 - h);
     min_gap = std::min(min_gap, system.gap(x));
   };
   for (int p = 0; p < panels; ++p) {

@@ -75,6 +75,14 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
   double norm = scaled_norm(r, y, omega);
   for (int it = 0; it <= options.max_iterations; ++it) {
     if (norm <= tolerance) {
+      // the last Newton step, from the map already evaluated, takes the state from a residual of size `norm` to
+      // one of size O(norm²): without it the fixed point is off by (M − I)⁻¹ r, large when a multiplier is
+      // near 1 (high Q)
+      const Eigen::FullPivLU<Eigen::Matrix2d> last(map.sensitivity.topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity());
+      if (last.isInvertible()) {
+        const Eigen::Vector2d step = -last.solve(r);
+        if (step.allFinite() && scaled_norm(step, y, omega) <= 1e3 * tolerance) y += step;
+      }
       PeriodicOrbit orbit;
       orbit.separation = model.separation;
       orbit.period_multiple = period_multiple;

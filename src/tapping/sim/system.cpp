@@ -87,12 +87,39 @@ double TappingSystem::interaction_slope(ContactBranch branch, double x, double v
     }
   }
   const double d = gap(x);
-  const double step = 1e-6 * std::max(1.0, std::abs(d));
   const double lo = region_lo(region), hi = region_hi(region);
+  if (!has_damping_ && model_.law.has_slopes()) {
+    // h = −H; beyond the region the law is continued by its boundary value (clamp_gap): slope 0 there
+    if (d < lo || d >= hi) return 0.0;
+    switch (branch) {
+      case ContactBranch::approach: return -model_.law.approach_slope(d);
+      case ContactBranch::departure: return -model_.law.departure_slope(d);
+      case ContactBranch::sticking: return -0.5 * (model_.law.approach_slope(d) + model_.law.departure_slope(d));
+    }
+  }
+  const double step = 1e-6 * std::max(1.0, std::abs(d));
   auto h = [&](double dd) { return interaction(branch, dd - separation_, velocity, region); };
   if (d - step >= lo && d + step < hi) return (h(d + step) - h(d - step)) / (2.0 * step);
   if (d + 2 * step < hi) return (-3.0 * h(d) + 4.0 * h(d + step) - h(d + 2 * step)) / (2.0 * step);
   return (3.0 * h(d) - 4.0 * h(d - step) + h(d - 2 * step)) / (2.0 * step);
+}
+
+double TappingSystem::interaction_with_slope(ContactBranch branch, double x, double velocity, int region,
+                                             double& slope) const {
+  if (linear_ || has_damping_ || !model_.law.has_slopes() || branch == ContactBranch::sticking) {
+    slope = interaction_slope(branch, x, velocity, region);
+    return interaction(branch, x, velocity, region);
+  }
+  const double d = gap(x);
+  const double lo = region_lo(region), hi = region_hi(region);
+  const bool inside = d >= lo && d < hi;
+  const double dc = inside ? d : clamp_gap(d, region);
+  if (branch == ContactBranch::approach) {
+    slope = inside ? -model_.law.approach_slope(d) : 0.0;
+    return -model_.law.approach(dc);
+  }
+  slope = inside ? -model_.law.departure_slope(d) : 0.0;
+  return -model_.law.departure(dc);
 }
 
 double TappingSystem::acceleration(ContactBranch branch, int region, double t, TipState s) const {
@@ -102,6 +129,12 @@ double TappingSystem::acceleration(ContactBranch branch, int region, double t, T
 double TappingSystem::acceleration(const Mode& mode, double t, TipState s) const {
   if (mode.branch == ContactBranch::sticking) return 0.0;
   return acceleration(mode.branch, mode.region, t, s);
+}
+
+double TappingSystem::acceleration_given_drive(const Mode& mode, double drive_term, TipState s) const {
+  if (mode.branch == ContactBranch::sticking) return 0.0;
+  return drive_term - damping_ * s.velocity - stiffness_ * s.position -
+         interaction(mode.branch, s.position, s.velocity, mode.region);
 }
 
 Mode TappingSystem::initial_mode(double t, TipState& s) const {

@@ -20,6 +20,9 @@ class HertzLaw final : public ForceLawModel {
   std::string name() const override { return "hertz"; }
   double approach(double gap) const override;
   double departure(double gap) const override;
+  bool has_slopes() const override { return true; }
+  double approach_slope(double gap) const override;   // −2E*_a √R (−d)^{1/2} in contact
+  double departure_slope(double gap) const override;  // −2E*_b √R (−d)^{1/2} in contact
   std::vector<double> switching_gaps() const override { return {0.0}; }
   bool branch_dependent(int region) const override { return region == 0 && modulus_a_ != modulus_b_; }
   void require_dissipative() const override;
@@ -42,6 +45,9 @@ class AdhesionHysteresisLaw final : public ForceLawModel {
   std::string name() const override { return "jkr"; }
   double approach(double gap) const override;
   double departure(double gap) const override;
+  bool has_slopes() const override { return true; }
+  double approach_slope(double gap) const override;
+  double departure_slope(double gap) const override;
   std::vector<double> switching_gaps() const override { return {a0_}; }
   bool branch_dependent(int region) const override { return region == 0; }
   void require_dissipative() const override;
@@ -62,6 +68,9 @@ class LennardJonesLaw final : public ForceLawModel {
   std::string name() const override { return "lennard_jones"; }
   double approach(double gap) const override;
   double departure(double gap) const override { return approach(gap); }
+  bool has_slopes() const override { return true; }
+  double approach_slope(double gap) const override;  // (A_H R/6)(2/d³ − 8a0⁶/d⁹), constant below a0/2
+  double departure_slope(double gap) const override { return approach_slope(gap); }
   std::vector<double> switching_gaps() const override { return {0.5 * a0_}; }
   double contact_gap() const override { return a0_; }  // where the force turns repulsive
   bool branch_dependent(int) const override { return false; }

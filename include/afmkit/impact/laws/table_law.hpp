@@ -75,6 +75,7 @@ class TableLaw final : public ForceLawModel {
   std::string name() const override { return "table"; }
   double approach(double gap) const override { return approach_.eval(gap); }
   double departure(double gap) const override { return retract_.eval(gap); }
+  bool smooth() const override { return false; }  // PCHIP: C¹ at the knots
   /// The largest distance of each branch (where the force jumps to 0); one value if both branches end together.
   std::vector<double> switching_gaps() const override { return switching_; }
   /// Contact: below the bottom of the approach curve's adhesion well (the tabulated distance of its most negative
