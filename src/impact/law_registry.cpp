@@ -185,7 +185,10 @@ ForceLaw LawRegistry::build(const std::string& name, const LawArguments& args) c
     throw InvalidParameter("force_curve", fmt::format("force_curve applies only to law = table (this run: law = {})",
                                                       name));
   const auto value = [&](const std::string& k) { return args.real(key(k), keys_); };
-  return spec.build(value, args);
+  ForceLaw law = spec.build(value, args);
+  // every command alike: a law that creates energy (K_b > K_a, E*_b > E*_a, …) only with allow_energy_gain
+  law.require_dissipative();
+  return law;
 }
 
 }  // namespace afmkit::impact

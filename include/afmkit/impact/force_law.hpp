@@ -18,8 +18,8 @@ namespace afmkit::impact {
 /// K_a, K_b ≥ 0 are stiffnesses (per unit mass in the tapping model); 0 ≤ F_a ≤ F_b are the attractive
 /// offsets at the contact edge (F > 0 pulls the tip towards the sample).
 /// The law dissipates energy at every penetration (area between the branches ≥ 0, seed-1 eq. 6) iff
-/// K_b ≤ K_a and F_a ≤ F_b. An impact (ImpactProblem) rejects K_b > K_a unless `allow_energy_gain` is set;
-/// the constructor itself accepts it (the tapping model may use such laws, see docs/conventions.md).
+/// K_b ≤ K_a and F_a ≤ F_b. An impact (ImpactProblem) and LawRegistry::build (every command) reject K_b > K_a unless
+/// `allow_energy_gain` is set; the constructor itself accepts it (docs/conventions.md).
 struct PiecewiseLinearLaw {
   double approach_stiffness;    // K_a
   double departure_stiffness;   // K_b

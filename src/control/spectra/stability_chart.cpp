@@ -4,13 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
-#include <mutex>
 #include <queue>
 
 #include <omp.h>
 
 #include "afmkit/control/delay_margin.hpp"
 #include "afmkit/control/spectrum.hpp"
+#include "afmkit/core/parallel.hpp"
 #include "afmkit/core/validate.hpp"
 #include "spectra_detail.hpp"
 #include "tracking.hpp"
@@ -40,19 +40,11 @@ void check_spec(const ChartSpec& s) {
 // Runs body(i) for i in [0, n) on `threads` OpenMP threads; rethrows the first exception.
 template <class F>
 void parallel_for(long n, int threads, F&& body) {
-  std::exception_ptr error;
-  std::mutex m;
+  ExceptionCollector errors;
   const int nt = threads > 0 ? threads : omp_get_max_threads();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
-  for (long i = 0; i < n; ++i) {
-    try {
-      body(i);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(m);
-      if (!error) error = std::current_exception();
-    }
-  }
-  if (error) std::rethrow_exception(error);
+  for (long i = 0; i < n; ++i) errors.run([&] { body(i); });
+  errors.rethrow();
 }
 
 // Connected components of equal tracked counts; each labelled by a certified count at its most interior point.

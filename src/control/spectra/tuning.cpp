@@ -5,13 +5,13 @@
 #include <array>
 #include <cmath>
 #include <exception>
-#include <mutex>
 #include <numbers>
 
 #include <omp.h>
 
 #include "afmkit/control/delay_margin.hpp"
 #include "afmkit/control/spectrum.hpp"
+#include "afmkit/core/parallel.hpp"
 #include "afmkit/core/validate.hpp"
 #include "spectra_detail.hpp"
 #include "tracking.hpp"
@@ -149,24 +149,20 @@ RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<voi
     out.coarse_y.push_back(spec.y_min + (spec.y_max - spec.y_min) * i / (n - 1));
   }
   out.coarse_worst_decay.assign(static_cast<std::size_t>(n) * n, 0.0);
-  std::exception_ptr error;
-  std::mutex m;
+  ExceptionCollector errors;
   const int nt = spec.threads > 0 ? spec.threads : omp_get_max_threads();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
   for (int j = 0; j < n; ++j) {
-    try {
+    errors.run([&] {
       WarmStart warm;
       for (int i = 0; i < n; ++i) {
         out.coarse_worst_decay[static_cast<std::size_t>(j) * n + i] =
             objective(out.coarse_x[i], out.coarse_y[j], warm, nullptr, nullptr);
       }
       if (progress) progress(n, total);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(m);
-      if (!error) error = std::current_exception();
-    }
+    });
   }
-  if (error) std::rethrow_exception(error);
+  errors.rethrow();
   out.evaluations = n * n;
   const auto best = std::max_element(out.coarse_worst_decay.begin(), out.coarse_worst_decay.end()) -
                     out.coarse_worst_decay.begin();
@@ -243,15 +239,12 @@ RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<voi
   std::vector<double> cert(n_cert);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
   for (std::size_t i = 0; i < n_cert; ++i) {
-    try {
+    errors.run([&] {
       const LoopSpec loop = spec.family.at(bx, by, objective.taus()[i % nt_tau], objective.rhos()[i / nt_tau]);
       cert[i] = -rightmost_roots(loop).spectral_abscissa;
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(m);
-      if (!error) error = std::current_exception();
-    }
+    });
   }
-  if (error) std::rethrow_exception(error);
+  errors.rethrow();
   out.certified_worst_decay = *std::min_element(cert.begin(), cert.end());
   std::vector<double> rs{spec.gain_ratio_min};
   if (spec.gain_ratio_min < 1.0 && spec.gain_ratio_max > 1.0) rs.push_back(1.0);

@@ -11,6 +11,7 @@
 #include <Eigen/LU>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/parallel.hpp"
 #include "afmkit/core/validate.hpp"
 #include "afmkit/tapping/continuation.hpp"
 #include "afmkit/tapping/observer.hpp"
@@ -283,8 +284,10 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
   quick.max_iterations = std::min(quick.max_iterations, 10);
   std::vector<std::vector<PeriodicOrbit>> found(tasks.size());
   std::vector<std::optional<TransientOutcome>> outcomes(tasks.size());
+  ExceptionCollector errors;  // a candidate that fails numerically is dropped; anything else is an error
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
   for (std::size_t i = 0; i < tasks.size(); ++i) {
+    errors.run([&] {
     try {
       switch (tasks[i].kind) {
         case SeedKind::transient:
@@ -297,9 +300,11 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
         default: found[i] = shoot_with_short_transients(model, tasks[i].start, options.grid_transient_periods, quick, sim);
       }
     } catch (const NumericalFailure&) {
-      // this candidate failed (time or event budget); others may succeed
+      // this candidate failed (time or event budget, divergence); others may succeed
     }
+    });
   }
+  errors.rethrow();
   for (auto& o : outcomes)
     if (o) out.transients.push_back(std::move(*o));
 
@@ -356,6 +361,7 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
     std::vector<std::vector<TipState>> crossings(runs.size());
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
     for (std::size_t r = 0; r < runs.size(); ++r) {
+      errors.run([&] {
       try {
         const ContinuationResult c = continue_orbits(model, runs[r].first, l - w, l + w, runs[r].second, copt);
         for (std::size_t k = 1; k < c.points.size(); ++k) {
@@ -372,19 +378,24 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
       } catch (const NumericalFailure&) {
         // a continuation that cannot start or proceed contributes no seeds
       }
+      });
     }
+    errors.rethrow();
     std::vector<Task> more;
     for (const auto& list : crossings)
       for (const TipState& s : list) more.push_back({SeedKind::continuation, OrbitSource::continuation, s});
     std::vector<std::optional<PeriodicOrbit>> shot(more.size());
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
     for (std::size_t i = 0; i < more.size(); ++i) {
-      try {
-        shot[i] = try_shoot(model, more[i].start, 1, options.shooting);
-      } catch (const NumericalFailure&) {
-        shot[i].reset();
-      }
+      errors.run([&] {
+        try {
+          shot[i] = try_shoot(model, more[i].start, 1, options.shooting);
+        } catch (const NumericalFailure&) {
+          shot[i].reset();
+        }
+      });
     }
+    errors.rethrow();
     for (std::size_t i = 0; i < more.size(); ++i) {
       const int seed = static_cast<int>(report.seeds.size());
       add_seed(more[i]);
@@ -392,17 +403,10 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
     }
   }
 
-  std::exception_ptr error;
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
-  for (std::size_t i = 0; i < out.orbits.size(); ++i) {
-    try {
-      out.orbits[i].metrics = analyse_orbit(model, out.orbits[i].orbit, options.shooting.simulation);
-    } catch (...) {
-#pragma omp critical(afmkit_orbit_error)
-      if (!error) error = std::current_exception();
-    }
-  }
-  if (error) std::rethrow_exception(error);
+  for (std::size_t i = 0; i < out.orbits.size(); ++i)
+    errors.run([&] { out.orbits[i].metrics = analyse_orbit(model, out.orbits[i].orbit, options.shooting.simulation); });
+  errors.rethrow();
   // by increasing amplitude; renumber the seeds' orbit indices
   std::vector<int> order(out.orbits.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);

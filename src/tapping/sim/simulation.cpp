@@ -64,6 +64,10 @@ SimulationResult simulate(const TappingModel& model, double t_begin, TipState st
     detail::run_closed_form(sys, rs, t_end, options, observer);
   else
     detail::run_adaptive(sys, rs, t_end, options, observer);
+  if (!std::isfinite(rs.y.position) || !std::isfinite(rs.y.velocity))
+    throw NumericalFailure(fmt::format("tapping simulation: the motion diverges (state x = {}, dx/dt = {} at t = {:.9g}); "
+                                       "a law that creates energy (allow_energy_gain) can drive it without bound",
+                                       rs.y.position, rs.y.velocity, rs.t));
   SimulationResult out;
   out.time = rs.t;
   out.state = rs.y;

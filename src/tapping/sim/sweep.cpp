@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/parallel.hpp"
 #include "afmkit/core/validate.hpp"
 #include "sweep_points.hpp"
 
@@ -248,19 +249,16 @@ void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, co
                    bool harmonic_balance, bool parallel) {
   std::optional<HarmonicBalance> hb;  // branch scan once, cheap queries
   if (harmonic_balance) hb.emplace(base);  // any law (closed form for piecewise-linear ones)
-  std::exception_ptr error;
+  ExceptionCollector errors;
 #pragma omp parallel for schedule(dynamic) if (parallel)
   for (std::size_t i = 0; i < points.size(); ++i) {
-    try {
+    errors.run([&] {
       SweepPoint& p = points[i];
       p.metrics = analyse_orbit(base.with_separation(p.separation), p.orbit, simulation);
       if (hb) attach_from(hb->solutions(p.separation), p);
-    } catch (...) {
-#pragma omp critical(afmkit_sweep_error)
-      if (!error) error = std::current_exception();
-    }
+    });
   }
-  if (error) std::rethrow_exception(error);
+  errors.rethrow();
 }
 
 }  // namespace detail
@@ -309,21 +307,18 @@ std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::v
   std::vector<OrbitSearchResult> out(separations.size());
   OrbitSearchOptions inner = options;
   inner.parallel = false;  // parallel over separations instead
-  std::exception_ptr error;
+  ExceptionCollector errors;
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
   for (std::size_t i = 0; i < separations.size(); ++i) {
-    try {
+    errors.run([&] {
       out[i] = find_orbits(base.with_separation(separations[i]), inner);
       if (progress) {
 #pragma omp critical(afmkit_grid_progress)
         progress(1);
       }
-    } catch (...) {
-#pragma omp critical(afmkit_grid_error)
-      if (!error) error = std::current_exception();
-    }
+    });
   }
-  if (error) std::rethrow_exception(error);
+  errors.rethrow();
   return out;
 }
 
