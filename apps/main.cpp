@@ -1,5 +1,7 @@
 // afmkit — command-line front end. Exit status: 0 success, 2 bad input (parameter, file, config),
 // 1 numerical failure (no convergence, budget exhausted) or any other error.
+#include <cstdio>
+#include <iostream>
 #include <new>
 #include <string>
 
@@ -8,11 +10,13 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/version.hpp"
+#include "afmkit/io/output.hpp"
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"afmkit: dynamics and control of atomic force microscopes (tapping-mode impact dynamics, "
                "first-harmonic rejection for rotational scanning)"};
+  afmkit::io::remove_temporaries_on_signal();  // Ctrl-C or a kill leaves no half-written output behind
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string(afmkit::version));
   afmkit::cli::register_demo(app);
@@ -56,6 +60,12 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const std::exception& e) {
     fmt::print(stderr, "afmkit: error: {}\n", e.what());
+    return 1;
+  }
+  // results printed to standard output must have arrived (a full disk, a closed pipe): otherwise exit 1
+  std::cout.flush();
+  if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    fmt::print(stderr, "afmkit: error: cannot write the results to standard output\n");
     return 1;
   }
   return 0;

@@ -70,29 +70,35 @@ tapping::PhysicalCantilever physical_cantilever(const io::ParamSet& p) {
 }
 }  // namespace
 
+namespace {
+// Wide but finite upper bounds: products of the model's scales stay far inside the double range (no inf/nan
+// results from extreme inputs; issue of ±1e308 parameters). Real cantilevers lie decades inside them.
+Range below(double hi) { return {0.0, hi, true, false}; }
+}  // namespace
+
 void add_tapping_model_params(io::ParamSet& p) {
   p.text("units", "normalised", "unit system of the model parameters and results", {"normalised", "physical"})
-      .real("quality_factor", 100.0, "quality factor Q = 1/(2ξ)", Range::positive())
-      .real("frequency_ratio", 1.0, "drive frequency over natural frequency ω/ω_n", Range::positive())
-      .real("separation", 10.0, "separation l (nm): sample surface at x = -l", Range::any())
+      .real("quality_factor", 100.0, "quality factor Q = 1/(2ξ)", below(1e9))
+      .real("frequency_ratio", 1.0, "drive frequency over natural frequency ω/ω_n", below(1e3))
+      .real("separation", 10.0, "separation l (nm): sample surface at x = -l", Range::closed(-1e6, 1e6))
       // normalised units (ω_n, lengths in nm, per-unit-mass forces in nm·ω_n²)
-      .real("natural_frequency", 1.0, "[normalised] natural frequency ω_n", Range::positive())
-      .real("drive_amplitude", 0.2, "[normalised] drive Γ (per unit mass)", Range::positive())
+      .real("natural_frequency", 1.0, "[normalised] natural frequency ω_n", below(1e12))
+      .real("drive_amplitude", 0.2, "[normalised] drive Γ (per unit mass)", below(1e12))
       .real("approach_stiffness", 10.0, "[normalised] K_a, sample stiffness while approaching (units of ω_n²)",
-            Range::non_negative())
+            Range::closed(0.0, 1e12))
       .real("departure_stiffness", 8.0, "[normalised] K_b, sample stiffness while departing (units of ω_n²)",
-            Range::non_negative())
-      .real("approach_adhesion", 0.0, "[normalised] F_a >= 0, attraction at contact while approaching", Range::non_negative())
+            Range::closed(0.0, 1e12))
+      .real("approach_adhesion", 0.0, "[normalised] F_a >= 0, attraction at contact while approaching", Range::closed(0.0, 1e12))
       .real("departure_adhesion", 0.0, "[normalised] F_b >= F_a, attraction at contact while departing",
-            Range::non_negative())
+            Range::closed(0.0, 1e12))
       // physical units
-      .real("spring_constant", 40.0, "[physical] cantilever spring constant k (N/m)", Range::positive())
-      .real("resonance_frequency", 300.0, "[physical] resonance frequency f0 (kHz)", Range::positive())
-      .real("free_amplitude", 20.0, "[physical] free amplitude at the drive frequency (nm)", Range::positive())
-      .real("sample_stiffness_approach", 400.0, "[physical] contact stiffness while approaching (N/m)", Range::non_negative())
-      .real("sample_stiffness_departure", 320.0, "[physical] contact stiffness while departing (N/m)", Range::non_negative())
-      .real("adhesion_approach", 0.0, "[physical] attraction at contact while approaching (nN)", Range::non_negative())
-      .real("adhesion_departure", 0.0, "[physical] attraction at contact while departing (nN)", Range::non_negative())
+      .real("spring_constant", 40.0, "[physical] cantilever spring constant k (N/m)", below(1e6))
+      .real("resonance_frequency", 300.0, "[physical] resonance frequency f0 (kHz)", below(1e7))
+      .real("free_amplitude", 20.0, "[physical] free amplitude at the drive frequency (nm)", below(1e6))
+      .real("sample_stiffness_approach", 400.0, "[physical] contact stiffness while approaching (N/m)", Range::closed(0.0, 1e9))
+      .real("sample_stiffness_departure", 320.0, "[physical] contact stiffness while departing (N/m)", Range::closed(0.0, 1e9))
+      .real("adhesion_approach", 0.0, "[physical] attraction at contact while approaching (nN)", Range::closed(0.0, 1e9))
+      .real("adhesion_departure", 0.0, "[physical] attraction at contact while departing (nN)", Range::closed(0.0, 1e9))
       ;
   add_law_params(p, impact::LawRegistry::builtin(), "hysteresis",
                  {"approach_stiffness", "departure_stiffness", "approach_adhesion", "departure_adhesion"});

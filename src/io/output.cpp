@@ -1,9 +1,10 @@
 #include "afmkit/io/output.hpp"
 
+#include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <stdexcept>
 
@@ -20,6 +21,37 @@ namespace fs = std::filesystem;
 
 constexpr std::size_t flush_threshold = 1 << 16;  // bytes buffered before a write
 
+// Temporaries being written, for the signal handler (SIGINT, SIGTERM, SIGHUP): fixed slots of fixed-size names so
+// that the handler only reads them and calls unlink (async-signal-safe). Process-wide by nature: a signal is.
+constexpr int temporary_slots = 32;
+constexpr std::size_t temporary_name_size = 4096;
+std::atomic<bool> slot_used[temporary_slots];
+char slot_name[temporary_slots][temporary_name_size];
+
+int register_temporary(const std::string& name) {
+  if (name.size() >= temporary_name_size) return -1;
+  for (int i = 0; i < temporary_slots; ++i) {
+    bool expected = false;
+    if (!slot_used[i].load() && slot_used[i].compare_exchange_strong(expected, true)) {
+      std::memcpy(slot_name[i], name.c_str(), name.size() + 1);
+      std::atomic_signal_fence(std::memory_order_seq_cst);
+      return i;
+    }
+  }
+  return -1;  // more than 32 outputs open at once: not cleaned on a signal (still removed on normal exit paths)
+}
+
+void release_temporary(int slot) {
+  if (slot >= 0) slot_used[slot].store(false);
+}
+
+extern "C" void remove_temporaries_and_reraise(int signal_number) {
+  for (int i = 0; i < temporary_slots; ++i)
+    if (slot_used[i].load()) ::unlink(slot_name[i]);
+  std::signal(signal_number, SIG_DFL);
+  std::raise(signal_number);
+}
+
 void create_parent(const fs::path& p) {
   if (!p.has_parent_path()) return;
   std::error_code ec;
@@ -27,7 +59,25 @@ void create_parent(const fs::path& p) {
   if (ec) throw InputError(fmt::format("cannot create directory '{}': {}", p.parent_path().string(), ec.message()));
 }
 
-std::string temporary_name(const std::string& path) { return fmt::format("{}.tmp.{}", path, ::getpid()); }
+/// The file an output path names: a symbolic link is followed (its target is replaced, the link stays); an
+/// existing path that is not a regular file (device, FIFO, directory, socket) is refused.
+std::string output_target(const std::string& path) {
+  if (path.empty()) throw InputError("output path is empty: give a file path");
+  std::error_code ec;
+  fs::path p(path);
+  for (int hops = 0; fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+    const fs::path next = fs::read_symlink(p, ec);
+    if (ec || hops == 40) throw InputError(fmt::format("cannot follow the symbolic link '{}'", path));
+    p = next.is_absolute() ? next : p.parent_path() / next;
+  }
+  const fs::file_status st = fs::status(p, ec);
+  if (fs::exists(st) && !fs::is_regular_file(st))
+    throw InputError(fmt::format("output '{}' is not a regular file (a device, FIFO or directory): give a file path",
+                                 path));
+  return p.string();
+}
+
+std::string temporary_name(const std::string& target) { return fmt::format("{}.tmp.{}", target, ::getpid()); }
 
 void move_into_place(const std::string& from, const std::string& to) {
   std::error_code ec;
@@ -38,33 +88,69 @@ void move_into_place(const std::string& from, const std::string& to) {
   }
 }
 
-/// Writes `content` to a temporary file next to `path`; returns its name.
-std::string write_temporary(const std::string& path, const std::string& content) {
-  create_parent(fs::path(path));
-  const std::string tmp = temporary_name(path);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(fmt::format("cannot write output file '{}'", path));
-    out << content;
-    out.flush();
-    if (!out) {
-      out.close();
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw InputError(fmt::format("error while writing output file '{}'", path));
-    }
+/// Flushes, syncs to disk and closes `file`; false on any failure.
+bool sync_and_close(std::FILE* file) {
+  bool ok = std::fflush(file) == 0;
+  ok = ::fsync(::fileno(file)) == 0 && ok;
+  return std::fclose(file) == 0 && ok;
+}
+
+/// A complete temporary file next to its target, registered for removal on a signal until released.
+struct Temporary {
+  std::string target, name;
+  int slot = -1;
+  void remove() noexcept {
+    std::error_code ec;
+    fs::remove(name, ec);
+    release_temporary(slot);
+    slot = -1;
   }
-  return tmp;
+  void move_into_place() {
+    ::afmkit::io::move_into_place(name, target);
+    release_temporary(slot);
+    slot = -1;
+  }
+};
+
+/// Writes `content` to a synced temporary file next to the target of `path`.
+Temporary write_temporary(const std::string& path, const std::string& content) {
+  Temporary t;
+  t.target = output_target(path);
+  create_parent(fs::path(t.target));
+  t.name = temporary_name(t.target);
+  t.slot = register_temporary(t.name);
+  std::FILE* f = std::fopen(t.name.c_str(), "wb");
+  if (!f) {
+    release_temporary(t.slot);
+    throw InputError(fmt::format("cannot write output file '{}': {}", path, std::strerror(errno)));
+  }
+  const bool written = std::fwrite(content.data(), 1, content.size(), f) == content.size();
+  if (!sync_and_close(f) || !written) {
+    t.remove();
+    throw InputError(fmt::format("error while writing output file '{}'", path));
+  }
+  return t;
 }
 
 }  // namespace
 
+void remove_temporaries_on_signal() {
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) std::signal(s, remove_temporaries_and_reraise);
+}
+
 TableWriter::TableWriter(std::string path, std::vector<std::string> columns)
-    : path_(std::move(path)), temporary_(temporary_name(path_)), columns_(std::move(columns)) {
+    : path_(std::move(path)), columns_(std::move(columns)) {
   if (columns_.empty()) throw std::logic_error("TableWriter: a table needs at least one column");
-  create_parent(fs::path(path_));
+  target_ = output_target(path_);
+  output_target(path_ + ".json");  // refuse a bad sidecar path before any work
+  temporary_ = temporary_name(target_);
+  create_parent(fs::path(target_));
+  slot_ = register_temporary(temporary_);
   file_ = std::fopen(temporary_.c_str(), "wb");
-  if (!file_) throw InputError(fmt::format("cannot write output file '{}': {}", path_, std::strerror(errno)));
+  if (!file_) {
+    release_temporary(slot_);
+    throw InputError(fmt::format("cannot write output file '{}': {}", path_, std::strerror(errno)));
+  }
   for (std::size_t i = 0; i < columns_.size(); ++i) {
     if (i) buffer_.push_back(',');
     buffer_.append(std::string_view(columns_[i]));
@@ -81,6 +167,8 @@ void TableWriter::discard() noexcept {
   file_ = nullptr;
   std::error_code ec;
   fs::remove(temporary_, ec);
+  release_temporary(slot_);
+  slot_ = -1;
 }
 
 void TableWriter::separator() {
@@ -136,28 +224,35 @@ void TableWriter::flush() {
 void TableWriter::commit(const nlohmann::json& sidecar) {
   if (cells_in_row_) throw std::logic_error(fmt::format("TableWriter: unfinished row in '{}'", path_));
   flush();
-  const bool failed = std::fflush(file_) != 0;
-  const bool close_failed = std::fclose(file_) != 0;
+  const bool ok = sync_and_close(file_);
   file_ = nullptr;
-  if (failed || close_failed) {
+  if (!ok) {
     discard();
     throw InputError(fmt::format("error while writing output file '{}'", path_));
   }
-  // Both files are complete on disk before either is moved into place.
-  std::string meta_temporary;
+  // Both files are complete and synced on disk before either is moved into place.
+  Temporary meta;
   try {
-    meta_temporary = write_temporary(path_ + ".json", sidecar.dump(2) + "\n");
+    meta = write_temporary(path_ + ".json", sidecar.dump(2) + "\n");
   } catch (...) {
     discard();
     throw;
   }
   committed_ = true;
-  move_into_place(temporary_, path_);
-  move_into_place(meta_temporary, path_ + ".json");
+  try {
+    ::afmkit::io::move_into_place(temporary_, target_);
+  } catch (...) {
+    meta.remove();
+    release_temporary(slot_);
+    throw;
+  }
+  release_temporary(slot_);
+  slot_ = -1;
+  meta.move_into_place();
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {
-  move_into_place(write_temporary(path, content), path);
+  write_temporary(path, content).move_into_place();
 }
 
 nlohmann::json make_sidecar(const std::string& command, const nlohmann::json& parameters,

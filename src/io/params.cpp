@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -22,10 +23,11 @@ std::string dashed(std::string key) {
   return key;
 }
 
-double real_of(const std::string& key, const std::string& text, const std::string& origin) {
+double real_of(const std::string& key, const std::string& text, const std::string& origin, const Range& range) {
   // nan / inf are accepted textually so that the range check rejects them with a clear message
   if (const auto v = parse_real(text)) return *v;
-  throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not a number", origin, key, text));
+  throw InvalidParameter(key, fmt::format("{}: {} = '{}' is not a number: must be {}", origin, key, text,
+                                          range.describe()));
 }
 /// Whether `text` is well-formed UTF-8 (no overlong forms, surrogates or code points above U+10FFFF).
 bool valid_utf8(const std::string& text) {
@@ -61,9 +63,9 @@ bool Range::contains(double v) const {
 
 std::string Range::describe() const {
   bool has_lo = lo > -1e307, has_hi = hi < 1e307;
-  if (has_lo && has_hi) return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
-  if (has_lo) return fmt::format("{} {} (finite)", lo_open ? ">" : ">=", lo);
-  if (has_hi) return fmt::format("{} {} (finite)", hi_open ? "<" : "<=", hi);
+  if (has_lo && has_hi) return fmt::format("in {}{:g}, {:g}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
+  if (has_lo) return fmt::format("{} {:g} (finite)", lo_open ? ">" : ">=", lo);
+  if (has_hi) return fmt::format("{} {:g} (finite)", hi_open ? "<" : "<=", hi);
   return "a finite number";
 }
 
@@ -162,7 +164,7 @@ void ParamSet::set_from_string(const std::string& key, const std::string& text) 
       [&](auto& v) {
         using T = std::decay_t<decltype(v)>;
         if constexpr (std::is_same_v<T, double>) {
-          v = real_of(key, text, origin);
+          v = real_of(key, text, origin, e.range);
         } else if constexpr (std::is_same_v<T, long>) {
           const auto i = parse_integer(text);
           if (!i)
@@ -181,7 +183,7 @@ void ParamSet::set_from_string(const std::string& key, const std::string& text) 
           std::vector<double> out;
           std::stringstream ss(text);
           std::string item;
-          while (std::getline(ss, item, ',')) out.push_back(real_of(key, item, origin));
+          while (std::getline(ss, item, ',')) out.push_back(real_of(key, item, origin, e.range));
           v = out;
         }
       },
@@ -258,6 +260,9 @@ void ParamSet::load_toml_text(const std::string& text, const std::string& origin
 
 void ParamSet::resolve() {
   if (!config_path_.empty()) {
+    std::error_code ec;
+    if (std::filesystem::exists(config_path_, ec) && !std::filesystem::is_regular_file(config_path_, ec))
+      throw InputError(fmt::format("--config: '{}' is not a regular file (a TOML file is expected)", config_path_));
     std::ifstream in(config_path_);
     if (!in) throw InputError(fmt::format("--config: cannot open file '{}'", config_path_));
     std::stringstream buf;

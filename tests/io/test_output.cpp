@@ -11,6 +11,10 @@
 #include <sstream>
 #include <string>
 
+#include <csignal>
+
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "afmkit/core/error.hpp"
@@ -133,4 +137,51 @@ TEST(TableWriter, RowsAreStreamedToDiskNotHeldInMemory) {
 
 TEST(TableWriter, UnwritableTargetIsAnInputError) {
   EXPECT_THROW(TableWriter("/proc/afmkit_cannot_write/t.csv", {"a"}), afmkit::InputError);
+}
+
+TEST(TableWriter, ATerminatingSignalRemovesTheTemporaries) {
+  const fs::path dir = fresh_dir("signal");
+  fs::create_directories(dir);
+  const std::string path = (dir / "out.csv").string();
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {  // the child writes half a table and is terminated by SIGTERM
+    afmkit::io::remove_temporaries_on_signal();
+    TableWriter out(path, {"a"});
+    for (int i = 0; i < 100000; ++i) out.row(i);  // flushed to the temporary as it goes
+    std::raise(SIGTERM);
+    std::_Exit(3);  // not reached
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status));  // ended by the signal, as without the handler
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  int left = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    ++left;
+    ADD_FAILURE() << "left behind: " << e.path();
+  }
+  EXPECT_EQ(left, 0);
+  fs::remove_all(dir);
+}
+
+TEST(TableWriter, ANonRegularTargetIsRefusedAndASymbolicLinkIsFollowed) {
+  const fs::path dir = fresh_dir("targets");
+  fs::create_directories(dir);
+  const std::string fifo = (dir / "fifo.csv").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_THROW(TableWriter(fifo, {"a"}), afmkit::InputError);
+  EXPECT_THROW(TableWriter(dir.string(), {"a"}), afmkit::InputError);  // a directory
+  // a link to a file that does not exist yet: the file is created, the link stays a link
+  fs::create_directories(dir / "data");
+  fs::create_symlink("data/real.csv", dir / "link.csv");
+  {
+    TableWriter out((dir / "link.csv").string(), {"a"});
+    out.row(1.5);
+    out.commit(nlohmann::json::object());
+  }
+  EXPECT_TRUE(fs::is_symlink(dir / "link.csv"));
+  EXPECT_EQ(slurp(dir / "data" / "real.csv"), "a\n1.5\n");
+  EXPECT_TRUE(fs::exists(dir / "link.csv.json"));
+  fs::remove_all(dir);
 }

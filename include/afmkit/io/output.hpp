@@ -57,7 +57,9 @@ class TableWriter {
 
  private:
   std::string path_;
+  std::string target_;  // path_, or the file its symbolic link points to
   std::string temporary_;
+  int slot_ = -1;       // registration for removal on a signal
   std::vector<std::string> columns_;
   std::FILE* file_ = nullptr;
   fmt::memory_buffer buffer_;
@@ -71,7 +73,13 @@ class TableWriter {
 };
 
 /// Write `content` to `path` atomically; creates parent directories. Throws afmkit::InputError on failure.
+/// Outputs (tables, sidecars, files): written to `<target>.tmp.<pid>`, synced, then renamed; a symbolic link is
+/// followed (its target is replaced); a path that exists but is not a regular file is refused (InputError).
 void write_file_atomic(const std::string& path, const std::string& content);
+
+/// Installs SIGINT/SIGTERM/SIGHUP handlers that remove the temporaries of outputs being written, then end the
+/// process by the same signal (the command-line program calls it once at start).
+void remove_temporaries_on_signal();
 
 /// Metadata of a run, written as the sidecar `<csv path>.json`.
 nlohmann::json make_sidecar(const std::string& command, const nlohmann::json& parameters,
