@@ -146,3 +146,26 @@ TEST(CApi, SaveRestoreBitForBit) {
   afmkit_filter_destroy(h);
   afmkit_filter_destroy(g);
 }
+
+TEST(CApi, InputLimitSkipsHugeSamples) {
+  afmkit_filter* h = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
+  ASSERT_NE(h, nullptr);
+  EXPECT_EQ(afmkit_filter_input_limit(h), AFMKIT_DEFAULT_INPUT_LIMIT);
+  std::vector<double> in = test_signal(20000), out(in.size());
+  in[100] = 1e308;  // finite but huge: skipped like NaN, the output stays finite
+  ASSERT_EQ(afmkit_filter_step_block(h, in.data(), out.data(), in.size()), AFMKIT_OK);
+  EXPECT_EQ(out[100], out[99]);
+  EXPECT_EQ(afmkit_filter_skipped_samples(h), 1u);
+  for (double u : out) ASSERT_TRUE(std::isfinite(u));
+  ASSERT_EQ(afmkit_filter_set_input_limit(h, 1.0), AFMKIT_OK);
+  EXPECT_EQ(afmkit_filter_input_limit(h), 1.0);
+  const double held = afmkit_filter_step(h, 0.5);
+  EXPECT_EQ(afmkit_filter_step(h, 1.5), held);
+  EXPECT_EQ(afmkit_filter_skipped_samples(h), 2u);
+  EXPECT_EQ(afmkit_filter_set_input_limit(h, 0.0), AFMKIT_INVALID_ARGUMENT);
+  const std::string msg = afmkit_filter_last_error(h);
+  EXPECT_NE(msg.find("input_limit"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("(0, 1e+150]"), std::string::npos) << msg;
+  EXPECT_EQ(afmkit_filter_input_limit(h), 1.0);  // unchanged on error
+  afmkit_filter_destroy(h);
+}

@@ -11,17 +11,32 @@
 // rank-1 coupling does not commute with the rotations), but A is diagonalisable with well separated eigenvalues
 // (≈ ikΩ − α for (20)), so the filter runs in real modal coordinates q (z = V q): each complex pair σ ± iω is a
 // damped rotation e^{σh}R(ωh) of two numbers, a real eigenvalue a scalar, u = w·q — O(N) per sample and equal to
-// e^{Ah} up to rounding (checked against the dense matrix exponential when configured). If V is ill-conditioned
-// (cond > 1e8, near-defective couplings) the filter falls back to the dense Φ (O(N²)); see uses_modal_form().
+// e^{Ah} up to rounding. Set-up without any N×N matrix: the eigenvalues by the Aberth iteration
+// (bank_eigenvalues, O(N²)), then per mode in O(N) the eigenvectors of the rank-1 perturbation A = A0 − b c_eᵀ
+// in closed form (MATH.md B.3): right v = (λ − A0)⁻¹ b, left u = (λ − A0)⁻ᵀ c_e (the 2×2 blocks of A0 inverted
+// one oscillator at a time; the rejected oscillators' exact modes ±ikΩ separately). O(N²) time, O(N) memory;
+// V is never stored (physical ↔ modal maps are recomputed, O(N²), outside the per-sample path). Checked per
+// mode: residual and ‖V‖_F‖V⁻¹‖_F < 1e8. If the check fails (near-defective couplings, a0 = 0) the filter falls
+// back to the dense Φ (O(N³) set-up, O(N²) per sample), allowed only for N ≤ kMaxDenseHarmonics; beyond that the
+// constructor throws InvalidParameter("harmonics"). See uses_modal_form().
+// Range of N: 1 … kMaxHarmonics (ZeroOrderHold; set-up ≈ 4 s at the upper end, O(N²)) and 1 … kMaxHarmonicsBlock
+// (BlockZeroOrderHold, O(N) set-up); larger N → InvalidParameter("harmonics").
 //
 // BlockZeroOrderHold — the block scheme sampled: e_n = m_n − x0 − Σ_kept x_k held over the interval, each
 // oscillator rotated exactly by kΩh and driven by e_n (rotations plus a rank-1 coupling, O(N), no eigenvectors).
 // Exact rejection of harmonic 1 and exact pass-through of harmonics 0, 2..N in the samples.
 //
-// step() is noexcept, lock-free and allocation-free. A non-finite sample is skipped: the returned output is the
+// step() is noexcept, lock-free and allocation-free. A sample that is non-finite or larger in magnitude than
+// input_limit() (default kDefaultInputLimit = 1e150) is skipped (rejected, not clamped): the returned output is the
 // previous one (held), skipped_samples() is incremented, and the state advances as if the sample had equalled the
 // controller's own reconstruction of the kept harmonics (m = x0 + Σ_{k kept} x_k, i.e. e = 0 at that instant), so
 // the oscillators keep their phase and no NaN/Inf ever enters the state.
+// Why 1e150 cannot overflow: the state is linear in the samples, z_n = Σ_j Φ^{n−1−j} Γ m_j. For a controller
+// that is not exponentially unstable (every |e^{λh}| ≤ 1, as for the couplings (20) in their stable range) each
+// modal coordinate is bounded by n · max|Γ_modal| · max|m| with n < 2⁶⁴ ≈ 1.8e19 samples, so with |m| ≤ 1e150
+// and coefficients below 1e100 the state stays below ≈ 1e270 < DBL_MAX ≈ 1.8e308, and so does u = w·q for
+// N ≤ 1e5. A physical signal (ADC counts, volts, nm) is never near 1e150, so the default rejects only garbage. An
+// exponentially unstable controller overflows from any input; no input limit can prevent that.
 //
 // reconfigure() changes any parameter while running without a jump: the oscillator states (x0, x_k, z_k) are
 // kept (new oscillators start at 0, removed ones are dropped), the rejected oscillators are rescaled by
@@ -31,6 +46,7 @@
 // save_state()/restore_state(): a flat array of doubles (layout below); restoring into a filter with the same
 // configuration reproduces the future outputs bit for bit; into a different configuration the physical state is
 // carried over as in reconfigure() (no gain rescaling).
+#include <complex>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -53,6 +69,11 @@ class RealtimeFilter {
   static RealtimeFilter with_couplings(double sample_rate, double rotation_frequency, int harmonics, double alpha,
                                        double beta, double gain, SampledForm form = SampledForm::ZeroOrderHold);
 
+  static constexpr double kDefaultInputLimit = 1e150;  // largest accepted |sample| by default (see above)
+  static constexpr int kMaxHarmonics = 10000;          // ZeroOrderHold: N range 1 … kMaxHarmonics
+  static constexpr int kMaxHarmonicsBlock = 100000;    // BlockZeroOrderHold: N range 1 … kMaxHarmonicsBlock
+  static constexpr int kMaxDenseHarmonics = 200;       // dense ZOH fallback only up to this N
+
   /// Output u_n for the measured sample m_n (see above). noexcept, O(N).
   double step(double measured) noexcept;
   /// step() for each sample; in and out may alias; processes min(in.size(), out.size()) samples.
@@ -63,8 +84,12 @@ class RealtimeFilter {
   void reconfigure(const OscillatorBank& controller, double sample_rate, SampledForm form);
   /// Bumpless change of K only.
   void set_gain(double gain);
-  /// Zero state, zero held output, counters cleared.
+  /// Zero state, zero held output, counters cleared (the input limit is kept).
   void reset() noexcept;
+  /// Largest accepted |sample|: samples with |m| > limit are skipped like NaN. Kept by reset(), reconfigure() and
+  /// restore_state(). Throws InvalidParameter("input_limit") unless 0 < limit ≤ kDefaultInputLimit.
+  void set_input_limit(double limit);
+  double input_limit() const noexcept { return input_limit_; }
 
   // ---- state ------------------------------------------------------------------------------------------------
   /// Layout: [0] magic 0x41464D4B, [1] layout version (1), [2] N, [3] internal size n_i, [4..5] configuration
@@ -95,7 +120,7 @@ class RealtimeFilter {
   bool uses_modal_form() const noexcept { return disc_.kind == Kind::Modal; }
 
   /// The sampled controller in the oscillator coordinates, z_{n+1} = Φ z_n + Γ m_n, u_n = C z_n (dense Φ, Γ, C),
-  /// reconstructed from the internal form; for tests and inspection.
+  /// reconstructed from the internal form; for tests and inspection (O(N³) time, O(N²) memory).
   Eigen::MatrixXd transition_matrix() const;
   Eigen::VectorXd input_vector() const;
   Eigen::RowVectorXd output_vector() const;
@@ -115,11 +140,19 @@ class RealtimeFilter {
     double g0 = 0.0;            // block form: x0 ← x0 + g0·e
     std::vector<double> kw;     // block form, per oscillator: (1 if kept, −K if rejected), interleaved
     std::vector<double> phi, gamma, out, err;  // dense fallback: row-major Φ, Γ, output row, c_e
-    Eigen::MatrixXd basis;      // V: physical z = V q
-    Eigen::MatrixXd basis_inv;  // V⁻¹
+    struct Mode {                // modal: eigenvalue λ (pairs: Im λ > 0) and the eigenvector scales
+      std::complex<double> lambda;
+      double v_scale = 0.0;            // v̂ = v_scale (λ − A0)⁻¹ b (unit norm); rejected: v̂ = (1, −i)/√2 in block k
+      std::complex<double> u_scale;    // û = u_scale (λ − A0)⁻ᵀ c_e (ûᵀv̂ = 1); rejected: û = (1, i)/√2 − u_scale (…)
+      int rejected = 0;                // k for the exact mode ikΩ of a rejected oscillator, else 0
+    };
+    std::vector<Mode> modes;    // modal: pairs, then reals (physical z = V q, V never stored)
     std::uint64_t fingerprint = 0;
   };
   static Discretisation discretise(const OscillatorBank& bank, double sample_rate, SampledForm form);
+  static Discretisation modal(const OscillatorBank& bank, double sample_rate, bool& ok);
+  static Eigen::VectorXd to_physical(const OscillatorBank& bank, const Discretisation& d, const double* q);
+  static Eigen::VectorXd to_internal(const OscillatorBank& bank, const Discretisation& d, const Eigen::VectorXd& z);
   double advance(double m) noexcept;
   double coast_input() const noexcept;
   void load_physical(const Eigen::VectorXd& z);  // q = V⁻¹ z
@@ -130,6 +163,7 @@ class RealtimeFilter {
   Discretisation disc_;
   std::vector<double> q_, q_tmp_;  // internal coordinates: modal ((q1, q2) per pair, then reals) or physical
   double held_ = 0.0;
+  double input_limit_ = kDefaultInputLimit;
   std::uint64_t skipped_ = 0, samples_ = 0;
 };
 

@@ -1,6 +1,8 @@
 #include "afmkit/control/realtime_filter.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <complex>
 #include <cstring>
 #include <numbers>
 
@@ -61,6 +63,14 @@ Eigen::VectorXd map_state(const Eigen::VectorXd& z, int n_new) {
 }  // namespace
 
 RealtimeFilter::Discretisation RealtimeFilter::discretise(const OscillatorBank& bank, double fs, SampledForm form) {
+  const bool block = form == SampledForm::BlockZeroOrderHold;
+  const int max_n = block ? kMaxHarmonicsBlock : kMaxHarmonics;
+  if (bank.harmonics() > max_n)
+    throw InvalidParameter("harmonics",
+                           fmt::format("harmonics = {} is out of range: must be an integer in [1, {}] for the {} form "
+                                       "(set-up cost {})",
+                                       bank.harmonics(), max_n, block ? "block zero-order-hold" : "zero-order-hold",
+                                       block ? "O(N)" : "O(N^2): about 4 s at the upper end"));
   check_sample_rate(bank, fs);
   const double h = 1.0 / fs;
   if (form == SampledForm::BlockZeroOrderHold) {
@@ -82,90 +92,22 @@ RealtimeFilter::Discretisation RealtimeFilter::discretise(const OscillatorBank& 
       d.g.insert(d.g.end(), {(sn * bank.a(k) - one_minus_c * bank.b(k)) / w, (one_minus_c * bank.a(k) + sn * bank.b(k)) / w});
       d.kw.insert(d.kw.end(), {bank.is_rejected(k) ? 0.0 : 1.0, bank.is_rejected(k) ? -bank.gain() : 0.0});
     }
-    d.basis = Eigen::MatrixXd::Identity(n, n);
-    d.basis_inv = d.basis;
     d.fingerprint = fingerprint(bank, fs, static_cast<int>(d.kind));
     return d;
   }
-  const Eigen::MatrixXd a = bank.state_matrix();
-  const Eigen::VectorXd b = bank.input_vector();
-  const Eigen::RowVectorXd out = -bank.output_vector(), err = bank.error_vector();
-  const int n = bank.state_size();
-  const ZeroOrderHold zoh = zero_order_hold(a, b, h);
-
-  Discretisation d;
-  d.n = n;
-  // ---- modal form -------------------------------------------------------------------------------------------
-  Eigen::EigenSolver<Eigen::MatrixXd> es(a, true);
-  bool ok = es.info() == Eigen::Success;
-  std::vector<std::complex<double>> pair_lambda, real_lambda;
-  std::vector<Eigen::VectorXcd> pair_vec, real_vec;
-  if (ok) {
-    const Eigen::VectorXcd& ev = es.eigenvalues();
-    const Eigen::MatrixXcd vec = es.eigenvectors();
-    for (Eigen::Index i = 0; i < ev.size(); ++i) {
-      if (ev(i).imag() == 0.0) {
-        real_lambda.push_back(ev(i));
-        real_vec.push_back(vec.col(i));
-      } else {
-        pair_lambda.push_back(ev(i));
-        pair_vec.push_back(vec.col(i));
-        ++i;  // skip the conjugate (Eigen stores pairs consecutively)
-      }
-    }
-  }
-  const int pairs = static_cast<int>(pair_lambda.size()), reals = static_cast<int>(real_lambda.size());
-  ok = ok && 2 * pairs + reals == n;
-  Eigen::MatrixXd v(n, n), blocks = Eigen::MatrixXd::Zero(n, n);
-  if (ok) {
-    for (int j = 0; j < pairs; ++j) {
-      v.col(2 * j) = pair_vec[j].real();
-      v.col(2 * j + 1) = pair_vec[j].imag();
-    }
-    for (int j = 0; j < reals; ++j) v.col(2 * pairs + j) = real_vec[j].real();
-    // (Eigen's eigenvectors have unit complex norm; the two columns of a pair must share one scale, so no
-    // per-column normalisation here.)
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(v);
-    ok = lu.isInvertible();
-    if (ok) {
-      d.basis_inv = lu.inverse();
-      d.basis = v;
-      ok = v.norm() * d.basis_inv.norm() < 1e8;
-    }
-  }
-  if (ok) {
-    const Eigen::VectorXd beta = d.basis_inv * b;
-    const Eigen::RowVectorXd w = out * v, e = err * v;
-    d.pairs = pairs;
-    d.reals = reals;
-    d.w.assign(w.data(), w.data() + n);
-    d.e.assign(e.data(), e.data() + n);
-    for (int j = 0; j < pairs; ++j) {
-      // block [[σ, ω], [−ω, σ]] in (q1, q2) ⇔ c = q1 + i q2 obeys ċ = μ c + (β1 + iβ2) m, μ = σ − iω;
-      // e^{μh} = P − iS ⇒ q1' = P q1 + S q2, q2' = P q2 − S q1
-      const std::complex<double> mu = std::conj(pair_lambda[j]);
-      const std::complex<double> e_mu = std::exp(mu * h);
-      const std::complex<double> g = h * phi_function(1, mu * h) * std::complex<double>(beta(2 * j), beta(2 * j + 1));
-      const double pp = e_mu.real(), ss = -e_mu.imag();
-      d.c.insert(d.c.end(), {pp, pp});
-      d.s.insert(d.s.end(), {ss, -ss});
-      d.g.insert(d.g.end(), {g.real(), g.imag()});
-      blocks(2 * j, 2 * j) = blocks(2 * j + 1, 2 * j + 1) = pp;
-      blocks(2 * j, 2 * j + 1) = ss;
-      blocks(2 * j + 1, 2 * j) = -ss;
-    }
-    for (int j = 0; j < reals; ++j) {
-      const double lam = real_lambda[j].real();
-      const int i = 2 * pairs + j;
-      d.r.push_back(std::exp(lam * h));
-      d.gr.push_back(h * phi_function(1, lam * h) * beta(i));
-      blocks(i, i) = d.r.back();
-    }
-    // The modal form must reproduce the dense matrix exponential.
-    const Eigen::MatrixXd phi_modal = v * blocks * d.basis_inv;
-    ok = (phi_modal - zoh.transition).norm() <= 1e-9 * std::max(1.0, zoh.transition.norm());
-  }
-  if (!ok) {  // dense fallback
+  bool ok = false;
+  Discretisation d = modal(bank, fs, ok);
+  if (!ok) {  // dense fallback: O(N³) set-up, O(N²) memory, so only for small N
+    if (bank.harmonics() > kMaxDenseHarmonics)
+      throw InvalidParameter(
+          "harmonics",
+          fmt::format("harmonics = {}: these couplings make the modal basis of the zero-order-hold form "
+                      "ill-conditioned or defective (or a0 = 0), which needs the dense O(N^3) fallback, allowed "
+                      "only for harmonics in [1, {}]; use the block form (BlockZeroOrderHold) or other couplings",
+                      bank.harmonics(), kMaxDenseHarmonics));
+    const Eigen::RowVectorXd out = -bank.output_vector(), err = bank.error_vector();
+    const int n = bank.state_size();
+    const ZeroOrderHold zoh = zero_order_hold(bank.state_matrix(), bank.input_vector(), h);
     d = Discretisation{};
     d.kind = Kind::Dense;
     d.n = n;
@@ -175,11 +117,237 @@ RealtimeFilter::Discretisation RealtimeFilter::discretise(const OscillatorBank& 
     d.gamma.assign(zoh.input.data(), zoh.input.data() + n);
     d.out.assign(out.data(), out.data() + n);
     d.err.assign(err.data(), err.data() + n);
-    d.basis = Eigen::MatrixXd::Identity(n, n);
-    d.basis_inv = d.basis;
   }
   d.fingerprint = fingerprint(bank, fs, static_cast<int>(d.kind));
   return d;
+}
+
+// ---- modal zero-order hold without N×N matrices (header comment; MATH.md B.3) ------------------------------------
+namespace {
+using cplx = std::complex<double>;
+
+struct BankView {  // the couplings in flat arrays (OscillatorBank::a() is bounds-checked)
+  int n = 0;
+  double omega = 0, a0 = 0, gain = 0, b_norm = 0, a_norm = 0;
+  std::vector<double> a, b;
+  std::vector<char> kept;
+  explicit BankView(const OscillatorBank& bank)
+      : n(bank.harmonics()), omega(bank.rotation_frequency()), a0(bank.a0()), gain(bank.gain()) {
+    double b2 = a0 * a0, a2 = 0.0;
+    for (int k = 1; k <= n; ++k) {
+      a.push_back(bank.a(k));
+      b.push_back(bank.b(k));
+      kept.push_back(bank.is_rejected(k) ? 0 : 1);
+      b2 += a.back() * a.back() + b.back() * b.back();
+      a2 += 2.0 * (k * omega) * (k * omega);
+    }
+    b_norm = std::sqrt(b2);
+    double ce2 = 1.0;
+    for (char c : kept) ce2 += c;
+    a_norm = std::sqrt(a2) + b_norm * std::sqrt(ce2);  // ≥ ‖A0 − b c_eᵀ‖_F
+  }
+};
+
+/// One O(N) pass at λ over v = (λ − A0)⁻¹ b and u = (λ − A0)⁻ᵀ c_e (block `skip` left out):
+/// D = 1 + c_eᵀ v (D(λ) = 0 at an eigenvalue, eq. 18), uᵀv = −D'(λ), ‖v‖², ‖u‖², c_rᵀ v.
+struct ModePass {
+  cplx d, utv, rej;
+  double v2 = 0, u2 = 0;
+};
+ModePass mode_pass(const BankView& bv, cplx l, int skip = 0) {
+  ModePass p;
+  const cplx r0 = 1.0 / l, v0 = bv.a0 * r0;
+  p.d = 1.0 + v0;
+  p.utv = r0 * v0;
+  p.v2 = std::norm(v0);
+  p.u2 = std::norm(r0);
+  const cplx l2 = l * l;
+  for (int k = 1; k <= bv.n; ++k) {
+    if (k == skip) continue;
+    const double kw = k * bv.omega, ak = bv.a[k - 1], bk = bv.b[k - 1];
+    const cplx den = l2 + kw * kw;
+    const cplx inv = std::conj(den) / std::norm(den);
+    const cplx vx = (l * ak - kw * bk) * inv, vz = (kw * ak + l * bk) * inv;
+    p.v2 += std::norm(vx) + std::norm(vz);
+    if (bv.kept[k - 1]) {
+      const cplx ux = l * inv, uz = -kw * inv;
+      p.d += vx;
+      p.utv += ux * vx + uz * vz;
+      p.u2 += std::norm(ux) + std::norm(uz);
+    } else {
+      p.rej += vx;
+    }
+  }
+  return p;
+}
+
+/// Σ_i ((λ − A0)⁻ᵀ c_e)_i z_i, O(N).
+cplx left_dot(const BankView& bv, cplx l, const double* z) {
+  cplx acc = z[0] / l;
+  const cplx l2 = l * l;
+  for (int k = 1; k <= bv.n; ++k) {
+    if (!bv.kept[k - 1]) continue;
+    const double kw = k * bv.omega;
+    const cplx den = l2 + kw * kw;
+    acc += (l * z[2 * k - 1] - kw * z[2 * k]) * (std::conj(den) / std::norm(den));
+  }
+  return acc;
+}
+
+/// z += Re(s (λ − A0)⁻¹ b), O(N).
+void add_right(const BankView& bv, cplx l, cplx s, double* z) {
+  z[0] += (s * bv.a0 / l).real();
+  const cplx l2 = l * l;
+  for (int k = 1; k <= bv.n; ++k) {
+    const double kw = k * bv.omega, ak = bv.a[k - 1], bk = bv.b[k - 1];
+    const cplx den = l2 + kw * kw;
+    const cplx f = s * std::conj(den) / std::norm(den);
+    z[2 * k - 1] += (f * (l * ak - kw * bk)).real();
+    z[2 * k] += (f * (kw * ak + l * bk)).real();
+  }
+}
+}  // namespace
+
+RealtimeFilter::Discretisation RealtimeFilter::modal(const OscillatorBank& bank, double fs, bool& ok) {
+  ok = false;
+  Discretisation d;
+  d.kind = Kind::Modal;
+  d.n = bank.state_size();
+  if (bank.a0() == 0.0) return d;  // the x0 mode is then λ = 0 with a zero row: not handled here
+  std::vector<cplx> ev;
+  try {
+    ev = bank_eigenvalues(bank);
+  } catch (const NumericalFailure&) {
+    return d;
+  }
+  if (static_cast<int>(ev.size()) != d.n) return d;
+  const BankView bv(bank);
+  const double h = 1.0 / fs, tol = 1e-10 * bv.omega * (bv.n + 1);
+  std::vector<Discretisation::Mode> pairs, reals;
+  int negative = 0;
+  for (cplx l : ev) {
+    Discretisation::Mode m;
+    const double kq = std::round(std::abs(l.imag()) / bv.omega);
+    if (l.real() == 0.0 && kq >= 1 && kq <= bv.n && kq * bv.omega == std::abs(l.imag()) &&
+        !bv.kept[static_cast<std::size_t>(kq) - 1]) {  // exact mode ±ikΩ of a rejected oscillator
+      if (l.imag() < 0) continue;
+      m.lambda = l;
+      m.rejected = static_cast<int>(kq);
+      pairs.push_back(m);
+      continue;
+    }
+    if (std::abs(l.imag()) <= tol) l = cplx(l.real(), 0.0);
+    if (l.imag() < 0) {
+      ++negative;
+      continue;
+    }
+    m.lambda = l;
+    (l.imag() == 0.0 ? reals : pairs).push_back(m);
+  }
+  int aberth_pairs = 0;
+  for (const auto& m : pairs) aberth_pairs += m.rejected == 0;
+  if (negative != aberth_pairs || 2 * static_cast<int>(pairs.size()) + static_cast<int>(reals.size()) != d.n) return d;
+  d.modes = std::move(pairs);
+  d.pairs = static_cast<int>(d.modes.size());
+  d.reals = static_cast<int>(reals.size());
+  d.modes.insert(d.modes.end(), reals.begin(), reals.end());
+
+  double v_frob2 = 0.0, u_frob2 = 0.0, worst_residual = 0.0;
+  for (int j = 0; j < d.pairs + d.reals; ++j) {
+    Discretisation::Mode& m = d.modes[static_cast<std::size_t>(j)];
+    const bool pair = j < d.pairs;
+    cplx beta, w, e;
+    double u2;
+    if (m.rejected) {
+      // v̂ = (1, −i)/√2 in block k; û = (1, i)/√2 − s (λ − A0)⁻ᵀ c_e with s = ûᵀb = (a_k + i b_k)/(√2 D(ikΩ))
+      const ModePass p = mode_pass(bv, m.lambda, m.rejected);
+      const cplx s = cplx(bv.a[m.rejected - 1], bv.b[m.rejected - 1]) / (std::sqrt(2.0) * p.d);
+      m.u_scale = s;
+      beta = s;
+      w = -bv.gain / std::sqrt(2.0);
+      e = 0.0;
+      u2 = 1.0 + std::norm(s) * p.u2;
+    } else {
+      ModePass p = mode_pass(bv, m.lambda);
+      // one Newton step on D (D' = −uᵀv), kept if it reduces |D|
+      cplx l1 = m.lambda + p.d / p.utv;
+      if (!pair) l1 = cplx(l1.real(), 0.0);
+      const ModePass p1 = mode_pass(bv, l1);
+      if (std::abs(p1.d) < std::abs(p.d)) {
+        m.lambda = l1;
+        p = p1;
+      }
+      const double vn = std::sqrt(p.v2);
+      m.v_scale = 1.0 / vn;
+      m.u_scale = vn / p.utv;
+      beta = (p.d - 1.0) * m.u_scale;  // ûᵀb = u_scale c_eᵀ(λ − A0)⁻¹ b
+      w = -bv.gain * p.rej * m.v_scale;
+      e = (p.d - 1.0) * m.v_scale;
+      u2 = p.u2 * std::norm(m.u_scale);
+      worst_residual = std::max(worst_residual, std::abs(p.d) * bv.b_norm * m.v_scale / bv.a_norm);  // ‖(A − λ)v̂‖/‖A‖
+    }
+    v_frob2 += 1.0;
+    if (pair) {
+      u_frob2 += 4.0 * u2;
+      const cplx mu = std::conj(m.lambda), e_mu = std::exp(mu * h);
+      const cplx g = h * phi_function(1, mu * h) * 2.0 * std::conj(beta);
+      d.c.insert(d.c.end(), {e_mu.real(), e_mu.real()});
+      d.s.insert(d.s.end(), {-e_mu.imag(), e_mu.imag()});
+      d.g.insert(d.g.end(), {g.real(), g.imag()});
+      d.w.insert(d.w.end(), {w.real(), w.imag()});
+      d.e.insert(d.e.end(), {e.real(), e.imag()});
+    } else {
+      u_frob2 += u2;
+      const double lam = m.lambda.real();
+      d.r.push_back(std::exp(lam * h));
+      d.gr.push_back(h * phi_function(1, lam * h) * beta.real());
+      d.w.push_back(w.real());
+      d.e.push_back(e.real());
+    }
+  }
+  const double cond = std::sqrt(v_frob2 * u_frob2);  // ‖V‖_F ‖V⁻¹‖_F, as for a dense eigenvector basis
+  ok = std::isfinite(cond) && cond < 1e8 && cond * worst_residual < 1e-10;
+  for (const auto* v : {&d.c, &d.s, &d.g, &d.w, &d.e, &d.r, &d.gr})
+    for (double x : *v) ok = ok && std::isfinite(x);
+  return d;
+}
+
+Eigen::VectorXd RealtimeFilter::to_physical(const OscillatorBank& bank, const Discretisation& d, const double* q) {
+  if (d.kind != Kind::Modal) return Eigen::Map<const Eigen::VectorXd>(q, d.n);
+  const BankView bv(bank);
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(d.n);
+  for (int j = 0; j < d.pairs + d.reals; ++j) {
+    const Discretisation::Mode& m = d.modes[static_cast<std::size_t>(j)];
+    const cplx c = j < d.pairs ? cplx(q[2 * j], -q[2 * j + 1]) : cplx(q[d.pairs + j], 0.0);  // z += Re(v̂ c)
+    if (c == 0.0) continue;
+    if (m.rejected) {
+      z(2 * m.rejected - 1) += (c / std::sqrt(2.0)).real();
+      z(2 * m.rejected) += (cplx(0.0, -1.0) * c / std::sqrt(2.0)).real();
+    } else {
+      add_right(bv, m.lambda, m.v_scale * c, z.data());
+    }
+  }
+  return z;
+}
+
+Eigen::VectorXd RealtimeFilter::to_internal(const OscillatorBank& bank, const Discretisation& d,
+                                            const Eigen::VectorXd& z) {
+  if (d.kind != Kind::Modal) return z;
+  const BankView bv(bank);
+  Eigen::VectorXd q(d.n);
+  for (int j = 0; j < d.pairs + d.reals; ++j) {
+    const Discretisation::Mode& m = d.modes[static_cast<std::size_t>(j)];
+    cplx p = left_dot(bv, m.lambda, z.data());  // ûᵀz
+    if (m.rejected) p = cplx(z(2 * m.rejected - 1), z(2 * m.rejected)) / std::sqrt(2.0) - m.u_scale * p;
+    else p *= m.u_scale;
+    if (j < d.pairs) {  // q1 + i q2 = 2 conj(ûᵀz)
+      q(2 * j) = 2.0 * p.real();
+      q(2 * j + 1) = -2.0 * p.imag();
+    } else {
+      q(d.pairs + j) = p.real();
+    }
+  }
+  return q;
 }
 
 RealtimeFilter::RealtimeFilter(const OscillatorBank& controller, double sample_rate, SampledForm form)
@@ -249,7 +417,7 @@ double RealtimeFilter::coast_input() const noexcept {
 
 double RealtimeFilter::step(double measured) noexcept {
   ++samples_;
-  if (!std::isfinite(measured)) {
+  if (!(std::abs(measured) <= input_limit_)) {  // NaN, ±inf and |m| > input_limit(): skipped
     ++skipped_;
     advance(coast_input());
     return held_;
@@ -264,12 +432,11 @@ void RealtimeFilter::step_block(std::span<const double> in, std::span<double> ou
 }
 
 Eigen::VectorXd RealtimeFilter::controller_state() const {
-  const Eigen::Map<const Eigen::VectorXd> q(q_.data(), disc_.n);
-  return disc_.basis * q;
+  return to_physical(bank_, disc_, q_.data());
 }
 
 void RealtimeFilter::load_physical(const Eigen::VectorXd& z) {
-  const Eigen::VectorXd q = disc_.basis_inv * z;
+  const Eigen::VectorXd q = to_internal(bank_, disc_, z);
   q_.assign(q.data(), q.data() + q.size());
   q_tmp_.assign(q_.size(), 0.0);
 }
@@ -295,7 +462,7 @@ void RealtimeFilter::reconfigure(const OscillatorBank& controller, double sample
       z(2 * k) *= scale;
     }
   }
-  const Eigen::VectorXd q = d.basis_inv * z;
+  const Eigen::VectorXd q = to_internal(controller, d, z);
   std::vector<double> qv(q.data(), q.data() + q.size()), tmp(qv.size(), 0.0);
   OscillatorBank bank = controller;
   // commit (no throwing operations below)
@@ -308,6 +475,15 @@ void RealtimeFilter::reconfigure(const OscillatorBank& controller, double sample
 }
 
 void RealtimeFilter::set_gain(double gain) { reconfigure(bank_.with_gain(gain), sample_rate_); }
+
+void RealtimeFilter::set_input_limit(double limit) {
+  if (!(limit > 0.0 && limit <= kDefaultInputLimit))
+    throw InvalidParameter("input_limit", fmt::format("input_limit = {} is out of range: must be in (0, {}] (the "
+                                                      "largest accepted |sample|; larger bounds could overflow the "
+                                                      "state)",
+                                                      limit, kDefaultInputLimit));
+  input_limit_ = limit;
+}
 
 void RealtimeFilter::reset() noexcept {
   std::fill(q_.begin(), q_.end(), 0.0);
@@ -365,7 +541,7 @@ void RealtimeFilter::restore_state(std::span<const double> in) {
     const auto off = static_cast<std::ptrdiff_t>(kHeader + static_cast<std::size_t>(ni));
     Eigen::VectorXd z(static_cast<Eigen::Index>(np));
     for (Eigen::Index i = 0; i < z.size(); ++i) z(i) = in[off + i];
-    const Eigen::VectorXd q = disc_.basis_inv * map_state(z, bank_.harmonics());
+    const Eigen::VectorXd q = to_internal(bank_, disc_, map_state(z, bank_.harmonics()));
     qv.assign(q.data(), q.data() + q.size());
   }
   q_.swap(qv);
@@ -398,7 +574,12 @@ Eigen::MatrixXd RealtimeFilter::transition_matrix() const {
     for (int j = 0; j < d.pairs; ++j) ce(1 + 2 * j) = d.kw[2 * j];
     return t - input_vector() * ce;
   }
-  return d.basis * t * d.basis_inv;
+  Eigen::MatrixXd phi(d.n, d.n);  // Φ = V T V⁻¹, one column at a time (V not stored)
+  for (int i = 0; i < d.n; ++i) {
+    const Eigen::VectorXd q = t * to_internal(bank_, d, Eigen::VectorXd::Unit(d.n, i));
+    phi.col(i) = to_physical(bank_, d, q.data());
+  }
+  return phi;
 }
 
 Eigen::VectorXd RealtimeFilter::input_vector() const {
@@ -408,7 +589,7 @@ Eigen::VectorXd RealtimeFilter::input_vector() const {
   if (d.kind == Kind::Block) g(0) = d.g0;
   for (int j = 0; j < 2 * d.pairs; ++j) g(d.offset + j) = d.g[j];
   for (int j = 0; j < d.reals; ++j) g(2 * d.pairs + j) = d.gr[j];
-  return d.basis * g;
+  return to_physical(bank_, d, g.data());
 }
 
 Eigen::RowVectorXd RealtimeFilter::output_vector() const {
@@ -419,7 +600,10 @@ Eigen::RowVectorXd RealtimeFilter::output_vector() const {
     for (int j = 0; j < d.pairs; ++j) w(1 + 2 * j) = d.kw[2 * j + 1];
     return w;
   }
-  return Eigen::Map<const Eigen::RowVectorXd>(d.w.data(), d.n) * d.basis_inv;
+  const Eigen::Map<const Eigen::RowVectorXd> w(d.w.data(), d.n);
+  Eigen::RowVectorXd c(d.n);  // C = w V⁻¹
+  for (int i = 0; i < d.n; ++i) c(i) = w.dot(to_internal(bank_, d, Eigen::VectorXd::Unit(d.n, i)));
+  return c;
 }
 
 }  // namespace afmkit::control
