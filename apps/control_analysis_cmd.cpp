@@ -423,11 +423,13 @@ void register_control_analysis(CLI::App& control) {
       "of the characteristic function; initial guesses by collocation (dense, N <= 40) or from the delay-free poles "
       "(Aberth, O(N^2)); certification O(N) evaluations along the box: O(N^2) in all",
       [](io::ParamSet& p) {
-        p.real("min_real", 0.0, "left edge of the search box [units of Omega] (default: automatic)")
+        p.group("Root search")
+            .real("min_real", 0.0, "left edge of the search box [units of Omega] (default: automatic)")
             .real("max_imag", 1.0, "half-height of the search box [units of Omega] (default: proven bound)",
                   Range::positive())
             .integer("count", 12, "automatic box: about this many rightmost roots", 1, 10000)
             .integer("nodes", 0, "Chebyshev collocation nodes per delay for the initial guesses (0: automatic)", 0, 400)
+            .group("Output")
             .flag("json", false, "print the result as JSON to stdout instead of writing the CSV")
             .text("output", "out/control_roots.csv", "output CSV path (JSON sidecar next to it)");
       },
@@ -437,11 +439,13 @@ void register_control_analysis(CLI::App& control) {
       "delay margin tau_c (largest delay keeping the loop stable; crossing formulas MATH.md B.9, ext. E1/E2). Cost: "
       "O(N) per crossing-function evaluation on points_per_omega x (N + 1) frequencies, O(N^2) stability check",
       [](io::ParamSet& p) {
-        p.real("reference_delay", 0.0, "delay where stability is required [units of T] (default: 0, Smith: "
+        p.group("Delay margin")
+            .real("reference_delay", 0.0, "delay where stability is required [units of T] (default: 0, Smith: "
                                        "model_delay)", Range::non_negative())
             .integer("points_per_omega", 64, "crossing-frequency bracketing grid density (points per Omega)", 4, 100000)
             .flag("compare", false, "tabulate tau_c for variants: rejected harmonics {1},{1,2},{1,3},{2},{1,2,3},"
                                     "{1,3,5}, N = inf, single oscillator, Smith predictor (periodic, classic)")
+            .group("Output")
             .flag("json", false, "print the one-shot answer as JSON to stdout instead of writing the CSV")
             .text("output", "out/control_margin.csv", "output CSV path (crossings; JSON sidecar next to it)");
       },
@@ -452,7 +456,8 @@ void register_control_analysis(CLI::App& control) {
       "labels, exact D-subdivision boundaries (paper Figs. 2, 4). Cost: O(N) per Newton step of each tracked root per "
       "grid point, O(N^2) per fresh spectrum and per certified region",
       [](io::ParamSet& p) {
-        p.text("quantity", "abscissa", "abscissa: spectral abscissa + unstable roots; margin: tau_c map",
+        p.group("Chart")
+            .text("quantity", "abscissa", "abscissa: spectral abscissa + unstable roots; margin: tau_c map",
                {"abscissa", "margin"})
             .real("x_min", 0.0, "a or alpha lower bound [units of Omega] (default -0.5 single, -0.1 otherwise)")
             .real("x_max", 1.0, "a or alpha upper bound [units of Omega] (default 2 single, 1 otherwise)")
@@ -461,6 +466,7 @@ void register_control_analysis(CLI::App& control) {
             .integer("x_points", 200, "grid points along x", 2, 100000)
             .integer("y_points", 200, "grid points along y", 2, 100000)
             .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024)
+            .group("Output")
             .flag("progress", true, "show progress on stderr")
             .text("output", "out/control_chart.csv", "grid CSV path (JSON sidecar next to it)")
             .text("boundaries_output", "out/control_chart_boundaries.csv", "boundary curves CSV path");
@@ -472,7 +478,8 @@ void register_control_analysis(CLI::App& control) {
       "rho = K/gamma in [gain_ratio_min, gain_ratio_max] (coarse grid + Nelder-Mead). Cost: per objective evaluation "
       "O(N^2) per gain ratio (fresh spectrum) plus O(N) per tracked-root Newton step",
       [](io::ParamSet& p) {
-        p.real("delay_max", 0.25, "largest delay [units of T]", Range::non_negative())
+        p.group("Tuning")
+            .real("delay_max", 0.25, "largest delay [units of T]", Range::non_negative())
             .integer("delay_points", 6, "delay grid points on [0, delay_max]", 1, 10000)
             .real("gain_ratio_min", 0.5, "smallest rho = K/gamma", Range::positive())
             .real("gain_ratio_max", 2.0, "largest rho = K/gamma", Range::positive())
@@ -484,6 +491,7 @@ void register_control_analysis(CLI::App& control) {
             .integer("coarse_points", 12, "coarse grid points per axis", 2, 10000)
             .integer("max_evaluations", 150, "Nelder-Mead budget", 0, 1000000)
             .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024)
+            .group("Output")
             .flag("progress", true, "show progress on stderr")
             .flag("json", false, "print the optimum as JSON to stdout instead of writing the CSV")
             .text("output", "out/control_tune.csv", "coarse-grid CSV path (JSON sidecar next to it)");

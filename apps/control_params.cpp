@@ -13,6 +13,7 @@ namespace afmkit::cli {
 using io::Range;
 
 void add_control_params(io::ParamSet& p, long max_harmonics) {
+  p.group("Controller");
   p.text("controller", "bank", "controller: single oscillator (eqs. 5-6), bank of N oscillators (eq. 15), "
                                "infinite bank (eq. 31) or Smith predictor around a bank",
          {"single", "bank", "infinite", "smith"})
@@ -32,9 +33,11 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
              Range::closed(1, static_cast<double>(max_harmonics)))
       .real("gain", 20.0, "controller gain K [units of Omega] (default: equal to plant_rate, design rule K = gamma)",
             Range::positive())
+      .group("Plant and delay")
       .text("plant", "static", "plant: static y = f + u/gamma (eq. 3) or first order (eq. 1)", {"static", "first_order"})
       .real("plant_rate", 20.0, "plant rate gamma [units of Omega]", Range::positive())
       .real("delay", 0.1, "measurement delay tau [units of T]", Range::non_negative())
+      .group("Smith predictor")
       .text("smith_bank", "bank", "controller inside the Smith predictor", {"bank", "infinite", "single"})
       .text("smith_structure", "periodic", "Smith predictor structure (periodic keeps exact rejection)",
             {"periodic", "classic"})

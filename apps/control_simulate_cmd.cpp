@@ -161,7 +161,8 @@ void run_simulate(const io::ParamSet& p) {
 void register_control_simulate(CLI::App& control) {
   auto params = std::make_shared<io::ParamSet>();
   add_control_params(*params);
-  params->integer("periods", 60, "number of rotation periods to simulate", 1, 10000000)
+  params->group("Simulation")
+      .integer("periods", 60, "number of rotation periods to simulate", 1, 10000000)
       .integer("steps_per_period", 2000, "fixed steps (samples) per rotation period T", 8, 100000000)
       .text("method", "ab3",
             "controller discretisation: ab3 (Adams-Bashforth 3, as in the paper), zoh (exact zero-order hold of the "
@@ -178,6 +179,7 @@ void register_control_simulate(CLI::App& control) {
       .real("delay_variation_frequency", 0.0, "angular frequency of the delay variation [units of Omega]",
             io::Range::non_negative())
       .integer("record_every", 10, "keep every n-th step in the CSV", 1, 1000000000)
+      .group("Output")
       .flag("json", false, "print the harmonic report as JSON to stdout instead of writing the CSV")
       .text("output", "out/control_simulate.csv", "output CSV path (JSON sidecar written next to it)");
   auto* cmd = control.add_subcommand(

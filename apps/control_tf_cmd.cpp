@@ -146,7 +146,8 @@ void run_tf(const io::ParamSet& p) {
 void register_control_tf(CLI::App& control) {
   auto params = std::make_shared<io::ParamSet>();
   add_control_params(*params, kMaxHarmonicsTf);
-  params->text("system", "controller",
+  params->group("Frequency response")
+      .text("system", "controller",
                "response to tabulate: controller C, plant P = exp(-s tau) P0, loop L = P C, sensitivity "
                "1/(1 + L), closed_loop (disturbance f -> output y)",
                {"controller", "plant", "loop", "sensitivity", "closed_loop"})
@@ -155,6 +156,7 @@ void register_control_tf(CLI::App& control) {
       .integer("points", 1000, "number of grid points (rows are streamed: O(N) work and O(1) memory per row)", 2,
                10000000)
       .flag("log_spacing", true, "logarithmic grid (false: linear)")
+      .group("Output")
       .flag("json", false, "print the tau = 0 stability summary as JSON to stdout instead of writing the CSV")
       .text("output", "out/control_tf.csv", "output CSV path (JSON sidecar written next to it)");
   auto* cmd = control.add_subcommand(

@@ -91,9 +91,11 @@ void register_demo(CLI::App& app) {
   params->set_default("approach_adhesion", "0.5");
   params->set_default("departure_adhesion", "1.0");
   params->set_default("frequency_ratio", "0.99");
-  params->real("separation_min", 7.0, "smallest separation of the sweep", io::Range::any())
+  params->group("Sweep")
+      .real("separation_min", 7.0, "smallest separation of the sweep", io::Range::any())
       .real("separation_max", 12.0, "largest separation of the sweep (> separation_min)", io::Range::any())
       .integer("points", 101, "separations per direction (>= 2)", 2, 1000000)
+      .group("Output")
       .text("output_dir", "out", "folder for demo_sweep.csv and demo_hb.csv (+ .json sidecars)");
   auto* cmd = app.add_subcommand("demo",
                                  "tapping-mode demonstration: approach-retract sweep with jumps and the harmonic-balance "

@@ -31,6 +31,7 @@ using io::Range;
 const char* const history_columns[] = {"t", "gap", "gap_rate", "force", "x1", "v1", "x2", "v2"};
 
 void add_impact_params(io::ParamSet& p) {
+  p.group("Bodies");
   p.real("mass1", 1.0, "mass m1 of the lower body (kg for the physical laws, docs/force-laws.md)", Range::positive())
       .real("mass2", 1.0, "mass m2 of the upper body (kg for the physical laws, docs/force-laws.md)", Range::positive())
       .real("velocity", 1.0,
@@ -41,11 +42,13 @@ void add_impact_params(io::ParamSet& p) {
       .real("gap", 1.0, "initial gap d(t_s) = x2 - x1 (nm for the physical laws); contact below the law's contact gap (0, or a0)", Range::any())
       .real("force1", 0.0, "constant external force F1 on body 1 (seed-1 eq. 1; nN for the physical laws)", Range::any())
       .real("force2", 0.0, "constant external force F2 on body 2", Range::any())
+      .group("Numerics")
       .text("method", "automatic", "solver: automatic (closed form for linear laws), closed_form, integrator",
             {"automatic", "closed_form", "integrator"})
       .real("relative_tolerance", 1e-11, "integrator relative tolerance", {0.0, 1e-2, true, false})
       .real("absolute_tolerance", 1e-13, "integrator absolute tolerance (scaled state)", Range::positive())
       .integer("points", 400, "time-history samples written with --output (>= 2; events are added)", 2, 10000000)
+      .group("Output")
       .flag("json", false, "print the result as JSON instead of the summary")
       .text("output", "", "CSV file for the time history (JSON sidecar written next to it); empty: none");
   add_law_params(p, impact::LawRegistry::builtin(), "hysteresis");

@@ -13,6 +13,7 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
                     const std::vector<std::string>& skip) {
   std::vector<std::string> summaries;
   for (const auto& name : registry.names()) summaries.push_back(fmt::format("{}: {}", name, registry.find(name).summary));
+  p.group("Contact law");
   p.text("law", default_law, fmt::format("tip-sample force law (docs/force-laws.md): {}", fmt::join(summaries, "; ")),
          registry.names())
       .text("force_curve", "",

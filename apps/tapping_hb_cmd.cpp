@@ -81,7 +81,8 @@ void run_hb(const io::ParamSet& p) {
 void register_tapping_hb(CLI::App& tapping) {
   auto params = std::make_shared<io::ParamSet>();
   add_tapping_model_params(*params);
-  params->real("q_min", -1.0, "smallest penetration parameter q = (A + l)/B of the curve", io::Range::any())
+  params->group("Harmonic balance curve")
+      .real("q_min", -1.0, "smallest penetration parameter q = (A + l)/B of the curve", io::Range::any())
       .real("q_max", 1.5, "largest q (> q_min); q >= 1 is the free oscillation", io::Range::any())
       .integer("points", 2000, "number of q samples (>= 2; the curve is held in memory, 96 bytes per sample)", 2,
                10000000)
@@ -89,6 +90,7 @@ void register_tapping_hb(CLI::App& tapping) {
             {"uniform", "refined"})
       .real("min_gap", 1e-10, "smallest 1 - q of the refined samples", {0.0, 1.0, true, true})
       .flag("minus_branch", true, "also write the '-' root of the quadratic (MATH.md E2) where it exists")
+      .group("Output")
       .text("output", "out/tapping_hb.csv", "output CSV path (JSON sidecar written next to it)");
   auto* cmd = tapping.add_subcommand(
       "hb", "harmonic-balance separation-amplitude curve over q (closed form for piecewise-linear laws, numerical "

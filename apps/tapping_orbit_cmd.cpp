@@ -183,7 +183,8 @@ void register_tapping_orbit(CLI::App& tapping) {
   auto params = std::make_shared<io::ParamSet>();
   add_tapping_model_params(*params);
   add_tapping_sim_params(*params);
-  params->flag("json", false, "print the result as JSON instead of the summary")
+  params->group("Output")
+      .flag("json", false, "print the result as JSON instead of the summary")
       .text("output", "out/tapping_orbit.csv", "output CSV path (JSON sidecar next to it); empty: no file");
   auto* cmd = tapping.add_subcommand(
       "orbit", "all periodic orbits at one separation: shooting from every HB solution, transients, a phase x "

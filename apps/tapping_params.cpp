@@ -77,11 +77,13 @@ Range below(double hi) { return {0.0, hi, true, false}; }
 }  // namespace
 
 void add_tapping_model_params(io::ParamSet& p) {
+  p.group("Model");
   p.text("units", "normalised", "unit system of the model parameters and results", {"normalised", "physical"})
       .real("quality_factor", 100.0, "quality factor Q = 1/(2ξ)", below(1e9))
       .real("frequency_ratio", 1.0, "drive frequency over natural frequency ω/ω_n", below(1e3))
       .real("separation", 10.0, "separation l (nm): sample surface at x = -l", Range::closed(-1e6, 1e6))
       // normalised units (ω_n, lengths in nm, per-unit-mass forces in nm·ω_n²)
+      .group("Model in normalised units (--units normalised)")
       .real("natural_frequency", 1.0, "[normalised] natural frequency ω_n", below(1e12))
       .real("drive_amplitude", 0.2, "[normalised] drive Γ (per unit mass)", below(1e12))
       .real("approach_stiffness", 10.0, "[normalised] K_a, sample stiffness while approaching (units of ω_n²)",
@@ -92,6 +94,7 @@ void add_tapping_model_params(io::ParamSet& p) {
       .real("departure_adhesion", 0.0, "[normalised] F_b >= F_a, attraction at contact while departing",
             Range::closed(0.0, 1e12))
       // physical units
+      .group("Model in physical units (--units physical)")
       .real("spring_constant", 40.0, "[physical] cantilever spring constant k (N/m)", below(1e6))
       .real("resonance_frequency", 300.0, "[physical] resonance frequency f0 (kHz)", below(1e7))
       .real("free_amplitude", 20.0, "[physical] free amplitude at the drive frequency (nm)", below(1e6))

@@ -3,6 +3,7 @@
 namespace afmkit::cli {
 
 void add_tapping_sim_params(io::ParamSet& p) {
+  p.group("Numerics");
   p.text("integrator", "automatic",
          "time integration: closed_form (exact, piecewise-linear laws), adaptive (DOP853, order 8, events located on "
          "its dense output; any law) or automatic",

@@ -105,7 +105,8 @@ void register_tapping_sweep(CLI::App& tapping) {
   auto params = std::make_shared<io::ParamSet>();
   add_tapping_model_params(*params);
   add_tapping_sim_params(*params);
-  params->real("separation_min", 5.0, "smallest separation of the sweep (nm)", io::Range::any())
+  params->group("Sweep")
+      .real("separation_min", 5.0, "smallest separation of the sweep (nm)", io::Range::any())
       .real("separation_max", 15.0, "largest separation of the sweep (nm), > separation_min", io::Range::any())
       .integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000)
       .text("mode", "instrument",
@@ -114,6 +115,7 @@ void register_tapping_sweep(CLI::App& tapping) {
             {"instrument", "continuation", "both"})
       .real("max_arclength_step", 0.2, "largest continuation step (nm, scaled arclength)", io::Range::positive())
       .integer("max_continuation_points", 5000, "continuation point budget", 2, 100000000)
+      .group("Output")
       .flag("json", false, "print the summary (jumps, folds) as JSON")
       .flag("quiet", false, "no progress output")
       .text("output", "out/tapping_sweep.csv", "output CSV path (JSON sidecar next to it); empty: no file");

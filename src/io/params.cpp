@@ -69,63 +69,82 @@ std::string Range::describe() const {
   return "a finite number";
 }
 
+void ParamSet::declare(const std::string& key, Entry e) {
+  e.group = group_;
+  if (!entries_.count(key)) order_.push_back(key);
+  entries_[key] = std::move(e);
+}
+ParamSet& ParamSet::group(const std::string& name) {
+  group_ = name;
+  return *this;
+}
 ParamSet& ParamSet::real(const std::string& key, double def, const std::string& help, Range range) {
-  entries_[key] = Entry{def, help, range};
-  order_.push_back(key);
+  declare(key, Entry{def, help, range});
   return *this;
 }
 ParamSet& ParamSet::integer(const std::string& key, long def, const std::string& help, long lo, long hi) {
   Entry e{def, help, Range::any()};
   e.ilo = lo;
   e.ihi = hi;
-  entries_[key] = e;
-  order_.push_back(key);
+  declare(key, std::move(e));
   return *this;
 }
 ParamSet& ParamSet::text(const std::string& key, const std::string& def, const std::string& help,
                          std::vector<std::string> choices) {
   Entry e{def, help, Range::any()};
   e.choices = std::move(choices);
-  entries_[key] = e;
-  order_.push_back(key);
+  declare(key, std::move(e));
   return *this;
 }
 ParamSet& ParamSet::flag(const std::string& key, bool def, const std::string& help) {
-  entries_[key] = Entry{def, help, Range::any()};
-  order_.push_back(key);
+  declare(key, Entry{def, help, Range::any()});
   return *this;
 }
 ParamSet& ParamSet::reals(const std::string& key, std::vector<double> def, const std::string& help, Range range) {
-  entries_[key] = Entry{std::move(def), help, range};
-  order_.push_back(key);
+  declare(key, Entry{std::move(def), help, range});
   return *this;
 }
 
 void ParamSet::add_options(CLI::App& app) {
-  app.add_option("--config", config_path_, "TOML file with parameters (keys as below, with underscores)");
+  app.add_option("--config", config_path_, "TOML file with parameters (keys as below, with underscores)")
+      ->type_name("FILE");
   for (const auto& key : order_) {
     Entry& e = entries_[key];
     std::string desc = e.help;
+    std::string type;
     std::visit(
         [&](const auto& v) {
           using T = std::decay_t<decltype(v)>;
           if constexpr (std::is_same_v<T, double>) {
+            type = "FLOAT";
             desc += fmt::format(" [default {}; {}]", v, e.range.describe());
           } else if constexpr (std::is_same_v<T, long>) {
+            type = "INT";
             desc += fmt::format(" [default {}; integer in [{}, {}]]", v, e.ilo, e.ihi);
           } else if constexpr (std::is_same_v<T, std::string>) {
+            type = e.choices.empty() ? "TEXT" : "NAME";
             desc += fmt::format(" [default '{}'{}]", v,
                                 e.choices.empty() ? "" : fmt::format("; one of {}", fmt::join(e.choices, ", ")));
           } else if constexpr (std::is_same_v<T, bool>) {
-            desc += fmt::format(" [default {}]", v ? "true" : "false");
+            desc += fmt::format(" [default {}]", v ? "on" : "off");
           } else {
+            type = "FLOAT,...";
             desc += fmt::format(" [default {}; comma-separated]", fmt::join(v, ","));
           }
         },
         e.value);
-    auto* opt = app.add_option_function<std::string>(
-        "--" + dashed(key), [&e](const std::string& s) { e.cli_text = s; }, desc);
-    if (std::holds_alternative<bool>(e.value)) opt->expected(0, 1)->default_str("true");
+    CLI::Option* opt = nullptr;
+    if (std::holds_alternative<bool>(e.value)) {
+      // a flag: `--json` turns it on, `--json=false` off (TOML: json = true / false)
+      opt = app.add_option_function<std::string>(
+          "--" + dashed(key), [&e](const std::string& s) { e.cli_text = s; }, desc);
+      opt->expected(0, 1)->type_name("");
+    } else {
+      opt = app.add_option_function<std::string>(
+          "--" + dashed(key), [&e](const std::string& s) { e.cli_text = s; }, desc);
+      opt->type_name(type);
+    }
+    opt->group(e.group);
   }
 }
 

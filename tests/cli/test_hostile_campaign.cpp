@@ -35,12 +35,13 @@ std::vector<Option> options_of(const std::string& command) {
   TempDir dir;
   const RunResult r = run_cli(command + " --help", dir);
   std::vector<Option> out;
-  const std::regex line(R"(^\s+(?:-\w,)?--([a-z0-9-]+)(\s+TEXT=true)?)");
+  // `--name TYPE` for options with a value, `--name` alone for flags
+  const std::regex line(R"(^\s+(?:-\w,)?--([a-z0-9-]+)(\s+(?:FLOAT,\.\.\.|FLOAT|INT|NAME|TEXT|FILE)\b)?)");
   std::istringstream in(r.out);
   std::string text;
   while (std::getline(in, text)) {
     std::smatch m;
-    if (std::regex_search(text, m, line) && !kSkipped.count(m[1].str())) out.push_back({m[1].str(), m[2].matched});
+    if (std::regex_search(text, m, line) && !kSkipped.count(m[1].str())) out.push_back({m[1].str(), !m[2].matched});
   }
   return out;
 }

@@ -44,6 +44,9 @@ class ParamSet {
   /// A list of reals: TOML array, or a comma-separated flag value "1,0.5,0.2".
   ParamSet& reals(const std::string& key, std::vector<double> def, const std::string& help,
                   Range range = Range::any());
+  /// Parameters declared after this call are listed under `name` in --help (model, drive, contact law, numerics,
+  /// output, …); before any call: "Options".
+  ParamSet& group(const std::string& name);
 
   /// Adds `--config FILE` and one `--<key-with-dashes>` option per parameter to `app`.
   void add_options(CLI::App& app);
@@ -80,12 +83,15 @@ class ParamSet {
     std::vector<std::string> choices;
     bool set = false;
     std::optional<std::string> cli_text;  // raw flag text captured by CLI11
+    std::string group;                    // heading in --help
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;
   std::map<std::string, Entry> entries_;
   std::vector<std::string> order_;
   std::string config_path_;
+  std::string group_ = "Options";
+  void declare(const std::string& key, Entry e);
 };
 
 }  // namespace afmkit::io
