@@ -1,5 +1,5 @@
 // afmkit control roots | margin | chart | tune: closed-loop spectra of the seed-2 harmonic-rejection loop under
-// delay (MATH.md B.2–B.9), delay margins, stability charts (Figs. 2, 4) and robust tuning.
+// delay (docs/theory-control.md#spectrum, #delay-margin), delay margins, stability charts (Figs. 2, 4) and robust tuning.
 // Units follow control_params.hpp: rates and frequencies in units of Ω, delays in units of T = 2π/Ω; every CSV
 // column and JSON value below uses the same units (roots in units of Ω, delays in units of T).
 #include <cmath>
@@ -86,7 +86,7 @@ void run_roots(const io::ParamSet& p) {
                     {"certified", "multiplicity confirmed by that count (1) or not counted (0)"},
                     {"correction", "last Newton correction / Omega"},
                     {"kind", "root (in the certified box) | near_chain (N = inf, left of the box, Newton from the "
-                             "chain asymptotics) | structural (MATH.md B.8, neutral realisation only)"}};
+                             "chain asymptotics) | structural (docs/theory-control.md#neutral-realisation; neutral realisation only)"}};
   if (p.flag("json")) {
     res["roots"] = nlohmann::json::array();
     for (const auto& r : sp.roots)
@@ -419,7 +419,7 @@ void register_control_analysis(CLI::App& control) {
   add_command(
       control, "roots",
       "rightmost closed-loop roots under delay (Newton on the exact characteristic function, certified by the "
-      "argument principle; N = inf: neutral chain bound and the MATH.md B.8 diagnosis). Cost: O(N) per evaluation "
+      "argument principle; N = inf: neutral chain bound and the structural diagnosis of docs/theory-control.md#neutral-realisation). Cost: O(N) per evaluation "
       "of the characteristic function; initial guesses by collocation (dense, N <= 40) or from the delay-free poles "
       "(Aberth, O(N^2)); certification O(N) evaluations along the box: O(N^2) in all",
       [](io::ParamSet& p) {
@@ -436,7 +436,7 @@ void register_control_analysis(CLI::App& control) {
       run_roots);
   add_command(
       control, "margin",
-      "delay margin tau_c (largest delay keeping the loop stable; crossing formulas MATH.md B.9, ext. E1/E2). Cost: "
+      "delay margin tau_c (largest delay keeping the loop stable; crossing formulas of docs/theory-control.md#delay-margin). Cost: "
       "O(N) per crossing-function evaluation on points_per_omega x (N + 1) frequencies, O(N^2) stability check",
       [](io::ParamSet& p) {
         p.group("Delay margin")

@@ -18,7 +18,7 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
                                "infinite bank (eq. 31) or Smith predictor around a bank",
          {"single", "bank", "infinite", "smith"})
       .real("rotation_frequency", 1.0, "rotation angular frequency Omega [rad/s]; rates below are in units of "
-                                       "Omega, delays in units of T = 2 pi/Omega", Range::positive())
+                                       "Omega, delays in units of T = 2 pi/Omega", Range{0.0, 1e12, true, false})
       .integer("harmonics", 10,
                max_harmonics == kMaxHarmonicsTf
                    ? "number N of oscillators of the bank (eq. 15); cost O(N) per frequency"
@@ -32,10 +32,10 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
       .reals("rejected", {1.0}, "harmonics removed from the output (bank controller), e.g. 1,3",
              Range::closed(1, static_cast<double>(max_harmonics)))
       .real("gain", 20.0, "controller gain K [units of Omega] (default: equal to plant_rate, design rule K = gamma)",
-            Range::positive())
+            Range{0.0, 1e12, true, false})
       .group("Plant and delay")
       .text("plant", "static", "plant: static y = f + u/gamma (eq. 3) or first order (eq. 1)", {"static", "first_order"})
-      .real("plant_rate", 20.0, "plant rate gamma [units of Omega]", Range::positive())
+      .real("plant_rate", 20.0, "plant rate gamma [units of Omega]", Range{0.0, 1e12, true, false})
       .real("delay", 0.1, "measurement delay tau [units of T]", Range::non_negative())
       .group("Smith predictor")
       .text("smith_bank", "bank", "controller inside the Smith predictor", {"bank", "infinite", "single"})
@@ -43,7 +43,7 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
             {"periodic", "classic"})
       .text("model_plant", "same", "kind of the Smith predictor's plant model", {"same", "static", "first_order"})
       .real("model_rate", 20.0, "Smith model rate gamma_hat [units of Omega] (default: equal to plant_rate)",
-            Range::positive())
+            Range{0.0, 1e12, true, false})
       .real("model_delay", 0.1, "Smith model delay tau_hat [units of T] (default: equal to delay)",
             Range::non_negative());
 }

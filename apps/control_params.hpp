@@ -1,5 +1,5 @@
 #pragma once
-// Shared controller/plant parameters of the `afmkit control …` commands (seed 2, MATH.md Part B).
+// Shared controller/plant parameters of the `afmkit control …` commands (seed 2, docs/theory-control.md).
 //
 // Units (nondimensional by default): rotation_frequency Ω is in rad/s (default 1, i.e. time in units of 1/Ω);
 // every RATE below (alpha, beta, a, b, gain, plant_rate, model_rate) is given in units of Ω, every DELAY

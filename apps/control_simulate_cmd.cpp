@@ -1,5 +1,5 @@
 // afmkit control simulate: time-domain closed loop of the seed-2 harmonic-rejection controller
-// (closed_loop_simulation.hpp; MATH.md B.1–B.3, B.8, B.10). Writes the time series as CSV
+// (closed_loop_simulation.hpp; docs/theory-control.md#simulation). Writes the time series as CSV
 //   t [s], y (plant output), u (control), m = y(t − τ) (measurement), target (uncontrolled steady state without the
 //   rejected harmonics: f_k for the static plant, γ f_k/(γ + ikΩ) for the first-order plant), f_minus_f1 (f − f^(1))
 // with a JSON sidecar holding the harmonic report; --json prints the report instead.

@@ -1,5 +1,5 @@
 // afmkit control tf: frequency response of the seed-2 controller, plant, loop, sensitivity or closed loop
-// (MATH.md B.2–B.7) on a frequency grid, as CSV (frequency, magnitude, phase, real, imag) with a JSON sidecar
+// (seed-2 eqs. 10, 18, 25, 28–31) on a frequency grid, as CSV (frequency, magnitude, phase, real, imag) with a JSON sidecar
 // holding the τ = 0 stability verdicts (eqs. 13, 22–24, 40–42, β_c(N)) and |S| at the harmonics.
 //   frequency is ω/Ω (harmonic number; the grid bounds frequency_min/max are in the same unit),
 //   magnitude = |G(iω)|, phase = arg G(iω) unwrapped along the grid [rad], real/imag = G(iω).
@@ -151,8 +151,8 @@ void register_control_tf(CLI::App& control) {
                "response to tabulate: controller C, plant P = exp(-s tau) P0, loop L = P C, sensitivity "
                "1/(1 + L), closed_loop (disturbance f -> output y)",
                {"controller", "plant", "loop", "sensitivity", "closed_loop"})
-      .real("frequency_min", 0.01, "lowest frequency of the grid [units of Omega]", io::Range::non_negative())
-      .real("frequency_max", 10.0, "highest frequency of the grid [units of Omega]", io::Range::positive())
+      .real("frequency_min", 0.01, "lowest frequency of the grid [units of Omega]", io::Range::closed(0.0, 1e12))
+      .real("frequency_max", 10.0, "highest frequency of the grid [units of Omega]", io::Range{0.0, 1e12, true, false})
       .integer("points", 1000, "number of grid points (rows are streamed: O(N) work and O(1) memory per row)", 2,
                10000000)
       .flag("log_spacing", true, "logarithmic grid (false: linear)")

@@ -86,7 +86,7 @@ void run_demo(const io::ParamSet& p) {
 void register_demo(CLI::App& app) {
   auto params = std::make_shared<io::ParamSet>();
   add_tapping_model_params(*params);
-  // The demonstration case of MATH.md A.8: attraction makes the amplitude curve fold and jump.
+  // The demonstration case of docs/theory-tapping.md#hb-accuracy: attraction makes the amplitude curve fold and jump.
   params->set_default("law", "attractive");
   params->set_default("approach_adhesion", "0.5");
   params->set_default("departure_adhesion", "1.0");

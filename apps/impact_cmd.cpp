@@ -1,4 +1,4 @@
-// afmkit impact: one two-body impact with a hysteresis force law (seed-1 §II, eqs. 1–6; MATH.md A.1).
+// afmkit impact: one two-body impact with a hysteresis force law (seed-1 §II, eqs. 1–6; docs/theory-tapping.md#impact).
 // Prints a summary (or the result as JSON with --json); --output FILE writes the time history as CSV
 // (t, gap, gap_rate, force, x1, v1, x2, v2) with a JSON sidecar holding the parameters and the summary.
 //

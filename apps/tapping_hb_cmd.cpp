@@ -1,4 +1,4 @@
-// afmkit tapping hb: the harmonic-balance separation–amplitude curve (seed-1 eqs. 18–19, 32–33, MATH.md A.7; any
+// afmkit tapping hb: the harmonic-balance separation–amplitude curve (seed-1 eqs. 18–19, 32–33, docs/theory-tapping.md#two-branch-solution; any
 // force law, issue 7.2) sampled over the penetration parameter q, as CSV (q, separation, amplitude, offset, phase,
 // branch) with a JSON sidecar holding the folds (jump points), the free amplitude and the solutions at `separation`.
 #include <memory>
@@ -89,7 +89,7 @@ void register_tapping_hb(CLI::App& tapping) {
       .text("spacing", "refined", "q sampling: uniform, or refined (half the samples log-spaced in 1 - q near grazing)",
             {"uniform", "refined"})
       .real("min_gap", 1e-10, "smallest 1 - q of the refined samples", {0.0, 1.0, true, true})
-      .flag("minus_branch", true, "also write the '-' root of the quadratic (MATH.md E2) where it exists")
+      .flag("minus_branch", true, "also write the '-' root of the quadratic (docs/theory-tapping.md#two-branch-solution) where it exists")
       .group("Output")
       .text("output", "out/tapping_hb.csv", "output CSV path (JSON sidecar written next to it)");
   auto* cmd = tapping.add_subcommand(

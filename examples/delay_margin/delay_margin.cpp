@@ -1,4 +1,5 @@
-// How much measurement delay does the first-harmonic rejection loop tolerate? (seed 2, MATH.md B.9)
+// How much measurement delay does the first-harmonic rejection loop tolerate? (seed 2,
+// docs/theory-control.md#delay-margin)
 //
 // A rotational-scanning AFM turns the sample at f_rot = 10 Hz; the height loop (static plant, rate γ = 20 Ω)
 // removes the sample tilt (first harmonic) with the oscillator-bank controller (couplings α = 0.1 Ω,

@@ -146,7 +146,7 @@ cplx infinite_tf(const InfiniteBank& bank, cplx s) {
 }
 
 cplx infinite_tf_quasi(const InfiniteBank& bank, cplx s) {
-  // cancelled double zeros of 𝒜 − ℬe^{−sT} at s = 0, ±iΩ (MATH.md B.7): take the limit
+  // cancelled double zeros of 𝒜 − ℬe^{−sT} at s = 0, ±iΩ (docs/theory-control.md#infinite-bank): take the limit
   if (at_harmonic(s, bank.rotation_frequency) && std::abs(s.imag()) <= bank.rotation_frequency)
     return limit_value(bank, s);
   const auto a = bank.a_coefficients(), b = bank.b_coefficients();
@@ -168,7 +168,7 @@ cplx infinite_tf_quasi(const InfiniteBank& bank, cplx s) {
     num = nn * (zi - 1.0);
     den = an * zi - bn;
   }
-  if (den == 0.0) return limit_value(bank, s);  // cancelled zeros at s = 0, ±iΩ (MATH.md B.7)
+  if (den == 0.0) return limit_value(bank, s);  // cancelled zeros at s = 0, ±iΩ (docs/theory-control.md#infinite-bank)
   return num / den;  // (31)
 }
 

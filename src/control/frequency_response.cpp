@@ -25,7 +25,8 @@ double frequency_grid_point(double lo, double hi, long points, bool log_spacing,
   if (i <= 0) return lo;
   if (i >= points - 1) return hi;
   const double t = static_cast<double>(i) / static_cast<double>(points - 1);
-  return log_spacing ? lo * std::pow(hi / lo, t) : lo + (hi - lo) * t;
+  // log grid as exp of a linear one: hi/lo may overflow (e.g. 10/1e-308) where log(lo), log(hi) do not
+  return log_spacing ? std::exp(std::log(lo) + (std::log(hi) - std::log(lo)) * t) : lo + (hi - lo) * t;
 }
 
 double PhaseUnwrapper::operator()(double x) {

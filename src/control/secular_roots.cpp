@@ -1,7 +1,8 @@
-// Delay-free roots of the seed-2 loop and the bank's eigenvalues without dense matrices (MATH.md B.3, B.5):
-// both are the roots of a polynomial known only through its logarithmic derivative, evaluated in O(N) per point
-// from the pole-free forms of loop.hpp, and found all at once by the Aberth–Ehrlich iteration started from the
-// first-order root positions ikΩ − g_k (seed-2 eq. 45; g_k = (a_k + i b_k)/2, Appendix A eq. 34).
+// Delay-free roots of the seed-2 loop and the bank's eigenvalues without dense matrices (seed-2 eqs. 19, 22;
+// docs/theory-control.md#oscillator-bank, #stability-tau0): both are the roots of a polynomial known only through its
+// logarithmic derivative, evaluated in O(N) per point from the pole-free forms of loop.hpp, and found all at once by
+// the Aberth–Ehrlich iteration started from the first-order root positions ikΩ − g_k (seed-2 eq. 45;
+// g_k = (a_k + i b_k)/2, Appendix A eq. 34).
 // Cost: O(N) per logarithmic derivative, O(N²) per sweep (the Aberth sums), a few sweeps.
 #include <algorithm>
 #include <cmath>

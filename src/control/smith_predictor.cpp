@@ -59,7 +59,7 @@ SmithRealisation smith_realisation(const SmithPredictor& sp) {
   const auto* bank = std::get_if<OscillatorBank>(&sp.bank);
   if (!bank)
     throw InvalidParameter("bank", "bank: a state-space realisation needs a finite OscillatorBank (the N = infinity "
-                                   "bank is a neutral delay system, MATH.md B.8)");
+                                   "bank is a neutral delay system, docs/theory-control.md#neutral-realisation)");
   return {ss(*bank), ss(sp.model_kind, sp.model_rate), sp.measurement_delay(), sp.correction_delay()};
 }
 

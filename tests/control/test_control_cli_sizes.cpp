@@ -69,7 +69,7 @@ TEST_F(ControlCliSizes, TfAtN1000MatchesStateSpaceAndN100000Answers) {
   const CliResult r = run("control tf --harmonics 1000 --points 5 --frequency-min 0.55 --frequency-max 2.55 "
                     "--log-spacing false --output tf.csv");
   ASSERT_EQ(r.status, 0) << r.err;
-  // independent: C(iω) = K c_1ᵀ (iωI − A)⁻¹ b with 2×2 blocks and Sherman–Morrison (MATH.md B.3), α = 0.1,
+  // independent: C(iω) = K c_1ᵀ (iωI − A)⁻¹ b with 2×2 blocks and Sherman–Morrison (seed-2 eqs. 37–39), α = 0.1,
   // β = −0.1, K = 20, Ω = 1: x-component of block k: (a_k s − kΩ b_k)/(s² + k²)
   const auto rows = afmkit::control::testing::read_tf_csv(dir_ / "tf.csv");
   for (const auto& row : rows) {
@@ -94,13 +94,14 @@ TEST_F(ControlCliSizes, RootsMarginChartTuneSimulateAnswerAtN1000) {
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(j["complete"].get<bool>());
-  EXPECT_LT(j["spectral_abscissa"].get<double>(), 0.0);  // τ = 0.1T < τ_c ≈ 0.29T (MATH.md B.9)
+  EXPECT_LT(j["spectral_abscissa"].get<double>(), 0.0);  // τ = 0.1T < τ_c ≈ 0.29T (docs/theory-control.md#delay-margin)
 
   // N = 1000 is the documented maximum of roots, margin, chart, tune and simulate (docs/commands.md)
   r = run("control margin --harmonics 1000 --json");
   ASSERT_EQ(r.status, 0) << r.err;
   j = nlohmann::json::parse(r.out);
-  // N → ∞ value τ_c/T = 0.294 at (α, β) = (0.1, −0.1) (MATH.md B.9); finite-N corrections are O(1/N)
+  // N → ∞ value τ_c/T = 0.294 at (α, β) = (0.1, −0.1) (docs/theory-control.md#delay-margin); finite-N corrections are
+  // O(1/N)
   EXPECT_NEAR(j["critical_delay"].get<double>(), 0.294, 0.005);
 
   r = run("control chart --harmonics 1000 --x-points 2 --y-points 2 --x-min 0.05 --x-max 0.15 --y-min -0.15 "

@@ -1,4 +1,4 @@
-// Closed-form controller transfer functions (MATH.md B.2–B.7) against state space and each other.
+// Closed-form controller transfer functions (seed-2 eqs. 10, 18, 25, 28–31) against state space and each other.
 #include <gtest/gtest.h>
 
 #include <numbers>
@@ -150,7 +150,7 @@ TEST(ControllerTf, InfiniteForms29And31AgreeAndAreTheLimitOfCN) {
     worst = std::max(worst, rel_err(controller_response(inf, s), infinite_tf(inf, s)));
   }
   EXPECT_LT(worst, 1e-11);
-  // |C_N − C∞| ≈ 1.14/N at the points of check_seed2_tf.py (MATH.md B.7)
+  // |C_N − C∞| ≈ 1.14/N at the points of the independent reference check (docs/theory-control.md#infinite-bank)
   const std::vector<cplx> pts{{0.0, 0.37 * kOmega}, {0.0, 1.5 * kOmega}, {0.0, 2.71 * kOmega}, {0.0, 5.5 * kOmega},
                               {0.2, 3.3}, {1.0, 0.5}};
   double prev = 1e9;

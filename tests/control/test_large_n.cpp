@@ -1,7 +1,7 @@
 // Large banks (issue 6): the O(N) transfer function and the O(N²) eigenvalues checked against independent
-// computations — the state-space solve C(s) = K c_rᵀ (sI − A)⁻¹ b (MATH.md B.3) done here with 2×2 block inverses
-// and Sherman–Morrison (A = A0 − b c_eᵀ is block-diagonal plus rank one), a dense LU solve at moderate N, dense
-// eigenvalues at moderate N, and the trace identities Σλ = tr A, Σλ² = tr A² at N = 1000.
+// computations — the state-space solve C(s) = K c_rᵀ (sI − A)⁻¹ b (docs/theory-control.md#oscillator-bank) done here
+// with 2×2 block inverses and Sherman–Morrison (A = A0 − b c_eᵀ is block-diagonal plus rank one), a dense LU solve at
+// moderate N, dense eigenvalues at moderate N, and the trace identities Σλ = tr A, Σλ² = tr A² at N = 1000.
 #include <gtest/gtest.h>
 
 #include <algorithm>

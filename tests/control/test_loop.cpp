@@ -1,5 +1,6 @@
 // Closed loop: characteristic function Δ(s) vs the delay-differential determinant and τ = 0 eigenvalues,
-// its derivative vs finite differences, limits and identities of MATH.md B.5–B.8, sensitivities, Smith predictor.
+// its derivative vs finite differences, limits and identities of docs/theory-control.md (seed-2 eqs. 20–33),
+// sensitivities, Smith predictor.
 #include <gtest/gtest.h>
 
 #include <numbers>
@@ -165,7 +166,7 @@ TEST(Loop, InfiniteBankIsTheLimitOfFiniteBanksAndTheReducedQuasiPolynomial) {
                          characteristic(loop_inf, s);
     EXPECT_LT(rel_err(reduced, quasi), 1e-11) << s;
   }
-  // the reduced Δ has no roots at the cancelled points 0, ±iΩ (MATH.md B.8 caveat)
+  // the reduced Δ has no roots at the cancelled points 0, ±iΩ (docs/theory-control.md#neutral-realisation caveat)
   EXPECT_GT(std::abs(characteristic(loop_inf, 0.0)), 1e-3);
   EXPECT_GT(std::abs(characteristic(loop_inf, cplx(0.0, kOmega))), 1e-3);
 }

@@ -1,5 +1,5 @@
-// τ = 0 stability (MATH.md B.2, B.5): conditions (13), (22), (40)–(42), (45), β_c(N), (24), against
-// closed-loop eigenvalues (A − (K/γ) b c_1ᵀ for the static plant) and perturbed polynomial roots.
+// τ = 0 stability (docs/theory-control.md#single-oscillator, #stability-tau0): conditions (13), (22), (40)–(42), (45),
+// β_c(N), (24), against closed-loop eigenvalues (A − (K/γ) b c_1ᵀ for the static plant) and perturbed polynomial roots.
 #include <gtest/gtest.h>
 
 #include <numbers>

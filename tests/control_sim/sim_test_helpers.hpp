@@ -1,7 +1,7 @@
 #pragma once
 // Independent reference computations for the control_sim tests: adaptive Runge–Kutta (Boost.Odeint
 // Dormand–Prince 5(4)) integration of linear systems, and a Newton solver for the one-oscillator characteristic
-// quasi-polynomial (MATH.md B.2, B.9).
+// quasi-polynomial (seed-2 eq. 12, docs/theory-control.md#delay-margin).
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -42,7 +42,7 @@ inline std::complex<double> one_oscillator_root(double omega, double a, double b
   return s;
 }
 
-/// Critical delay of eq. (12) (MATH.md B.9 ext. E1) and the crossing frequency ν, for b = 0:
+/// Critical delay of eq. (12) (seed-2 ext. E1) and the crossing frequency ν, for b = 0:
 /// ν⁴ − (2Ω² + ρ²a²)ν² + Ω⁴ = 0, e^{−iντ} = (ν² − Ω²)/(ρ i a ν); smallest positive τ over both roots ν².
 inline std::pair<double, double> one_oscillator_critical_delay(double omega, double a, double rho) {
   const double p = 2.0 * omega * omega + rho * rho * a * a;

@@ -1,6 +1,7 @@
-// Closed-loop simulation against independent results: the analytic steady state (MATH.md B.1, B.3: first harmonic
-// removed, harmonics 0, 2..N equal to f_k or γ f_k/(γ + ikΩ)), the rightmost root of the one-oscillator
-// quasi-polynomial (eq. 12, Newton), a Runge–Kutta integration of plant (1) between samples, and input validation.
+// Closed-loop simulation against independent results: the analytic steady state
+// (docs/theory-control.md#oscillator-bank: first harmonic removed, harmonics 0, 2..N equal to f_k or γ f_k/(γ + ikΩ)),
+// the rightmost root of the one-oscillator quasi-polynomial (eq. 12, Newton), a Runge–Kutta integration of plant (1)
+// between samples, and input validation.
 #include <gtest/gtest.h>
 
 #include <boost/numeric/odeint.hpp>
@@ -17,7 +18,7 @@ using namespace afmkit::control;
 namespace {
 constexpr double kOmega = 1.0;
 constexpr double kT = 2.0 * std::numbers::pi;
-constexpr double kGamma = 20.0;  // γ = 20 Ω (Fig. 3/5 parameters, MATH.md B.11)
+constexpr double kGamma = 20.0;  // γ = 20 Ω (Fig. 3/5 parameters, docs/theory-control.md#simulation)
 
 OscillatorBank fig5_bank(double gain = kGamma) { return OscillatorBank::with_couplings(kOmega, 10, 0.1, -0.1, gain); }
 
@@ -55,7 +56,7 @@ TEST_P(Ab3SteadyState, FirstHarmonicRemovedOthersPreserved) {
   const auto res = simulate_closed_loop(plant, fig5_bank(), opts(60, 2000));
   const auto& r = res.report;
   ASSERT_FALSE(r.diverged);
-  // AB3 integrator floor: O(h³), MATH.md B.10 reports 7.15e-8 at 2000 steps per period.
+  // AB3 integrator floor: O(h³), docs/theory-control.md#simulation reports 7.15e-8 at 2000 steps per period.
   EXPECT_LT(r.residual_first_harmonic, 2e-7);
   ASSERT_EQ(r.harmonics.size(), 10u);  // k = 0, 2..10
   for (const auto& hc : r.harmonics) {
@@ -96,7 +97,7 @@ TEST(ClosedLoopSimulation, ZeroOrderHoldRemovesFirstHarmonicExactly) {
 }
 
 TEST(ClosedLoopSimulation, GainMismatchStillRejects) {
-  // K = γ̂ ≠ γ (MATH.md B.10: K = 0.5γ and 2γ still converge)
+  // K = γ̂ ≠ γ (docs/theory-control.md#simulation: K = 0.5γ and 2γ still converge)
   const Plant plant = fig5_plant(PlantKind::Static, 0.1);
   for (double rho : {0.5, 2.0}) {
     const auto r = simulate_closed_loop(plant, fig5_bank(rho * kGamma), opts(80, 2000)).report;
@@ -146,7 +147,8 @@ TEST(ClosedLoopSimulation, FirstOrderPlantStepIsExact) {
 }
 
 TEST(ClosedLoopSimulation, GrowthRateEqualsRightmostRootAboveCriticalDelay) {
-  // One oscillator (5),(6), (a, b) = (0.5, 0)Ω, K = γ, static plant (3): τ_c/T = 0.195 (MATH.md B.9).
+  // One oscillator (5),(6), (a, b) = (0.5, 0)Ω, K = γ, static plant (3): τ_c/T = 0.195
+  // (docs/theory-control.md#delay-margin).
   const double a = 0.5 * kOmega;
   const auto [tau_c, nu] = simref::one_oscillator_critical_delay(kOmega, a, 1.0);
   EXPECT_NEAR(tau_c / kT, 0.195, 5e-4);

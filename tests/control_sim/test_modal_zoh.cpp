@@ -34,7 +34,7 @@ TEST(ModalZoh, MatchesDenseZeroOrderHold) {
 }
 
 TEST(ModalZoh, LargeBankSimulationRejectsFirstHarmonic) {
-  // N = 300: zoh and ab3 both converge to the same steady state (MATH.md B.3 target); zoh is O(N) per step
+  // N = 300: zoh and ab3 both converge to the same steady state (seed-2 eq. 16 target); zoh is O(N) per step
   const auto bank = OscillatorBank::with_couplings(1.0, 300, 0.3, -0.1, 20.0);
   const Plant plant(PlantKind::Static, 20.0, 1.0, 0.1 * 2.0 * 3.141592653589793, Disturbance::paper_example(1));
   SimulationOptions o;

@@ -1,10 +1,13 @@
-// Fig. 7 of seed 2: the N = ∞ neutral realisation (eqs. 32–33) vs the truncated bank (eq. 15), MATH.md B.8.
-//  * convergence of the truncated controller to the neutral one as N grows (∝ 1/N, MATH.md: 0.32, 0.081 for
+// Fig. 7 of seed 2: the N = ∞ neutral realisation (eqs. 32–33) vs the truncated bank (eq. 15),
+// docs/theory-control.md#neutral-realisation.
+//  * convergence of the truncated controller to the neutral one as N grows (∝ 1/N,
+//    docs/theory-control.md#simulation: 0.32, 0.081 for
 //    N = 10, 40 over 40 periods),
 //  * long-run residual of the first harmonic: first order in h for the neutral form, third order for the bank
-//    (MATH.md: 1.04e-3/5.2e-4/2.6e-4 vs 4.6e-6/5.7e-7/7.2e-8 at 500/1000/2000 steps per period),
+//    (docs/theory-control.md#simulation: 1.04e-3/5.2e-4/2.6e-4 vs 4.6e-6/5.7e-7/7.2e-8 at 500/1000/2000
+//    steps per period),
 //  * the cause: the closed-loop quasi-polynomial of the neutral realisation vanishes at s = iΩ and s = 0
-//    (cancelled factors, MATH.md B.7), i.e. it has roots exactly on the imaginary axis.
+//    (cancelled factors, docs/theory-control.md#infinite-bank), i.e. it has roots exactly on the imaginary axis.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -45,8 +48,8 @@ TEST(NeutralRealisation, TruncatedBankConvergesToItAsOneOverN) {
     dev[idx++] = d;
   }
   EXPECT_GT(dev[0], 0.1);
-  EXPECT_LT(dev[0], 1.0);                  // MATH.md: 0.32
-  EXPECT_NEAR(dev[0] / dev[1], 4.0, 1.2);  // ∝ 1/N (MATH.md: 0.32/0.081 = 3.95)
+  EXPECT_LT(dev[0], 1.0);                  // docs/theory-control.md#simulation: 0.32
+  EXPECT_NEAR(dev[0] / dev[1], 4.0, 1.2);  // ∝ 1/N (docs/theory-control.md#simulation: 0.32/0.081 = 3.95)
 }
 
 TEST(NeutralRealisation, LongRunErrorIsFirstOrderInStepTruncatedIsThirdOrder) {
@@ -63,7 +66,8 @@ TEST(NeutralRealisation, LongRunErrorIsFirstOrderInStepTruncatedIsThirdOrder) {
     EXPECT_NEAR(std::log2(neutral[j] / neutral[j + 1]), 1.0, 0.3) << j;      // O(h)
     EXPECT_NEAR(std::log2(truncated[j] / truncated[j + 1]), 3.0, 0.3) << j;  // O(h³)
   }
-  // magnitudes as in MATH.md B.8 (random phases of f differ, so only the order of magnitude is compared)
+  // magnitudes as in docs/theory-control.md#simulation (random phases of f differ, so only the order of magnitude is
+  // compared)
   EXPECT_GT(neutral[0], 3e-4);
   EXPECT_LT(neutral[0], 3e-3);
   EXPECT_GT(truncated[2], 2e-8);

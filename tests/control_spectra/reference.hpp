@@ -1,8 +1,9 @@
 #pragma once
 // Independent references for the spectra tests:
 //  * full-state Chebyshev collocation of the infinitesimal generator (Breda–Maset–Vermiglio, the algorithm of
-//    MATH.md checks/seed2_common.dde_eigs) on delay-differential matrices assembled here from the controller's
-//    state-space matrices (OscillatorBank::state_matrix etc.), not from loop.hpp's characteristic function;
+//    the independent check in docs/theory-control.md#delay-margin) on delay-differential matrices assembled here from
+//    the controller's state-space matrices (OscillatorBank::state_matrix etc.), not from loop.hpp's characteristic
+//    function;
 //  * the neutral quasi-polynomial γ(𝒜 − ℬe^{−sT}) + e^{−sτ}𝒩(1 − e^{−sT}) from the InfiniteBank coefficients.
 #include <complex>
 #include <numbers>

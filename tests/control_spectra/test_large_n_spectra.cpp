@@ -1,7 +1,7 @@
 // Spectra of large banks (issue 6): the margin at N = 200 and 1000 checked by the certified spectrum just below
 // and above τ_c (argument-principle counts on Δ, an independent route from the crossing search), convergence of
-// τ_c(N) toward the N = ∞ value of MATH.md B.9, and the rightmost roots at N = 400 checked by the Δ residual and
-// the certified count.
+// τ_c(N) toward the N = ∞ value of docs/theory-control.md#delay-margin, and the rightmost roots at N = 400 checked by
+// the Δ residual and the certified count.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -30,7 +30,7 @@ TEST(LargeNSpectra, MarginIsConfirmedByCertifiedCountsAtN200) {
 }
 
 TEST(LargeNSpectra, MarginConvergesToTheInfiniteBank) {
-  // MATH.md B.9: τ_c/T = 0.294 for N = ∞ at (α, β) = (0.1, −0.1)Ω, K = γ
+  // docs/theory-control.md#delay-margin: τ_c/T = 0.294 for N = ∞ at (α, β) = (0.1, −0.1)Ω, K = γ
   const double inf = delay_margin(LoopSpec(InfiniteBank(1.0, 0.1, -0.1, kGamma), PlantKind::Static, kGamma, 0.0)).upper;
   EXPECT_NEAR(inf / kT, 0.294, 5e-4);
   const double e100 = std::abs(delay_margin(bank_loop(100, 0.0)).upper - inf);

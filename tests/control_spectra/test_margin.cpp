@@ -1,6 +1,6 @@
-// Delay margins: MATH.md B.9 numbers, E1 closed form vs E2 search, and every τ_c checked by the spectrum just
-// below (0.97 τ_c: stable) and above (1.03 τ_c: unstable) — by the independent full-state collocation for finite
-// banks and by the argument principle for N = ∞ and the Smith predictor.
+// Delay margins: the numbers of docs/theory-control.md#delay-margin, E1 closed form vs E2 search, and every τ_c checked
+// by the spectrum just below (0.97 τ_c: stable) and above (1.03 τ_c: unstable) — by the independent full-state
+// collocation for finite banks and by the argument principle for N = ∞ and the Smith predictor.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -50,7 +50,7 @@ TEST(DelayMargin, InfiniteBankMathMdValues) {
     EXPECT_EQ(unstable_roots(loop.with_delay(0.97 * m.upper)).count, 0);
     EXPECT_GT(unstable_roots(loop.with_delay(1.03 * m.upper)).count, 0);
   }
-  // gain-estimate mismatch (MATH.md B.9): ρ = 0.5 → 0.327 T, ρ = 2 → 0.239 T
+  // gain-estimate mismatch (docs/theory-control.md#delay-margin): ρ = 0.5 → 0.327 T, ρ = 2 → 0.239 T
   for (const auto& [rho, expected] : {std::pair{0.5, 0.327}, std::pair{2.0, 0.239}}) {
     const LoopSpec loop(InfiniteBank(kOmega, 0.1, -0.1, rho * kGamma), PlantKind::Static, kGamma, 0.0);
     EXPECT_NEAR(delay_margin(loop).upper / kT, expected, 5e-4);
@@ -75,7 +75,8 @@ TEST(DelayMargin, ClosedFormE1EqualsGeneralSearchE2) {
 }
 
 TEST(DelayMargin, CriticalDelaysBracketTheSpectrumCrossing) {
-  // finite banks: checked by the independent full-state collocation (MATH.md checks 40/40 and 25/25 analogues)
+  // finite banks: checked by the independent full-state collocation (analogues of the 40/40 and 25/25 checks of
+  // docs/theory-control.md#delay-margin)
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> ua(0.05, 2.0), ub(-2.0, 0.95), ual(0.02, 1.0), ube(-0.22, 1.0);
   int checked = 0;
@@ -95,7 +96,7 @@ TEST(DelayMargin, CriticalDelaysBracketTheSpectrumCrossing) {
     EXPECT_GT(reference_abscissa(bank, PlantKind::Static, kGamma, 1.03 * m.upper), 0.0);
     ++checked;
   }
-  // N = 10 (MATH.md: 25/25 with the Python collocation): argument-principle counts on Δ
+  // N = 10 (theory-control.md#delay-margin: 25/25 with an independent collocation): argument-principle counts on Δ
   for (int i = 0; i < 6; ++i) {
     const LoopSpec loop(OscillatorBank::with_couplings(kOmega, 10, ual(rng), ube(rng), kGamma), PlantKind::Static,
                         kGamma, 0.0);

@@ -44,7 +44,7 @@ TEST(Spectrum, SingleOscillatorMatchesCollocationAndMathMd) {
   const Spectrum sp = rightmost_roots(loop);
   ASSERT_TRUE(sp.complete);
   EXPECT_TRUE(sp.box_is_proven);
-  // MATH.md B.2: rightmost root +0.0102 for τ = 0.2T (simulation diverges)
+  // Fig. 3 case (docs/theory-control.md#simulation): rightmost root +0.0102 for τ = 0.2T (simulation diverges)
   EXPECT_NEAR(sp.spectral_abscissa, 0.0102, 5e-5);
   EXPECT_EQ(sp.unstable_count, 2);
   expect_matches_reference(sp, test::reference_roots(bank, PlantKind::Static, kGamma, 0.2 * kT, 60), 1e-8);
@@ -144,7 +144,7 @@ TEST(Spectrum, InfiniteBankNeutralChainAndStructuralRoots) {
   EXPECT_NEAR(*sp.neutral_bound, std::log(std::abs(r)) / kT, 1e-14);
   EXPECT_GT(sp.spectral_abscissa, 0.0);  // τ = 0.1T > τ_c = 0.089T
   EXPECT_EQ(sp.unstable_count, 2);
-  // every root is a zero of the neutral quasi-polynomial built from the 𝒜, ℬ, 𝒩 coefficients (MATH.md B.7)
+  // every root is a zero of the neutral quasi-polynomial built from the 𝒜, ℬ, 𝒩 coefficients (seed-2 eq. 31)
   for (const auto& root : sp.roots) {
     const cplx s = root.value;
     const double scale = std::abs(test::neutral_quasi_polynomial(bank, kGamma, tau, s + 1e-3)) / 1e-3;

@@ -1,4 +1,5 @@
-// Closed-form impacts with piecewise-linear hysteresis (seed-1 eqs. 2, 3, 6, 11, 26; MATH.md A.1, ext. E0).
+// Closed-form impacts with piecewise-linear hysteresis (seed-1 eqs. 2, 3, 6, 11, 26, ext. E0;
+// docs/theory-tapping.md#impact).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,7 +15,7 @@ double momentum(const Body& a, const Body& b) { return a.mass * a.velocity + b.m
 }  // namespace
 
 TEST(ImpactClosedForm, RestitutionIsSqrtOfStiffnessRatio) {
-  // MATH.md ext. E0: e = √(K_b/K_a), independent of masses and speed; loss = ½(K_a − K_b)δ² (eq. 6) =
+  // seed-1 ext. E0: e = √(K_b/K_a), independent of masses and speed; loss = ½(K_a − K_b)δ² (eq. 6) =
   // (1 − e²) μ/2 v² (eq. 3) = direct kinetic-energy difference.
   for (double ratio : {1.0, 1.25, 4.0, 100.0}) {
     for (auto [m1, m2, speed] : {std::tuple{1.0, 1.0, 1.0}, std::tuple{3.0, 0.2, 2.5}, std::tuple{1e-11, 1e-9, 1e6}}) {

@@ -1,5 +1,5 @@
 // Edge cases of the impact solvers (issue 6): nearly elastic impacts (e -> 1, seed-1 eqs. 2, 3, 6 and
-// MATH.md ext. E0), laws that would create energy (K_b > K_a), extreme inputs, and the streamed history.
+// ext. E0), laws that would create energy (K_b > K_a), extreme inputs, and the streamed history.
 #include <gtest/gtest.h>
 
 #include <cfloat>
@@ -49,7 +49,7 @@ Reference reference(ld ka, ld kb, ld fa, ld fb, ld mu, ld g, ld d0, ld v0) {
 }  // namespace
 
 // Defect 1: nearly elastic impacts. Closed form e = √(K_b/K_a), ΔE = (1 − e²) μ v²/2 = (K_a − K_b)/K_a · μ v²/2
-// (MATH.md ext. E0, seed-1 eq. 3), evaluated in long double from the stored K_a, K_b (K_a − K_b is exact).
+// (seed-1 ext. E0 and eq. 3), evaluated in long double from the stored K_a, K_b (K_a − K_b is exact).
 TEST(NearlyElastic, ClosedFormKeepsRelativeAccuracyOfOneMinusEAndTheLoss) {
   static_assert(LDBL_MANT_DIG >= 64, "the reference needs extended precision");
   for (double deficit : deficits) {

@@ -14,7 +14,7 @@ namespace {
 using impact::PiecewiseLinearLaw;
 
 TappingModel resonant(double ka, double l, double w = 1.0) {
-  // Q = 100, Γ|L(iω_n)| = 20 (MATH.md A.10 proposal), e = 0.8.
+  // Q = 100, Γ|L(iω_n)| = 20 (the Figs. 3–4 values of docs/theory-tapping.md#large-stiffness), e = 0.8.
   return TappingModel(Cantilever(1.0, 100.0), Drive(0.2, w), PiecewiseLinearLaw::linear_hysteresis(ka, 0.64 * ka), l);
 }
 
@@ -97,7 +97,7 @@ TEST(Approximations, LimitE8ByEvaluationAtVeryNegativeQ) {
     ASSERT_TRUE(far.has_value());
     EXPECT_NEAR(far->separation, *limit, 1e-6 * std::max(1.0, std::abs(*limit)));  // l − l_∞ = O(1/q)
   }
-  // MATH.md A.4 values (printed to 4 decimals): −2.9845 (K_a = 1), −1.5708 (K_a = 10).
+  // docs/theory-tapping.md#minimum-separation values (printed to 4 decimals): −2.9845 (K_a = 1), −1.5708 (K_a = 10).
   auto e08 = [](double ka) {
     return TappingModel(Cantilever(1.0, 100.0), Drive(0.2, 1.0), PiecewiseLinearLaw::linear_hysteresis(ka, 0.8 * ka), 0.0);
   };

@@ -152,7 +152,8 @@ TEST(ClosedForms, PhaseConventionAgainstTimeDomainSimulation) {
   mean /= n;
   const double amp_c = 2 * c / n, amp_s = 2 * s / n;  // x ≈ A + B cos φ cos ωt + B sin φ sin ωt
   const double amplitude = std::hypot(amp_c, amp_s), phase = std::atan2(amp_s, amp_c);
-  // HB is a one-harmonic approximation: MATH.md A.8 reports B within 1–2 %, A within 0.3 %, φ within 0.005.
+  // HB is a one-harmonic approximation: docs/theory-tapping.md#hb-accuracy reports B within 1–2 %, A within 0.3 %, φ
+  // within 0.005.
   EXPECT_NEAR(amplitude / hb.amplitude, 1.0, 0.02);
   EXPECT_NEAR(mean, hb.offset, 0.01 * std::abs(hb.offset));
   EXPECT_NEAR(phase, hb.phase, 0.01);

@@ -87,7 +87,8 @@ TEST(Folds, LocatedTo1e10AndChangeTheNumberOfSolutions) {
 }
 
 TEST(Folds, MathMdExample) {
-  // MATH.md A.7: l_max = 14.7161 at q = 0.998443 (python dense grid; grid spacing ~1e-6 there).
+  // docs/theory-tapping.md#two-branch-solution: l_max = 14.7161 at q = 0.998443 (python dense grid; grid spacing ~1e-6
+  // there).
   const TappingModel model(Cantilever(1.0, 100.0), Drive(0.2, 0.995), PiecewiseLinearLaw::repulsive_attractive(10, 8, 0.3, 0.6), 0.0);
   const auto folds = harmonic_balance_folds(model);
   const auto it = std::find_if(folds.begin(), folds.end(), [](const HbFold& f) { return f.point.q > 0.9; });
@@ -96,7 +97,7 @@ TEST(Folds, MathMdExample) {
   EXPECT_EQ(it->point.branch, HbBranch::Plus);
   EXPECT_NEAR(it->point.separation, 14.7161, 1e-4);
   EXPECT_NEAR(it->point.q, 0.998443, 3e-6);
-  // MATH.md A.8 sweep case: fold l_max = 10.1003 (B = 10.1247), free amplitude 8.9982.
+  // docs/theory-tapping.md#hb-accuracy demo case: fold l_max = 10.1003 (B = 10.1247), free amplitude 8.9982.
   const TappingModel sweep(Cantilever(1.0, 100.0), Drive(0.2, 0.99), PiecewiseLinearLaw::repulsive_attractive(10, 8, 0.5, 1.0), 0.0);
   const HarmonicBalance hb(sweep);
   EXPECT_NEAR(hb.free_amplitude(), 8.9982, 1e-4);
@@ -111,7 +112,7 @@ TEST(Folds, MathMdExample) {
 }
 
 TEST(Folds, NoneForRepulsiveBelowResonance) {
-  // MATH.md A.4: l(q) strictly increasing for ω ≤ ω_n in the repulsive model.
+  // docs/theory-tapping.md#harmonic-balance: l(q) strictly increasing for ω ≤ ω_n in the repulsive model.
   for (double w : {0.99, 1.0})
     for (double ka : {1.0, 10.0, 1000.0}) {
       const TappingModel model(Cantilever(1.0, 100.0), Drive(0.2, w), PiecewiseLinearLaw::linear_hysteresis(ka, 0.64 * ka), 0.0);

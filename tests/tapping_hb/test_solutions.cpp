@@ -1,5 +1,5 @@
-// All solutions at fixed separation (MATH.md A.7) against multi-start Newton on (17) with quadrature DFs,
-// and against an independent dense scan of l(q).
+// All solutions at fixed separation (docs/theory-tapping.md#two-branch-solution) against multi-start Newton on (17)
+// with quadrature DFs, and against an independent dense scan of l(q).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +15,8 @@ namespace {
 using impact::PiecewiseLinearLaw;
 constexpr double pi = std::numbers::pi;
 
-// MATH.md A.7 example: Q = 100, ω_n = 1, Γ = 0.2, K_a = 10, K_b = 8, F_a = 0.3, F_b = 0.6, ω = 0.995.
+// docs/theory-tapping.md#two-branch-solution example: Q = 100, ω_n = 1, Γ = 0.2, K_a = 10, K_b = 8, F_a = 0.3,
+// F_b = 0.6, ω = 0.995.
 TappingModel example(double l) {
   return TappingModel(Cantilever(1.0, 100.0), Drive(0.2, 0.995), PiecewiseLinearLaw::repulsive_attractive(10, 8, 0.3, 0.6), l);
 }
@@ -59,7 +60,7 @@ TEST(Solutions, MultiStartNewtonFindsExactlyTheClosedFormSolutions) {
 
 TEST(Solutions, ExampleFromMathMd) {
   const auto at = harmonic_balance_solutions(example(14.5));
-  ASSERT_EQ(at.size(), 3u);  // free + two contact solutions (MATH.md A.7)
+  ASSERT_EQ(at.size(), 3u);  // free + two contact solutions (docs/theory-tapping.md#two-branch-solution)
   EXPECT_NEAR(at[0].amplitude, 14.195357, 1e-6);
   EXPECT_EQ(at[0].branch, HbBranch::Free);
   EXPECT_NEAR(at[1].amplitude, 14.500637, 1e-6);

@@ -1,5 +1,6 @@
 #pragma once
-// Shared models of the tapping-simulation tests (MATH.md A.8 parameters: ω_n = 1, Q = 100, Γ = 0.2).
+// Shared models of the tapping-simulation tests (docs/theory-tapping.md#hb-accuracy parameters: ω_n = 1, Q = 100, Γ =
+// 0.2).
 #include "afmkit/tapping/model.hpp"
 
 namespace afmkit::tapping::testing {

@@ -1,6 +1,7 @@
 // Periodic orbits: shooting, Floquet multipliers, observables and energy balance, against independent
 // references (linear-oscillator eigenvalues, the exact free response, the python/scipy time-domain check of
-// MATH.md A.8, the area between the hysteresis branches, a discrete Fourier transform of sampled states).
+// docs/theory-tapping.md#hb-accuracy, the area between the hysteresis branches, a discrete Fourier transform of sampled
+// states).
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -63,7 +64,7 @@ TEST(Orbit, FreeOrbitAtResonanceHasQuarterPeriodLag) {
 
 struct TableRow {
   double ka, kb, fa, fb, l;
-  double sim_offset, sim_amplitude, sim_phase;  // MATH.md A.8 (scipy RK45, independent of this code)
+  double sim_offset, sim_amplitude, sim_phase;  // docs/theory-tapping.md#hb-accuracy (scipy RK45, independent of this code)
   double hb_amplitude;
 };
 
@@ -94,7 +95,8 @@ TEST(Orbit, MatchesIndependentTimeDomainCheckAndHarmonicBalanceOverPredicts) {
 
 TEST(Orbit, EnergyBalanceAndContactLossEqualAreaBetweenBranches) {
   // per cycle: drive work = viscous + contact loss (1e-9), and the contact loss is the area enclosed by the
-  // two force branches down to the maximum penetration δ: (F_b − F_a) δ + ½ (K_a − K_b) δ² (MATH.md A.1)
+  // two force branches down to the maximum penetration δ: (F_b − F_a) δ + ½ (K_a − K_b) δ² (seed-1 eq. 6,
+  // docs/theory-tapping.md#impact)
   struct Case {
     double ka, kb, fa, fb, l, omega, quality, gamma;
   };
@@ -232,7 +234,8 @@ TEST(Orbit, NotSettledResponseIsReportedWithinBudget) {
 }
 
 TEST(Orbit, FindOrbitsReturnsAllThreeCoexistingOrbits) {
-  // MATH.md A.8 hysteresis case inside the loop: free (stable), middle (unstable), large contact (stable)
+  // docs/theory-tapping.md#hb-accuracy hysteresis case inside the loop: free (stable), middle (unstable), large contact
+  // (stable)
   const auto model = make_model(10, 8, 0.5, 1, 10.0, 0.99);
   const auto r = find_orbits(model);
   ASSERT_EQ(r.harmonic_balance.size(), 3u);

@@ -1,5 +1,6 @@
-// Separation sweeps and continuation: the hysteresis loop of MATH.md A.8, the fold and the unstable middle
-// branch, cross-checked with an independent transient of the adaptive integrator and with harmonic balance.
+// Separation sweeps and continuation: the hysteresis loop of docs/theory-tapping.md#hb-accuracy, the fold and the
+// unstable middle branch, cross-checked with an independent transient of the adaptive integrator and with harmonic
+// balance.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -16,7 +17,8 @@ namespace {
 using testing::make_model;
 using testing::repulsive_model;
 
-// MATH.md A.8 sweep case: K_a = 10, K_b = 8, F_a = 0.5, F_b = 1, ω = 0.99 (HB: l_free = 8.9982, fold 10.1003)
+// Demo sweep case (docs/theory-tapping.md#hb-accuracy): K_a = 10, K_b = 8, F_a = 0.5, F_b = 1, ω = 0.99 (HB: l_free =
+// 8.9982, fold 10.1003)
 TappingModel loop_model(double l = 10.0) { return make_model(10, 8, 0.5, 1, l, 0.99); }
 
 class HysteresisSweep : public ::testing::Test {
@@ -32,7 +34,7 @@ TEST_F(HysteresisSweep, ApproachJumpsIntoContactAtGrazing) {
   ASSERT_EQ(result_->approach_jumps.size(), 1u);
   const double jump = result_->approach_jumps[0];
   EXPECT_LT(jump, l_free);
-  EXPECT_GT(jump, l_free - 0.02 - 1e-9);  // first grid point below grazing: 8.98, as in MATH.md A.8
+  EXPECT_GT(jump, l_free - 0.02 - 1e-9);  // first grid point below grazing: 8.98, as in docs/theory-tapping.md#hb-accuracy
   for (const SweepPoint& p : result_->approach) {
     if (p.separation > l_free) EXPECT_NEAR(p.metrics.amplitude, l_free, 1e-9);  // free response above grazing
     EXPECT_TRUE(p.orbit.stable);
@@ -41,8 +43,9 @@ TEST_F(HysteresisSweep, ApproachJumpsIntoContactAtGrazing) {
 
 TEST_F(HysteresisSweep, RetractStaysInContactUpToTheFold) {
   ASSERT_EQ(result_->retract_jumps.size(), 1u);
-  // MATH.md A.8 (fixed-step RK4, 120 periods per step) reports the jump at l ∈ (10.12, 10.14]; the exact flow
-  // puts the fold at l* ≈ 10.1138, so the first free grid point is 10.12 (see the adaptive cross-check below).
+  // The reference of docs/theory-tapping.md#hb-accuracy (fixed-step RK4, 120 periods per step) reports the jump at l ∈
+  // (10.12, 10.14]; the exact flow puts the fold at l* ≈ 10.1138, so the first free grid point is 10.12 (see the
+  // adaptive cross-check below).
   EXPECT_GT(result_->retract_jumps[0], 10.10);
   EXPECT_LE(result_->retract_jumps[0], 10.14 + 1e-9);
   const double l_free = loop_model().free_amplitude();
@@ -51,7 +54,7 @@ TEST_F(HysteresisSweep, RetractStaysInContactUpToTheFold) {
     if (p.separation < result_->retract_jumps[0] - 1e-9) {
       EXPECT_LT(p.metrics.min_gap, 0.0);  // contact branch
       if (p.separation > l_free) EXPECT_GT(p.metrics.amplitude, l_free + 1e-3);  // above the free amplitude
-      // HB tracks this branch to within 0.3 % (MATH.md A.8: 0.22 % for the RK4 simulation)
+      // HB tracks this branch to within 0.3 % (docs/theory-tapping.md#hb-accuracy: 0.22 % for the RK4 simulation)
       EXPECT_NEAR(p.hb_amplitude, p.metrics.amplitude, 3e-3 * p.metrics.amplitude);
     } else {
       EXPECT_NEAR(p.metrics.amplitude, l_free, 1e-9);

@@ -1,5 +1,5 @@
 #pragma once
-// Time-domain simulation of the seed-2 closed loop (MATH.md B.1–B.3, B.8, B.10):
+// Time-domain simulation of the seed-2 closed loop (docs/theory-control.md#simulation):
 //   plant   first order ẏ = −γ (y − f(Ωt)) + u (eq. 1) or static y = f(Ωt) + u/γ (eq. 3), plant.hpp
 //   measure m(t) = y(t − τ(t))   (τ may vary slowly: Plant::delay_at; off-grid values by cubic interpolation)
 //   control u = −w, w = controller output: finite oscillator bank (eq. 15, 6) or the N = ∞ neutral
@@ -14,7 +14,7 @@
 //   * BlockZeroOrderHold — each oscillator exact for the held error e_n (discretisation.hpp: SampledForm), u held;
 //     finite banks only. The two ZOH forms are what RealtimeFilter runs (computed there independently).
 // The first-order plant is integrated exactly over each step for the polynomial u and the trigonometric f
-// (φ-functions), so only the controller discretisation contributes error. Initial state (MATH.md B.10):
+// (φ-functions), so only the controller discretisation contributes error. Initial state (theory-control.md#simulation):
 // controller 0; y(t ≤ 0) = the uncontrolled steady-state output (the plant ran before the controller started).
 //
 // Report: harmonics of y over the last period (exact projection of the M samples), compared with the analytic

@@ -1,5 +1,5 @@
 #pragma once
-// Closed-form transfer functions of the seed-2 controllers (MATH.md B.2–B.7), W = C(s) M, each evaluated
+// Closed-form transfer functions of the seed-2 controllers (seed-2 eqs. 10, 18, 25, 28–31), W = C(s) M, each evaluated
 // literally at any complex s. Exactly at a singular point of the literal formula (s = 0, s = ±ikΩ, and for
 // (31) the cancelled zeros of 𝒜 − ℬe^{−sT}) the value is taken from the pole-free form
 // `controller_response` (loop.hpp), i.e. the limit; exactly at a pole of C the result has infinite magnitude.

@@ -1,7 +1,7 @@
 #pragma once
-// Delay margin of the seed-2 loop (MATH.md B.9, seed-2 ext. E1/E2): the interval of measurement delays τ around
-// a reference delay (0 for the plain loop; the model delay τ̂ for the Smith predictor) in which the closed loop
-// stays exponentially stable.
+// Delay margin of the seed-2 loop (seed-2 ext. E1/E2, docs/theory-control.md#delay-margin): the interval of measurement
+// delays τ around a reference delay (0 for the plain loop; the model delay τ̂ for the Smith predictor) in which the
+// closed loop stays exponentially stable.
 //
 // For every loop of loop.hpp, Δ(s; τ) = X(s) + Y(s) e^{−sτ} with X, Y independent of τ. A root crosses the
 // imaginary axis at s = iν (ν > 0) for delay τ iff

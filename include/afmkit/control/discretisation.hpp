@@ -1,5 +1,5 @@
 #pragma once
-// Time discretisation of the seed-2 controller and plant (MATH.md B.10):
+// Time discretisation of the seed-2 controller and plant (docs/theory-control.md#simulation):
 //   * exact zero-order hold (ZOH) of an LTI system via the exponential of the augmented matrix,
 //   * φ-functions, used to integrate the first-order plant (seed-2 eq. 1) exactly over a step when its input is a
 //     polynomial in time,

@@ -1,6 +1,6 @@
 #pragma once
-// Harmonic content of periodic signals of the seed-2 loop (MATH.md B.1, B.3, B.10).
-// Convention: a T-periodic signal s(t) = Re Σ_{k≥0} c_k e^{ikΩt} (c_0 real = mean), i.e. for
+// Harmonic content of periodic signals of the seed-2 loop (docs/theory-control.md#rejection-problem, #oscillator-bank,
+// #simulation). Convention: a T-periodic signal s(t) = Re Σ_{k≥0} c_k e^{ikΩt} (c_0 real = mean), i.e. for
 // F sin(kΩt + φ) the complex amplitude is c_k = −i F e^{iφ}.
 #include <complex>
 #include <span>

@@ -1,8 +1,9 @@
 #pragma once
-// The N = ∞ controller with couplings (20) (MATH.md B.7, seed-2 eqs. 28–31) as a ratio of quasi-polynomials
+// The N = ∞ controller with couplings (20) (seed-2 eqs. 28–31, docs/theory-control.md#infinite-bank)
+// as a ratio of quasi-polynomials
 //   C∞(s) = 𝒩(s)(1 − e^{−sT}) / (𝒜(s) − ℬ(s) e^{−sT}),   𝒩(s) = 2K s²(αs + βΩ),   T = 2π/Ω,
-// realised in the time domain by the neutral delay-differential equations (32)–(33) (MATH.md B.8).
-// Only the first harmonic is rejected in this form.
+// realised in the time domain by the neutral delay-differential equations (32)–(33)
+// (docs/theory-control.md#neutral-realisation). Only the first harmonic is rejected in this form.
 #include <array>
 #include <complex>
 

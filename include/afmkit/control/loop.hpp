@@ -1,7 +1,7 @@
 #pragma once
-// The closed loop of seed 2 (MATH.md B.1–B.9) as a linear time-invariant system with delays:
+// The closed loop of seed 2 (docs/theory-control.md#spectrum) as a linear time-invariant system with delays:
 //   plant      P(s) = e^{−sτ} P0(s),  P0 = 1/γ (static plant, eq. 3/9) or 1/(s + γ) (first-order plant, eq. 1)
-//   controller W = C(s) M, u = −w   (negative feedback, MATH.md B.0); C = bank (eq. 18 / 29) or Smith predictor
+//   controller W = C(s) M, u = −w   (negative feedback, docs/conventions.md); C = bank (eq. 18 / 29) or Smith predictor
 //   closed-loop poles: 1 + P(s) C(s) = 0  (eq. 12, 19, 21).
 //
 // Characteristic function Δ(s) (entire in s; its zeros are exactly the closed-loop poles, no cancelled factors):
@@ -11,8 +11,9 @@
 //     N = ∞ bank:   d = Q∞ (F∞ − H1),  Kn = K Q∞ H1,   Q∞(s) = (Ω/π) sinh(πs/Ω) = lim Q_N (eqs. 23, 43, 44);
 //                   removable singularities at s = 0, ±iΩ are evaluated by series. This is the limit N → ∞ of
 //                   the finite-bank Δ and does NOT contain the spurious factor s²(s² + Ω²) of the
-//                   quasi-polynomial γ(𝒜 − ℬe^{−sT}) + e^{−sτ}𝒩(1 − e^{−sT}) (MATH.md B.7/B.8 caveat):
-//                   γ(𝒜 − ℬe^{−sT}) + e^{−sτ}𝒩(1 − e^{−sT}) = (2π/Ω) γ s²(s² + Ω²) e^{−πs/Ω} Δ(s)  (static plant).
+//                   quasi-polynomial γ(𝒜 − ℬe^{−sT}) + e^{−sτ}𝒩(1 − e^{−sT})
+//                   (docs/theory-control.md#neutral-realisation caveat): γ(𝒜 − ℬe^{−sT}) + e^{−sτ}𝒩(1 − e^{−sT}) =
+//                   (2π/Ω) γ s²(s² + Ω²) e^{−πs/Ω} Δ(s)  (static plant).
 //   plain loop:     Δ = M(s) d + Kn e^{−sτ}/γ,                       M = 1 (static) or 1 + s/γ (first order)
 //   Smith loop:     Δ = M M̂ d + Kn [M (1 − e^{−sτ_c})/γ̂ + M̂ e^{−s(τ_m + τ)}/γ]   (smith_predictor.hpp;
 //                   M̂ = 1 or 1 + s/γ̂, τ_m = measurement_delay, τ_c = correction_delay)
@@ -91,7 +92,7 @@ std::complex<double> loop_response(const LoopSpec& loop, std::complex<double> s)
 /// Sensitivity S = 1/(1 + L): disturbance at the plant output → output.
 std::complex<double> sensitivity(const LoopSpec& loop, std::complex<double> s);
 /// Closed loop, disturbance f → output y: G_f S with G_f = 1 (static plant) or γ/(s + γ) (first order).
-/// S(ikΩ) = 0 for rejected k, = 1 for kept k (internal-model principle, MATH.md B.3).
+/// S(ikΩ) = 0 for rejected k, = 1 for kept k (internal-model principle, docs/theory-control.md#oscillator-bank).
 std::complex<double> disturbance_response(const LoopSpec& loop, std::complex<double> s);
 
 // ---- delay-differential form (finite banks only) ------------------------------------------------------------

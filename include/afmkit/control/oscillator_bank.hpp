@@ -1,11 +1,12 @@
 #pragma once
-// The harmonic-rejection controller of seed 2 (MATH.md B.2–B.5): a zero-frequency integrator x0 and N
-// harmonic oscillators (x_k, z_k) at kΩ, driven by the measured signal m(t) = y(t − τ) from which the
+// The harmonic-rejection controller of seed 2 (eqs. 5–20, docs/theory-control.md#oscillator-bank): a zero-frequency
+// integrator x0 and N harmonic oscillators (x_k, z_k) at kΩ, driven by the measured signal m(t) = y(t − τ) from which
+// the
 // reconstructed *kept* harmonics are subtracted:
 //   e  = m − x0 − Σ_{k kept} x_k                                   (square bracket of eq. 15)
 //   ẋ0 = a0 e,   ẋ_k = −kΩ z_k + a_k e,   ż_k = kΩ x_k + b_k e        (eq. 15)
 //   u  = −K Σ_{k rejected} x_k                                      (eq. 6; rejected = {1} in the paper)
-// Conventions (MATH.md B.0): negative feedback U(s) = −C(s) M(s); K = γ̂ (estimate of the plant rate γ) is
+// Conventions (docs/conventions.md): negative feedback U(s) = −C(s) M(s); K = γ̂ (estimate of the plant rate γ) is
 // the design rule; couplings (20): a0 = α, a_k = 2α, b_k = −2β/k.
 // State ordering: (x0, x1, z1, x2, z2, …, xN, zN) ∈ ℝ^{2N+1}.
 #include <complex>
@@ -40,7 +41,7 @@ class OscillatorBank {
   int state_size() const { return 2 * harmonics() + 1; }
 
   /// State-space matrices of the controller from m to w = −u = K Σ_rej x_k: ż = A z + B m, w = C z.
-  /// A = A0 − b c_eᵀ (MATH.md B.3). Dense (2N+1)×(2N+1).
+  /// A = A0 − b c_eᵀ (docs/theory-control.md#oscillator-bank). Dense (2N+1)×(2N+1).
   Eigen::MatrixXd state_matrix() const;
   Eigen::VectorXd input_vector() const;   // b = (a0, a1, b1, …)
   Eigen::RowVectorXd output_vector() const;  // K c_rᵀ

@@ -1,5 +1,5 @@
 #pragma once
-// The plant of seed 2 (MATH.md B.1): height signal y, plant rate γ, rotation frequency Ω, disturbance f
+// The plant of seed 2 (eqs. 1–4): height signal y, plant rate γ, rotation frequency Ω, disturbance f
 // (2π-periodic topography + tilt), control u with unit sensitivity, measurement m(t) = y(t − τ).
 //   first-order plant (eq. 1):  ẏ = −γ (y − f(Ωt)) + u
 //   static plant      (eq. 3):  y = f(Ωt) + u/γ

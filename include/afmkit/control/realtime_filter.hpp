@@ -13,7 +13,7 @@
 // damped rotation e^{σh}R(ωh) of two numbers, a real eigenvalue a scalar, u = w·q — O(N) per sample and equal to
 // e^{Ah} up to rounding. Set-up without any N×N matrix: the eigenvalues by the Aberth iteration
 // (bank_eigenvalues, O(N²)), then per mode in O(N) the eigenvectors of the rank-1 perturbation A = A0 − b c_eᵀ
-// in closed form (MATH.md B.3): right v = (λ − A0)⁻¹ b, left u = (λ − A0)⁻ᵀ c_e (the 2×2 blocks of A0 inverted
+// in closed form (docs/theory-control.md#oscillator-bank): right v = (λ − A0)⁻¹ b, left u = (λ − A0)⁻ᵀ c_e (the 2×2 blocks of A0 inverted
 // one oscillator at a time; the rejected oscillators' exact modes ±ikΩ separately). O(N²) time, O(N) memory;
 // V is never stored (physical ↔ modal maps are recomputed, O(N²), outside the per-sample path). Checked per
 // mode: residual and ‖V‖_F‖V⁻¹‖_F < 1e8. If the check fails (near-defective couplings, a0 = 0) the filter falls

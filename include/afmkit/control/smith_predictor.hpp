@@ -1,6 +1,6 @@
 #pragma once
 // Smith-predictor variant of the harmonic-rejection controller (beyond the paper; seed-2 Discussion suggests
-// "a classical Smith predictor"). Notation: P(s) = e^{−sτ} P0(s) the true plant (MATH.md B.1), P̂0 the model
+// "a classical Smith predictor"). Notation: P(s) = e^{−sτ} P0(s) the true plant (seed-2 eq. 9), P̂0 the model
 // of its delay-free part with rate estimate γ̂ (static: 1/γ̂, first order: 1/(s+γ̂)), τ̂ the delay estimate,
 // C(s) the oscillator bank (finite, eq. 18, or N = ∞, eq. 29), negative feedback u = −w.
 //
@@ -68,7 +68,7 @@ struct SmithPredictor {
 ///   m̂(t) = m(t − measurement_delay) + ŷ(t) − ŷ(t − correction_delay),   ŷ = model(u),   w = bank(m̂),   u = −w,
 /// so that W/M = bank(s) e^{−sτ_m} / (1 + bank(s) model(s) (1 − e^{−sτ_c})) = controller_response (loop.hpp).
 struct SmithRealisation {
-  StateSpace bank;           // m̂ → w (= −u): ss(bank), MATH.md B.3
+  StateSpace bank;           // m̂ → w (= −u): ss(bank), docs/theory-control.md#oscillator-bank
   StateSpace model;          // u → ŷ: P̂0 = 1/γ̂ (static gain) or dŷ/dt = −γ̂ ŷ + u
   double measurement_delay;  // τ_m
   double correction_delay;   // τ_c

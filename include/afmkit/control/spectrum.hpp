@@ -1,6 +1,6 @@
 #pragma once
-// Closed-loop spectrum of the seed-2 harmonic-rejection loop under delay (MATH.md B.2–B.9), computed on the
-// exact characteristic function Δ(s) of loop.hpp (no Padé approximation):
+// Closed-loop spectrum of the seed-2 harmonic-rejection loop under delay (docs/theory-control.md#spectrum), computed on
+// the exact characteristic function Δ(s) of loop.hpp (no Padé approximation):
 //   * initial guesses: Chebyshev collocation of the infinitesimal generator (finite banks, dde_collocation.hpp)
 //     or argument-principle subdivision (N = ∞ neutral form, and as a fallback);
 //   * every root refined by Newton on Δ until the correction is ≤ tolerance·max(Ω, |s|);
@@ -8,9 +8,10 @@
 //     along the box boundary, adaptive steps keeping the phase increments ≤ 0.5 rad and consistent with
 //     Δ'/Δ) must equal the number of refined roots (with multiplicity) found inside.
 // For the N = ∞ bank the spectrum of the neutral equation has a chain of roots accumulating at
-//   Re s = ln|B4/A4| / T   (B4/A4 = (Ω − πα)/(Ω + πα), MATH.md B.7; the difference-equation spectrum bound),
+//   Re s = ln|B4/A4| / T   (B4/A4 = (Ω − πα)/(Ω + πα), seed-2 eq. 31; the difference-equation spectrum bound),
 // reported as `neutral_bound`; the spectral abscissa is then max(rightmost root, bound). The realisation (32)–(33)
-// of that controller has additional roots exactly on the imaginary axis (MATH.md B.8), reported in `structural`.
+// of that controller has additional roots exactly on the imaginary axis (docs/theory-control.md#neutral-realisation),
+// reported in `structural`.
 #include <complex>
 #include <limits>
 #include <optional>
@@ -67,7 +68,7 @@ struct Spectrum {
   /// N = ∞: roots between the neutral bound and box.real_min found by Newton from the chain asymptotics
   /// s_m ≈ bound + i(m [+ ½])Ω (not certified; they enter the spectral abscissa)
   std::vector<std::complex<double>> near_chain;
-  std::vector<StructuralRoot> structural;   ///< MATH.md B.8 diagnosis of the neutral realisation
+  std::vector<StructuralRoot> structural;   ///< diagnosis of the neutral realisation (theory-control.md)
   std::vector<std::string> notes;
 };
 
@@ -105,8 +106,8 @@ struct RootBounds {
 };
 RootBounds root_bounds(const LoopSpec& loop, double min_real);
 
-/// MATH.md B.8: roots of the neutral realisation (32)–(33) on the imaginary axis (double root at 0, ±iΩ),
-/// counted with the argument principle on γ(𝒜 − ℬe^{−sT}) + e^{−sτ}𝒩(1 − e^{−sT}) built from the InfiniteBank
+/// Roots of the neutral realisation (32)–(33) on the imaginary axis (double root at 0, ±iΩ;
+/// docs/theory-control.md#neutral-realisation), counted with the argument principle on γ(𝒜 − ℬe^{−sT}) + e^{−sτ}𝒩(1 − e^{−sT}) built from the InfiniteBank
 /// coefficients. Empty for finite banks.
 std::vector<StructuralRoot> neutral_realisation_roots(const LoopSpec& loop);
 

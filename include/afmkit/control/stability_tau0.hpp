@@ -1,5 +1,5 @@
 #pragma once
-// Stability without delay (τ = 0), MATH.md B.2 and B.5 (seed-2 eqs. 13, 22–24, 40–46).
+// Stability without delay (τ = 0), seed-2 eqs. 13, 22–24, 40–46 (docs/theory-control.md#stability-tau0).
 // Static plant (eq. 3) unless a LoopSpec says otherwise; ρ = K/γ.
 #include <complex>
 #include <vector>

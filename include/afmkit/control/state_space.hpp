@@ -1,7 +1,7 @@
 #pragma once
 // A small LTI toolbox (names as in python-control): state-space value type `StateSpace` / `ss`,
 // evaluation G(s) = C (sI − A)^{-1} B + D at any complex s, `series`, `parallel`, `feedback`.
-// Realisations of the seed-2 controller and plant (MATH.md B.1, B.3) are provided as `ss(...)` overloads.
+// Realisations of the seed-2 controller and plant (seed-2 eqs. 1, 3, 15) are provided as `ss(...)` overloads.
 #include <complex>
 
 #include <Eigen/Dense>
@@ -34,8 +34,8 @@ struct StateSpace {
 StateSpace ss(Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C, Eigen::MatrixXd D);
 /// Static gain D (no states).
 StateSpace ss(double gain);
-/// The controller from m to w = −u (W = C M): A = A0 − b c_eᵀ, B = b, C = K c_rᵀ, D = 0 (MATH.md B.3).
-/// Includes x0 even when a0 = 0 (then x0 is an uncontrollable mode at s = 0).
+/// The controller from m to w = −u (W = C M): A = A0 − b c_eᵀ, B = b, C = K c_rᵀ, D = 0
+/// (docs/theory-control.md#oscillator-bank). Includes x0 even when a0 = 0 (then x0 is an uncontrollable mode at s = 0).
 StateSpace ss(const OscillatorBank& bank);
 /// Delay-free plant from u to y: static 1/γ (D only) or first order ẏ = −γ y + u (eq. 1 with f = 0).
 StateSpace ss(PlantKind kind, double plant_rate);

@@ -1,6 +1,6 @@
 #pragma once
 // Rational transfer functions with real coefficients (python-control's `tf`), polynomials, and the exact
-// rational form of the seed-2 controllers and plants (MATH.md B.2, B.3). Rational forms of a bank have
+// rational form of the seed-2 controllers and plants (seed-2 eqs. 10, 18). Rational forms of a bank have
 // coefficients up to ∏k²Ω² and are well conditioned for moderate N only (≲ 15); for any N use the pole-free
 // evaluations of loop.hpp (`controller_response`) or controller_tf.hpp.
 #include <complex>

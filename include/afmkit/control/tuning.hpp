@@ -1,6 +1,6 @@
 #pragma once
-// Robust tuning of the couplings (MATH.md B.9: the paper's "universal" values α ≈ 0.1Ω, β ≈ −0.1Ω, computed):
-// maximise over (x, y) = (α, β) (or (a, b) for one oscillator) the worst-case decay rate
+// Robust tuning of the couplings (docs/theory-control.md#tuning: the paper's "universal" values α ≈ 0.1Ω, β ≈ −0.1Ω,
+// computed): maximise over (x, y) = (α, β) (or (a, b) for one oscillator) the worst-case decay rate
 //   J(x, y) = min_{τ ∈ [0, τ_max], ρ ∈ [ρ_min, ρ_max]} ( −spectral abscissa of the loop at (x, y, τ, ρ) ),
 // ρ = K/γ the gain-estimate error (the controller K is fixed, the plant rate is γ = K/ρ), on a grid of delays
 // and gain ratios. Coarse grid over the window, then Nelder–Mead from the best grid point. The spectral

@@ -1,5 +1,5 @@
 #pragma once
-// Hysteresis interaction forces (seed-1 eq. 4, as corrected in MATH.md A.1):
+// Hysteresis interaction forces (seed-1 eq. 4, as corrected in docs/theory-tapping.md#impact):
 //   H(d, ḋ) = H_a(d) while approaching (ḋ < 0), H_b(d) while departing (ḋ > 0), ½(H_a + H_b) at ḋ = 0.
 // Sign convention: H > 0 is repulsive (pushes the two bodies apart). d is the gap between the bodies.
 // In the tapping model (seed-1 eq. 8) d = x + l and h(x, ẋ) = −H(x + l, ẋ) (per unit mass).
@@ -34,7 +34,7 @@ struct PiecewiseLinearLaw {
   static PiecewiseLinearLaw linear_hysteresis(double k_approach, double k_departure);  // eq. (11)
   static PiecewiseLinearLaw repulsive_attractive(double k_approach, double k_departure, double f_approach,
                                                  double f_departure);                  // eq. (26)
-  /// K_b giving restitution e for an impulsive impact: K_b = e² K_a (MATH.md ext. E0). e ∈ (0, 1]; e > 1 only
+  /// K_b giving restitution e for an impulsive impact: K_b = e² K_a (seed-1 ext. E0). e ∈ (0, 1]; e > 1 only
   /// with allow_energy_gain. Computed as K_a − K_a(1 − e)(1 + e), the nearest to e² K_a for e → 1.
   static double departure_stiffness_for_restitution(double k_approach, double restitution,
                                                     bool allow_energy_gain = false);

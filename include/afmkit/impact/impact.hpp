@@ -1,12 +1,12 @@
 #pragma once
-// Two-body impact with hysteresis interaction forces (seed-1 §II, eqs. 1–6; MATH.md A.1).
+// Two-body impact with hysteresis interaction forces (seed-1 §II, eqs. 1–6; docs/theory-tapping.md#impact).
 //
 //   m1 ẍ1 = F1(t) − H(d, ḋ),   m2 ẍ2 = F2(t) + H(d, ḋ),   d = x2 − x1 (gap)            (seed-1 eq. 1)
 //   relative motion: d̈ = H(d, ḋ)/μ + F2/m2 − F1/m1,   μ = m1 m2/(m1 + m2) (reduced mass)
 //
 // H is a ForceLaw (H > 0 repulsive, acting on body 2): approach branch H_a while ḋ < 0, departure branch
-// H_b while ḋ > 0 (seed-1 eq. 4 as corrected in MATH.md A.1). The impact interval [t_s, t_f] runs from the
-// initial state (t_s = 0, gap d(t_s), ḋ(t_s) < 0) through the instant t̄ of minimum gap back to the same
+// H_b while ḋ > 0 (seed-1 eq. 4 as corrected in docs/theory-tapping.md#impact). The impact interval [t_s, t_f] runs
+// from the initial state (t_s = 0, gap d(t_s), ḋ(t_s) < 0) through the instant t̄ of minimum gap back to the same
 // gap d(t_f) = d(t_s) (seed-1 §II). Piecewise-linear laws (eqs. 10, 11, 26) with constant external forces
 // are solved in closed form with exact event times; any other law or time-dependent forcing is integrated
 // (Dormand–Prince 5(4) with dense output and event location).

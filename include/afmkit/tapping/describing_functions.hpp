@@ -1,13 +1,14 @@
 #pragma once
-// Describing functions of the piecewise-linear hysteresis law (seed-1 eqs. 12–15, 26–31; MATH.md A.3, A.6) —
-// the closed-form fast path; any other law: numerical_describing_functions.hpp (the ForceLaw overloads dispatch).
+// Describing functions of the piecewise-linear hysteresis law (seed-1 eqs. 12–15, 26–31;
+// docs/theory-tapping.md#describing-functions) — the closed-form fast path; any other law:
+// numerical_describing_functions.hpp (the ForceLaw overloads dispatch).
 //
 // Ansatz x(t) = A + B cos ωt (B > 0) with penetration parameter q = (A + l)/B (eq. 15):
 //   N0·A = ⟨h⟩ = Σ_F χ̄(q) − Σ_K Ω̄(q) B                                   (eq. 29, the mean of h)
 //   N1   = Φ(q)/B + Ψ(q),  Φ = −Σ_F Φ̄_R + iΔ_F Φ̄_I,  Ψ = Σ_K Ψ̄_R − iΔ_K Ψ̄_I  (eqs. 29–31)
 // with Σ_F = F_a + F_b, Σ_K = K_a + K_b, Δ_F = F_b − F_a, Δ_K = K_b − K_a (eq. 28) and the bar functions
-// of MATH.md A.6 extended to every real q (q ≥ 1: no contact, |q| < 1: contact on the phase interval
-// (π − a, π + a) with the contact angle a = arccos q, q ≤ −1: permanent contact). N0 alone (= ⟨h⟩/A) is
+// of seed-1 eq. 28 (docs/theory-tapping.md#describing-functions) extended to every real q (q ≥ 1: no contact,
+// |q| < 1: contact on the phase interval (π − a, π + a) with the contact angle a = arccos q, q ≤ −1: permanent contact). N0 alone (= ⟨h⟩/A) is
 // never formed: A may be zero.
 //
 // Accuracy near grazing: for q → 1⁻ the differences in Ω̄ and Ψ̄_R cancel (Ω̄ ≈ a³/6π, Ψ̄_R ≈ a³/3π); they are
@@ -20,7 +21,8 @@
 
 namespace afmkit::tapping {
 
-/// The six bar functions of MATH.md A.6 (seed-1 eq. 28 abbreviations) at one q, or their derivatives.
+/// The six bar functions of docs/theory-tapping.md#describing-functions (seed-1 eq. 28 abbreviations) at one q, or
+/// their derivatives.
 struct BarFunctions {
   double chi;    // χ̄
   double omega;  // Ω̄

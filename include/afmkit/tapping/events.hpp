@@ -25,7 +25,7 @@ struct TipState {
   double velocity = 0.0;  // ẋ
 };
 
-/// Which force branch is active (seed-1 eq. 4 as corrected in MATH.md A.1).
+/// Which force branch is active (seed-1 eq. 4 as corrected in docs/theory-tapping.md#impact).
 enum class ContactBranch { approach, departure, sticking };
 const char* contact_branch_name(ContactBranch branch);
 

@@ -1,6 +1,6 @@
 #pragma once
-// Harmonic balance (HB) of the tapping-mode model (seed-1 eqs. 16–19, 32–33, MATH.md ext. E1–E7) for any
-// force law.
+// Harmonic balance (HB) of the tapping-mode model (seed-1 eqs. 16–19, 32–33, ext. E1–E7; docs/theory-tapping.md) for
+// any force law.
 //
 // Ansatz x(t) ≈ A + B cos(ωt − φ) for the drive Γ cos(ωt) (B > 0). The penetration parameter
 // q = (A + l)/B (eq. 15) parametrises every solution.
@@ -44,8 +44,8 @@ struct HbPoint {
   HbBranch branch;
 };
 
-/// Every HB solution at model.separation (MATH.md A.7 algorithm), sorted by increasing amplitude.
-/// (For a general law this builds HarmonicBalance(model): reuse one object for many separations.)
+/// Every HB solution at model.separation (algorithm of docs/theory-tapping.md#two-branch-solution), sorted by
+/// increasing amplitude. (For a general law this builds HarmonicBalance(model): reuse one object for many separations.)
 std::vector<HbPoint> harmonic_balance_solutions(const TappingModel& model);
 
 /// The HB point for a given q on a branch (std::nullopt if that root does not exist or B <= 0).

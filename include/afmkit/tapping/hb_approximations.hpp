@@ -1,7 +1,8 @@
 #pragma once
 // Large-stiffness (impulsive-impact) approximations of the harmonic balance, seed-1 eqs. (20)–(25), and the
-// minimum separation with an oscillating solution (MATH.md A.4 ext. E8), as corrected in MATH.md A.5.
-// Valid for large K_a with e = √(K_b/K_a) fixed and l < Γ|L(iω)|; (25) assumes ω = ω_n.
+// minimum separation with an oscillating solution (seed-1 ext. E8), as corrected in
+// docs/theory-tapping.md#large-stiffness. Valid for large K_a with e = √(K_b/K_a) fixed and l < Γ|L(iω)|; (25) assumes
+// ω = ω_n.
 #include <optional>
 
 #include "afmkit/tapping/model.hpp"
@@ -35,7 +36,7 @@ double impulsive_phase(const TappingModel& model);
 
 /// Ext. E8, generalised to F_a, F_b and either sign of K_a − K_b: lim_{q→−∞} l(q) on the "+" branch. With
 /// κ = 2(K_a − K_b)/π, δ = 2Δ_F/π:  l_∞ = −(1 + L(0)Σ_K/2)(Γ − sgn(κ)δ)/|κ| + L(0)Σ_F/2
-/// (F_a = F_b = 0, K_a > K_b: exactly MATH.md E8, the minimum separation with an oscillating solution).
+/// (F_a = F_b = 0, K_a > K_b: exactly seed-1 ext. E8, the minimum separation with an oscillating solution).
 /// −∞ if K_a = K_b and the "+" branch exists for q ≤ −1 (l → −∞); std::nullopt if the "+" branch does not reach q → −∞ (Γ ≤ sgn(κ)δ).
 std::optional<double> minimum_separation_limit(const TappingModel& model);
 

@@ -1,7 +1,7 @@
 #pragma once
 // One point of a harmonic-balance branch, with the slope of the separation along the branch
-// (MATH.md A.7, seed-1 ext. E1–E6). Lower-level than harmonic_balance.hpp: the root solver and the fold
-// finder are built on it; it is public for users who trace the curve themselves.
+// (seed-1 ext. E1–E6, docs/theory-tapping.md#two-branch-solution). Lower-level than harmonic_balance.hpp: the root
+// solver and the fold finder are built on it; it is public for users who trace the curve themselves.
 //
 // For a penetration parameter q < 1, with M = L(iω)⁻¹ + Ψ(q) and Φ = Φ(q) (eq. 30), the first-harmonic
 // balance |MB + Φ| = Γ (eq. 33) is the real quadratic (E1)

@@ -292,7 +292,7 @@ ClosedLoopSimulation::ClosedLoopSimulation(Plant plant, Bank controller, Simulat
                                                      "must be ab3 (the neutral realisation, eqs. 32-33, is stepped by "
                                                      "AB3)", to_string(o.stepping)));
     validate::require(ib.alpha > 0.0, "alpha", ib.alpha,
-                      "> 0 for the N = infinity neutral realisation (|B4/A4| < 1, MATH.md B.7)");
+                      "> 0 for the N = infinity neutral realisation (|B4/A4| < 1, docs/theory-control.md#infinite-bank)");
     const double wc = ib.rotation_frequency, wp = plant_.rotation_frequency;
     validate::require(std::abs(wc - wp) <= 1e-12 * wp, "rotation_frequency", wc,
                       fmt::format("equal to the plant's rotation frequency {} for the N = infinity controller (its "

@@ -68,8 +68,8 @@ class BankBlockZoh {
   Eigen::RowVectorXd c_, ce_;
 };
 
-/// N = ∞ controller, neutral realisation (32)–(33) (MATH.md B.8), AB3 on ξ, delay lines of one period
-/// (M steps) that read 0 before the controller has run one period (Heaviside rule).
+/// N = ∞ controller, neutral realisation (32)–(33) (docs/theory-control.md#neutral-realisation), AB3 on ξ, delay lines
+/// of one period (M steps) that read 0 before the controller has run one period (Heaviside rule).
 class NeutralAb3 {
  public:
   NeutralAb3(const InfiniteBank& bank, int steps_per_period, double step);

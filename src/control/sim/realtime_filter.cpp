@@ -122,7 +122,7 @@ RealtimeFilter::Discretisation RealtimeFilter::discretise(const OscillatorBank& 
   return d;
 }
 
-// ---- modal zero-order hold without N×N matrices (header comment; MATH.md B.3) ------------------------------------
+// ---- modal zero-order hold without N×N matrices (header comment; docs/theory-control.md#oscillator-bank) ------------------------------------
 namespace {
 using cplx = std::complex<double>;
 

@@ -1,4 +1,4 @@
-// Delay margin from the crossing conditions (delay_margin.hpp; MATH.md B.9, seed-2 ext. E1/E2).
+// Delay margin from the crossing conditions (delay_margin.hpp; seed-2 ext. E1/E2, docs/theory-control.md#delay-margin).
 #include "afmkit/control/delay_margin.hpp"
 
 #include <algorithm>

@@ -1,5 +1,6 @@
-// MATH.md B.8 diagnosis: roots of the neutral realisation (32)–(33) of the N = ∞ controller that are not poles
-// of the reduced closed loop. The realisation's characteristic quasi-polynomial (B.7 coefficients of InfiniteBank)
+// Diagnosis of docs/theory-control.md#neutral-realisation: roots of the neutral realisation (32)–(33) of the N = ∞
+// controller that are not poles of the reduced closed loop. The realisation's characteristic quasi-polynomial (seed-2
+// eq. 31 coefficients of InfiniteBank)
 //   Δ_N = c_D (𝒜 − ℬ e^{−sT}) + c_N 𝒩 (1 − e^{−sT})
 // (plain loop: c_D = M, c_N = e^{−sτ}/γ; Smith: c_D = M M̂, c_N = M(1 − e^{−sτ_c})/γ̂ + M̂ e^{−s(τ_m+τ)}/γ)
 // is compared with the reduced Δ of loop.hpp by counting the zeros of both in small boxes around 0 and ±iΩ:
@@ -73,7 +74,8 @@ std::vector<StructuralRoot> neutral_realisation_roots(const LoopSpec& loop) {
       if (m > 0) {
         out.push_back({centre, m,
                        fmt::format("neutral realisation (32)-(33): cancelled factor s^2(s^2+Omega^2) of "
-                                   "C_inf = N(1-e^(-sT))/(A-B e^(-sT)) (MATH.md B.7/B.8); root on the imaginary "
+                                   "C_inf = N(1-e^(-sT))/(A-B e^(-sT)) (seed-2 eq. 31, docs/theory-control.md#neutral-realisation); "
+                                   "root on the imaginary "
                                    "axis, multiplicity {} by the argument principle: marginal stability",
                                    m)});
       }

@@ -1,4 +1,5 @@
-// All harmonic-balance solutions at a separation and the folds of the branches (MATH.md A.7, ext. E1–E7).
+// All harmonic-balance solutions at a separation and the folds of the branches (seed-1 ext. E1–E7,
+// docs/theory-tapping.md#two-branch-solution, #folds).
 #include "afmkit/tapping/harmonic_balance.hpp"
 
 #include <algorithm>

@@ -1,4 +1,5 @@
-// Large-stiffness approximations (seed-1 eqs. 20–25) and the q → −∞ limit (MATH.md ext. E8).
+// Large-stiffness approximations (seed-1 eqs. 20–25) and the q → −∞ limit (seed-1 ext. E8,
+// docs/theory-tapping.md#minimum-separation).
 #include "afmkit/tapping/hb_approximations.hpp"
 
 #include <algorithm>
