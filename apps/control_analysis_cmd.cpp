@@ -424,9 +424,10 @@ void register_control_analysis(CLI::App& control) {
       "(Aberth, O(N^2)); certification O(N) evaluations along the box: O(N^2) in all",
       [](io::ParamSet& p) {
         p.group("Root search")
-            .real("min_real", 0.0, "left edge of the search box [units of Omega] (default: automatic)")
-            .real("max_imag", 1.0, "half-height of the search box [units of Omega] (default: proven bound)",
-                  Range::positive())
+            .real("min_real", 0.0, "left edge of the search box [units of Omega]")
+            .default_text("automatic")
+            .real("max_imag", 1.0, "half-height of the search box [units of Omega]", Range::positive())
+            .default_text("proven bound")
             .integer("count", 12, "automatic box: about this many rightmost roots", 1, 10000)
             .integer("nodes", 0, "Chebyshev collocation nodes per delay for the initial guesses (0: automatic)", 0, 400)
             .group("Output")
@@ -440,8 +441,8 @@ void register_control_analysis(CLI::App& control) {
       "O(N) per crossing-function evaluation on points_per_omega x (N + 1) frequencies, O(N^2) stability check",
       [](io::ParamSet& p) {
         p.group("Delay margin")
-            .real("reference_delay", 0.0, "delay where stability is required [units of T] (default: 0, Smith: "
-                                       "model_delay)", Range::non_negative())
+            .real("reference_delay", 0.0, "delay where stability is required [units of T]", Range::non_negative())
+            .default_text("0; Smith predictor: model_delay")
             .integer("points_per_omega", 64, "crossing-frequency bracketing grid density (points per Omega)", 4, 100000)
             .flag("compare", false, "tabulate tau_c for variants: rejected harmonics {1},{1,2},{1,3},{2},{1,2,3},"
                                     "{1,3,5}, N = inf, single oscillator, Smith predictor (periodic, classic)")
@@ -459,10 +460,14 @@ void register_control_analysis(CLI::App& control) {
         p.group("Chart")
             .text("quantity", "abscissa", "abscissa: spectral abscissa + unstable roots; margin: tau_c map",
                {"abscissa", "margin"})
-            .real("x_min", 0.0, "a or alpha lower bound [units of Omega] (default -0.5 single, -0.1 otherwise)")
-            .real("x_max", 1.0, "a or alpha upper bound [units of Omega] (default 2 single, 1 otherwise)")
-            .real("y_min", 0.0, "b or beta lower bound [units of Omega] (default -2 single, -0.4 otherwise)")
-            .real("y_max", 1.0, "b or beta upper bound [units of Omega] (default 1.5 single, 1 otherwise)")
+            .real("x_min", 0.0, "a or alpha lower bound [units of Omega]")
+            .default_text("-0.5 single, -0.1 otherwise")
+            .real("x_max", 1.0, "a or alpha upper bound [units of Omega]")
+            .default_text("2 single, 1 otherwise")
+            .real("y_min", 0.0, "b or beta lower bound [units of Omega]")
+            .default_text("-2 single, -0.4 otherwise")
+            .real("y_max", 1.0, "b or beta upper bound [units of Omega]")
+            .default_text("1.5 single, 1 otherwise")
             .integer("x_points", 200, "grid points along x", 2, 100000)
             .integer("y_points", 200, "grid points along y", 2, 100000)
             .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024)
@@ -484,10 +489,13 @@ void register_control_analysis(CLI::App& control) {
             .real("gain_ratio_min", 0.5, "smallest rho = K/gamma", Range::positive())
             .real("gain_ratio_max", 2.0, "largest rho = K/gamma", Range::positive())
             .integer("gain_points", 3, "rho grid points (geometric)", 1, 10000)
-            .real("x_min", 0.01, "a or alpha lower bound [units of Omega] (default 0.01)")
-            .real("x_max", 0.6, "a or alpha upper bound [units of Omega] (default 2 single, 0.6 otherwise)")
-            .real("y_min", -0.24, "b or beta lower bound [units of Omega] (default -2 single, -0.24 otherwise)")
-            .real("y_max", 0.3, "b or beta upper bound [units of Omega] (default 0.9 single, 0.3 otherwise)")
+            .real("x_min", 0.01, "a or alpha lower bound [units of Omega]")
+            .real("x_max", 0.6, "a or alpha upper bound [units of Omega]")
+            .default_text("2 single, 0.6 otherwise")
+            .real("y_min", -0.24, "b or beta lower bound [units of Omega]")
+            .default_text("-2 single, -0.24 otherwise")
+            .real("y_max", 0.3, "b or beta upper bound [units of Omega]")
+            .default_text("0.9 single, 0.3 otherwise")
             .integer("coarse_points", 12, "coarse grid points per axis", 2, 10000)
             .integer("max_evaluations", 150, "Nelder-Mead budget", 0, 1000000)
             .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024)

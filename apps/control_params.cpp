@@ -31,8 +31,8 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
       .real("b", 0.0, "coupling b of the single oscillator (eq. 5) [units of Omega]")
       .reals("rejected", {1.0}, "harmonics removed from the output (bank controller), e.g. 1,3",
              Range::closed(1, static_cast<double>(max_harmonics)))
-      .real("gain", 20.0, "controller gain K [units of Omega] (default: equal to plant_rate, design rule K = gamma)",
-            Range{0.0, 1e12, true, false})
+      .real("gain", 20.0, "controller gain K [units of Omega] (design rule K = gamma)", Range{0.0, 1e12, true, false})
+      .default_text("= plant_rate")
       .group("Plant and delay")
       .text("plant", "static", "plant: static y = f + u/gamma (eq. 3) or first order (eq. 1)", {"static", "first_order"})
       .real("plant_rate", 20.0, "plant rate gamma [units of Omega]", Range{0.0, 1e12, true, false})
@@ -42,10 +42,10 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
       .text("smith_structure", "periodic", "Smith predictor structure (periodic keeps exact rejection)",
             {"periodic", "classic"})
       .text("model_plant", "same", "kind of the Smith predictor's plant model", {"same", "static", "first_order"})
-      .real("model_rate", 20.0, "Smith model rate gamma_hat [units of Omega] (default: equal to plant_rate)",
-            Range{0.0, 1e12, true, false})
-      .real("model_delay", 0.1, "Smith model delay tau_hat [units of T] (default: equal to delay)",
-            Range::non_negative());
+      .real("model_rate", 20.0, "Smith model rate gamma_hat [units of Omega]", Range{0.0, 1e12, true, false})
+      .default_text("= plant_rate")
+      .real("model_delay", 0.1, "Smith model delay tau_hat [units of T]", Range::non_negative())
+      .default_text("= delay");
 }
 
 void require_memory(const std::string& parameter, double value, double bytes_per_unit) {

@@ -172,7 +172,8 @@ void register_control_simulate(CLI::App& control) {
       .reals("disturbance_amplitudes", {1.0, 0.15, 0.1, 0.075, 0.06, 0.05, 0.3 / 7.0, 0.0375},
              "F_1, F_2, ... of f (eq. 14); default: the Fig. 5 example F1 = 1, F_k = 0.3/k (k = 2..8)",
              io::Range::non_negative())
-      .reals("disturbance_phases", {}, "phi_1, phi_2, ... [rad] (default: random from disturbance_seed, phi_1 = 0)")
+      .reals("disturbance_phases", {}, "phi_1, phi_2, ... [rad]")
+      .default_text("random from disturbance_seed, phi_1 = 0")
       .integer("disturbance_seed", 1, "seed of the random phases", 0, 4294967295L)
       .real("delay_variation", 0.0, "amplitude of a slow sinusoidal delay variation [units of T] (<= delay)",
             io::Range::non_negative())

@@ -28,6 +28,7 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
     const std::string laws = fmt::format("[{}] ", fmt::join(registry.laws_using(k.key), ", "));
     io::Range range{k.lower, std::min(k.upper, 1e308), k.lower_open, false};
     p.real(k.key, k.default_value, laws + k.help + unit, range);
+    if (!k.follows.empty()) p.default_text("= " + k.follows);
   }
 }
 

@@ -78,6 +78,11 @@ ParamSet& ParamSet::group(const std::string& name) {
   group_ = name;
   return *this;
 }
+ParamSet& ParamSet::default_text(const std::string& text) {
+  if (order_.empty()) throw std::logic_error("ParamSet::default_text before any parameter");
+  entries_[order_.back()].default_text = text;
+  return *this;
+}
 ParamSet& ParamSet::real(const std::string& key, double def, const std::string& help, Range range) {
   declare(key, Entry{def, help, range});
   return *this;
@@ -112,24 +117,25 @@ void ParamSet::add_options(CLI::App& app) {
     Entry& e = entries_[key];
     std::string desc = e.help;
     std::string type;
+    auto shown = [&](const auto& value) { return e.default_text.empty() ? fmt::format("{}", value) : e.default_text; };
     std::visit(
         [&](const auto& v) {
           using T = std::decay_t<decltype(v)>;
           if constexpr (std::is_same_v<T, double>) {
             type = "FLOAT";
-            desc += fmt::format(" [default {}; {}]", v, e.range.describe());
+            desc += fmt::format(" [default {}; {}]", shown(v), e.range.describe());
           } else if constexpr (std::is_same_v<T, long>) {
             type = "INT";
-            desc += fmt::format(" [default {}; integer in [{}, {}]]", v, e.ilo, e.ihi);
+            desc += fmt::format(" [default {}; integer in [{}, {}]]", shown(v), e.ilo, e.ihi);
           } else if constexpr (std::is_same_v<T, std::string>) {
             type = e.choices.empty() ? "TEXT" : "NAME";
-            desc += fmt::format(" [default '{}'{}]", v,
+            desc += fmt::format(" [default {}{}]", e.default_text.empty() ? "'" + v + "'" : e.default_text,
                                 e.choices.empty() ? "" : fmt::format("; one of {}", fmt::join(e.choices, ", ")));
           } else if constexpr (std::is_same_v<T, bool>) {
-            desc += fmt::format(" [default {}]", v ? "on" : "off");
+            desc += fmt::format(" [default {}]", e.default_text.empty() ? (v ? "on" : "off") : e.default_text);
           } else {
             type = "FLOAT,...";
-            desc += fmt::format(" [default {}; comma-separated]", fmt::join(v, ","));
+            desc += fmt::format(" [default {}; comma-separated]", e.default_text.empty() ? fmt::format("{}", fmt::join(v, ",")) : e.default_text);
           }
         },
         e.value);

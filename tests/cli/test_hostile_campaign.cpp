@@ -11,14 +11,12 @@
 #include <vector>
 
 #include "cli_run.hpp"
+#include "help_walk.hpp"
 
 using namespace afmkit_test;
 
 namespace {
 
-const std::vector<std::string> kCommands = {"demo",          "impact",        "tapping orbit", "tapping hb",
-                                            "tapping sweep", "control tf",    "control roots", "control margin",
-                                            "control chart", "control tune",  "control simulate"};
 
 // values of the classes found by the campaign: not a number, the double range's ends, beyond it, negative
 const std::vector<std::string> kValues = {"nan", "1e308", "-1e308", "1e400", "-1", "abc"};
@@ -26,42 +24,10 @@ const std::vector<std::string> kValues = {"nan", "1e308", "-1e308", "1e400", "-1
 // options not probed with numbers: help, the config file and the output path (probed by their own tests)
 const std::set<std::string> kSkipped = {"help", "config", "output"};
 
-struct Option {
-  std::string name;
-  bool flag;
-};
-
-std::vector<Option> options_of(const std::string& command) {
-  TempDir dir;
-  const RunResult r = run_cli(command + " --help", dir);
-  std::vector<Option> out;
-  // `--name TYPE` for options with a value, `--name` alone for flags
-  const std::regex line(R"(^\s+(?:-\w,)?--([a-z0-9-]+)(\s+(?:FLOAT,\.\.\.|FLOAT|INT|NAME|TEXT|FILE)\b)?)");
-  std::istringstream in(r.out);
-  std::string text;
-  while (std::getline(in, text)) {
-    std::smatch m;
-    if (std::regex_search(text, m, line) && !kSkipped.count(m[1].str())) out.push_back({m[1].str(), !m[2].matched});
-  }
-  return out;
-}
-
-/// Subcommand names listed by `afmkit <prefix> --help`.
-std::vector<std::string> subcommands_of(const std::string& prefix) {
-  TempDir dir;
-  const RunResult r = run_cli(prefix + " --help", dir);
-  std::vector<std::string> out;
-  std::istringstream in(r.out);
-  std::string text;
-  bool listing = false;
-  while (std::getline(in, text)) {
-    if (text.rfind("Subcommands:", 0) == 0) {
-      listing = true;
-      continue;
-    }
-    std::smatch m;
-    if (listing && std::regex_search(text, m, std::regex(R"(^  ([a-z]+)\s)"))) out.push_back(m[1].str());
-  }
+std::vector<HelpOption> probed_options(const std::string& command) {
+  std::vector<HelpOption> out;
+  for (const HelpOption& o : options_of(command))
+    if (!kSkipped.count(o.name)) out.push_back(o);
   return out;
 }
 
@@ -79,12 +45,7 @@ RunResult run_bounded(const std::string& args, const TempDir& dir) {
 }  // namespace
 
 TEST(HostileCampaign, TheCommandListIsEveryLeafCommand) {
-  std::vector<std::string> leaves;
-  for (const std::string& top : subcommands_of("")) {
-    const auto subs = subcommands_of(top);
-    if (subs.empty()) leaves.push_back(top);
-    for (const std::string& s : subs) leaves.push_back(top + " " + s);
-  }
+  const auto leaves = leaf_commands();
   EXPECT_EQ(std::set<std::string>(leaves.begin(), leaves.end()),
             std::set<std::string>(kCommands.begin(), kCommands.end()));
 }
@@ -93,16 +54,16 @@ class HostileCampaign : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(HostileCampaign, EveryOptionWithEveryHostileValueEndsWithAStatusAndLeavesNoTemporary) {
   const std::string command = GetParam();
-  const auto options = options_of(command);
+  const auto options = probed_options(command);
   ASSERT_FALSE(options.empty()) << command;
   bool has_output = false, has_quiet = false;
-  for (const Option& o : options) has_quiet |= o.name == "quiet";
+  for (const HelpOption& o : options) has_quiet |= o.name == "quiet";
   {
     TempDir d;
     has_output = run_cli(command + " --help", d).out.find("--output") != std::string::npos;
   }
   int runs = 0;
-  for (const Option& o : options) {
+  for (const HelpOption& o : options) {
     if (o.flag) continue;
     for (const std::string& v : kValues) {
       TempDir dir;

@@ -47,6 +47,9 @@ class ParamSet {
   /// Parameters declared after this call are listed under `name` in --help (model, drive, contact law, numerics,
   /// output, …); before any call: "Options".
   ParamSet& group(const std::string& name);
+  /// What --help shows as the default of the last declared parameter when it is not a fixed value ("automatic",
+  /// "= plant_rate", …); the declared default stays the value used when nothing else applies.
+  ParamSet& default_text(const std::string& text);
 
   /// Adds `--config FILE` and one `--<key-with-dashes>` option per parameter to `app`.
   void add_options(CLI::App& app);
@@ -84,6 +87,7 @@ class ParamSet {
     bool set = false;
     std::optional<std::string> cli_text;  // raw flag text captured by CLI11
     std::string group;                    // heading in --help
+    std::string default_text;             // shown instead of the value in --help, if set
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;
