@@ -30,7 +30,7 @@ inline std::string help_of(const std::string& command) {
 
 inline std::vector<HelpOption> options_of(const std::string& command) {
   std::vector<HelpOption> out;
-  const std::regex line(R"(^\s+(?:-\w,)?--([a-z0-9-]+)(?:\s+(FLOAT,\.\.\.|FLOAT|INT|NAME|TEXT|FILE)\b)?\s*(.*)$)");
+  const std::regex line(R"(^\s+(?:-\w,)?--([a-z0-9-]+)(?:\s+(FLOAT,\.\.\.|FLOAT|INT|NAME|TEXT|FILE)(?=\s|$))?\s*(.*)$)");
   std::istringstream in(help_of(command));
   std::string text;
   while (std::getline(in, text)) {

@@ -85,6 +85,50 @@ TEST_P(HostileCampaign, EveryOptionWithEveryHostileValueEndsWithAStatusAndLeaves
   RecordProperty("runs", runs);
 }
 
+// Crossed ranges: every pair --X-min / --X-max given the wrong way round is bad input (exit 2), naming one of them.
+TEST_P(HostileCampaign, EveryCrossedRangeIsBadInput) {
+  const std::string command = GetParam();
+  const auto options = probed_options(command);
+  std::set<std::string> names;
+  for (const HelpOption& o : options) names.insert(o.name);
+  for (const std::string& lo : names) {
+    if (lo.size() < 4 || lo.compare(lo.size() - 4, 4, "-min") != 0) continue;
+    const std::string stem = lo.substr(0, lo.size() - 4), hi = stem + "-max";
+    if (!names.count(hi)) continue;
+    TempDir dir;
+    const std::string args = command + " --" + lo + " 5 --" + hi + " 1" + (names.count("quiet") ? " --quiet" : "");
+    const RunResult r = run_bounded(args, dir);
+    EXPECT_EQ(r.status, 2) << "afmkit " << args << "\n" << r.err;
+    std::string underscored = stem;
+    for (char& c : underscored)
+      if (c == '-') c = '_';
+    EXPECT_NE(r.err.find(underscored), std::string::npos) << "afmkit " << args << "\n" << r.err;
+  }
+}
+
+// Hostile TOML: every key of the command given a value of the wrong kind (array, table, text, a number too large
+// for TOML) is bad input naming the key or the file; nothing is written.
+TEST_P(HostileCampaign, EveryKeyWithAHostileTomlValueIsBadInput) {
+  const std::string command = GetParam();
+  for (const HelpOption& o : probed_options(command)) {
+    std::string key = o.name;
+    for (char& c : key)
+      if (c == '-') c = '_';
+    for (const std::string& value : {std::string("[1, 2]"), std::string("{ a = 1 }"), std::string("99999999999999999999"),
+                                     std::string("1979-05-27"), std::string("'") + std::string(5000, 'x') + "'"}) {
+      if (o.type == "TEXT" && value[0] == '\'') continue;      // long text is a valid (missing) file name
+      if (o.type == "FLOAT,..." && value[0] == '[') continue;  // an array is what a list key takes
+      TempDir dir;
+      dir.write("hostile.toml", key + " = " + value + "\n");
+      const RunResult r = run_bounded(command + " --config hostile.toml --output out.csv", dir);
+      if (command == "demo" && r.err.find("--output") != std::string::npos) continue;  // demo writes to a folder
+      EXPECT_TRUE(r.status == 1 || r.status == 2) << "afmkit " << command << " with " << key << " = " << value.substr(0, 40)
+                                                  << "\nexit " << r.status << "\n" << r.err;
+      EXPECT_FALSE(std::filesystem::exists(dir.path / "out.csv")) << command << " " << key;
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Commands, HostileCampaign, ::testing::ValuesIn(kCommands),
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            std::string name = info.param;
@@ -92,3 +136,26 @@ INSTANTIATE_TEST_SUITE_P(Commands, HostileCampaign, ::testing::ValuesIn(kCommand
                              if (c == ' ') c = '_';
                            return name;
                          });
+
+// Output paths and kills, for a command that writes a table: refused paths exit 2 and leave nothing; a run killed
+// while it computes or writes leaves no temporary.
+TEST(HostileOutputs, RefusedPathsAndKilledRunsLeaveNothingBehind) {
+  TempDir dir;
+  std::filesystem::create_directories(dir.path / "folder");
+  dir.write("file.txt", "x");
+  ASSERT_EQ(std::system(("mkfifo '" + dir.file("fifo.csv") + "'").c_str()), 0);
+  for (const std::string& out : {std::string("folder"), std::string("fifo.csv"), std::string("file.txt/out.csv"),
+                                 std::string(300, 'n') + ".csv"}) {
+    const RunResult r = run_bounded("tapping hb --points 50 --output '" + out + "'", dir);
+    EXPECT_EQ(r.status, 2) << out.substr(0, 40) << "\n" << r.err;
+  }
+  // killed at several moments of a run that computes and then streams 2e5 rows
+  for (const char* after : {"0.05", "0.2", "0.5", "1"}) {
+    const std::string line = "timeout -s TERM " + std::string(after) + " '" + std::string(AFMKIT_CLI) +
+                             "' control tf --points 200000 --output killed.csv >/dev/null 2>&1";
+    std::system(("cd '" + dir.path.string() + "' && " + line).c_str());
+    for (const auto& e : std::filesystem::recursive_directory_iterator(dir.path))
+      EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << "killed after " << after << " s left "
+                                                                               << e.path();
+  }
+}
