@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "cli_run.hpp"
 
 namespace afmkit_test {
@@ -13,6 +15,14 @@ namespace afmkit_test {
 inline const std::vector<std::string> kCommands = {"demo",          "impact",        "tapping orbit", "tapping hb",
                                                    "tapping sweep", "control tf",    "control roots", "control margin",
                                                    "control chart", "control tune",  "control simulate"};
+
+/// A gtest parameter name for a command: "tapping orbit" -> "tapping_orbit".
+inline std::string command_test_name(const ::testing::TestParamInfo<std::string>& info) {
+  std::string name = info.param;
+  for (char& c : name)
+    if (c == ' ') c = '_';
+  return name;
+}
 
 /// One option line of --help: `--name TYPE  description` (type empty for a flag). A long name whose description
 /// starts on the next line gets that line as its description.

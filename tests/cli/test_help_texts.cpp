@@ -39,9 +39,4 @@ TEST_P(HelpText, EveryOptionIsTypedHasOneDefaultAndCitesOnlyTheProject) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Commands, HelpText, ::testing::ValuesIn(kCommands),
-                         [](const ::testing::TestParamInfo<std::string>& info) {
-                           std::string name = info.param;
-                           for (char& c : name)
-                             if (c == ' ') c = '_';
-                           return name;
-                         });
+command_test_name);

@@ -130,12 +130,7 @@ TEST_P(HostileCampaign, EveryKeyWithAHostileTomlValueIsBadInput) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Commands, HostileCampaign, ::testing::ValuesIn(kCommands),
-                         [](const ::testing::TestParamInfo<std::string>& info) {
-                           std::string name = info.param;
-                           for (char& c : name)
-                             if (c == ' ') c = '_';
-                           return name;
-                         });
+command_test_name);
 
 // Output paths and kills, for a command that writes a table: refused paths exit 2 and leave nothing; a run killed
 // while it computes or writes leaves no temporary.
