@@ -1,4 +1,4 @@
-// Numerical describing functions (numerical_describing_functions.hpp) against the closed forms of seed 000 for the
+// Numerical describing functions (numerical_describing_functions.hpp) against the closed forms of seed 1 for the
 // piecewise-linear laws (≤ 1e-12 of the N1 scale, including grazing and permanent contact) and against an
 // independent tanh_sinh quadrature for the non-linear laws (DMT + vdW, JKR-like with its jump, Kelvin–Voigt with
 // its velocity term, Lennard-Jones, Hertz).
