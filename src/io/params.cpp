@@ -139,18 +139,11 @@ void ParamSet::add_options(CLI::App& app) {
           }
         },
         e.value);
-    CLI::Option* opt = nullptr;
-    if (std::holds_alternative<bool>(e.value)) {
-      // a flag: `--json` turns it on, `--json=false` off (TOML: json = true / false)
-      opt = app.add_option_function<std::string>(
-          "--" + dashed(key), [&e](const std::string& s) { e.cli_text = s; }, desc);
-      opt->expected(0, 1)->type_name("");
-    } else {
-      opt = app.add_option_function<std::string>(
-          "--" + dashed(key), [&e](const std::string& s) { e.cli_text = s; }, desc);
-      opt->type_name(type);
-    }
-    opt->group(e.group);
+    CLI::Option* opt =
+        app.add_option_function<std::string>("--" + dashed(key), [&e](const std::string& s) { e.cli_text = s; }, desc);
+    // a flag (empty type): `--json` turns it on, `--json=false` off (TOML: json = true / false)
+    if (type.empty()) opt->expected(0, 1);
+    opt->type_name(type)->group(e.group);
   }
 }
 

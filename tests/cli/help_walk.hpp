@@ -38,10 +38,11 @@ inline std::string help_of(const std::string& command) {
   return run_cli(command + " --help", dir).out;
 }
 
-inline std::vector<HelpOption> options_of(const std::string& command) {
+/// The options listed in a --help text.
+inline std::vector<HelpOption> options_in(const std::string& help) {
   std::vector<HelpOption> out;
   const std::regex line(R"(^\s+(?:-\w,)?--([a-z0-9-]+)(?:\s+(FLOAT,\.\.\.|FLOAT|INT|NAME|TEXT|FILE)(?=\s|$))?\s*(.*)$)");
-  std::istringstream in(help_of(command));
+  std::istringstream in(help);
   std::string text;
   while (std::getline(in, text)) {
     std::smatch m;
@@ -53,6 +54,8 @@ inline std::vector<HelpOption> options_of(const std::string& command) {
   }
   return out;
 }
+
+inline std::vector<HelpOption> options_of(const std::string& command) { return options_in(help_of(command)); }
 
 /// Subcommand names listed by `afmkit <prefix> --help`.
 inline std::vector<std::string> subcommands_of(const std::string& prefix) {

@@ -52,7 +52,8 @@ class TappingSystem {
   double acceleration(const Mode& mode, double t, TipState s) const;
   /// h(x, ẋ) and ∂h/∂x together (one region lookup; the law's closed-form slopes when it has them).
   double interaction_with_slope(ContactBranch branch, double x, double velocity, int region, double& slope) const;
-  /// The same with the drive term Γ cos ωt given (integrators that advance the drive phase themselves).
+  /// Γ cos ωt − 2ξω_n ẋ − ω_n² x − h(x, ẋ) with the drive term Γ cos ωt given (any branch, sticking included;
+  /// acceleration(mode, …) answers 0 in the sticking mode) (integrators that advance the drive phase themselves).
   double acceleration_given_drive(const Mode& mode, double drive_term, TipState s) const;
   double drive_frequency() const { return omega_; }
   /// ẍ with the given branch's force in `region`.

@@ -123,7 +123,7 @@ double TappingSystem::interaction_with_slope(ContactBranch branch, double x, dou
 }
 
 double TappingSystem::acceleration(ContactBranch branch, int region, double t, TipState s) const {
-  return drive(t) - damping_ * s.velocity - stiffness_ * s.position - interaction(branch, s.position, s.velocity, region);
+  return acceleration_given_drive({region, branch}, drive(t), s);
 }
 
 double TappingSystem::acceleration(const Mode& mode, double t, TipState s) const {
@@ -132,7 +132,6 @@ double TappingSystem::acceleration(const Mode& mode, double t, TipState s) const
 }
 
 double TappingSystem::acceleration_given_drive(const Mode& mode, double drive_term, TipState s) const {
-  if (mode.branch == ContactBranch::sticking) return 0.0;
   return drive_term - damping_ * s.velocity - stiffness_ * s.position -
          interaction(mode.branch, s.position, s.velocity, mode.region);
 }
