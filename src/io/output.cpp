@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +13,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/version.hpp"
+#include "afmkit/io/params.hpp"
 
 namespace afmkit::io {
 
@@ -138,9 +140,42 @@ void remove_temporaries_on_signal() {
   for (int s : {SIGINT, SIGTERM, SIGHUP}) std::signal(s, remove_temporaries_and_reraise);
 }
 
-TableWriter::TableWriter(std::string path, std::vector<std::string> columns)
+nlohmann::json columns_json(const std::vector<Column>& columns) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const Column& c : columns) j.push_back({{"name", c.name}, {"unit", c.unit}, {"description", c.description}});
+  return j;
+}
+
+nlohmann::json finite_json(nlohmann::json value) {
+  if (value.is_number_float()) {
+    const double v = value.get<double>();
+    if (std::isnan(v)) return nullptr;
+    if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  } else if (value.is_structured()) {
+    for (auto& item : value) item = finite_json(std::move(item));
+  }
+  return value;
+}
+
+std::string json_text(const nlohmann::json& value) { return finite_json(value).dump(2); }
+
+namespace {
+std::vector<Column> transitional(const std::vector<std::string>& names) {
+  std::vector<Column> c;
+  for (const auto& n : names) c.push_back({n, "?", "?"});
+  return c;
+}
+}  // namespace
+TableWriter::TableWriter(std::string path, const std::vector<std::string>& names)
+    : TableWriter(std::move(path), transitional(names)) {}
+
+TableWriter::TableWriter(std::string path, std::vector<Column> columns)
     : path_(std::move(path)), columns_(std::move(columns)) {
   if (columns_.empty()) throw std::logic_error("TableWriter: a table needs at least one column");
+  for (const Column& c : columns_)
+    if (c.name.empty() || c.unit.empty() || c.description.empty())
+      throw std::logic_error(fmt::format("TableWriter: column '{}' of '{}' needs a name, a unit and a description",
+                                         c.name, path_));
   target_ = output_target(path_);
   output_target(path_ + ".json");  // refuse a bad sidecar path before any work
   temporary_ = temporary_name(target_);
@@ -153,7 +188,7 @@ TableWriter::TableWriter(std::string path, std::vector<std::string> columns)
   }
   for (std::size_t i = 0; i < columns_.size(); ++i) {
     if (i) buffer_.push_back(',');
-    buffer_.append(std::string_view(columns_[i]));
+    buffer_.append(std::string_view(columns_[i].name));
   }
   buffer_.push_back('\n');
 }
@@ -233,7 +268,9 @@ void TableWriter::commit(const nlohmann::json& sidecar) {
   // Both files are complete and synced on disk before either is moved into place.
   Temporary meta;
   try {
-    meta = write_temporary(path_ + ".json", sidecar.dump(2) + "\n");
+    nlohmann::json described = sidecar;
+    described["columns"] = columns_json(columns_);
+    meta = write_temporary(path_ + ".json", json_text(described) + "\n");
   } catch (...) {
     discard();
     throw;
@@ -256,14 +293,19 @@ void write_file_atomic(const std::string& path, const std::string& content) {
 }
 
 nlohmann::json make_sidecar(const std::string& command, const nlohmann::json& parameters,
-                            const nlohmann::json& results) {
+                            const nlohmann::json& results, const nlohmann::json& parameter_units) {
   nlohmann::json j;
   j["program"] = "afmkit";
   j["version"] = afmkit::version;
   j["command"] = command;
   j["parameters"] = parameters;
+  if (!parameter_units.empty()) j["parameter_units"] = parameter_units;
   if (!results.empty()) j["results"] = results;
   return j;
+}
+
+nlohmann::json make_sidecar(const std::string& command, const ParamSet& parameters, const nlohmann::json& results) {
+  return make_sidecar(command, parameters.to_json(), results, parameters.units_json());
 }
 
 }  // namespace afmkit::io

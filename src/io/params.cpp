@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -69,26 +70,45 @@ std::string Range::describe() const {
   return "a finite number";
 }
 
+ParamSet::Entry ParamSet::make_entry(Value value, const std::string& help, Range range) {
+  Entry e;
+  e.value = std::move(value);
+  e.help = help;
+  e.range = range;
+  return e;
+}
+
 void ParamSet::declare(const std::string& key, Entry e) {
   e.group = group_;
   if (!entries_.count(key)) order_.push_back(key);
   entries_[key] = std::move(e);
+  last_ = key;
 }
 ParamSet& ParamSet::group(const std::string& name) {
   group_ = name;
   return *this;
 }
 ParamSet& ParamSet::default_text(const std::string& text) {
-  if (order_.empty()) throw std::logic_error("ParamSet::default_text before any parameter");
-  entries_[order_.back()].default_text = text;
+  if (last_.empty()) throw std::logic_error("ParamSet::default_text before any parameter");
+  entries_[last_].default_text = text;
   return *this;
 }
+ParamSet& ParamSet::unit(const std::string& unit) {
+  if (last_.empty()) throw std::logic_error("ParamSet::unit before any parameter");
+  Entry& e = entries_[last_];
+  if (std::holds_alternative<std::string>(e.value) || std::holds_alternative<bool>(e.value))
+    throw std::logic_error(fmt::format("ParamSet::unit: '{}' is not a number", last_));
+  e.unit = unit;
+  return *this;
+}
+const std::string& ParamSet::unit_of(const std::string& key) const& { return entry(key).unit; }
 ParamSet& ParamSet::real(const std::string& key, double def, const std::string& help, Range range) {
-  declare(key, Entry{def, help, range});
+  declare(key, make_entry(def, help, range));
   return *this;
 }
 ParamSet& ParamSet::integer(const std::string& key, long def, const std::string& help, long lo, long hi) {
-  Entry e{def, help, Range::any()};
+  Entry e = make_entry(def, help, Range::any());
+  e.unit = "count";  // a number of things, unless unit() says otherwise
   e.ilo = lo;
   e.ihi = hi;
   declare(key, std::move(e));
@@ -96,17 +116,17 @@ ParamSet& ParamSet::integer(const std::string& key, long def, const std::string&
 }
 ParamSet& ParamSet::text(const std::string& key, const std::string& def, const std::string& help,
                          std::vector<std::string> choices) {
-  Entry e{def, help, Range::any()};
+  Entry e = make_entry(def, help, Range::any());
   e.choices = std::move(choices);
   declare(key, std::move(e));
   return *this;
 }
 ParamSet& ParamSet::flag(const std::string& key, bool def, const std::string& help) {
-  declare(key, Entry{def, help, Range::any()});
+  declare(key, make_entry(def, help, Range::any()));
   return *this;
 }
 ParamSet& ParamSet::reals(const std::string& key, std::vector<double> def, const std::string& help, Range range) {
-  declare(key, Entry{std::move(def), help, range});
+  declare(key, make_entry(std::move(def), help, range));
   return *this;
 }
 
@@ -118,15 +138,18 @@ void ParamSet::add_options(CLI::App& app) {
     std::string desc = e.help;
     std::string type;
     auto shown = [&](const auto& value) { return e.default_text.empty() ? fmt::format("{}", value) : e.default_text; };
+    const bool numeric = !std::holds_alternative<std::string>(e.value) && !std::holds_alternative<bool>(e.value);
+    if (numeric && e.unit.empty() && std::getenv("AFMKIT_REQUIRE_UNITS"))  // TRANSITIONAL: always, once all declare units  // every number a user sees carries its unit (docs/units.md)
+      throw std::logic_error(fmt::format("ParamSet: parameter '{}' is declared without a unit", key));
     std::visit(
         [&](const auto& v) {
           using T = std::decay_t<decltype(v)>;
           if constexpr (std::is_same_v<T, double>) {
             type = "FLOAT";
-            desc += fmt::format(" [default {}; {}]", shown(v), e.range.describe());
+            desc += fmt::format(" [unit: {}; default {}; {}]", e.unit, shown(v), e.range.describe());
           } else if constexpr (std::is_same_v<T, long>) {
             type = "INT";
-            desc += fmt::format(" [default {}; integer in [{}, {}]]", shown(v), e.ilo, e.ihi);
+            desc += fmt::format(" [unit: {}; default {}; integer in [{}, {}]]", e.unit, shown(v), e.ilo, e.ihi);
           } else if constexpr (std::is_same_v<T, std::string>) {
             type = e.choices.empty() ? "TEXT" : "NAME";
             desc += fmt::format(" [default {}{}]", e.default_text.empty() ? "'" + v + "'" : e.default_text,
@@ -135,7 +158,9 @@ void ParamSet::add_options(CLI::App& app) {
             desc += fmt::format(" [default {}]", e.default_text.empty() ? (v ? "on" : "off") : e.default_text);
           } else {
             type = "FLOAT,...";
-            desc += fmt::format(" [default {}; comma-separated]", e.default_text.empty() ? fmt::format("{}", fmt::join(v, ",")) : e.default_text);
+            desc += fmt::format(" [unit: {}; default {}; comma-separated, each {}]", e.unit,
+                                e.default_text.empty() ? fmt::format("{}", fmt::join(v, ",")) : e.default_text,
+                                e.range.describe());
           }
         },
         e.value);
@@ -307,6 +332,13 @@ const std::vector<double>& ParamSet::reals(const std::string& key) const& {
   return std::get<std::vector<double>>(entry(key).value);
 }
 bool ParamSet::was_set(const std::string& key) const { return entry(key).set; }
+
+nlohmann::json ParamSet::units_json() const {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& key : order_)
+    if (!entries_.at(key).unit.empty()) j[key] = entries_.at(key).unit;
+  return j;
+}
 
 nlohmann::json ParamSet::to_json() const {
   nlohmann::json j = nlohmann::json::object();

@@ -38,6 +38,13 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
+/// Columns named `names`, each a dimensionless test column.
+std::vector<afmkit::io::Column> cols(std::initializer_list<const char*> names) {
+  std::vector<afmkit::io::Column> c;
+  for (const char* n : names) c.push_back({n, "dimensionless", std::string("test column ") + n});
+  return c;
+}
+
 bool any_temporary(const fs::path& dir) {
   for (const auto& f : fs::directory_iterator(dir))
     if (f.path().string().find(".tmp.") != std::string::npos) return true;
@@ -57,7 +64,7 @@ TEST(TableWriter, DoublesRoundTripBitExactAndCellsHaveTheirText) {
   values.push_back(-0.0);
   values.push_back(std::numeric_limits<double>::denorm_min());
   {
-    TableWriter out((dir / "sub/t.csv").string(), {"x", "n", "flag", "name"});
+    TableWriter out((dir / "sub/t.csv").string(), cols({"x", "n", "flag", "name"}));
     for (std::size_t i = 0; i < values.size(); ++i) out.row(values[i], static_cast<long>(i) - 5, i % 2 == 0, "abc");
     out.row(std::numeric_limits<double>::quiet_NaN(), 0L, false, "undefined");
     EXPECT_EQ(out.size(), values.size() + 1);
@@ -93,7 +100,7 @@ TEST(TableWriter, DoublesRoundTripBitExactAndCellsHaveTheirText) {
 
 TEST(TableWriter, RowWidthIsChecked) {
   const fs::path dir = fresh_dir("width");
-  TableWriter out((dir / "t.csv").string(), {"a", "b"});
+  TableWriter out((dir / "t.csv").string(), cols({"a", "b"}));
   EXPECT_THROW(out.row(1.0), std::logic_error);
   EXPECT_THROW(out.row(1.0, 2.0, 3.0), std::logic_error);
   fs::remove_all(dir);
@@ -104,7 +111,7 @@ TEST(TableWriter, AbandonedWriterLeavesNothingAndKeepsTheOldFile) {
   fs::create_directories(dir);
   { std::ofstream(dir / "t.csv") << "old\n"; }
   try {
-    TableWriter out((dir / "t.csv").string(), {"a"});
+    TableWriter out((dir / "t.csv").string(), cols({"a"}));
     for (int i = 0; i < 100000; ++i) out.row(i * 0.5);
     throw std::runtime_error("interrupted");  // e.g. a numerical failure half way
   } catch (const std::runtime_error&) {
@@ -118,7 +125,7 @@ TEST(TableWriter, AbandonedWriterLeavesNothingAndKeepsTheOldFile) {
 TEST(TableWriter, RowsAreStreamedToDiskNotHeldInMemory) {
   // Before commit, all but the last buffer of the rows must already be in the temporary file.
   const fs::path dir = fresh_dir("stream");
-  TableWriter out((dir / "t.csv").string(), {"a", "b", "c"});
+  TableWriter out((dir / "t.csv").string(), cols({"a", "b", "c"}));
   std::size_t bytes = 6;  // header "a,b,c\n"
   for (int i = 0; i < 200000; ++i) {
     out.row(i + 0.25, i, true);
@@ -130,13 +137,13 @@ TEST(TableWriter, RowsAreStreamedToDiskNotHeldInMemory) {
   ASSERT_FALSE(temporary.empty());
   EXPECT_GE(fs::file_size(temporary) + (1u << 16), bytes);
   EXPECT_FALSE(fs::exists(dir / "t.csv"));  // not in place before commit
-  out.commit(afmkit::io::make_sidecar("test", {}));
+  out.commit(afmkit::io::make_sidecar("test", nlohmann::json::object()));
   EXPECT_EQ(fs::file_size(dir / "t.csv"), bytes);
   fs::remove_all(dir);
 }
 
 TEST(TableWriter, UnwritableTargetIsAnInputError) {
-  EXPECT_THROW(TableWriter("/proc/afmkit_cannot_write/t.csv", {"a"}), afmkit::InputError);
+  EXPECT_THROW(TableWriter("/proc/afmkit_cannot_write/t.csv", cols({"a"})), afmkit::InputError);
 }
 
 TEST(TableWriter, ATerminatingSignalRemovesTheTemporaries) {
@@ -147,7 +154,7 @@ TEST(TableWriter, ATerminatingSignalRemovesTheTemporaries) {
   ASSERT_GE(child, 0);
   if (child == 0) {  // the child writes half a table and is terminated by SIGTERM
     afmkit::io::remove_temporaries_on_signal();
-    TableWriter out(path, {"a"});
+    TableWriter out(path, cols({"a"}));
     for (int i = 0; i < 100000; ++i) out.row(i);  // flushed to the temporary as it goes
     std::raise(SIGTERM);
     std::_Exit(3);  // not reached
@@ -170,13 +177,13 @@ TEST(TableWriter, ANonRegularTargetIsRefusedAndASymbolicLinkIsFollowed) {
   fs::create_directories(dir);
   const std::string fifo = (dir / "fifo.csv").string();
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  EXPECT_THROW(TableWriter(fifo, {"a"}), afmkit::InputError);
-  EXPECT_THROW(TableWriter(dir.string(), {"a"}), afmkit::InputError);  // a directory
+  EXPECT_THROW(TableWriter(fifo, cols({"a"})), afmkit::InputError);
+  EXPECT_THROW(TableWriter(dir.string(), cols({"a"})), afmkit::InputError);  // a directory
   // a link to a file that does not exist yet: the file is created, the link stays a link
   fs::create_directories(dir / "data");
   fs::create_symlink("data/real.csv", dir / "link.csv");
   {
-    TableWriter out((dir / "link.csv").string(), {"a"});
+    TableWriter out((dir / "link.csv").string(), cols({"a"}));
     out.row(1.5);
     out.commit(nlohmann::json::object());
   }
@@ -184,4 +191,35 @@ TEST(TableWriter, ANonRegularTargetIsRefusedAndASymbolicLinkIsFollowed) {
   EXPECT_EQ(slurp(dir / "data" / "real.csv"), "a\n1.5\n");
   EXPECT_TRUE(fs::exists(dir / "link.csv.json"));
   fs::remove_all(dir);
+}
+
+TEST(TableWriter, TheSidecarDescribesEveryColumnAndAColumnNeedsAUnit) {
+  const fs::path dir = fresh_dir("columns");
+  {
+    TableWriter out((dir / "t.csv").string(), {{"separation", "nm", "separation l"}, {"phase", "rad", "phase φ"}});
+    out.row(1.0, 0.5);
+    out.commit(afmkit::io::make_sidecar("test", nlohmann::json::object()));
+  }
+  const auto meta = nlohmann::json::parse(slurp(dir / "t.csv.json"));
+  ASSERT_EQ(meta["columns"].size(), 2u);
+  EXPECT_EQ(meta["columns"][0], (nlohmann::json{{"name", "separation"}, {"unit", "nm"}, {"description", "separation l"}}));
+  EXPECT_EQ(meta["columns"][1]["unit"], "rad");
+  EXPECT_THROW(TableWriter((dir / "u.csv").string(), std::vector<afmkit::io::Column>{{"separation", "", "separation l"}}), std::logic_error);
+  EXPECT_THROW(TableWriter((dir / "u.csv").string(), std::vector<afmkit::io::Column>{{"separation", "nm", ""}}), std::logic_error);
+  fs::remove_all(dir);
+}
+
+TEST(JsonConvention, NotDefinedIsNullAndInfiniteIsASignedString) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const nlohmann::json in = {{"a", nan}, {"b", {1.5, inf, -inf}}, {"c", {{"d", nan}}}, {"e", "text"}, {"f", 2}};
+  const nlohmann::json out = afmkit::io::finite_json(in);
+  EXPECT_TRUE(out["a"].is_null());
+  EXPECT_EQ(out["b"], (nlohmann::json{1.5, "inf", "-inf"}));
+  EXPECT_TRUE(out["c"]["d"].is_null());
+  EXPECT_EQ(out["e"], "text");
+  EXPECT_EQ(out["f"], 2);
+  // what nlohmann alone would write: both as null (the distinction would be lost)
+  EXPECT_EQ(nlohmann::json(inf).dump(), "null");
+  EXPECT_EQ(nlohmann::json::parse(afmkit::io::json_text(in))["b"][1], "inf");
 }

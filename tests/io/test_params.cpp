@@ -7,6 +7,9 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/params.hpp"
 
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
 using afmkit::InputError;
 using afmkit::InvalidParameter;
 using afmkit::io::ParamSet;
@@ -16,10 +19,12 @@ namespace {
 ParamSet make() {
   ParamSet p;
   p.real("quality_factor", 100.0, "Q", Range::positive())
+      .unit("dimensionless")
       .integer("points", 10, "number of points", 1, 1000)
       .text("law", "hysteresis", "force law", {"linear", "hysteresis"})
       .flag("verbose", false, "talk")
-      .reals("amplitudes", {1.0, 0.5}, "harmonic amplitudes", Range::non_negative());
+      .reals("amplitudes", {1.0, 0.5}, "harmonic amplitudes", Range::non_negative())
+      .unit("nm");
   return p;
 }
 }  // namespace
@@ -94,4 +99,29 @@ TEST(ParamSet, FloatForAnIntegerKey) {
       EXPECT_NE(std::string(e.what()).find("integer"), std::string::npos) << text;
     }
   }
+}
+
+TEST(ParamSet, EveryNumberCarriesItsUnitIntoHelpAndSidecar) {
+  auto p = make();
+  CLI::App app;
+  p.add_options(app);
+  const std::string help = app.help();
+  EXPECT_NE(help.find("[unit: dimensionless; default 100"), std::string::npos) << help;
+  EXPECT_NE(help.find("[unit: count; default 10"), std::string::npos) << help;  // integers count things
+  EXPECT_NE(help.find("[unit: nm; default 1,0.5"), std::string::npos) << help;
+  const nlohmann::json units = p.units_json();
+  EXPECT_EQ(units["quality_factor"], "dimensionless");
+  EXPECT_EQ(units["amplitudes"], "nm");
+  EXPECT_FALSE(units.contains("law"));  // names and flags have no unit
+  EXPECT_EQ(p.unit_of("points"), "count");
+}
+
+TEST(ParamSet, ANumberWithoutAUnitIsAProgrammingError) {
+  ParamSet p;
+  p.real("separation", 1.0, "separation", Range::any());
+  CLI::App app;
+  EXPECT_THROW(p.add_options(app), std::logic_error);
+  ParamSet q;
+  q.text("law", "hysteresis", "force law");
+  EXPECT_THROW(q.unit("nm"), std::logic_error);  // a name has no unit
 }

@@ -3,7 +3,9 @@
 // parameters, the afmkit version and summary results. Tables are streamed: each row is formatted into a small
 // buffer and appended to a temporary file next to the target; commit() renames it into place (atomic), so a
 // failed or interrupted run never leaves a half-written output and memory stays bounded by a buffer, not the
-// file. Undefined values (NaN) are written as `nan` (docs/conventions.md).
+// file. Every column has a unit and a description, listed in the sidecar's "columns" array (docs/units.md).
+// Undefined values: `nan` in CSV, `null` in JSON; infinite values: `inf`/`-inf` in CSV, "inf"/"-inf" in JSON
+// (docs/conventions.md#undefined-values).
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -12,18 +14,40 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "afmkit/io/params.hpp"
+
 namespace afmkit::io {
+
+/// One column of a table: its CSV header name, its unit (docs/units.md: "nm", "rad", "dimensionless", …) and
+/// what it holds. The sidecar lists them in order as {"name", "unit", "description"}.
+struct Column {
+  std::string name;
+  std::string unit;
+  std::string description;
+};
+
+/// The sidecar's "columns" array for `columns`.
+nlohmann::json columns_json(const std::vector<Column>& columns);
+
+/// `value` with afmkit's one convention for non-finite numbers in JSON: NaN (not defined) becomes null, ±infinity
+/// the strings "inf" / "-inf" (nlohmann would write both as null). Applied to every sidecar and printed document.
+nlohmann::json finite_json(nlohmann::json value);
+/// `finite_json(value)` as indented text (what sidecars and `--json` print).
+std::string json_text(const nlohmann::json& value);
 
 /// Streams a column-named CSV table to `path` atomically. Cells are numbers (shortest round-trip text),
 /// integers, strings or booleans (0/1). Usage:
-///   TableWriter out(path, {"separation", "amplitude"});
+///   TableWriter out(path, {{"separation", "nm", "separation l"}, {"amplitude", "nm", "amplitude A"}});
 ///   for (...) out.row(l, B);
-///   out.commit(make_sidecar(...));     // rename into place, then write the sidecar
+///   out.commit(make_sidecar(...));     // rename into place, then write the sidecar (with "columns" added)
 /// A writer destroyed without commit() removes its temporary file.
 class TableWriter {
  public:
-  /// Opens `<path>.tmp.<pid>` (creating parent folders). Throws afmkit::InputError when that is impossible.
-  TableWriter(std::string path, std::vector<std::string> columns);
+  /// Opens `<path>.tmp.<pid>` (creating parent folders). Throws afmkit::InputError when that is impossible, and
+  /// std::logic_error when a column has an empty name, unit or description (a programming error).
+  TableWriter(std::string path, std::vector<Column> columns);
+  /// TRANSITIONAL (removed before this change lands): columns without units.
+  TableWriter(std::string path, const std::vector<std::string>& names);
   ~TableWriter();
   TableWriter(const TableWriter&) = delete;
   TableWriter& operator=(const TableWriter&) = delete;
@@ -45,12 +69,12 @@ class TableWriter {
     end_row();
   }
 
-  /// Flushes, renames the table into place and writes `<path>.json` (atomically). Throws InputError on an
-  /// I/O failure (nothing is left behind then).
+  /// Flushes, renames the table into place and writes `<path>.json` (atomically): `sidecar` with the "columns"
+  /// array added. Throws InputError on an I/O failure (nothing is left behind then).
   void commit(const nlohmann::json& sidecar);
 
-  const std::vector<std::string>& columns() const& { return columns_; }
-  std::vector<std::string> columns() const&& { return columns_; }
+  const std::vector<Column>& columns() const& { return columns_; }
+  std::vector<Column> columns() const&& { return columns_; }
   std::size_t size() const { return rows_; }  ///< rows written so far
   const std::string& path() const& { return path_; }
   std::string path() const&& { return path_; }
@@ -60,7 +84,7 @@ class TableWriter {
   std::string target_;  // path_, or the file its symbolic link points to
   std::string temporary_;
   int slot_ = -1;       // registration for removal on a signal
-  std::vector<std::string> columns_;
+  std::vector<Column> columns_;
   std::FILE* file_ = nullptr;
   fmt::memory_buffer buffer_;
   std::size_t rows_ = 0;
@@ -81,8 +105,13 @@ void write_file_atomic(const std::string& path, const std::string& content);
 /// process by the same signal (the command-line program calls it once at start).
 void remove_temporaries_on_signal();
 
-/// Metadata of a run, written as the sidecar `<csv path>.json`.
+/// Metadata of a run, written as the sidecar `<csv path>.json`: program, version, command, parameters (their
+/// values as given), parameter_units (when given: key -> unit), results; TableWriter::commit adds "columns".
 nlohmann::json make_sidecar(const std::string& command, const nlohmann::json& parameters,
+                            const nlohmann::json& results = nlohmann::json::object(),
+                            const nlohmann::json& parameter_units = nlohmann::json::object());
+/// The same from a command's parameter set (values and units).
+nlohmann::json make_sidecar(const std::string& command, const ParamSet& parameters,
                             const nlohmann::json& results = nlohmann::json::object());
 
 }  // namespace afmkit::io

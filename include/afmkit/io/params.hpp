@@ -50,6 +50,11 @@ class ParamSet {
   /// What --help shows as the default of the last declared parameter when it is not a fixed value ("automatic",
   /// "= plant_rate", …); the declared default stays the value used when nothing else applies.
   ParamSet& default_text(const std::string& text);
+  /// The unit of the last declared number (docs/units.md: "nm", "rad", "dimensionless", "units of Omega", …),
+  /// shown in --help and written to sidecars. Every real parameter needs one (add_options throws
+  /// std::logic_error otherwise); integers default to "count".
+  ParamSet& unit(const std::string& unit);
+  const std::string& unit_of(const std::string& key) const&;
 
   /// Adds `--config FILE` and one `--<key-with-dashes>` option per parameter to `app`.
   void add_options(CLI::App& app);
@@ -73,6 +78,8 @@ class ParamSet {
 
   /// All parameters and their values, for the JSON sidecar.
   nlohmann::json to_json() const;
+  /// The unit of every numeric parameter (key -> unit), for the JSON sidecar.
+  nlohmann::json units_json() const;
   /// Path given with --config ("" if none).
   const std::string& config_path() const& { return config_path_; }
   std::string config_path() const&& { return config_path_; }
@@ -88,6 +95,7 @@ class ParamSet {
     std::optional<std::string> cli_text;  // raw flag text captured by CLI11
     std::string group;                    // heading in --help
     std::string default_text;             // shown instead of the value in --help, if set
+    std::string unit;                     // numbers only (docs/units.md)
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;
@@ -95,7 +103,9 @@ class ParamSet {
   std::vector<std::string> order_;
   std::string config_path_;
   std::string group_ = "Options";
+  std::string last_;  // the parameter default_text() and unit() apply to
   void declare(const std::string& key, Entry e);
+  static Entry make_entry(Value value, const std::string& help, Range range);
 };
 
 }  // namespace afmkit::io

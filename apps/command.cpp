@@ -1,0 +1,53 @@
+#include "command.hpp"
+
+#include <memory>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+namespace afmkit::cli {
+
+CLI::App& add_command(CLI::App& parent, const std::string& name, const std::string& help, const Declare& declare,
+                      Run run) {
+  auto params = std::make_shared<io::ParamSet>();
+  declare(*params);
+  CLI::App* cmd = parent.add_subcommand(name, help);
+  params->add_options(*cmd);
+  cmd->callback([params, run = std::move(run)] {
+    params->resolve();
+    run(*params);
+  });
+  return *cmd;
+}
+
+void add_output_params(io::ParamSet& p, const std::string& default_path, const std::string& what) {
+  p.group("Output")
+      .flag("json", false, "print the results as JSON to standard output instead of a summary line (with the table "
+                           "itself when no file is written)")
+      .text("output", default_path, what + " CSV path (JSON sidecar describing every column next to it); empty: no file");
+}
+
+CommandOutput::CommandOutput(const io::ParamSet& params, std::string command, const std::string& output_key)
+    : params_(params), command_(std::move(command)), path_(params.text(output_key)), json_(params.flag("json")) {
+  keep_rows_ = json_ && path_.empty();
+}
+
+void CommandOutput::open(std::vector<io::Column> columns) {
+  columns_ = std::move(columns);
+  if (!path_.empty()) file_.emplace(path_, columns_);
+}
+
+void CommandOutput::finish(const nlohmann::json& results, const std::string& summary) {
+  if (file_) file_->commit(io::make_sidecar(command_, params_, results));
+  if (json_) {
+    nlohmann::json document = results;
+    if (keep_rows_) document["table"] = {{"columns", io::columns_json(columns_)}, {"rows", rows_}};
+    else if (!path_.empty()) document["output"] = path_;
+    fmt::print("{}\n", io::json_text(document));
+    return;
+  }
+  if (path_.empty()) fmt::print("{}\n", summary);
+  else fmt::print("{} -> {} rows in {} (columns and units in {}.json)\n", summary, count_, path_, path_);
+}
+
+}  // namespace afmkit::cli

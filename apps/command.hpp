@@ -1,0 +1,80 @@
+#pragma once
+// One registration for every subcommand of the `afmkit` program, and the output conventions they share.
+//
+//   add_command(tapping, "hb", "harmonic-balance curve …",
+//               [](io::ParamSet& p) { add_tapping_model_params(p); p.group("…").real(…).unit(…); },
+//               run_hb);
+// declares the command's parameters (TOML keys = flags), adds them as typed, grouped options, and in the callback
+// resolves them (defaults < --config file < flags) and calls `run`.
+//
+// Outputs (docs/commands.md#outputs): a command that computes a table writes it to --output (CSV + JSON sidecar
+// describing every column; empty path: no file) and prints a one-line summary, or with --json the summary as JSON
+// (plus, when no file is written, the table itself: {"columns": [...], "rows": [[...], ...]}).
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/params.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace afmkit::cli {
+
+using Declare = std::function<void(io::ParamSet&)>;
+using Run = std::function<void(const io::ParamSet&)>;
+
+/// Adds subcommand `name` to `parent` (see above); returns it.
+CLI::App& add_command(CLI::App& parent, const std::string& name, const std::string& help, const Declare& declare,
+                      Run run);
+
+/// The "Output" group every table command has: `output` (CSV path, default `default_path`; empty: no file) and
+/// the `json` flag.
+void add_output_params(io::ParamSet& p, const std::string& default_path, const std::string& what);
+
+/// A command's table: written to the --output file when one is given, else (with --json) kept for the printed
+/// document. finish() commits the file and prints the summary.
+class CommandOutput {
+ public:
+  CommandOutput(const io::ParamSet& params, std::string command, const std::string& output_key = "output");
+
+  /// Opens the table (file or memory) with its columns; call once before adding rows.
+  void open(std::vector<io::Column> columns);
+  /// Adds one row; cells as io::TableWriter::row.
+  template <class... Cells>
+  void row(const Cells&... cells) {
+    if (file_) file_->row(cells...);
+    if (keep_rows_) rows_.push_back(nlohmann::json::array({nlohmann::json(cell_value(cells))...}));
+    ++count_;
+  }
+  std::size_t rows() const { return count_; }
+  const std::string& path() const& { return path_; }
+  bool writes_file() const { return !path_.empty(); }
+
+  /// Commits the file with the sidecar (parameters, `results`, columns). Then prints `results` as JSON (--json;
+  /// with the rows when no file was written), or `summary` and where the table went.
+  void finish(const nlohmann::json& results, const std::string& summary);
+
+ private:
+  template <class T>
+  static auto cell_value(const T& v) {
+    if constexpr (std::is_convertible_v<T, std::string_view> && !std::is_arithmetic_v<T>) return std::string(v);
+    else return v;
+  }
+  const io::ParamSet& params_;
+  std::string command_;
+  std::string path_;
+  bool json_ = false;
+  bool keep_rows_ = false;
+  std::vector<io::Column> columns_;
+  std::optional<io::TableWriter> file_;
+  nlohmann::json rows_ = nlohmann::json::array();
+  std::size_t count_ = 0;
+};
+
+}  // namespace afmkit::cli
