@@ -24,7 +24,7 @@ void add_output_params(io::ParamSet& p, const std::string& default_path, const s
   p.group("Output")
       .flag("json", false, "print the results as JSON to standard output instead of a summary line (with the table "
                            "itself when no file is written)")
-      .text("output", default_path, what + " CSV path (JSON sidecar describing every column next to it); empty: no file");
+      .file("output", default_path, what + " CSV path (JSON sidecar describing every column next to it); empty: no file");
 }
 
 CommandOutput::CommandOutput(const io::ParamSet& params, std::string command, const std::string& output_key)
@@ -46,8 +46,8 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
     fmt::print("{}\n", io::json_text(document));
     return;
   }
-  if (path_.empty()) fmt::print("{}\n", summary);
-  else fmt::print("{} -> {} rows in {} (columns and units in {}.json)\n", summary, count_, path_, path_);
+  if (!summary.empty()) fmt::print("{}\n", summary);
+  if (!path_.empty()) fmt::print("wrote {} rows to {} (columns, units and results in {}.json)\n", count_, path_, path_);
 }
 
 }  // namespace afmkit::cli

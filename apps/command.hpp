@@ -57,7 +57,7 @@ class CommandOutput {
   bool writes_file() const { return !path_.empty(); }
 
   /// Commits the file with the sidecar (parameters, `results`, columns). Then prints `results` as JSON (--json;
-  /// with the rows when no file was written), or `summary` and where the table went.
+  /// with the rows when no file was written), or `summary` (if not empty) and where the table went.
   void finish(const nlohmann::json& results, const std::string& summary);
 
  private:

@@ -1,6 +1,7 @@
 // afmkit demo: the Quick-start main job. A tapping-mode demonstration on the repulsive–attractive hysteresis
 // law of seed 1 (eq. 26) where attraction makes the separation–amplitude curve fold: an instrument-like
 // approach–retract sweep (with its jumps and hysteresis) and the harmonic-balance curve, written to out/.
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -15,6 +16,7 @@
 #include "afmkit/io/progress.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/sweep.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_tables.hpp"
@@ -23,7 +25,39 @@ namespace afmkit::cli {
 
 namespace {
 
-void run_demo(const io::ParamSet& p) {
+// The demonstration case in normalised units (docs/theory-tapping.md#hb-accuracy): attraction makes the amplitude
+// curve fold and jump. Γ = 0.2, K_a = 10, K_b = 8, F_a = 0.5, F_b = 1, ω/ω_n = 0.99, l in [7, 12].
+constexpr double demo_drive = 0.2, demo_approach_adhesion = 0.5, demo_departure_adhesion = 1.0;
+constexpr double demo_approach_stiffness = 10.0, demo_departure_stiffness = 8.0;
+constexpr double demo_separation_min = 7.0, demo_separation_max = 12.0;
+
+/// The parameters with the demonstration case's defaults. In physical units the same dimensionless case: lengths
+/// scaled by s = A_free / A_free(normalised case) (the model is linear in the lengths), forces by s·k, sample
+/// stiffnesses by k — so the fold the demo exists to show is kept whatever k and A_free the user gives. Values
+/// the user gives win.
+io::ParamSet with_demo_defaults(const io::ParamSet& given) {
+  io::ParamSet p = given;
+  auto fill = [&](const std::string& key, double value) {
+    if (!p.was_set(key)) p.set_default(key, fmt::format("{}", value));
+  };
+  double s = 1.0;
+  if (p.text("units") == "physical") {
+    const double r = p.real("frequency_ratio"), q = p.real("quality_factor"), k = p.real("spring_constant");
+    const double gain = 1.0 / std::hypot(1.0 - r * r, r / q);  // |L(iω)| of the normalised cantilever
+    s = p.real("free_amplitude") / (demo_drive * gain);
+    fill("adhesion_approach", demo_approach_adhesion * s * k);
+    fill("adhesion_departure", demo_departure_adhesion * s * k);
+    fill("sample_stiffness_approach", demo_approach_stiffness * k);
+    fill("sample_stiffness_departure", demo_departure_stiffness * k);
+  }
+  fill("separation_min", demo_separation_min * s);
+  fill("separation_max", demo_separation_max * s);
+  fill("separation", 0.5 * (demo_separation_min + demo_separation_max) * s);
+  return p;
+}
+
+void run_demo(const io::ParamSet& given) {
+  const io::ParamSet p = with_demo_defaults(given);
   const double l_min = p.real("separation_min"), l_max = p.real("separation_max");
   if (!(l_min < l_max))
     throw InvalidParameter("separation_max",
@@ -59,52 +93,58 @@ void run_demo(const io::ParamSet& p) {
     for (auto& v : jumps[side]) v = v.get<double>() * scales.length;
   const nlohmann::json results = {{"hb_folds", folds},
                                   {"sweep_jumps", jumps},
-                                  {"free_amplitude", model.free_amplitude() * scales.length}};
-  io::TableWriter hb(dir + "/demo_hb.csv", hb_columns());
+                                  {"free_amplitude", model.free_amplitude() * scales.length},
+                                  {"units", {{"length", scales.length_unit}}}};
+  io::TableWriter hb(dir + "/demo_hb.csv", hb_columns(scales));
   write_hb_rows(hb, curve, scales);
-  io::TableWriter table(dir + "/demo_sweep.csv", sweep_columns());
+  io::TableWriter table(dir + "/demo_sweep.csv", sweep_columns(scales));
   write_sweep_rows(table, sweep.approach, scales);
   write_sweep_rows(table, sweep.retract, scales);
-  hb.commit(io::make_sidecar("demo (harmonic balance)", p.to_json(), results));
-  table.commit(io::make_sidecar("demo (sweep)", p.to_json(), results));
+  hb.commit(io::make_sidecar("demo (harmonic balance)", p, results));
+  table.commit(io::make_sidecar("demo (sweep)", p, results));
 
-  const char* unit = p.text("units") == "physical" ? " nm" : "";
-  fmt::print("afmkit demo: tapping cantilever, law '{}', Q = {}, drive at {} x resonance\n", model.law.name(),
-             model.cantilever.quality_factor, p.real("frequency_ratio"));
+  const std::string unit = std::string(" ") + scales.length_unit;
+  fmt::print("afmkit demo: tapping cantilever, law '{}', Q = {}, drive at {} x resonance ({} units)\n",
+             model.law.name(), model.cantilever.quality_factor, p.real("frequency_ratio"), p.text("units"));
   fmt::print("  free amplitude {:.4f}{}\n", model.free_amplitude() * scales.length, unit);
   for (const auto& f : folds)
     fmt::print("  harmonic balance fold (jump point) at separation {:.4f}{}, amplitude {:.4f}{}\n",
                f["separation"].get<double>(), unit, f["amplitude"].get<double>(), unit);
   for (double l : jumps["approach"]) fmt::print("  sweep: approach jumped at separation {:.4f}{}\n", l, unit);
   for (double l : jumps["retract"]) fmt::print("  sweep: retract jumped at separation {:.4f}{}\n", l, unit);
-  fmt::print("  wrote {}/demo_sweep.csv ({} orbits) and {}/demo_hb.csv ({} HB points), with .json sidecars\n", dir,
-             table.size(), dir, hb.size());
+  fmt::print("  wrote {}/demo_sweep.csv ({} orbits) and {}/demo_hb.csv ({} HB points); columns, units and results "
+             "in the .json sidecars\n",
+             dir, table.size(), dir, hb.size());
 }
 
 }  // namespace
 
 void register_demo(CLI::App& app) {
-  auto params = std::make_shared<io::ParamSet>();
-  add_tapping_model_params(*params);
-  // The demonstration case of docs/theory-tapping.md#hb-accuracy: attraction makes the amplitude curve fold and jump.
-  params->set_default("law", "attractive");
-  params->set_default("approach_adhesion", "0.5");
-  params->set_default("departure_adhesion", "1.0");
-  params->set_default("frequency_ratio", "0.99");
-  params->group("Sweep")
-      .real("separation_min", 7.0, "smallest separation of the sweep", io::Range::any())
-      .real("separation_max", 12.0, "largest separation of the sweep (> separation_min)", io::Range::any())
-      .integer("points", 101, "separations per direction (>= 2)", 2, 1000000)
-      .group("Output")
-      .text("output_dir", "out", "folder for demo_sweep.csv and demo_hb.csv (+ .json sidecars)");
-  auto* cmd = app.add_subcommand("demo",
-                                 "tapping-mode demonstration: approach-retract sweep with jumps and the harmonic-balance "
-                                 "curve, written to out/ (the Quick-start main job)");
-  params->add_options(*cmd);
-  cmd->callback([params] {
-    params->resolve();
-    run_demo(*params);
-  });
+  add_command(
+      app, "demo",
+      "tapping-mode demonstration: approach-retract sweep with jumps and the harmonic-balance curve, written to out/ "
+      "(the Quick-start main job)",
+      [](io::ParamSet& p) {
+        add_tapping_model_params(p);
+        // The demonstration case (with_demo_defaults above; physical defaults follow the cantilever).
+        p.set_default("law", "attractive");
+        p.set_default("approach_adhesion", fmt::format("{}", demo_approach_adhesion));
+        p.set_default("departure_adhesion", fmt::format("{}", demo_departure_adhesion));
+        p.set_default("frequency_ratio", "0.99");
+        p.default_text("0.99");
+        p.group("Sweep")
+            .real("separation_min", demo_separation_min, "smallest separation of the sweep", io::Range::any())
+            .unit(kLengthUnit)
+            .default_text("7 normalised; physical: the same case scaled to free_amplitude")
+            .real("separation_max", demo_separation_max, "largest separation of the sweep (> separation_min)",
+                  io::Range::any())
+            .unit(kLengthUnit)
+            .default_text("12 normalised; physical: the same case scaled to free_amplitude")
+            .integer("points", 101, "separations per direction (>= 2)", 2, 1000000)
+            .group("Output")
+            .file("output_dir", "out", "folder for demo_sweep.csv and demo_hb.csv (+ .json sidecars)");
+      },
+      run_demo);
 }
 
 }  // namespace afmkit::cli

@@ -2,9 +2,9 @@
 // Prints a summary (or the result as JSON with --json); --output FILE writes the time history as CSV
 // (t, gap, gap_rate, force, x1, v1, x2, v2) with a JSON sidecar holding the parameters and the summary.
 //
-// Units: any consistent set for the piecewise-linear laws. The other laws (docs/force-laws.md) are in nN for gaps
-// in nm (E* in GPa, R in nm, Hamaker in J); then masses in kg and speeds in nm/s give times in s
-// (1 nN / 1 kg = 1 nm/s²) and energies in nN·nm (1e-18 J).
+// Units (docs/units.md): gaps and positions in nm, forces in nN, masses in kg, speeds in nm/s, times in s, energies
+// in aJ (1 nN · 1 nm = 1e-18 J; 1 nN / 1 kg = 1 nm/s², so the set is consistent), stiffnesses in N/m (= nN/nm).
+// The piecewise-linear laws work in any consistent set; the others need this one (E* in GPa, R in nm, A_H in J).
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -19,6 +19,7 @@
 #include "afmkit/impact/impact.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "law_params.hpp"
 
@@ -28,29 +29,51 @@ namespace {
 
 using io::Range;
 
-const char* const history_columns[] = {"t", "gap", "gap_rate", "force", "x1", "v1", "x2", "v2"};
+std::vector<io::Column> history_columns() {
+  return {{"t", "s", "time"},
+          {"gap", "nm", "gap d = x2 - x1"},
+          {"gap_rate", "nm/s", "gap rate dd/dt"},
+          {"force", "nN", "interaction force on body 2 (positive: repulsive)"},
+          {"x1", "nm", "position of body 1"},
+          {"v1", "nm/s", "velocity of body 1"},
+          {"x2", "nm", "position of body 2"},
+          {"v2", "nm/s", "velocity of body 2"}};
+}
+
+/// Units of the result values (JSON "units" and the summary).
+const nlohmann::json result_units = {{"time", "s"},   {"gap", "nm"},      {"gap_rate", "nm/s"}, {"force", "nN"},
+                                     {"energy", "aJ"}, {"mass", "kg"},     {"velocity", "nm/s"},
+                                     {"restitution", "dimensionless"},     {"steps", "count"}};
 
 void add_impact_params(io::ParamSet& p) {
   p.group("Bodies");
-  p.real("mass1", 1.0, "mass m1 of the lower body (kg for the physical laws, docs/force-laws.md)", Range::positive())
-      .real("mass2", 1.0, "mass m2 of the upper body (kg for the physical laws, docs/force-laws.md)", Range::positive())
+  p.real("mass1", 1.0, "mass m1 of the lower body", Range::positive())
+      .unit("kg")
+      .real("mass2", 1.0, "mass m2 of the upper body", Range::positive())
+      .unit("kg")
       .real("velocity", 1.0,
-            "relative approach speed -(v2 - v1) > 0, centre of mass at rest (nm/s for the physical laws); or give v1, v2",
-            Range::positive())
+            "relative approach speed -(v2 - v1) > 0, centre of mass at rest; or give v1, v2", Range::positive())
+      .unit("nm/s")
       .real("v1", 0.0, "initial velocity of body 1 (instead of velocity; needs v2 - v1 < 0)", Range::any())
+      .unit("nm/s")
       .real("v2", 0.0, "initial velocity of body 2 (instead of velocity)", Range::any())
-      .real("gap", 1.0, "initial gap d(t_s) = x2 - x1 (nm for the physical laws); contact below the law's contact gap (0, or a0)", Range::any())
-      .real("force1", 0.0, "constant external force F1 on body 1 (seed-1 eq. 1; nN for the physical laws)", Range::any())
+      .unit("nm/s")
+      .real("gap", 1.0, "initial gap d(t_s) = x2 - x1; contact below the law's contact gap (0, or a0)", Range::any())
+      .unit("nm")
+      .real("force1", 0.0, "constant external force F1 on body 1 (seed-1 eq. 1)", Range::any())
+      .unit("nN")
       .real("force2", 0.0, "constant external force F2 on body 2", Range::any())
+      .unit("nN")
       .group("Numerics")
       .text("method", "automatic", "solver: automatic (closed form for linear laws), closed_form, integrator",
             {"automatic", "closed_form", "integrator"})
       .real("relative_tolerance", 1e-11, "integrator relative tolerance", {0.0, 1e-2, true, false})
-      .real("absolute_tolerance", 1e-13, "integrator absolute tolerance (scaled state)", Range::positive())
+      .unit("dimensionless")
+      .real("absolute_tolerance", 1e-13, "integrator absolute tolerance of the scaled state", Range::positive())
+      .unit("dimensionless")
       .integer("points", 400, "time-history samples written with --output (>= 2; events are added)", 2, 10000000)
-      .group("Output")
-      .flag("json", false, "print the result as JSON instead of the summary")
-      .text("output", "", "CSV file for the time history (JSON sidecar written next to it); empty: none");
+      ;
+  add_output_params(p, "", "time history");
   add_law_params(p, impact::LawRegistry::builtin(), "hysteresis");
 }
 
@@ -119,6 +142,7 @@ nlohmann::json result_json(const impact::ImpactResult& r, const impact::ForceLaw
   if (const auto* lin = law.piecewise_linear();
       lin && lin->approach_stiffness > 0 && lin->approach_adhesion == 0 && lin->departure_adhesion == 0)
     j["restitution_impulsive_limit"] = std::sqrt(lin->departure_stiffness / lin->approach_stiffness);  // ext. E0
+  j["units"] = result_units;
   return j;  // NaN (undefined quantities) is written as null
 }
 
@@ -138,25 +162,25 @@ void check_disk_space(const std::string& output, long points) {
 }
 
 void print_summary(const impact::ImpactResult& r, const impact::ForceLaw& law) {
-  auto num = [](double v) { return std::isnan(v) ? std::string("-") : fmt::format("{:.10g}", v); };
+  auto num = [](double v) { return fmt::format("{:.10g}", v); };  // undefined: nan (docs/conventions.md)
   fmt::print("impact ({} law, {}): {}\n", law.name(), r.method, impact::to_string(r.outcome));
   if (r.outcome == impact::ImpactOutcome::captured) fmt::print("  capture: {}\n", r.capture_reason);
-  fmt::print("  reduced mass               {}\n", num(r.reduced_mass));
-  fmt::print("  gap d(t_s) -> minimum      {} -> {} (max penetration {})\n", num(r.reference_gap), num(r.minimum_gap),
+  fmt::print("  reduced mass               {} kg\n", num(r.reduced_mass));
+  fmt::print("  gap d(t_s) -> minimum      {} -> {} nm (max penetration {} nm)\n", num(r.reference_gap), num(r.minimum_gap),
              num(r.max_penetration));
-  fmt::print("  times t_s, t_min, t_f      {}, {}, {}\n", num(r.start_time), num(r.minimum_time), num(r.end_time));
+  fmt::print("  times t_s, t_min, t_f      {}, {}, {} s\n", num(r.start_time), num(r.minimum_time), num(r.end_time));
   if (r.contact)
-    fmt::print("  contact                    {} .. {} (duration {})\n", num(r.contact_start), num(r.contact_end),
+    fmt::print("  contact                    {} .. {} s (duration {} s)\n", num(r.contact_start), num(r.contact_end),
                num(r.contact_duration));
   else
     fmt::print("  contact                    none\n");
-  fmt::print("  gap rate before / after    {} / {}\n", num(r.approach_gap_rate), num(r.departure_gap_rate));
+  fmt::print("  gap rate before / after    {} / {} nm/s\n", num(r.approach_gap_rate), num(r.departure_gap_rate));
   fmt::print("  restitution e (eq. 2)      {} (1 - e = {})\n", num(r.restitution), num(r.restitution_deficit));
-  fmt::print("  kinetic energy loss        {} (simulated)\n", num(r.kinetic_energy_loss));
-  fmt::print("                             {} (eq. 3, from e)\n", num(r.energy_loss_restitution));
-  fmt::print("                             {} (eq. 6, area between branches)\n", num(r.energy_loss_area));
-  fmt::print("  peak force / min force     {} / {}\n", num(r.peak_force), num(r.min_force));
-  fmt::print("  after: v1 = {}, v2 = {}\n", num(r.body1_after.velocity), num(r.body2_after.velocity));
+  fmt::print("  kinetic energy loss        {} aJ (simulated)\n", num(r.kinetic_energy_loss));
+  fmt::print("                             {} aJ (eq. 3, from e)\n", num(r.energy_loss_restitution));
+  fmt::print("                             {} aJ (eq. 6, area between branches)\n", num(r.energy_loss_area));
+  fmt::print("  peak force / min force     {} / {} nN\n", num(r.peak_force), num(r.min_force));
+  fmt::print("  after: v1 = {}, v2 = {} nm/s\n", num(r.body1_after.velocity), num(r.body2_after.velocity));
 }
 
 void run_impact(const io::ParamSet& p) {
@@ -168,42 +192,27 @@ void run_impact(const io::ParamSet& p) {
                                             : impact::ImpactMethod::automatic;
   options.relative_tolerance = p.real("relative_tolerance");
   options.absolute_tolerance = p.real("absolute_tolerance");
-  const std::string output = p.text("output");
-  options.history_points = output.empty() ? 0 : p.integer("points");
-  if (!output.empty()) check_disk_space(output, options.history_points);
+  CommandOutput out(p, "impact");
+  options.history_points = out.writes_file() ? p.integer("points") : 0;
+  if (out.writes_file()) check_disk_space(out.path(), options.history_points);
 
   // The history is streamed row by row into the CSV (memory does not grow with --points).
-  std::optional<io::TableWriter> table;
-  if (!output.empty()) {
-    table.emplace(output, std::vector<std::string>(std::begin(history_columns), std::end(history_columns)));
-    options.on_sample = [&table](const impact::ImpactSample& s) {
-      table->row(s.time, s.gap, s.gap_rate, s.force, s.position1, s.velocity1, s.position2, s.velocity2);
+  out.open(history_columns());
+  if (out.writes_file())
+    options.on_sample = [&out](const impact::ImpactSample& s) {
+      out.row(s.time, s.gap, s.gap_rate, s.force, s.position1, s.velocity1, s.position2, s.velocity2);
     };
-  }
   const impact::ImpactResult r = impact::simulate_impact(problem, options);
-  const nlohmann::json summary = result_json(r, problem.law());
-  if (table) table->commit(io::make_sidecar("impact", p.to_json(), summary));
-
-  if (p.flag("json")) {
-    fmt::print("{}\n", summary.dump(2));
-  } else {
-    print_summary(r, problem.law());
-    if (table) fmt::print("wrote {} rows to {} (summary in {}.json)\n", table->size(), output, output);
-  }
+  if (!p.flag("json")) print_summary(r, problem.law());
+  out.finish(result_json(r, problem.law()), "");
 }
 
 }  // namespace
 
 void register_impact(CLI::App& app) {
-  auto params = std::make_shared<io::ParamSet>();
-  add_impact_params(*params);
-  auto* cmd = app.add_subcommand(
-      "impact", "two-body impact with a hysteresis force law: restitution, energy loss, contact (seed-1 eqs. 1-6)");
-  params->add_options(*cmd);
-  cmd->callback([params] {
-    params->resolve();
-    run_impact(*params);
-  });
+  add_command(app, "impact",
+              "two-body impact with a hysteresis force law: restitution, energy loss, contact (seed-1 eqs. 1-6)",
+              add_impact_params, run_impact);
 }
 
 }  // namespace afmkit::cli

@@ -16,7 +16,7 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
   p.group("Contact law");
   p.text("law", default_law, fmt::format("tip-sample force law (docs/force-laws.md): {}", fmt::join(summaries, "; ")),
          registry.names())
-      .text("force_curve", "",
+      .file("force_curve", "",
             "[table] force-curve file: approach and retract force vs distance, units in the header "
             "(docs/force-laws.md)")
       .flag("allow_energy_gain", false,
@@ -24,10 +24,9 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
             "restitution > 1, departure_modulus > effective_modulus, ...)");
   for (const auto& k : registry.keys()) {
     if (std::find(skip.begin(), skip.end(), k.key) != skip.end()) continue;
-    const std::string unit = k.unit.empty() ? std::string() : fmt::format(" ({})", k.unit);
     const std::string laws = fmt::format("[{}] ", fmt::join(registry.laws_using(k.key), ", "));
     io::Range range{k.lower, std::min(k.upper, 1e308), k.lower_open, false};
-    p.real(k.key, k.default_value, laws + k.help + unit, range);
+    p.real(k.key, k.default_value, laws + k.help, range).unit(k.unit.empty() ? "dimensionless" : k.unit);
     if (!k.follows.empty()) p.default_text("= " + k.follows);
   }
 }

@@ -1,6 +1,7 @@
 // afmkit tapping hb: the harmonic-balance separation–amplitude curve (seed-1 eqs. 18–19, 32–33, docs/theory-tapping.md#two-branch-solution; any
 // force law, issue 7.2) sampled over the penetration parameter q, as CSV (q, separation, amplitude, offset, phase,
-// branch) with a JSON sidecar holding the folds (jump points), the free amplitude and the solutions at `separation`.
+// branch) with a JSON sidecar holding the folds (jump points), the free amplitude and the solutions at `separation`;
+// --json prints them (with the curve when --output "" writes no file).
 #include <memory>
 #include <string>
 
@@ -14,6 +15,7 @@
 #include "afmkit/io/params.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/hb_approximations.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_tables.hpp"
@@ -49,10 +51,10 @@ void run_hb(const io::ParamSet& p) {
   options.include_minus = p.flag("minus_branch");
   // The curve is held in memory (both branches: 2 points per q sample) before it is streamed out.
   memory::require_fits("points", static_cast<double>(options.points), 2.0 * sizeof(tapping::HbPoint));
-  const std::string output = p.text("output");
-  io::TableWriter table(output, hb_columns());
+  CommandOutput out(p, "tapping hb");
+  out.open(hb_columns(scales));
   const std::vector<tapping::HbPoint> curve = tapping::harmonic_balance_curve(model, options);
-  write_hb_rows(table, curve, scales);
+  write_hb_rows(out, curve, scales);
 
   const tapping::HarmonicBalance hb(model);
   nlohmann::json folds = nlohmann::json::array();
@@ -66,40 +68,43 @@ void run_hb(const io::ParamSet& p) {
   nlohmann::json results = {{"folds", folds},
                             {"free_amplitude", hb.free_amplitude() * scales.length},
                             {"solutions_at_separation", solutions},
-                            {"rows", table.size()}};
+                            {"rows", out.rows()},
+                            {"units", {{"length", scales.length_unit}, {"phase", "rad"}, {"q", "dimensionless"}}}};
   if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
     if (const auto limit = tapping::minimum_separation_limit(model))
-      results["minimum_separation_limit"] = *limit * scales.length;  // (−∞ written as null)
+      results["minimum_separation_limit"] = *limit * scales.length;  // −∞ is written "-inf"
   }
-  table.commit(io::make_sidecar("tapping hb", p.to_json(), results));
-  fmt::print("wrote {} rows to {} ({} fold(s), {} solution(s) at separation {})\n", table.size(), output,
-             folds.size(), solutions.size(), p.real("separation"));
+  out.finish(results, fmt::format("{} fold(s), {} solution(s) at separation {} {}", folds.size(), solutions.size(),
+                                  p.real("separation"), scales.length_unit));
 }
 
 }  // namespace
 
 void register_tapping_hb(CLI::App& tapping) {
-  auto params = std::make_shared<io::ParamSet>();
-  add_tapping_model_params(*params);
-  params->group("Harmonic balance curve")
-      .real("q_min", -1.0, "smallest penetration parameter q = (A + l)/B of the curve", io::Range::any())
-      .real("q_max", 1.5, "largest q (> q_min); q >= 1 is the free oscillation", io::Range::any())
-      .integer("points", 2000, "number of q samples (>= 2; the curve is held in memory, 96 bytes per sample)", 2,
-               10000000)
-      .text("spacing", "refined", "q sampling: uniform, or refined (half the samples log-spaced in 1 - q near grazing)",
-            {"uniform", "refined"})
-      .real("min_gap", 1e-10, "smallest 1 - q of the refined samples", {0.0, 1.0, true, true})
-      .flag("minus_branch", true, "also write the '-' root of the quadratic (docs/theory-tapping.md#two-branch-solution) where it exists")
-      .group("Output")
-      .text("output", "out/tapping_hb.csv", "output CSV path (JSON sidecar written next to it)");
-  auto* cmd = tapping.add_subcommand(
-      "hb", "harmonic-balance separation-amplitude curve over q (closed form for piecewise-linear laws, numerical "
-            "describing functions for the others), with folds (jump points)");
-  params->add_options(*cmd);
-  cmd->callback([params] {
-    params->resolve();
-    run_hb(*params);
-  });
+  add_command(
+      tapping, "hb",
+      "harmonic-balance separation-amplitude curve over q (closed form for piecewise-linear laws, numerical "
+      "describing functions for the others), with folds (jump points)",
+      [](io::ParamSet& p) {
+        add_tapping_model_params(p);
+        p.group("Harmonic balance curve")
+            .real("q_min", -1.0, "smallest penetration parameter q = (A + l)/B of the curve", io::Range::any())
+            .unit("dimensionless")
+            .real("q_max", 1.5, "largest q (> q_min); q >= 1 is the free oscillation", io::Range::any())
+            .unit("dimensionless")
+            .integer("points", 2000, "number of q samples (>= 2; the curve is held in memory, 96 bytes per sample)", 2,
+                     10000000)
+            .text("spacing", "refined",
+                  "q sampling: uniform, or refined (half the samples log-spaced in 1 - q near grazing)",
+                  {"uniform", "refined"})
+            .real("min_gap", 1e-10, "smallest 1 - q of the refined samples", {0.0, 1.0, true, true})
+            .unit("dimensionless")
+            .flag("minus_branch", true,
+                  "also write the '-' root of the quadratic (docs/theory-tapping.md#two-branch-solution) where it "
+                  "exists");
+        add_output_params(p, "out/tapping_hb.csv", "harmonic-balance curve");
+      },
+      run_hb);
 }
 
 }  // namespace afmkit::cli

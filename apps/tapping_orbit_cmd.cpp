@@ -14,6 +14,7 @@
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/tapping/orbit.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
@@ -21,8 +22,6 @@
 namespace afmkit::cli {
 
 namespace {
-
-nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
 /// Seeds of each kind (tapping::SeedKind names) among `seeds` (indices into the search report).
 nlohmann::json seeds_by_kind(const std::vector<int>& seeds, const tapping::OrbitSearchReport& report) {
@@ -71,7 +70,7 @@ nlohmann::json orbit_json(const tapping::FoundOrbit& f, const tapping::OrbitSear
           {"seeds", f.seeds},
           {"period_multiple", o.period_multiple},
           {"stable", o.stable},
-          {"floquet_max", number(o.floquet_max)},
+          {"floquet_max", o.floquet_max},
           {"floquet_multipliers",
            {{{"re", o.floquet_multipliers[0].real()}, {"im", o.floquet_multipliers[0].imag()}},
             {{"re", o.floquet_multipliers[1].real()}, {"im", o.floquet_multipliers[1].imag()}}}},
@@ -117,36 +116,52 @@ void run_orbit(const io::ParamSet& p) {
     if (!t.message.empty()) j["message"] = t.message;
     transients.push_back(j);
   }
-  const nlohmann::json summary = {{"separation", p.real("separation")},
-                                  {"free_amplitude", model.free_amplitude() * scales.length},
-                                  {"harmonic_balance", hb},
-                                  {"orbits", orbits},
-                                  {"transients", transients},
-                                  {"search", search_json(r.report, scales)}};
-  const std::string output = p.text("output");
-  if (!output.empty()) {
-    io::TableWriter table(output, {"source", "period_multiple", "stable", "amplitude", "offset", "phase", "harmonic_2",
-                                   "harmonic_3", "harmonic_4", "harmonic_5", "contact_fraction", "peak_force",
-                                   "min_gap", "energy_dissipated", "viscous_dissipation", "contact_dissipation",
-                                   "floquet_max", "sticking_time", "initial_position", "initial_velocity"});
-    for (const tapping::FoundOrbit& f : r.orbits) {
-      const auto& m = f.metrics;
-      const double l = scales.length;
-      table.row(tapping::orbit_source_name(f.source), f.orbit.period_multiple, f.orbit.stable, m.amplitude * l,
-                m.offset * l, m.phase, m.harmonics[0] * l, m.harmonics[1] * l, m.harmonics[2] * l,
-                m.harmonics[3] * l, m.contact_fraction, m.peak_force * scales.force, m.min_gap * l,
-                m.energy_dissipated() * scales.energy, m.viscous_dissipation * scales.energy,
-                m.contact_dissipation * scales.energy, f.orbit.floquet_max, m.sticking_duration * scales.time,
-                f.orbit.initial.position * l, f.orbit.initial.velocity * l / scales.time);
-    }
-    table.commit(io::make_sidecar("tapping orbit", p.to_json(), summary));
+  const std::string length = scales.length_unit, velocity = length + "/" + scales.time_unit;
+  const nlohmann::json summary = {
+      {"separation", p.real("separation")},
+      {"free_amplitude", model.free_amplitude() * scales.length},
+      {"harmonic_balance", hb},
+      {"orbits", orbits},
+      {"transients", transients},
+      {"search", search_json(r.report, scales)},
+      {"units", {{"length", length}, {"velocity", velocity}, {"force", scales.force_unit},
+                 {"energy", scales.energy_unit}, {"time", scales.time_unit}, {"phase", "rad"}, {"seconds", "s"}}}};
+  CommandOutput out(p, "tapping orbit");
+  out.open({{"source", "label", "how the orbit was found first (harmonic_balance, transient, grid, contact, continuation)"},
+            {"period_multiple", "count", "n of a period-n orbit (1: the drive period)"},
+            {"stable", "boolean (0/1)", "1: all Floquet multipliers inside the unit circle"},
+            {"amplitude", length, "first-harmonic amplitude B"},
+            {"offset", length, "mean deflection A"},
+            {"phase", "rad", "phase lag φ of the first harmonic behind the drive (docs/conventions.md), in (-π, π]"},
+            {"harmonic_2", length, "amplitude of the 2nd harmonic"},
+            {"harmonic_3", length, "amplitude of the 3rd harmonic"},
+            {"harmonic_4", length, "amplitude of the 4th harmonic"},
+            {"harmonic_5", length, "amplitude of the 5th harmonic"},
+            {"contact_fraction", "dimensionless", "fraction of the period with the gap below the law's contact gap"},
+            {"peak_force", scales.force_unit, "largest tip-sample force (positive: repulsive)"},
+            {"min_gap", length, "smallest gap x + l"},
+            {"energy_dissipated", scales.energy_unit, "energy dissipated per drive period (viscous + contact)"},
+            {"viscous_dissipation", scales.energy_unit, "viscous (cantilever damping) part per drive period"},
+            {"contact_dissipation", scales.energy_unit, "tip-sample (hysteresis) part per drive period"},
+            {"floquet_max", "dimensionless", "largest Floquet multiplier modulus"},
+            {"sticking_time", scales.time_unit, "time spent sticking to the sample per orbit"},
+            {"initial_position", length, "tip position x at drive phase 0 on the orbit"},
+            {"initial_velocity", velocity, "tip velocity at drive phase 0 on the orbit"}});
+  for (const tapping::FoundOrbit& f : r.orbits) {
+    const auto& m = f.metrics;
+    const double l = scales.length;
+    out.row(tapping::orbit_source_name(f.source), f.orbit.period_multiple, f.orbit.stable, m.amplitude * l,
+            m.offset * l, m.phase, m.harmonics[0] * l, m.harmonics[1] * l, m.harmonics[2] * l, m.harmonics[3] * l,
+            m.contact_fraction, m.peak_force * scales.force, m.min_gap * l, m.energy_dissipated() * scales.energy,
+            m.viscous_dissipation * scales.energy, m.contact_dissipation * scales.energy, f.orbit.floquet_max,
+            m.sticking_duration * scales.time, f.orbit.initial.position * l, f.orbit.initial.velocity * l / scales.time);
   }
   if (p.flag("json")) {
-    fmt::print("{}\n", summary.dump(2));
+    out.finish(summary, "");
     return;
   }
-  fmt::print("separation {}: {} HB solution(s), {} periodic orbit(s)\n", p.real("separation"), hb.size(),
-             r.orbits.size());
+  fmt::print("separation {} {}: {} HB solution(s), {} periodic orbit(s); amplitudes, offsets in {}, phases in rad\n",
+             p.real("separation"), length, hb.size(), r.orbits.size(), length);
   for (const tapping::HbPoint& h : r.harmonic_balance)
     fmt::print("  HB {:5s} amplitude {:.6g}  offset {:.6g}  phase {:.6g}\n", tapping::branch_name(h.branch),
                h.amplitude * scales.length, h.offset * scales.length, h.phase);
@@ -170,30 +185,26 @@ void run_orbit(const io::ParamSet& p) {
       converged += rep.converged_by_kind[k];
     }
     fmt::print("  search: {} seeds, {} converged (converged/seeds: {}); {} branch continuations over l in [{:.6g}, "
-               "{:.6g}]; {:.3g} s\n",
+               "{:.6g}] {}; {:.3g} s\n",
                rep.seeds.size(), converged, kinds, rep.continuation_runs, rep.bracket_min * scales.length,
-               rep.bracket_max * scales.length, rep.seconds);
+               rep.bracket_max * scales.length, length, rep.seconds);
   }
-  if (!output.empty()) fmt::print("wrote {} rows to {} (details in {}.json)\n", r.orbits.size(), output, output);
+  out.finish(summary, "");
 }
 
 }  // namespace
 
 void register_tapping_orbit(CLI::App& tapping) {
-  auto params = std::make_shared<io::ParamSet>();
-  add_tapping_model_params(*params);
-  add_tapping_sim_params(*params);
-  params->group("Output")
-      .flag("json", false, "print the result as JSON instead of the summary")
-      .text("output", "out/tapping_orbit.csv", "output CSV path (JSON sidecar next to it); empty: no file");
-  auto* cmd = tapping.add_subcommand(
-      "orbit", "all periodic orbits at one separation: shooting from every HB solution, transients, a phase x "
-               "amplitude grid, contact states and branch continuation; Floquet stability, harmonics, contact, energy");
-  params->add_options(*cmd);
-  cmd->callback([params] {
-    params->resolve();
-    run_orbit(*params);
-  });
+  add_command(
+      tapping, "orbit",
+      "all periodic orbits at one separation: shooting from every HB solution, transients, a phase x amplitude grid, "
+      "contact states and branch continuation; Floquet stability, harmonics, contact, energy",
+      [](io::ParamSet& p) {
+        add_tapping_model_params(p);
+        add_tapping_sim_params(p);
+        add_output_params(p, "out/tapping_orbit.csv", "orbits");
+      },
+      run_orbit);
 }
 
 }  // namespace afmkit::cli

@@ -80,28 +80,45 @@ void add_tapping_model_params(io::ParamSet& p) {
   p.group("Model");
   p.text("units", "normalised", "unit system of the model parameters and results", {"normalised", "physical"})
       .real("quality_factor", 100.0, "quality factor Q = 1/(2ξ)", below(1e9))
+      .unit("dimensionless")
       .real("frequency_ratio", 1.0, "drive frequency over natural frequency ω/ω_n", below(1e3))
-      .real("separation", 10.0, "separation l (nm): sample surface at x = -l", Range::closed(-1e6, 1e6))
+      .unit("dimensionless")
+      .real("separation", 10.0, "separation l: sample surface at x = -l", Range::closed(-1e6, 1e6))
+      .unit(kLengthUnit)
       // normalised units (ω_n, lengths in nm, per-unit-mass forces in nm·ω_n²)
       .group("Model in normalised units (--units normalised)")
       .real("natural_frequency", 1.0, "[normalised] natural frequency ω_n", below(1e12))
+      .unit("rad/t")
       .real("drive_amplitude", 0.2, "[normalised] drive Γ (per unit mass)", below(1e12))
-      .real("approach_stiffness", 10.0, "[normalised] K_a, sample stiffness while approaching (units of ω_n²)",
+      .unit("L/t^2")
+      .real("approach_stiffness", 10.0, "[normalised] K_a, sample stiffness while approaching (per unit mass)",
             Range::closed(0.0, 1e12))
-      .real("departure_stiffness", 8.0, "[normalised] K_b, sample stiffness while departing (units of ω_n²)",
+      .unit("1/t^2")
+      .real("departure_stiffness", 8.0, "[normalised] K_b, sample stiffness while departing (per unit mass)",
             Range::closed(0.0, 1e12))
-      .real("approach_adhesion", 0.0, "[normalised] F_a >= 0, attraction at contact while approaching", Range::closed(0.0, 1e12))
-      .real("departure_adhesion", 0.0, "[normalised] F_b >= F_a, attraction at contact while departing",
+      .unit("1/t^2")
+      .real("approach_adhesion", 0.0, "[normalised] F_a >= 0, attraction at contact while approaching (per unit mass)",
             Range::closed(0.0, 1e12))
+      .unit("L/t^2")
+      .real("departure_adhesion", 0.0, "[normalised] F_b >= F_a, attraction at contact while departing (per unit mass)",
+            Range::closed(0.0, 1e12))
+      .unit("L/t^2")
       // physical units
       .group("Model in physical units (--units physical)")
-      .real("spring_constant", 40.0, "[physical] cantilever spring constant k (N/m)", below(1e6))
-      .real("resonance_frequency", 300.0, "[physical] resonance frequency f0 (kHz)", below(1e7))
-      .real("free_amplitude", 20.0, "[physical] free amplitude at the drive frequency (nm)", below(1e6))
-      .real("sample_stiffness_approach", 400.0, "[physical] contact stiffness while approaching (N/m)", Range::closed(0.0, 1e9))
-      .real("sample_stiffness_departure", 320.0, "[physical] contact stiffness while departing (N/m)", Range::closed(0.0, 1e9))
-      .real("adhesion_approach", 0.0, "[physical] attraction at contact while approaching (nN)", Range::closed(0.0, 1e9))
-      .real("adhesion_departure", 0.0, "[physical] attraction at contact while departing (nN)", Range::closed(0.0, 1e9))
+      .real("spring_constant", 40.0, "[physical] cantilever spring constant k", below(1e6))
+      .unit("N/m")
+      .real("resonance_frequency", 300.0, "[physical] resonance frequency f0", below(1e7))
+      .unit("kHz")
+      .real("free_amplitude", 20.0, "[physical] free amplitude at the drive frequency", below(1e6))
+      .unit("nm")
+      .real("sample_stiffness_approach", 400.0, "[physical] contact stiffness while approaching", Range::closed(0.0, 1e9))
+      .unit("N/m")
+      .real("sample_stiffness_departure", 320.0, "[physical] contact stiffness while departing", Range::closed(0.0, 1e9))
+      .unit("N/m")
+      .real("adhesion_approach", 0.0, "[physical] attraction at contact while approaching", Range::closed(0.0, 1e9))
+      .unit("nN")
+      .real("adhesion_departure", 0.0, "[physical] attraction at contact while departing", Range::closed(0.0, 1e9))
+      .unit("nN")
       ;
   add_law_params(p, impact::LawRegistry::builtin(), "hysteresis",
                  {"approach_stiffness", "departure_stiffness", "approach_adhesion", "departure_adhesion"});

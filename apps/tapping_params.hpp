@@ -7,6 +7,9 @@
 
 namespace afmkit::cli {
 
+/// Unit of a length parameter of the tapping commands: nm in physical runs, the model length L in normalised runs.
+inline constexpr const char* kLengthUnit = "nm (physical) or L (normalised)";
+
 /// units, cantilever, drive, force law, separation.
 void add_tapping_model_params(io::ParamSet& p);
 /// The normalised model at the parameter `separation` (nm in physical units).

@@ -9,14 +9,18 @@ void add_tapping_sim_params(io::ParamSet& p) {
          "its dense output; any law) or automatic",
          {"automatic", "closed_form", "adaptive"})
       .real("relative_tolerance", 1e-10, "adaptive integrator relative tolerance", {0.0, 1.0, true, true})
-      .real("absolute_tolerance", 1e-12, "adaptive integrator absolute tolerance (model length units)",
+      .unit("dimensionless")
+      .real("absolute_tolerance", 1e-12, "adaptive integrator absolute tolerance of the model state",
             io::Range::positive())
+      .unit("L (= nm in physical runs)")
       .real("shooting_tolerance", 1e-11, "Newton convergence of periodic orbits |P(y) - y| / |y|",
             {0.0, 1.0, true, true})
+      .unit("dimensionless")
       .integer("max_newton_iterations", 30, "Newton iterations per shooting solve", 1, 1000)
       .integer("max_period_multiple", 4, "look for period-n responses up to this n", 1, 16)
       .integer("max_transient_periods", 20000, "drive periods a transient may take to settle", 24, 100000000)
-      .real("time_budget", 30.0, "wall-clock budget of one shooting solve (s)", io::Range::positive());
+      .real("time_budget", 30.0, "wall-clock budget of one shooting solve", io::Range::positive())
+      .unit("s");
 }
 
 tapping::ShootingOptions shooting_options_from(const io::ParamSet& p) {

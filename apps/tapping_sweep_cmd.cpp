@@ -1,6 +1,7 @@
 // afmkit tapping sweep: separation sweeps of periodic orbits — as an instrument does (approach then retract,
 // each orbit continued from the previous one, transients where a branch ends: jumps and hysteresis) and/or by
 // pseudo-arclength continuation through folds (unstable branches included). HB value beside each point.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -13,10 +14,12 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
+#include "afmkit/io/number_list.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/io/progress.hpp"
 #include "afmkit/tapping/continuation.hpp"
 #include "afmkit/tapping/sweep.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
@@ -32,15 +35,43 @@ nlohmann::json scaled(const std::vector<double>& v, double f) {
   return j;
 }
 
+/// The separations of the instrument sweep (model units): the explicit list (`separations` or `separations_file`)
+/// when one is given, else `points` equally spaced in [separation_min, separation_max].
+std::vector<double> sweep_separations(const io::ParamSet& p, double length_scale) {
+  if (p.was_set("separations") && p.was_set("separations_file"))
+    throw InvalidParameter("separations", "give either separations or separations_file, not both");
+  std::vector<double> list;
+  if (p.was_set("separations")) list = p.reals("separations");
+  else if (p.was_set("separations_file")) list = io::read_number_list(p.text("separations_file"), "separations_file");
+  else return {};
+  const char* key = p.was_set("separations") ? "separations" : "separations_file";
+  for (double& l : list) {
+    if (!(std::abs(l) <= 1e6))
+      throw InvalidParameter(key, fmt::format("{} contains {}: every separation must be in [-1e+06, 1e+06]", key, l));
+    l /= length_scale;
+  }
+  std::sort(list.begin(), list.end());
+  list.erase(std::unique(list.begin(), list.end()), list.end());
+  if (list.size() < 2)
+    throw InvalidParameter(key, fmt::format("{} holds {} distinct separation(s): at least 2 are needed", key,
+                                            list.size()));
+  return list;
+}
+
 void run_sweep(const io::ParamSet& p) {
   const tapping::TappingModel base = tapping_model_from(p);
   const TappingScales scales = tapping_scales_from(p);
-  const double l_min = p.real("separation_min") / scales.length, l_max = p.real("separation_max") / scales.length;
-  if (!(l_min < l_max))
+  const std::vector<double> list = sweep_separations(p, scales.length);
+  double l_min = p.real("separation_min") / scales.length, l_max = p.real("separation_max") / scales.length;
+  if (!list.empty()) {
+    l_min = list.front();
+    l_max = list.back();
+  } else if (!(l_min < l_max)) {
     throw InvalidParameter("separation_min", fmt::format("separation_min = {} is out of range: must be < "
                                                          "separation_max = {}",
                                                          p.real("separation_min"), p.real("separation_max")));
-  const int points = static_cast<int>(p.integer("points"));
+  }
+  const int points = list.empty() ? static_cast<int>(p.integer("points")) : static_cast<int>(list.size());
   // Both directions are held in memory (then streamed out).
   memory::require_fits("points", static_cast<double>(points), 2.0 * sizeof(tapping::SweepPoint));
   const std::string& mode = p.text("mode");
@@ -48,27 +79,26 @@ void run_sweep(const io::ParamSet& p) {
   const bool continuation = mode == "continuation" || mode == "both";
   const bool quiet = p.flag("json") || p.flag("quiet");
 
-  const std::string output = p.text("output");
-  std::optional<io::TableWriter> table;
-  if (!output.empty()) table.emplace(output, sweep_columns());
-  long rows = 0;
-  const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) {
-    rows += static_cast<long>(points.size());
-    if (table) write_sweep_rows(*table, points, scales);
-  };
+  CommandOutput out(p, "tapping sweep");
+  out.open(sweep_columns(scales));
+  const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) { write_sweep_rows(out, points, scales); };
   nlohmann::json results = nlohmann::json::object();
+  std::string summary;
   if (instrument) {
     io::Progress progress("tapping sweep (approach + retract)", 2L * points, !quiet);
     tapping::SweepOptions options;
     options.shooting = shooting_options_from(p);
     options.transient = transient_options_from(p);
     options.progress = [&progress](long n) { progress.advance(n); };
-    const tapping::SweepResult r = tapping::sweep_instrument(base, l_min, l_max, points, options);
+    const tapping::SweepResult r = list.empty() ? tapping::sweep_instrument(base, l_min, l_max, points, options)
+                                                : tapping::sweep_instrument(base, list, options);
     progress.finish();
     write_rows(r.approach);
     write_rows(r.retract);
     results["approach_jumps"] = scaled(r.approach_jumps, scales.length);
     results["retract_jumps"] = scaled(r.retract_jumps, scales.length);
+    summary += fmt::format("instrument sweep: jumps on approach at {}, on retract at {} ({})",
+                           results["approach_jumps"].dump(), results["retract_jumps"].dump(), scales.length_unit);
   }
   if (continuation) {
     tapping::ContinuationOptions options;
@@ -82,51 +112,51 @@ void run_sweep(const io::ParamSet& p) {
     results["grazing"] = scaled(c.grazing, scales.length);
     results["continuation_stop"] = c.stop_reason;
     results["continuation_points"] = c.points.size();
+    summary += fmt::format("{}continuation: {} points, folds at {}, grazing at {} ({}; {})", summary.empty() ? "" : "\n",
+                           c.points.size(), results["folds"].dump(), results["grazing"].dump(), scales.length_unit,
+                           c.stop_reason);
   }
   results["free_amplitude"] = base.free_amplitude() * scales.length;
-  results["rows"] = rows;
-  if (table) table->commit(io::make_sidecar("tapping sweep", p.to_json(), results));
-  if (p.flag("json")) {
-    fmt::print("{}\n", results.dump(2));
-    return;
-  }
-  if (instrument)
-    fmt::print("instrument sweep: jumps on approach at {}, on retract at {}\n", results["approach_jumps"].dump(),
-               results["retract_jumps"].dump());
-  if (continuation)
-    fmt::print("continuation: {} points, folds at {}, grazing at {} ({})\n", results["continuation_points"].dump(),
-               results["folds"].dump(), results["grazing"].dump(), results["continuation_stop"].get<std::string>());
-  if (!output.empty()) fmt::print("wrote {} rows to {} (details in {}.json)\n", rows, output, output);
+  results["rows"] = out.rows();
+  results["units"] = {{"length", scales.length_unit}, {"energy", scales.energy_unit}, {"force", scales.force_unit}};
+  out.finish(results, summary);
 }
 
 }  // namespace
 
 void register_tapping_sweep(CLI::App& tapping) {
-  auto params = std::make_shared<io::ParamSet>();
-  add_tapping_model_params(*params);
-  add_tapping_sim_params(*params);
-  params->group("Sweep")
-      .real("separation_min", 5.0, "smallest separation of the sweep (nm)", io::Range::any())
-      .real("separation_max", 15.0, "largest separation of the sweep (nm), > separation_min", io::Range::any())
-      .integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000)
-      .text("mode", "instrument",
-            "instrument (approach then retract, jumps and hysteresis), continuation (pseudo-arclength through "
-            "folds, unstable branches) or both",
-            {"instrument", "continuation", "both"})
-      .real("max_arclength_step", 0.2, "largest continuation step (nm, scaled arclength)", io::Range::positive())
-      .integer("max_continuation_points", 5000, "continuation point budget", 2, 100000000)
-      .group("Output")
-      .flag("json", false, "print the summary (jumps, folds) as JSON")
-      .flag("quiet", false, "no progress output")
-      .text("output", "out/tapping_sweep.csv", "output CSV path (JSON sidecar next to it); empty: no file");
-  auto* cmd = tapping.add_subcommand(
-      "sweep", "separation sweep of periodic orbits: instrument approach/retract (jumps, hysteresis) and/or "
-               "continuation through folds; HB beside each point");
-  params->add_options(*cmd);
-  cmd->callback([params] {
-    params->resolve();
-    run_sweep(*params);
-  });
+  add_command(
+      tapping, "sweep",
+      "separation sweep of periodic orbits: instrument approach/retract (jumps, hysteresis) and/or continuation "
+      "through folds; HB beside each point",
+      [](io::ParamSet& p) {
+        add_tapping_model_params(p);
+        add_tapping_sim_params(p);
+        p.group("Sweep")
+            .real("separation_min", 5.0, "smallest separation of the sweep", io::Range::any())
+            .unit(kLengthUnit)
+            .real("separation_max", 15.0, "largest separation of the sweep, > separation_min", io::Range::any())
+            .unit(kLengthUnit)
+            .integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000)
+            .reals("separations", {},
+                   "explicit separations of the instrument sweep instead of the uniform grid (any order, e.g. "
+                   "20,18,16,15.5); the continuation runs between the smallest and the largest",
+                   io::Range::closed(-1e6, 1e6))
+            .unit(kLengthUnit)
+            .default_text("none: points on [separation_min, separation_max]")
+            .file("separations_file", "",
+                  "file with the separations instead (numbers separated by commas, spaces or lines; # comments)")
+            .text("mode", "instrument",
+                  "instrument (approach then retract, jumps and hysteresis), continuation (pseudo-arclength through "
+                  "folds, unstable branches) or both",
+                  {"instrument", "continuation", "both"})
+            .real("max_arclength_step", 0.2, "largest continuation step (scaled arclength)", io::Range::positive())
+            .unit(kLengthUnit)
+            .integer("max_continuation_points", 5000, "continuation point budget", 2, 100000000);
+        add_output_params(p, "out/tapping_sweep.csv", "sweep");
+        p.flag("quiet", false, "no progress output");
+      },
+      run_sweep);
 }
 
 }  // namespace afmkit::cli

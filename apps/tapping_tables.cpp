@@ -2,31 +2,40 @@
 
 namespace afmkit::cli {
 
-std::vector<std::string> hb_columns() { return {"q", "separation", "amplitude", "offset", "phase", "branch"}; }
-
-void write_hb_rows(io::TableWriter& out, const std::vector<tapping::HbPoint>& curve, const tapping::UnitScales& s) {
-  for (const tapping::HbPoint& pt : curve)
-    out.row(pt.q, pt.separation * s.length, pt.amplitude * s.length, pt.offset * s.length, pt.phase,
-            tapping::branch_name(pt.branch));
+std::vector<io::Column> hb_columns(const tapping::UnitScales& s) {
+  const std::string L = s.length_unit;
+  return {{"q", "dimensionless", "penetration parameter q = (A + l)/B (seed-1 eq. 15); q >= 1: free oscillation"},
+          {"separation", L, "separation l where this harmonic-balance solution exists"},
+          {"amplitude", L, "first-harmonic amplitude B of x(t) = A + B cos(ωt − φ)"},
+          {"offset", L, "mean deflection A"},
+          {"phase", "rad", "phase lag φ of the first harmonic behind the drive (docs/conventions.md), in (-π, π]"},
+          {"branch", "label", "root of the harmonic-balance quadratic: plus, minus or free "
+                              "(docs/theory-tapping.md#two-branch-solution)"}};
 }
 
-std::vector<std::string> sweep_columns() {
-  return {"separation", "direction", "amplitude", "offset", "phase", "stable", "contact_fraction",
-          "energy_dissipated", "peak_force", "min_gap", "floquet_max", "period_multiple", "periodic",
-          "jumped", "arclength", "harmonic_2", "harmonic_3", "hb_amplitude", "hb_offset", "hb_phase",
-          "hb_solutions"};
-}
-
-void write_sweep_rows(io::TableWriter& out, const std::vector<tapping::SweepPoint>& points,
-                      const tapping::UnitScales& s) {
-  for (const tapping::SweepPoint& pt : points) {
-    const auto& m = pt.metrics;
-    out.row(pt.separation * s.length, tapping::direction_name(pt.direction), m.amplitude * s.length,
-            m.offset * s.length, m.phase, pt.orbit.stable, m.contact_fraction, m.energy_dissipated() * s.energy,
-            m.peak_force * s.force, m.min_gap * s.length, pt.orbit.floquet_max, pt.orbit.period_multiple,
-            pt.periodic, pt.jumped, pt.arclength, m.harmonics[0] * s.length, m.harmonics[1] * s.length,
-            pt.hb_amplitude * s.length, pt.hb_offset * s.length, pt.hb_phase, pt.hb_solutions);
-  }
+std::vector<io::Column> sweep_columns(const tapping::UnitScales& s) {
+  const std::string L = s.length_unit;
+  return {{"separation", L, "separation l of the orbit"},
+          {"direction", "label", "approach, retract (instrument sweep) or continuation"},
+          {"amplitude", L, "first-harmonic amplitude B of the periodic orbit"},
+          {"offset", L, "mean deflection A of the orbit"},
+          {"phase", "rad", "phase lag φ of the first harmonic behind the drive (docs/conventions.md), in (-π, π]"},
+          {"stable", "boolean (0/1)", "1: all Floquet multipliers inside the unit circle"},
+          {"contact_fraction", "dimensionless", "fraction of the period with the gap below the law's contact gap"},
+          {"energy_dissipated", s.energy_unit, "energy dissipated per drive period (viscous + contact)"},
+          {"peak_force", s.force_unit, "largest tip-sample force over the period (positive: repulsive)"},
+          {"min_gap", L, "smallest gap x + l over the period"},
+          {"floquet_max", "dimensionless", "largest Floquet multiplier modulus"},
+          {"period_multiple", "count", "n of a period-n orbit (1: the drive period)"},
+          {"periodic", "boolean (0/1)", "0: the transient did not settle (metrics describe one period of it)"},
+          {"jumped", "boolean (0/1)", "1: the response jumped to another branch at this point"},
+          {"arclength", L, "pseudo-arclength of the continuation (state scaled by the amplitude; 0 in instrument sweeps)"},
+          {"harmonic_2", L, "amplitude of the 2nd harmonic of x(t)"},
+          {"harmonic_3", L, "amplitude of the 3rd harmonic of x(t)"},
+          {"hb_amplitude", L, "nearest harmonic-balance amplitude at the same separation (nan: none)"},
+          {"hb_offset", L, "its mean deflection (nan: none)"},
+          {"hb_phase", "rad", "its phase (nan: none)"},
+          {"hb_solutions", "count", "number of harmonic-balance solutions at this separation"}};
 }
 
 }  // namespace afmkit::cli

@@ -1,6 +1,6 @@
 #pragma once
 // The CSV tables of tapping results, shared by `tapping hb`, `tapping sweep` and `demo`, so that their
-// column names (which users rely on) are defined once.
+// column names, units and descriptions (which users rely on) are defined once.
 #include <string>
 #include <vector>
 
@@ -8,18 +8,35 @@
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/sweep.hpp"
 #include "afmkit/tapping/units.hpp"
+#include "command.hpp"
 
 namespace afmkit::cli {
 
-/// Columns: q, separation, amplitude, offset, phase, branch.
-std::vector<std::string> hb_columns();
-void write_hb_rows(io::TableWriter& out, const std::vector<tapping::HbPoint>& curve, const tapping::UnitScales& scales);
+/// Columns: q, separation, amplitude, offset, phase, branch (lengths in the units of `scales`).
+std::vector<io::Column> hb_columns(const tapping::UnitScales& scales);
+/// Rows of the curve into `out` (a CommandOutput or an io::TableWriter opened with hb_columns).
+template <class Table>
+void write_hb_rows(Table& out, const std::vector<tapping::HbPoint>& curve, const tapping::UnitScales& s) {
+  for (const tapping::HbPoint& pt : curve)
+    out.row(pt.q, pt.separation * s.length, pt.amplitude * s.length, pt.offset * s.length, pt.phase,
+            tapping::branch_name(pt.branch));
+}
 
 /// Columns: separation, direction, amplitude, offset, phase, stable, contact_fraction, energy_dissipated,
 /// then peak_force, min_gap, floquet_max, period_multiple, periodic, jumped, arclength, harmonic_2, harmonic_3,
 /// hb_amplitude, hb_offset, hb_phase, hb_solutions.
-std::vector<std::string> sweep_columns();
-void write_sweep_rows(io::TableWriter& out, const std::vector<tapping::SweepPoint>& points,
-                      const tapping::UnitScales& scales);
+std::vector<io::Column> sweep_columns(const tapping::UnitScales& scales);
+/// Rows of the points into `out` (a CommandOutput or an io::TableWriter opened with sweep_columns).
+template <class Table>
+void write_sweep_rows(Table& out, const std::vector<tapping::SweepPoint>& points, const tapping::UnitScales& s) {
+  for (const tapping::SweepPoint& pt : points) {
+    const auto& m = pt.metrics;
+    out.row(pt.separation * s.length, tapping::direction_name(pt.direction), m.amplitude * s.length,
+            m.offset * s.length, m.phase, pt.orbit.stable, m.contact_fraction, m.energy_dissipated() * s.energy,
+            m.peak_force * s.force, m.min_gap * s.length, pt.orbit.floquet_max, pt.orbit.period_multiple,
+            pt.periodic, pt.jumped, pt.arclength, m.harmonics[0] * s.length, m.harmonics[1] * s.length,
+            pt.hb_amplitude * s.length, pt.hb_offset * s.length, pt.hb_phase, pt.hb_solutions);
+  }
+}
 
 }  // namespace afmkit::cli

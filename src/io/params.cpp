@@ -121,6 +121,11 @@ ParamSet& ParamSet::text(const std::string& key, const std::string& def, const s
   declare(key, std::move(e));
   return *this;
 }
+ParamSet& ParamSet::file(const std::string& key, const std::string& def, const std::string& help) {
+  text(key, def, help);
+  entries_[key].is_file = true;
+  return *this;
+}
 ParamSet& ParamSet::flag(const std::string& key, bool def, const std::string& help) {
   declare(key, make_entry(def, help, Range::any()));
   return *this;
@@ -151,7 +156,7 @@ void ParamSet::add_options(CLI::App& app) {
             type = "INT";
             desc += fmt::format(" [unit: {}; default {}; integer in [{}, {}]]", e.unit, shown(v), e.ilo, e.ihi);
           } else if constexpr (std::is_same_v<T, std::string>) {
-            type = e.choices.empty() ? "TEXT" : "NAME";
+            type = e.is_file ? "FILE" : e.choices.empty() ? "TEXT" : "NAME";
             desc += fmt::format(" [default {}{}]", e.default_text.empty() ? "'" + v + "'" : e.default_text,
                                 e.choices.empty() ? "" : fmt::format("; one of {}", fmt::join(e.choices, ", ")));
           } else if constexpr (std::is_same_v<T, bool>) {

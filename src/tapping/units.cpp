@@ -30,6 +30,10 @@ UnitScales PhysicalCantilever::scales() const {
   s.force = spring_constant;
   s.energy = spring_constant;
   s.time = 1.0 / (2.0 * std::numbers::pi * resonance_frequency * 1e3);
+  s.length_unit = "nm";
+  s.force_unit = "nN";
+  s.energy_unit = "aJ";
+  s.time_unit = "s";
   return s;
 }
 

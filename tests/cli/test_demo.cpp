@@ -89,3 +89,30 @@ TEST(Demo, PrintedFoldsEqualThoseOfTappingHbOnTheSameModel) {
     EXPECT_LT(closest, 1e-3 * std::max(1.0, std::abs(l)));
   }
 }
+
+// `demo --units physical` runs the same dimensionless case (lengths scaled by s = A_free / A_free,normalised):
+// the folds and jumps the demo exists to show are kept, at s times the normalised separations, whatever spring
+// constant and free amplitude are given.
+TEST(Demo, PhysicalUnitsKeepTheFoldAtTheScaledSeparation) {
+  TempDir dir;
+  const auto normalised = run_cli("demo --points 21 --output-dir n", dir);
+  ASSERT_EQ(normalised.status, 0) << normalised.err;
+  const auto physical = run_cli("demo --points 21 --units physical --spring-constant 3 --free-amplitude 35 "
+                                "--output-dir p",
+                                dir);
+  ASSERT_EQ(physical.status, 0) << physical.err;
+  const auto n = nlohmann::json::parse(slurp(dir.path / "n/demo_hb.csv.json"))["results"];
+  const auto p = nlohmann::json::parse(slurp(dir.path / "p/demo_hb.csv.json"))["results"];
+  EXPECT_NEAR(p["free_amplitude"].get<double>(), 35.0, 1e-9);
+  const double s = 35.0 / n["free_amplitude"].get<double>();
+  ASSERT_GE(n["hb_folds"].size(), 1u);
+  ASSERT_EQ(p["hb_folds"].size(), n["hb_folds"].size());
+  for (std::size_t i = 0; i < n["hb_folds"].size(); ++i)
+    EXPECT_NEAR(p["hb_folds"][i]["separation"].get<double>(), s * n["hb_folds"][i]["separation"].get<double>(),
+                1e-7 * s);
+  ASSERT_FALSE(n["sweep_jumps"]["retract"].empty());
+  ASSERT_EQ(p["sweep_jumps"]["retract"].size(), n["sweep_jumps"]["retract"].size());
+  EXPECT_NEAR(p["sweep_jumps"]["retract"][0].get<double>(), s * n["sweep_jumps"]["retract"][0].get<double>(), 1e-7 * s);
+  EXPECT_EQ(p["units"]["length"], "nm");
+  EXPECT_EQ(n["units"]["length"], "L");
+}

@@ -1,11 +1,16 @@
 // Every command example of the README and docs/ runs as written and succeeds (under the sanitizer build too,
-// where this is how the documented command lines are checked for memory errors and undefined behaviour).
+// where this is how the documented command lines are checked for memory errors and undefined behaviour), and
+// every CSV table it writes is self-describing: its JSON sidecar lists every header column, in order, with a unit
+// and a description (docs/commands.md#outputs).
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "cli_run.hpp"
 
@@ -66,6 +71,38 @@ std::vector<Example> examples() {
 
 class DocumentedExample : public ::testing::TestWithParam<Example> {};
 
+/// Every CSV below `dir` (not following links) has a sidecar whose "columns" match its header, each with a unit
+/// and a description.
+void expect_self_describing_tables(const std::filesystem::path& dir, const std::string& origin) {
+  namespace fs = std::filesystem;
+  for (auto it = fs::recursive_directory_iterator(dir); it != fs::recursive_directory_iterator(); ++it) {
+    if (it->is_symlink()) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    if (it->path().extension() != ".csv") continue;
+    std::ifstream csv(it->path());
+    std::string header;
+    std::getline(csv, header);
+    std::vector<std::string> names;
+    std::istringstream cells(header);
+    for (std::string name; std::getline(cells, name, ',');) names.push_back(name);
+    std::ifstream sidecar(it->path().string() + ".json");
+    ASSERT_TRUE(sidecar) << origin << ": " << it->path() << " has no sidecar";
+    const auto meta = nlohmann::json::parse(sidecar);
+    ASSERT_TRUE(meta.contains("columns")) << origin << ": " << it->path() << ".json has no column list";
+    const auto& columns = meta["columns"];
+    ASSERT_EQ(columns.size(), names.size()) << origin << ": " << it->path();
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      EXPECT_EQ(columns[i].value("name", ""), names[i]) << origin << ": " << it->path();
+      EXPECT_FALSE(columns[i].value("unit", "").empty()) << origin << ": column " << names[i] << " has no unit";
+      EXPECT_FALSE(columns[i].value("description", "").empty())
+          << origin << ": column " << names[i] << " has no description";
+    }
+    EXPECT_TRUE(meta.contains("parameter_units")) << origin << ": " << it->path();
+  }
+}
+
 }  // namespace
 
 TEST(DocumentedExamples, AreFound) { EXPECT_GE(examples().size(), 20u); }
@@ -77,6 +114,7 @@ TEST_P(DocumentedExample, RunsAndSucceeds) {
                                             dir.path / "examples");
   const auto r = run_shell(GetParam().command, dir);
   EXPECT_EQ(r.status, 0) << GetParam().origin << ": " << GetParam().command << "\n" << r.err;
+  expect_self_describing_tables(dir.path, GetParam().origin);
 }
 
 INSTANTIATE_TEST_SUITE_P(Docs, DocumentedExample, ::testing::ValuesIn(examples()),

@@ -1,6 +1,6 @@
 // Every command's --help as a new user reads it: every option typed (numbers as FLOAT/INT, choices as NAME,
-// files as FILE or TEXT), flags without a value type, one default each, and no reference to a file outside the
-// project (the theory is in docs/theory-*.md).
+// files as FILE), every number with its unit ("[unit: …", docs/units.md), flags without a value type, one default
+// each, and no reference to a file outside the project (the theory is in docs/theory-*.md).
 #include <gtest/gtest.h>
 
 #include <set>
@@ -11,8 +11,8 @@
 using namespace afmkit_test;
 
 namespace {
-// options whose value is free text: file paths and folders
-const std::set<std::string> kTextOptions = {"output", "boundaries-output", "output-dir", "force-curve"};
+// options whose value is free text (none today: paths are FILE, choices NAME)
+const std::set<std::string> kTextOptions = {};
 }  // namespace
 
 class HelpText : public ::testing::TestWithParam<std::string> {};
@@ -29,6 +29,13 @@ TEST_P(HelpText, EveryOptionIsTypedHasOneDefaultAndCitesOnlyTheProject) {
     if (o.name == "help" || o.name == "version") continue;
     if (o.type == "TEXT") EXPECT_TRUE(kTextOptions.count(o.name)) << command << " --" << o.name << " is untyped (TEXT)";
     if (o.flag) EXPECT_EQ(o.description.find("TEXT=true"), std::string::npos) << command << " --" << o.name;
+    // every number carries its unit, named and not empty
+    if (o.type == "FLOAT" || o.type == "INT" || o.type == "FLOAT,...") {
+      const std::size_t at = o.description.find("[unit: ");
+      EXPECT_NE(at, std::string::npos) << command << " --" << o.name << " has no unit: " << o.description;
+      if (at != std::string::npos)
+        EXPECT_NE(o.description[at + 7], ';') << command << " --" << o.name << " has an empty unit";
+    }
     // one default: the [default …] the parameter set prints, no second "(default: …)" in the help text
     std::size_t defaults = 0;
     for (std::size_t at = o.description.find("default"); at != std::string::npos;

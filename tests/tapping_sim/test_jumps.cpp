@@ -199,5 +199,24 @@ TEST(Jumps, FollowBranchStopsAtTheFold) {
   EXPECT_THROW(follow_branch(base, contact, std::nan("")), InvalidParameter);
 }
 
+// An explicit list of separations (any order, duplicates) is the same sweep as the grid it holds: approach from
+// the largest down, retract from the smallest up.
+TEST(Jumps, AListOfSeparationsIsTheSweepOfItsSortedPoints) {
+  const TappingModel base = make_model(10, 8, 0, 0, 20.0, 1.0);
+  const SweepResult grid = sweep_instrument(base, 18.0, 21.0, 7);
+  const SweepResult list = sweep_instrument(base, std::vector<double>{19.5, 21.0, 18.0, 20.5, 18.5, 19.0, 20.0, 18.0});
+  ASSERT_EQ(list.approach.size(), grid.approach.size());
+  ASSERT_EQ(list.retract.size(), grid.retract.size());
+  for (std::size_t i = 0; i < grid.approach.size(); ++i) {
+    EXPECT_NEAR(list.approach[i].separation, grid.approach[i].separation, 1e-12);
+    EXPECT_NEAR(list.approach[i].metrics.amplitude, grid.approach[i].metrics.amplitude, 1e-9);
+    EXPECT_NEAR(list.retract[i].separation, grid.retract[i].separation, 1e-12);
+    EXPECT_NEAR(list.retract[i].metrics.amplitude, grid.retract[i].metrics.amplitude, 1e-9);
+  }
+  EXPECT_GT(list.approach.front().separation, list.approach.back().separation);
+  EXPECT_THROW(sweep_instrument(base, std::vector<double>{10.0, 10.0}), afmkit::InvalidParameter);
+  EXPECT_THROW(sweep_instrument(base, std::vector<double>{10.0, std::nan("")}), afmkit::InvalidParameter);
+}
+
 }  // namespace
 }  // namespace afmkit::tapping

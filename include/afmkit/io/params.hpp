@@ -40,6 +40,8 @@ class ParamSet {
   ParamSet& integer(const std::string& key, long def, const std::string& help, long lo, long hi);
   ParamSet& text(const std::string& key, const std::string& def, const std::string& help,
                  std::vector<std::string> choices = {});
+  /// A file path (a text shown as FILE in --help).
+  ParamSet& file(const std::string& key, const std::string& def, const std::string& help);
   ParamSet& flag(const std::string& key, bool def, const std::string& help);
   /// A list of reals: TOML array, or a comma-separated flag value "1,0.5,0.2".
   ParamSet& reals(const std::string& key, std::vector<double> def, const std::string& help,
@@ -96,6 +98,7 @@ class ParamSet {
     std::string group;                    // heading in --help
     std::string default_text;             // shown instead of the value in --help, if set
     std::string unit;                     // numbers only (docs/units.md)
+    bool is_file = false;                 // a path: FILE in --help
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;

@@ -82,6 +82,10 @@ std::optional<PeriodicOrbit> follow_branch(const TappingModel& base, const Perio
 /// Validates: finite l_min < l_max, points ≥ 2 -> InvalidParameter.
 SweepResult sweep_instrument(const TappingModel& base, double l_min, double l_max, int points,
                              const SweepOptions& options = {});
+/// The same over an explicit list of separations (any order, duplicates merged; at least 2 distinct, finite):
+/// approach visits them from the largest down, retract from the smallest up.
+SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separations,
+                             const SweepOptions& options = {});
 
 /// Every orbit (find_orbits) at each separation, the separations processed in parallel.
 std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::vector<double>& separations,

@@ -12,12 +12,17 @@
 
 namespace afmkit::tapping {
 
-/// Multiply a model quantity by these factors to obtain it in the user's units.
+/// Multiply a model quantity by these factors to obtain it in the user's units, named by the *_unit fields
+/// (docs/units.md). Default: the normalised model (length unit L, time unit t; forces and energies per unit mass).
 struct UnitScales {
   double length = 1.0;  // nm per model length unit
   double force = 1.0;   // nN per model force unit (normalised: 1)
   double energy = 1.0;  // aJ per model energy unit (normalised: 1)
   double time = 1.0;    // s per model time unit (normalised: 1)
+  const char* length_unit = "L";
+  const char* force_unit = "L/t^2";
+  const char* energy_unit = "L^2/t^2";
+  const char* time_unit = "t";
 };
 
 /// The cantilever and drive as measured on an instrument.

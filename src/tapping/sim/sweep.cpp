@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "afmkit/tapping/sweep.hpp"
 
 #include <cmath>
@@ -266,14 +267,23 @@ void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, co
 SweepResult sweep_instrument(const TappingModel& base, double l_min, double l_max, int points,
                              const SweepOptions& options) {
   check_range(l_min, l_max, points);
+  std::vector<double> up(points);
+  for (int k = 0; k < points; ++k) up[k] = l_min + (l_max - l_min) * k / (points - 1);
+  up.front() = l_min;
+  up.back() = l_max;
+  return sweep_instrument(base, up, options);
+}
+
+SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separations, const SweepOptions& options) {
+  for (double l : separations) validate::finite("separations", l);
+  std::sort(separations.begin(), separations.end());
+  separations.erase(std::unique(separations.begin(), separations.end()), separations.end());
+  validate::require(separations.size() >= 2, "separations", static_cast<double>(separations.size()),
+                    "at least 2 distinct separations");
   options.validate();
-  std::vector<double> down(points), up(points);
-  for (int k = 0; k < points; ++k) {
-    up[k] = l_min + (l_max - l_min) * k / (points - 1);
-    down[points - 1 - k] = up[k];
-  }
-  up.front() = down.back() = l_min;
-  up.back() = down.front() = l_max;
+  const std::vector<double> up = separations;
+  const std::vector<double> down(separations.rbegin(), separations.rend());
+  const double l_max = up.back();
   // start far from the sample: the free response, settled if it touches at l_max
   const TappingModel start_model = base.with_separation(l_max);
   SweepPoint start;
