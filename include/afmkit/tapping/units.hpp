@@ -1,8 +1,9 @@
 #pragma once
 // Physical units as AFM users state them, and their conversion to the normalised model of seed-1 eq. (8).
 //
-// Normalised units (the papers' form): time in 1/ω_n (ω_n = 1), lengths in nm, interaction and drive
-// "forces" per unit mass in nm·ω_n². With cantilever spring constant k [N/m]:
+// Normalised units (the papers' form): time unit t (= 1/ω_n for ω_n = 1), length unit L (any; nm when the model
+// is built from physical units), interaction and drive "forces" per unit mass in L/t² (docs/units.md). A physical
+// run builds the normalised model with ω_n = 1 and L = nm; with cantilever spring constant k [N/m]:
 //   force      F [nN]  ↔  h = F / k            (1 nN / (1 N/m) = 1 nm)
 //   stiffness  k_s [N/m] ↔ K = k_s / k          (in units of ω_n², e.g. K_a)
 //   energy     E [aJ]  =  k · E_model           (k [N/m] · 1 nm² = 1e-18 J = 1 aJ)
