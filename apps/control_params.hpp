@@ -1,56 +1,22 @@
 #pragma once
-// Shared controller/plant parameters of the `afmkit control …` commands (seed 2, docs/theory-control.md).
-//
-// Units (nondimensional by default): rotation_frequency Ω is in rad/s (default 1, i.e. time in units of 1/Ω);
-// every RATE below (alpha, beta, a, b, gain, plant_rate, model_rate) is given in units of Ω, every DELAY
-// (delay, model_delay) in units of the rotation period T = 2π/Ω. Example: alpha = 0.1 means α = 0.1 Ω,
-// delay = 0.1 means τ = 0.1 T. Physical run: rotation_frequency = 314.159 (50 Hz), plant_rate = 20 (γ = 20Ω).
-//
-//   controller      single | bank | infinite | smith          (default bank)
-//   harmonics       N of the bank (eq. 15)                      (default 10; range per command: kMaxHarmonics*)
-//   alpha, beta     couplings (20) in units of Ω                (default 0.1, −0.1: the "universal" setting)
-//   a, b            couplings of the single oscillator (5)      (default 0.5, 0)
-//   rejected        harmonics removed from the output (bank)    (default 1; e.g. "1,3")
-//   gain            K in units of Ω                             (default: = plant_rate, design rule K = γ̂)
-//   plant           static (eq. 3) | first_order (eq. 1)        (default static)
-//   plant_rate      γ in units of Ω                             (default 20)
-//   delay           τ in units of T                             (default 0.1)
-//   smith_bank      bank | infinite | single: controller inside the Smith predictor (default bank)
-//   smith_structure periodic | classic                          (default periodic, see smith_predictor.hpp)
-//   model_plant     same | static | first_order: kind of the predictor model P̂0 (default same as plant)
-//   model_rate      γ̂ in units of Ω                             (default: = plant_rate)
-//   model_delay     τ̂ in units of T                             (default: = delay)
+// Shared controller/plant parameters of the `afmkit control …` commands (seed 2, docs/theory-control.md): the
+// command line and TOML form of control::ControlSettings (include/afmkit/control/settings.hpp), whose units are the
+// user's: every RATE (alpha, beta, a, b, gain, plant_rate, model_rate) in units of Ω ("Omega"), every DELAY
+// (delay, model_delay) in units of the rotation period T = 2π/Ω ("T"), Ω itself (rotation_frequency) in rad/s
+// (default 1). Example: alpha = 0.1 means α = 0.1 Ω, delay = 0.1 means τ = 0.1 T. Physical run:
+// rotation_frequency = 314.159 (50 Hz), plant_rate = 20 (γ = 20 Ω). Every table and JSON value of these commands
+// uses the same units; the sidecars give the resolved settings in both forms ("settings": Ω and T, "settings_si":
+// rad/s and s).
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "afmkit/control/loop.hpp"
+#include "afmkit/control/settings.hpp"
 #include "afmkit/io/params.hpp"
 
 namespace afmkit::cli {
-
-/// The parameters above, resolved to physical units (rad/s, s).
-struct ControlSettings {
-  std::string controller;          // single | bank | infinite | smith
-  double rotation_frequency = 1;   // Ω [rad/s]
-  double period = 0;               // T = 2π/Ω [s]
-  int harmonics = 10;              // N
-  double alpha = 0, beta = 0;      // α, β [rad/s]
-  double a = 0, b = 0;             // single-oscillator couplings [rad/s]
-  std::vector<int> rejected{1};
-  double gain = 0;                 // K [rad/s]
-  control::PlantKind plant = control::PlantKind::Static;
-  double plant_rate = 0;           // γ [rad/s]
-  double delay = 0;                // τ [s]
-  std::string smith_bank = "bank";
-  control::SmithPredictor::Structure smith_structure = control::SmithPredictor::Structure::Periodic;
-  control::PlantKind model_plant = control::PlantKind::Static;
-  double model_rate = 0;           // γ̂ [rad/s]
-  double model_delay = 0;          // τ̂ [s]
-
-  nlohmann::json to_json() const;  // resolved values (physical units) for sidecars
-};
 
 /// Largest `harmonics` of each command (docs/commands.md states the costs behind them):
 ///   tf: O(N) per frequency (transfer function as a sum over the oscillators);
@@ -59,17 +25,21 @@ struct ControlSettings {
 inline constexpr long kMaxHarmonicsTf = 100000;
 inline constexpr long kMaxHarmonicsSpectra = 1000;
 
-/// Adds the parameters listed above to `params`; `max_harmonics` bounds `harmonics` (and `rejected`).
+/// Adds the shared parameters (with their units) to `params`; `max_harmonics` bounds `harmonics` (and `rejected`).
 void add_control_params(io::ParamSet& params, long max_harmonics = kMaxHarmonicsSpectra);
-/// Throws InvalidParameter(parameter, …) when a request of `rows` rows of `bytes_per_row` bytes held in memory
-/// does not fit in half of the available memory (MemAvailable), before any work.
+/// Throws InvalidParameter(parameter, …) when `value` units of `bytes_per_unit` bytes held in memory do not fit in
+/// half of the available memory (MemAvailable), before any work.
 void require_memory(const std::string& parameter, double value, double bytes_per_unit);
-/// Resolves the parameters (after params.resolve()); throws InvalidParameter naming the parameter.
-ControlSettings control_settings_from(const io::ParamSet& params);
-/// The controller described by the settings (bank / infinite / single / Smith predictor).
-control::Controller control_controller_from(const ControlSettings& settings);
-/// The loop described by the parameters.
-control::LoopSpec control_loop_from(const io::ParamSet& params);
-control::LoopSpec control_loop_from(const ControlSettings& settings);
+/// The settings given (after params.resolve()), validated: InvalidParameter naming the parameter.
+control::ControlSettings control_settings_from(const io::ParamSet& params);
+
+/// The resolved settings as given (Ω, T; defaults such as gain = plant_rate filled in), with their "units".
+nlohmann::json settings_json(const control::ControlSettings& settings);
+/// The same in the library's units (rad/s, s), with their "units".
+nlohmann::json settings_si_json(const control::ControlSettings& settings);
+/// The parameters as run, for a sidecar: `params` with the defaults that depend on other values resolved (gain,
+/// model_rate, model_delay) and `values` (key, value in the parameter's own unit) replacing the given ones.
+io::ParamSet params_as_run(const io::ParamSet& params, const control::ControlSettings& settings,
+                           const std::vector<std::pair<std::string, double>>& values = {});
 
 }  // namespace afmkit::cli

@@ -1,11 +1,10 @@
 // afmkit control tf: frequency response of the seed-2 controller, plant, loop, sensitivity or closed loop
-// (seed-2 eqs. 10, 18, 25, 28–31) on a frequency grid, as CSV (frequency, magnitude, phase, real, imag) with a JSON sidecar
-// holding the τ = 0 stability verdicts (eqs. 13, 22–24, 40–42, β_c(N)) and |S| at the harmonics.
-//   frequency is ω/Ω (harmonic number; the grid bounds frequency_min/max are in the same unit),
-//   magnitude = |G(iω)|, phase = arg G(iω) unwrapped along the grid [rad], real/imag = G(iω).
-// --json prints the summary (no CSV). Controller/plant parameters and units: control_params.hpp.
+// (seed-2 eqs. 10, 18, 25, 28–31) on a frequency grid, as CSV (frequency, magnitude, phase, real, imag) with a JSON
+// sidecar holding the τ = 0 stability verdicts (eqs. 13, 22–24, 40–42, β_c(N)) and |S| at the harmonics.
+// Units (control_params.hpp): frequency ω in units of Ω (the harmonic number at ω = kΩ); the response in the
+// units of the system: the controller C in units of Ω (C/Ω), the plant P in units of 1/Ω (P·Ω), the loop,
+// sensitivity and closed loop dimensionless; phase = arg G(iω) unwrapped along the grid [rad].
 #include <complex>
-#include <memory>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -15,14 +14,14 @@
 #include "afmkit/control/frequency_response.hpp"
 #include "afmkit/control/stability_tau0.hpp"
 #include "afmkit/core/error.hpp"
-#include "afmkit/io/output.hpp"
-#include "afmkit/io/params.hpp"
+#include "command.hpp"
 #include "commands.hpp"
 #include "control_params.hpp"
 
 namespace afmkit::cli {
 
 namespace {
+using control::ControllerKind;
 
 control::LoopSystem system_from(const std::string& s) {
   if (s == "plant") return control::LoopSystem::Plant;
@@ -32,23 +31,34 @@ control::LoopSystem system_from(const std::string& s) {
   return control::LoopSystem::Controller;
 }
 
-nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+// Unit of the response of `system` and the factor taking the library's value (rad/s, s) to it.
+struct ResponseUnit {
+  std::string unit;
+  double factor;
+};
+ResponseUnit response_unit(const std::string& system, double w) {
+  if (system == "controller") return {"Omega", 1.0 / w};  // C = W/M: a rate
+  if (system == "plant") return {"1/Omega", w};           // P = Y/U: an inverse rate
+  return {"dimensionless", 1.0};
+}
 
-// τ = 0 verdicts: eigenvalues for finite banks (any K, plant), closed-form conditions at the design point K = γ.
-nlohmann::json stability_summary(const ControlSettings& c, const control::LoopSpec& loop) {
+// τ = 0 verdicts (units of Ω): eigenvalues for finite banks (any K, plant), closed-form conditions at the design
+// point K = γ.
+nlohmann::json stability_summary(const control::ControlSettings& c) {
   nlohmann::json j;
-  const double w = c.rotation_frequency;
-  const std::string inner = c.controller == "smith" ? c.smith_bank : c.controller;
-  const bool finite_bank = inner != "infinite";
-  if (finite_bank && (inner == "single" || c.harmonics <= kMaxHarmonicsSpectra)) {
+  nlohmann::json units;
+  const control::ControlSettingsSi si = control::to_si(c);
+  const double w = si.rotation_frequency;
+  const ControllerKind inner = c.bank_kind();
+  const bool finite_bank = inner != ControllerKind::Infinite;
+  if (finite_bank && (inner == ControllerKind::Single || c.harmonics <= kMaxHarmonicsSpectra)) {
     // delay-free loop with the bank alone (for the Smith predictor: its nominal loop with an exact model)
-    const control::LoopSpec plain(c.controller == "smith" ? control_controller_from([&] {
-      ControlSettings b = c;
-      b.controller = c.smith_bank;
-      return b;
-    }()) : loop.controller, c.plant, c.plant_rate, 0.0);
-    const double abscissa = control::undelayed_spectral_abscissa(plain);
+    control::ControlSettings plain = c;
+    plain.controller = inner;
+    plain.delay = 0.0;
+    const double abscissa = control::undelayed_spectral_abscissa(control::loop_from(plain)) / w;
     j["delay_free_spectral_abscissa"] = abscissa;
+    units["delay_free_spectral_abscissa"] = "Omega";
     j["delay_free_stable"] = abscissa < 0.0;
     j["delay_free_basis"] = "eigenvalues of the closed-loop state matrix with tau = 0 (roots of the delay-free "
                             "characteristic polynomial, O(N^2))";
@@ -58,54 +68,59 @@ nlohmann::json stability_summary(const ControlSettings& c, const control::LoopSp
     j["delay_free_basis"] = fmt::format("not computed for harmonics > {} (cost O(N^2)); the design-point verdict "
                                         "below is O(N)", kMaxHarmonicsSpectra);
   }
-  if (inner == "single") {
-    j["eq13_stable"] = control::single_oscillator_stable_tau0(w, c.a, c.b, c.gain, c.plant_rate);
-    j["eq13_b_limit"] = c.plant_rate * w / c.gain;
+  if (inner == ControllerKind::Single) {
+    j["eq13_stable"] = control::single_oscillator_stable_tau0(w, si.a, si.b, si.gain, si.plant_rate);
+    j["eq13_b_limit"] = si.plant_rate / si.gain;  // b < γΩ/K, in units of Ω
+    units["eq13_b_limit"] = "Omega";
   } else {
-    const bool infinite = inner == "infinite";
+    const bool infinite = inner == ControllerKind::Infinite;
     const auto bc = infinite ? control::critical_beta_limit(w) : control::critical_beta(c.harmonics, w);
-    j["beta_critical"] = bc.beta;
-    j["beta_critical_over_omega"] = bc.beta / w;
-    j["crossing_frequency"] = bc.crossing_frequency;
-    j["design_point_stable"] = c.alpha > 0.0 && c.beta > bc.beta;
+    j["beta_critical"] = bc.beta / w;
+    j["beta_critical_over_omega"] = bc.beta / w;  // the same (kept for readers of earlier sidecars)
+    j["crossing_frequency"] = bc.crossing_frequency / w;
+    units["beta_critical"] = units["beta_critical_over_omega"] = units["crossing_frequency"] = "Omega";
+    j["design_point_stable"] = c.alpha > 0.0 && si.beta > bc.beta;
     j["design_point_basis"] = infinite ? "eq. (24): alpha > 0 and beta > -Omega/4 (K = gamma, static plant, tau = 0)"
                                        : "alpha > 0 and beta > beta_c(N) (K = gamma, static plant, tau = 0)";
     if (!infinite) {
-      const auto nc = control::necessary_conditions(c.harmonics, w, c.alpha, c.beta);
+      const auto nc = control::necessary_conditions(c.harmonics, w, si.alpha, si.beta);
       j["eq40_coefficient"] = nc.coefficient_2n;
       j["eq41_coefficient_normalised"] = nc.coefficient_1_normalised;
       j["eq42_limit_condition"] = nc.limit_condition;
     }
   }
+  j["units"] = units;
   return j;
 }
 
-nlohmann::json summary(const ControlSettings& c, const control::LoopSpec& loop) {
+nlohmann::json summary(const control::ControlSettings& c, const control::LoopSpec& loop) {
   nlohmann::json j;
-  j["loop"] = loop.describe();
-  j["settings"] = c.to_json();
+  j["loop"] = control::describe_in_rotation_units(loop);
+  j["settings"] = settings_json(c);
+  j["settings_si"] = settings_si_json(c);
   j["gain_ratio"] = loop.gain_ratio();
-  j["tau0"] = stability_summary(c, loop);
+  j["tau0"] = stability_summary(c);
   nlohmann::json harmonics = nlohmann::json::array();
-  const int kmax = c.controller == "single" ? 3 : std::min(c.controller == "infinite" ? 5 : c.harmonics + 1, 8);
+  const int kmax = c.controller == ControllerKind::Single ? 3
+                                                          : std::min(c.controller == ControllerKind::Infinite ? 5
+                                                                                                              : c.harmonics + 1,
+                                                                     8);
   for (int k = 1; k <= kmax; ++k) {
-    const std::complex<double> s(0.0, k * c.rotation_frequency);
+    const std::complex<double> s(0.0, k * loop.rotation_frequency());
     harmonics.push_back({{"harmonic", k},
-                         {"sensitivity_magnitude", finite_or_null(std::abs(control::sensitivity(loop, s)))},
-                         {"closed_loop_magnitude", finite_or_null(std::abs(control::disturbance_response(loop, s)))}});
+                         {"sensitivity_magnitude", std::abs(control::sensitivity(loop, s))},
+                         {"closed_loop_magnitude", std::abs(control::disturbance_response(loop, s))}});
   }
   j["at_harmonics"] = harmonics;
+  j["units"] = {{"gain_ratio", "dimensionless"},
+                {"at_harmonics", {{"harmonic", "count"}, {"sensitivity_magnitude", "dimensionless"},
+                                  {"closed_loop_magnitude", "dimensionless"}}}};
   return j;
 }
 
 void run_tf(const io::ParamSet& p) {
-  const ControlSettings c = control_settings_from(p);
-  const control::LoopSpec loop = control_loop_from(c);
-  const nlohmann::json results = summary(c, loop);
-  if (p.flag("json")) {
-    fmt::print("{}\n", results.dump(2));
-    return;
-  }
+  const control::ControlSettings c = control_settings_from(p);
+  const control::LoopSpec loop = control::loop_from(c);
   const double fmin = p.real("frequency_min"), fmax = p.real("frequency_max");
   const bool log_spacing = p.flag("log_spacing");
   if (!(fmax > fmin))
@@ -114,58 +129,60 @@ void run_tf(const io::ParamSet& p) {
   if (log_spacing && fmin <= 0.0)
     throw InvalidParameter("frequency_min", fmt::format("frequency_min = {} is out of range: must be > 0 with "
                                                         "log_spacing (or set --log-spacing false)", fmin));
-  const double w = c.rotation_frequency;
   const long points = p.integer("points");
-  const control::LoopSystem which = system_from(p.text("system"));
-  nlohmann::json res = results;
-  res["system"] = p.text("system");
-  res["columns"] = {{"frequency", "omega/Omega"},
-                    {"magnitude", "|G(i omega)|"},
-                    {"phase", "unwrapped arg G(i omega) [rad]"},
-                    {"real", "Re G(i omega)"},
-                    {"imag", "Im G(i omega)"}};
+  const io::ParamSet as_run = params_as_run(p, c);
+  CommandOutput out(as_run, "control tf");
+  // without a file, --json holds the rows in memory (a few hundred bytes each)
+  if (!out.writes_file() && p.flag("json")) require_memory("points", static_cast<double>(points), 256.0);
+  nlohmann::json res = summary(c, loop);
+  const double w = c.rotation_frequency;
+  const std::string system = p.text("system");
+  const ResponseUnit unit = response_unit(system, w);
+  const control::LoopSystem which = system_from(system);
+  res["system"] = system;
   res["rows"] = points;
   res["cost"] = "O(N) per frequency (sum over the oscillators); rows streamed to the file";
-  const std::string output = p.text("output");
+  out.open({{"frequency", "Omega", "angular frequency omega of the grid point (omega = k Omega at harmonic k)"},
+            {"magnitude", unit.unit, "|G(i omega)| of the system"},
+            {"phase", "rad", "arg G(i omega), unwrapped along the grid"},
+            {"real", unit.unit, "Re G(i omega)"},
+            {"imag", unit.unit, "Im G(i omega)"}});
   // each frequency is computed and its row written at once: memory is bounded by a row, not by the file
-  io::TableWriter table(output, {"frequency", "magnitude", "phase", "real", "imag"});
   control::PhaseUnwrapper unwrap;
   for (long i = 0; i < points; ++i) {
     const double omega = control::frequency_grid_point(fmin * w, fmax * w, points, log_spacing, i);
     const std::complex<double> g = control::evaluate(loop, which, {0.0, omega});
     double magnitude, phase;
     control::magnitude_phase(g, magnitude, phase);
-    table.row(omega / w, magnitude, unwrap(phase), g.real(), g.imag());
+    out.row(omega / w, magnitude * unit.factor, unwrap(phase), g.real() * unit.factor, g.imag() * unit.factor);
   }
-  table.commit(io::make_sidecar("control tf", p.to_json(), res));
-  fmt::print("wrote {} rows ({} of {}) to {}\n", points, p.text("system"), loop.describe(), output);
+  out.finish(res, fmt::format("{} frequencies of the {} ({})", points, system, res["loop"].get<std::string>()));
 }
 
 }  // namespace
 
 void register_control_tf(CLI::App& control) {
-  auto params = std::make_shared<io::ParamSet>();
-  add_control_params(*params, kMaxHarmonicsTf);
-  params->group("Frequency response")
-      .text("system", "controller",
-               "response to tabulate: controller C, plant P = exp(-s tau) P0, loop L = P C, sensitivity "
-               "1/(1 + L), closed_loop (disturbance f -> output y)",
-               {"controller", "plant", "loop", "sensitivity", "closed_loop"})
-      .real("frequency_min", 0.01, "lowest frequency of the grid [units of Omega]", io::Range::closed(0.0, 1e12))
-      .real("frequency_max", 10.0, "highest frequency of the grid [units of Omega]", io::Range{0.0, 1e12, true, false})
-      .integer("points", 1000, "number of grid points (rows are streamed: O(N) work and O(1) memory per row)", 2,
-               10000000)
-      .flag("log_spacing", true, "logarithmic grid (false: linear)")
-      .group("Output")
-      .flag("json", false, "print the tau = 0 stability summary as JSON to stdout instead of writing the CSV")
-      .text("output", "out/control_tf.csv", "output CSV path (JSON sidecar written next to it)");
-  auto* cmd = control.add_subcommand(
-      "tf", "frequency response of the harmonic-rejection controller / loop (seed 2), tau = 0 stability summary");
-  params->add_options(*cmd);
-  cmd->callback([params] {
-    params->resolve();
-    run_tf(*params);
-  });
+  add_command(
+      control, "tf",
+      "frequency response of the harmonic-rejection controller / loop (seed 2), tau = 0 stability summary",
+      [](io::ParamSet& p) {
+        add_control_params(p, kMaxHarmonicsTf);
+        p.group("Frequency response")
+            .text("system", "controller",
+                  "response to tabulate: controller C (units of Omega), plant P = exp(-s tau) P0 (units of 1/Omega), "
+                  "loop L = P C, sensitivity 1/(1 + L), closed_loop (disturbance f -> output y; all three "
+                  "dimensionless)",
+                  {"controller", "plant", "loop", "sensitivity", "closed_loop"})
+            .real("frequency_min", 0.01, "lowest frequency of the grid", io::Range::closed(0.0, 1e12))
+            .unit("Omega")
+            .real("frequency_max", 10.0, "highest frequency of the grid", io::Range{0.0, 1e12, true, false})
+            .unit("Omega")
+            .integer("points", 1000, "number of grid points (rows are streamed: O(N) work and O(1) memory per row)",
+                     2, 10000000)
+            .flag("log_spacing", true, "logarithmic grid (false: linear)");
+        add_output_params(p, "out/control_tf.csv", "frequency-response");
+      },
+      run_tf);
 }
 
 }  // namespace afmkit::cli

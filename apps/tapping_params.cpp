@@ -86,7 +86,8 @@ void add_tapping_model_params(io::ParamSet& p) {
       .real("separation", 10.0, "separation l: sample surface at x = -l", Range::closed(-1e6, 1e6))
       .unit(kLengthUnit)
       // normalised units (ω_n, lengths in nm, per-unit-mass forces in nm·ω_n²)
-      .group("Model in normalised units (--units normalised)")
+      .group("Model in normalised units (--units normalised; --units physical --help lists the physical keys)",
+             "units", "normalised")
       .real("natural_frequency", 1.0, "[normalised] natural frequency ω_n", below(1e12))
       .unit("rad/t")
       .real("drive_amplitude", 0.2, "[normalised] drive Γ (per unit mass)", below(1e12))
@@ -104,7 +105,7 @@ void add_tapping_model_params(io::ParamSet& p) {
             Range::closed(0.0, 1e12))
       .unit("L/t^2")
       // physical units
-      .group("Model in physical units (--units physical)")
+      .group("Model in physical units (--units physical)", "units", "physical")
       .real("spring_constant", 40.0, "[physical] cantilever spring constant k", below(1e6))
       .unit("N/m")
       .real("resonance_frequency", 300.0, "[physical] resonance frequency f0", below(1e7))

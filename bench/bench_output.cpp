@@ -37,10 +37,15 @@ void BM_TableWriter(benchmark::State& state) {
   const long rss_before = peak_rss_kib();
   std::size_t bytes = 0;
   for (auto _ : state) {
-    afmkit::io::TableWriter out(file, {"q", "separation", "amplitude", "offset", "phase", "branch"});
+    afmkit::io::TableWriter out(file, {{"q", "dimensionless", "q"},
+                                       {"separation", "L", "separation"},
+                                       {"amplitude", "L", "amplitude"},
+                                       {"offset", "L", "offset"},
+                                       {"phase", "rad", "phase"},
+                                       {"branch", "label", "branch"}});
     for (long i = 0; i < rows; ++i)
       out.row(value(i, 0), value(i, 1), value(i, 2), value(i, 3), value(i, 4), i % 2 ? "plus" : "minus");
-    out.commit(afmkit::io::make_sidecar("bench", {}));
+    out.commit(afmkit::io::make_sidecar("bench", nlohmann::json::object()));
     bytes = std::filesystem::file_size(file);
   }
   state.SetBytesProcessed(static_cast<std::int64_t>(bytes) * state.iterations());

@@ -159,16 +159,6 @@ nlohmann::json finite_json(nlohmann::json value) {
 
 std::string json_text(const nlohmann::json& value) { return finite_json(value).dump(2); }
 
-namespace {
-std::vector<Column> transitional(const std::vector<std::string>& names) {
-  std::vector<Column> c;
-  for (const auto& n : names) c.push_back({n, "?", "?"});
-  return c;
-}
-}  // namespace
-TableWriter::TableWriter(std::string path, const std::vector<std::string>& names)
-    : TableWriter(std::move(path), transitional(names)) {}
-
 TableWriter::TableWriter(std::string path, std::vector<Column> columns)
     : path_(std::move(path)), columns_(std::move(columns)) {
   if (columns_.empty()) throw std::logic_error("TableWriter: a table needs at least one column");
@@ -232,7 +222,16 @@ TableWriter& TableWriter::cell(bool value) {
 
 TableWriter& TableWriter::cell(std::string_view text) {
   separator();
-  buffer_.append(text);
+  if (text.find_first_of(",\"\r\n") == std::string_view::npos) {
+    buffer_.append(text);
+    return *this;
+  }
+  buffer_.push_back('"');  // RFC 4180: quoted, inner quotes doubled
+  for (const char c : text) {
+    if (c == '"') buffer_.push_back('"');
+    buffer_.push_back(c);
+  }
+  buffer_.push_back('"');
   return *this;
 }
 

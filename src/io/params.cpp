@@ -88,6 +88,36 @@ ParamSet& ParamSet::group(const std::string& name) {
   group_ = name;
   return *this;
 }
+ParamSet& ParamSet::group(const std::string& name, const std::string& when_key, const std::string& when_value) {
+  group_ = name;
+  group_conditions_[name] = {when_key, when_value};
+  return *this;
+}
+
+namespace {
+/// --help formatter that leaves out the groups whose condition (a text option's value) does not hold.
+class ConditionalGroupFormatter : public CLI::Formatter {
+ public:
+  struct Condition {
+    std::string option, value, default_value;
+  };
+  ConditionalGroupFormatter(const CLI::App* app, std::map<std::string, Condition> conditions)
+      : app_(app), conditions_(std::move(conditions)) {}
+  std::string make_group(std::string group, bool is_positional, std::vector<const CLI::Option*> opts) const override {
+    if (const auto it = conditions_.find(group); it != conditions_.end()) {
+      const CLI::Option* opt = app_->get_option_no_throw(it->second.option);
+      const std::string current =
+          opt && !opt->results().empty() ? opt->results().back() : it->second.default_value;
+      if (current != it->second.value) return {};
+    }
+    return CLI::Formatter::make_group(std::move(group), is_positional, std::move(opts));
+  }
+
+ private:
+  const CLI::App* app_;
+  std::map<std::string, Condition> conditions_;
+};
+}  // namespace
 ParamSet& ParamSet::default_text(const std::string& text) {
   if (last_.empty()) throw std::logic_error("ParamSet::default_text before any parameter");
   entries_[last_].default_text = text;
@@ -136,6 +166,14 @@ ParamSet& ParamSet::reals(const std::string& key, std::vector<double> def, const
 }
 
 void ParamSet::add_options(CLI::App& app) {
+  if (!group_conditions_.empty()) {
+    std::map<std::string, ConditionalGroupFormatter::Condition> conditions;
+    for (const auto& [group, condition] : group_conditions_) {
+      const Entry& e = entry(condition.first);
+      conditions[group] = {"--" + dashed(condition.first), condition.second, std::get<std::string>(e.value)};
+    }
+    app.formatter(std::make_shared<ConditionalGroupFormatter>(&app, std::move(conditions)));
+  }
   app.add_option("--config", config_path_, "TOML file with parameters (keys as below, with underscores)")
       ->type_name("FILE");
   for (const auto& key : order_) {
@@ -144,7 +182,7 @@ void ParamSet::add_options(CLI::App& app) {
     std::string type;
     auto shown = [&](const auto& value) { return e.default_text.empty() ? fmt::format("{}", value) : e.default_text; };
     const bool numeric = !std::holds_alternative<std::string>(e.value) && !std::holds_alternative<bool>(e.value);
-    if (numeric && e.unit.empty() && std::getenv("AFMKIT_REQUIRE_UNITS"))  // TRANSITIONAL: always, once all declare units  // every number a user sees carries its unit (docs/units.md)
+    if (numeric && e.unit.empty())  // every number a user sees carries its unit (docs/units.md)
       throw std::logic_error(fmt::format("ParamSet: parameter '{}' is declared without a unit", key));
     std::visit(
         [&](const auto& v) {

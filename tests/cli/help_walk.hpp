@@ -55,7 +55,25 @@ inline std::vector<HelpOption> options_in(const std::string& help) {
   return out;
 }
 
-inline std::vector<HelpOption> options_of(const std::string& command) { return options_in(help_of(command)); }
+/// The --help texts of a command: its plain help, and for a command whose groups depend on the unit system
+/// (the plain help points at `--units physical --help`) the physical one too.
+inline std::vector<std::string> helps_of(const std::string& command) {
+  std::vector<std::string> helps{help_of(command)};
+  if (helps[0].find("--units physical --help") != std::string::npos) helps.push_back(help_of(command + " --units physical"));
+  return helps;
+}
+
+/// Every option of a command (the union over helps_of).
+inline std::vector<HelpOption> options_of(const std::string& command) {
+  std::vector<HelpOption> out;
+  for (const std::string& help : helps_of(command))
+    for (const HelpOption& o : options_in(help)) {
+      bool known = false;
+      for (const HelpOption& k : out) known = known || k.name == o.name;
+      if (!known) out.push_back(o);
+    }
+  return out;
+}
 
 /// Subcommand names listed by `afmkit <prefix> --help`.
 inline std::vector<std::string> subcommands_of(const std::string& prefix) {

@@ -75,7 +75,7 @@ TEST_F(ControlTfCli, SingleOscillatorCsvMatchesEq10) {
 }
 
 TEST_F(ControlTfCli, JsonSummaryHasCriticalBetaAndRejection) {
-  const CliRun r = run("--harmonics 1 --json", dir_);
+  const CliRun r = run("--harmonics 1 --json --output ''", dir_);
   ASSERT_EQ(r.status, 0) << r.err;
   std::ifstream in(dir_ / "stdout.txt");
   const auto j = nlohmann::json::parse(in);

@@ -223,3 +223,16 @@ TEST(JsonConvention, NotDefinedIsNullAndInfiniteIsASignedString) {
   EXPECT_EQ(nlohmann::json(inf).dump(), "null");
   EXPECT_EQ(nlohmann::json::parse(afmkit::io::json_text(in))["b"][1], "inf");
 }
+
+TEST(TableWriter, TextCellsWithCommasOrQuotesAreQuotedAsRfc4180) {
+  const fs::path dir = fresh_dir("quote");
+  {
+    TableWriter out((dir / "t.csv").string(), cols({"name", "x"}));
+    out.row("plain", 1.0);
+    out.row("bank N=10, rejected 1,3", 2.0);
+    out.row("say \"hi\"", 3.0);
+    out.commit(afmkit::io::make_sidecar("test", nlohmann::json::object()));
+  }
+  EXPECT_EQ(slurp(dir / "t.csv"), "name,x\nplain,1\n\"bank N=10, rejected 1,3\",2\n\"say \"\"hi\"\"\",3\n");
+  fs::remove_all(dir);
+}

@@ -37,6 +37,9 @@ struct SimulationOptions {
   int steps_per_period = 2000;   // M: h = T/M (≥ 8, Nyquist M > 2N, AB3 region)
   ControllerStepping stepping = ControllerStepping::AdamsBashforth3;
   int record_every = 1;          // keep every n-th step in the time series (0: no time series)
+  /// Highest harmonic order k in the report (0: the bank's N, or for N = ∞ the highest order of f). Orders above
+  /// N show what the controller does to harmonics it does not model (< M/2).
+  int report_max_order = 0;
 };
 
 /// One harmonic of y over the last period against its analytic steady-state target.
@@ -55,8 +58,11 @@ struct SimulationReport {
   bool delay_exceeds_period = false;               // τ ≥ T somewhere (allowed; the paper assumes τ < T)
   std::complex<double> first_harmonic;             // y_1 over the last period
   double residual_first_harmonic = 0;              // |y_1|
-  std::vector<HarmonicComparison> harmonics;       // k = 0 and every non-rejected k ≤ N (N = ∞: ≤ max order of f)
-  double max_harmonic_error = 0;                   // max over `harmonics`
+  std::vector<HarmonicComparison> harmonics;       // k = 0 … report_max_order except a rejected k = 1 (rejected
+                                                   // k target 0); default up to N (N = ∞: the max order of f)
+  int bank_max_order = 0;                          // N (N = ∞: max order of f): orders the controller models
+  double max_harmonic_error = 0;                   // max over `harmonics` with k ≤ bank_max_order
+  double max_harmonic_error_above = 0;             // max over `harmonics` with k > bank_max_order (NaN: none)
   std::complex<double> control_first_harmonic;     // u_1 (expected −γ f_1 when only k = 1 is rejected)
   std::vector<double> envelope;                    // |y_1| of each complete period
   double growth_rate = 0;                          // fitted slope of ln envelope [1/s] (NaN if undetermined)
@@ -87,6 +93,7 @@ using SampleSink = std::function<void(const TimeSample&)>;
 class ClosedLoopSimulation {
  public:
   /// Validates (InvalidParameter naming the parameter and the allowed range): periods ≥ 1;
+  /// 0 ≤ report_max_order < steps_per_period/2;
   /// steps_per_period ≥ 8 and > 2·(highest harmonic of the controller and of f) (Nyquist); record_every ≥ 0;
   /// AB3: h·λ inside the AB3 stability region for every eigenvalue λ of the controller's state matrix (growing
   /// modes are mirrored, −λ̄); N = ∞: AB3 only, α > 0 (|B4/A4| < 1), controller Ω = plant Ω.

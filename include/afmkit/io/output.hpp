@@ -36,7 +36,8 @@ nlohmann::json finite_json(nlohmann::json value);
 std::string json_text(const nlohmann::json& value);
 
 /// Streams a column-named CSV table to `path` atomically. Cells are numbers (shortest round-trip text),
-/// integers, strings or booleans (0/1). Usage:
+/// integers, strings or booleans (0/1); a string holding a comma, a double quote or a line break is quoted as in
+/// RFC 4180 ("a,b" -> "\"a,b\"", a quote doubled). Usage:
 ///   TableWriter out(path, {{"separation", "nm", "separation l"}, {"amplitude", "nm", "amplitude A"}});
 ///   for (...) out.row(l, B);
 ///   out.commit(make_sidecar(...));     // rename into place, then write the sidecar (with "columns" added)
@@ -46,8 +47,6 @@ class TableWriter {
   /// Opens `<path>.tmp.<pid>` (creating parent folders). Throws afmkit::InputError when that is impossible, and
   /// std::logic_error when a column has an empty name, unit or description (a programming error).
   TableWriter(std::string path, std::vector<Column> columns);
-  /// TRANSITIONAL (removed before this change lands): columns without units.
-  TableWriter(std::string path, const std::vector<std::string>& names);
   ~TableWriter();
   TableWriter(const TableWriter&) = delete;
   TableWriter& operator=(const TableWriter&) = delete;

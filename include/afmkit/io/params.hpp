@@ -49,6 +49,10 @@ class ParamSet {
   /// Parameters declared after this call are listed under `name` in --help (model, drive, contact law, numerics,
   /// output, …); before any call: "Options".
   ParamSet& group(const std::string& name);
+  /// A group that applies only when the text parameter `when_key` has the value `when_value` (e.g. the physical
+  /// model keys when units = physical): --help lists it only then (judged from the flags given with --help, else
+  /// the default); its keys are still accepted (the command decides whether they conflict).
+  ParamSet& group(const std::string& name, const std::string& when_key, const std::string& when_value);
   /// What --help shows as the default of the last declared parameter when it is not a fixed value ("automatic",
   /// "= plant_rate", …); the declared default stays the value used when nothing else applies.
   ParamSet& default_text(const std::string& text);
@@ -107,6 +111,7 @@ class ParamSet {
   std::string config_path_;
   std::string group_ = "Options";
   std::string last_;  // the parameter default_text() and unit() apply to
+  std::map<std::string, std::pair<std::string, std::string>> group_conditions_;  // group -> (key, value)
   void declare(const std::string& key, Entry e);
   static Entry make_entry(Value value, const std::string& help, Range range);
 };

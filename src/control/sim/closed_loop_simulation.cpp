@@ -276,6 +276,11 @@ ClosedLoopSimulation::ClosedLoopSimulation(Plant plant, Bank controller, Simulat
                                          static_cast<long>(std::ceil(static_cast<double>(o.periods) *
                                                                      o.steps_per_period / 5e7))));
   }
+  if (o.report_max_order < 0 || 2L * o.report_max_order >= o.steps_per_period)
+    throw InvalidParameter("report_max_order",
+                           fmt::format("report_max_order = {} is out of range: must be an integer in [0, {}] (below "
+                                       "half of steps_per_period = {})",
+                                       o.report_max_order, (o.steps_per_period - 1) / 2, o.steps_per_period));
   const bool infinite = std::holds_alternative<InfiniteBank>(controller_);
   int highest = max_disturbance_order(plant_.disturbance);
   if (!infinite) highest = std::max(highest, std::get<OscillatorBank>(controller_).harmonics());
@@ -356,24 +361,29 @@ SimulationResult ClosedLoopSimulation::run(const SimulationProgress& progress, c
     rep.first_harmonic = {nan, nan};
     rep.residual_first_harmonic = std::numeric_limits<double>::infinity();
     rep.max_harmonic_error = std::numeric_limits<double>::infinity();
+    rep.max_harmonic_error_above = std::numeric_limits<double>::infinity();
     rep.control_first_harmonic = {nan, nan};
     return res;
   }
-  int kmax = std::max(max_disturbance_order(plant_.disturbance), 1);
-  if (const auto* ob = std::get_if<OscillatorBank>(&controller_)) kmax = ob->harmonics();
+  int bank_order = std::max(max_disturbance_order(plant_.disturbance), 1);
+  if (const auto* ob = std::get_if<OscillatorBank>(&controller_)) bank_order = ob->harmonics();
+  rep.bank_max_order = bank_order;
+  const int kmax = std::max(options_.report_max_order > 0 ? options_.report_max_order : bank_order, 1);
   const auto cy = fourier_coefficients(last.y, kmax);
   rep.first_harmonic = cy[1];
   rep.residual_first_harmonic = std::abs(cy[1]);
   rep.control_first_harmonic = fourier_coefficients(last.u, 1)[1];
   const bool first_rejected = std::find(rej.begin(), rej.end(), 1) != rej.end();
   rep.max_harmonic_error = 0.0;
+  rep.max_harmonic_error_above = kmax > bank_order ? 0.0 : std::numeric_limits<double>::quiet_NaN();
   for (int k = 0; k <= kmax; ++k) {
     if (k == 1 && first_rejected) continue;
     const bool is_rej = std::find(rej.begin(), rej.end(), k) != rej.end();
     const std::complex<double> target = is_rej ? 0.0 : uncontrolled_harmonic(plant_, k);
     const double err = std::abs(cy[k] - target);
     rep.harmonics.push_back({k, cy[k], target, err});
-    rep.max_harmonic_error = std::max(rep.max_harmonic_error, err);
+    double& worst = k <= bank_order ? rep.max_harmonic_error : rep.max_harmonic_error_above;
+    worst = std::max(worst, err);
   }
   return res;
 }

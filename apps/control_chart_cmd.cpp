@@ -1,0 +1,245 @@
+// afmkit control chart: stability charts of the seed-2 loop in the coupling plane (paper Figs. 2, 4) at one delay or
+// several (`delays`: one chart per delay in the same table, column `delay`), with the exact D-subdivision
+// boundaries in a second table; or (quantity = margin) the delay-margin map τ_c(x, y). Units: control_params.hpp
+// (couplings, abscissa and frequencies in units of Ω, delays in units of T).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/control/stability_chart.hpp"
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/progress.hpp"
+#include "command.hpp"
+#include "control_analysis.hpp"
+#include "control_params.hpp"
+
+namespace afmkit::cli {
+
+namespace {
+using io::Range;
+
+// The settings at each delay of the run: `delays` when given (validated entry by entry, naming `delays`), else
+// `delay`.
+std::vector<control::ControlSettings> settings_per_delay(const io::ParamSet& p, const control::ControlSettings& c) {
+  if (p.reals("delays").empty()) return {c};
+  if (p.text("quantity") == "margin" && p.reals("delays").size() > 1)
+    throw InvalidParameter("delays", fmt::format("delays has {} entries: must have one with quantity = margin (the "
+                                                 "delay-margin map does not depend on the delay)",
+                                                 p.reals("delays").size()));
+  std::vector<control::ControlSettings> out;
+  for (double d : p.reals("delays")) {
+    control::ControlSettings at = c;
+    at.delay = d;
+    try {
+      at.validate();
+    } catch (const InvalidParameter& e) {
+      if (e.parameter() != "delay") throw;
+      throw InvalidParameter("delays", fmt::format("delays contains {}: {}", d, e.what()));
+    }
+    out.push_back(at);
+  }
+  return out;
+}
+
+// Description of the x or y column: the coupling of the family's chart plane.
+std::string axis_text(const control::LoopFamily& f, char axis) {
+  const bool single = f.kind == control::LoopFamily::Kind::SingleOscillator;
+  if (axis == 'x') return single ? "coupling a (eq. 5) of the grid point" : "coupling alpha (eq. 20) of the grid point";
+  return single ? "coupling b (eq. 5) of the grid point" : "coupling beta (eq. 20) of the grid point";
+}
+
+void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, const Window& win) {
+  const control::RotationUnits u = c.units();
+  const control::LoopFamily family = control::LoopFamily::from_loop(control::loop_from(c));
+  const int nx = static_cast<int>(p.integer("x_points")), ny = static_cast<int>(p.integer("y_points"));
+  const io::ParamSet as_run = params_as_run(p, c, window_values(win));
+  CommandOutput out(as_run, "control chart --quantity margin");
+  require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * (out.writes_file() ? 64.0 : 320.0));
+  out.open({{"x", "Omega", axis_text(family, 'x')},
+            {"y", "Omega", axis_text(family, 'y')},
+            {"critical_delay", "T", "delay margin tau_c (inf: no crossing, nan: unstable at tau = 0)"},
+            {"crossing_frequency", "Omega", "crossing frequency nu at tau_c"}});
+  io::Progress progress("control chart (grid points)", static_cast<long>(nx) * ny, p.flag("progress"));
+  const control::MarginMap m =
+      control::delay_margin_map(family, u.rate(win.x_min), u.rate(win.x_max), nx, u.rate(win.y_min), u.rate(win.y_max),
+                                ny, static_cast<int>(p.integer("threads")),
+                                [&progress](long n, long) { progress.advance(n); });
+  progress.finish();
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j) * nx + i;
+      out.row(u.in_omega(m.x[i]), u.in_omega(m.y[j]), u.in_periods(m.critical_delay[k]),
+              u.in_omega(m.crossing_frequency[k]));
+    }
+  nlohmann::json res;
+  res["family"] = describe_family(family);
+  res["x"] = family.x_name();
+  res["y"] = family.y_name();
+  res["window"] = window_json(win);
+  res["x_points"] = nx;
+  res["y_points"] = ny;
+  res["settings"] = settings_json(c);
+  res["settings_si"] = settings_si_json(c);
+  out.finish(res, fmt::format("the {}x{} delay-margin map", nx, ny));
+}
+
+void run_chart(const io::ParamSet& p) {
+  const control::ControlSettings c = control_settings_from(p);
+  const std::vector<control::ControlSettings> runs = settings_per_delay(p, c);
+  const control::LoopFamily first = control::LoopFamily::from_loop(control::loop_from(runs.front()));
+  const Window win = window_from(p, first, {-0.5, 2.0, -2.0, 1.5}, {-0.1, 1.0, -0.4, 1.0});
+  if (p.text("quantity") == "margin") return run_margin_map(p, runs.front(), win);
+  const control::RotationUnits u = c.units();
+  const int nx = static_cast<int>(p.integer("x_points")), ny = static_cast<int>(p.integer("y_points"));
+  std::vector<std::pair<std::string, double>> values = window_values(win);
+  io::ParamSet as_run = params_as_run(p, c, values);
+  std::string delays_text;
+  for (const auto& r : runs) delays_text += fmt::format("{}{}", delays_text.empty() ? "" : ",", r.delay);
+  as_run.set_from_string("delays", delays_text);
+  CommandOutput out(as_run, "control chart");
+  const bool json = p.flag("json");
+  const std::string bout = p.text("boundaries_output");
+  // memory of one chart (values, counts, labels and the tracked roots of each point), and of the rows --json keeps
+  require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * 64.0);
+  if (json && !out.writes_file())
+    require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * 320.0 * runs.size());
+  const std::vector<io::Column> boundary_columns = {
+      {"curve", "label", "polyline id (within its delay)"},
+      {"frequency", "Omega", "crossing frequency nu of the imaginary-axis roots on the curve (0: root at s = 0)"},
+      {"x", "Omega", axis_text(first, 'x')},
+      {"y", "Omega", axis_text(first, 'y')},
+      {"delay", "T", "measurement delay tau of the chart"}};
+  std::optional<io::TableWriter> boundaries;
+  if (!bout.empty()) boundaries.emplace(bout, boundary_columns);
+  nlohmann::json boundary_rows = nlohmann::json::array();  // --json without a boundaries file
+  out.open({{"x", "Omega", axis_text(first, 'x')},
+            {"y", "Omega", axis_text(first, 'y')},
+            {"spectral_abscissa", "Omega", "largest real part of the closed-loop roots (= -decay rate)"},
+            {"unstable_roots", "count",
+             "roots with Re s > 0 (region label, argument-principle count; -1: infinitely many)"},
+            {"region", "label", "region id (connected set of grid points with equal counts, within its delay)"},
+            {"delay", "T", "measurement delay tau of the chart"}});
+  io::Progress progress("control chart (grid points)", static_cast<long>(nx) * ny * static_cast<long>(runs.size()),
+                        p.flag("progress"));
+  nlohmann::json charts = nlohmann::json::array();
+  long curves = 0;
+  for (const control::ControlSettings& at : runs) {
+    const control::LoopSpec loop = control::loop_from(at);
+    control::ChartSpec spec;
+    spec.family = control::LoopFamily::from_loop(loop);
+    spec.x_min = u.rate(win.x_min);
+    spec.x_max = u.rate(win.x_max);
+    spec.y_min = u.rate(win.y_min);
+    spec.y_max = u.rate(win.y_max);
+    spec.x_points = nx;
+    spec.y_points = ny;
+    spec.threads = static_cast<int>(p.integer("threads"));
+    const control::StabilityChart chart =
+        control::stability_chart(spec, [&progress](long n, long) { progress.advance(n); });
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const std::size_t k = static_cast<std::size_t>(j) * nx + i;
+        out.row(u.in_omega(chart.x[i]), u.in_omega(chart.y[j]), u.in_omega(chart.abscissa[k]),
+                static_cast<long>(chart.unstable_roots[k]), static_cast<long>(chart.region[k]), at.delay);
+      }
+    for (std::size_t ci = 0; ci < chart.boundaries.size(); ++ci)
+      for (const auto& q : chart.boundaries[ci]) {
+        if (boundaries)
+          boundaries->row(static_cast<long>(ci), u.in_omega(q.frequency), u.in_omega(q.x), u.in_omega(q.y), at.delay);
+        else if (json)
+          boundary_rows.push_back({static_cast<long>(ci), u.in_omega(q.frequency), u.in_omega(q.x), u.in_omega(q.y),
+                                   at.delay});
+      }
+    curves += static_cast<long>(chart.boundaries.size());
+    nlohmann::json regions = nlohmann::json::array();
+    for (const auto& r : chart.regions)
+      regions.push_back({{"id", r.id}, {"unstable_roots", r.unstable_roots}, {"tracked_roots", r.tracked_roots},
+                         {"points", r.points}, {"x", u.in_omega(r.x)}, {"y", u.in_omega(r.y)},
+                         {"certified", r.certified}});
+    charts.push_back({{"delay", at.delay},
+                      {"family", describe_family(spec.family)},
+                      {"delay_exceeds_period", loop.delay >= loop.period()},
+                      {"regions", regions},
+                      {"boundary_curves", chart.boundaries.size()},
+                      {"mismatched_points", chart.mismatched_points},
+                      {"recomputed_points", chart.recomputed_points},
+                      {"lower_bound_points", chart.lower_bound_points}});
+  }
+  progress.finish();
+  nlohmann::json res;
+  res["x"] = first.x_name();
+  res["y"] = first.y_name();
+  res["window"] = window_json(win);
+  res["x_points"] = nx;
+  res["y_points"] = ny;
+  res["delays"] = nlohmann::json::array();
+  for (const auto& at : runs) res["delays"].push_back(at.delay);
+  res["charts"] = charts;
+  res["boundaries_file"] = bout;
+  res["settings"] = settings_json(c);
+  res["settings_si"] = settings_si_json(c);
+  res["units"] = {{"window", "Omega"}, {"delays", "T"},
+                  {"charts", {{"delay", "T"}, {"regions", {{"x", "Omega"}, {"y", "Omega"}, {"points", "count"},
+                                                           {"unstable_roots", "count"}, {"tracked_roots", "count"}}}}}};
+  if (boundaries) {
+    nlohmann::json bres;
+    bres["x"] = first.x_name();
+    bres["y"] = first.y_name();
+    bres["window"] = window_json(win);
+    bres["delays"] = res["delays"];
+    bres["grid_file"] = out.path();
+    boundaries->commit(io::make_sidecar("control chart (D-subdivision boundaries)", as_run, bres));
+  } else if (json) {
+    res["boundaries"] = {{"columns", io::columns_json(boundary_columns)}, {"rows", boundary_rows}};
+  }
+  out.finish(res, fmt::format("{} {}x{} chart{} ({} boundary curves{})", runs.size(), nx, ny, runs.size() > 1 ? "s" : "",
+                              curves, bout.empty() ? "" : " in " + bout));
+}
+
+}  // namespace
+
+void add_control_chart(CLI::App& control) {
+  add_command(
+      control, "chart",
+      "stability chart in the coupling plane (a, b) or (alpha, beta): spectral abscissa grid, certified region "
+      "labels, exact D-subdivision boundaries (paper Figs. 2, 4), at one delay or several (delays). Cost: O(N) per "
+      "Newton step of each tracked root per grid point, O(N^2) per fresh spectrum and per certified region",
+      [](io::ParamSet& p) {
+        add_control_params(p);
+        p.group("Chart")
+            .text("quantity", "abscissa", "abscissa: spectral abscissa + unstable roots; margin: tau_c map",
+                  {"abscissa", "margin"})
+            .reals("delays", {}, "several delays: one chart per delay in the same table (column delay), boundaries "
+                                 "likewise; replaces delay", Range::non_negative())
+            .unit("T")
+            .default_text("= delay")
+            .real("x_min", 0.0, "a or alpha lower bound")
+            .unit("Omega")
+            .default_text("-0.5 single, -0.1 otherwise")
+            .real("x_max", 1.0, "a or alpha upper bound")
+            .unit("Omega")
+            .default_text("2 single, 1 otherwise")
+            .real("y_min", 0.0, "b or beta lower bound")
+            .unit("Omega")
+            .default_text("-2 single, -0.4 otherwise")
+            .real("y_max", 1.0, "b or beta upper bound")
+            .unit("Omega")
+            .default_text("1.5 single, 1 otherwise")
+            .integer("x_points", 200, "grid points along x", 2, 100000)
+            .integer("y_points", 200, "grid points along y", 2, 100000)
+            .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024);
+        add_output_params(p, "out/control_chart.csv", "grid");
+        p.flag("progress", true, "show progress on stderr")
+            .file("boundaries_output", "out/control_chart_boundaries.csv",
+                  "boundary curves CSV path (JSON sidecar next to it); empty: no file (with --json: in the printed "
+                  "document)");
+      },
+      run_chart);
+}
+
+}  // namespace afmkit::cli

@@ -1,0 +1,131 @@
+// afmkit control tune: robust couplings of the seed-2 loop: maximise the worst-case decay rate over a delay range
+// and a gain-error range (tuning.hpp). Units: control_params.hpp (couplings and decay rates in units of Ω, delays
+// in units of T, gain ratios dimensionless).
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/control/tuning.hpp"
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/progress.hpp"
+#include "command.hpp"
+#include "control_analysis.hpp"
+#include "control_params.hpp"
+
+namespace afmkit::cli {
+
+namespace {
+using io::Range;
+
+void run_tune(const io::ParamSet& p) {
+  const control::ControlSettings c = control_settings_from(p);
+  const control::LoopSpec loop = control::loop_from(c);
+  const control::RotationUnits u = c.units();
+  control::RobustTuningSpec s;
+  s.family = control::LoopFamily::from_loop(loop);
+  const Window win = window_from(p, s.family, {0.01, 2.0, -2.0, 0.9}, {0.01, 0.6, -0.24, 0.3});
+  s.x_min = u.rate(win.x_min);
+  s.x_max = u.rate(win.x_max);
+  s.y_min = u.rate(win.y_min);
+  s.y_max = u.rate(win.y_max);
+  s.delay_max = u.delay(p.real("delay_max"));
+  s.delay_points = static_cast<int>(p.integer("delay_points"));
+  s.gain_ratio_min = p.real("gain_ratio_min");
+  s.gain_ratio_max = p.real("gain_ratio_max");
+  if (s.gain_ratio_max < s.gain_ratio_min)
+    throw InvalidParameter("gain_ratio_max", fmt::format("gain_ratio_max = {} is out of range: must be >= "
+                                                         "gain_ratio_min = {}", s.gain_ratio_max, s.gain_ratio_min));
+  s.gain_points = static_cast<int>(p.integer("gain_points"));
+  s.coarse_points = static_cast<int>(p.integer("coarse_points"));
+  s.max_evaluations = static_cast<int>(p.integer("max_evaluations"));
+  s.threads = static_cast<int>(p.integer("threads"));
+  const io::ParamSet as_run = params_as_run(p, c, window_values(win));
+  CommandOutput out(as_run, "control tune");
+  require_memory("coarse_points", static_cast<double>(s.coarse_points),
+                 s.coarse_points * (out.writes_file() ? 32.0 : 256.0));
+  out.open({{"x", "Omega", std::string(s.family.x_name()) + " of the coarse grid point"},
+            {"y", "Omega", std::string(s.family.y_name()) + " of the coarse grid point"},
+            {"worst_decay_rate", "Omega",
+             "objective: smallest decay rate -max Re s over the delays and gain ratios (tracked spectra)"}});
+  io::Progress progress("control tune (objective evaluations)",
+                        static_cast<long>(s.coarse_points) * s.coarse_points + s.max_evaluations, p.flag("progress"));
+  const control::RobustTuning r = control::robust_tuning(s, [&progress](long n, long) { progress.advance(n); });
+  progress.finish();
+  const int n = s.coarse_points;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      out.row(u.in_omega(r.coarse_x[i]), u.in_omega(r.coarse_y[j]),
+              u.in_omega(r.coarse_worst_decay[static_cast<std::size_t>(j) * n + i]));
+  nlohmann::json res;
+  res["family"] = describe_family(s.family);
+  res["x"] = s.family.x_name();
+  res["y"] = s.family.y_name();
+  res["optimum"] = {{s.family.x_name(), u.in_omega(r.x)}, {s.family.y_name(), u.in_omega(r.y)}};
+  res["worst_decay_rate"] = u.in_omega(r.worst_decay);
+  res["certified_worst_decay_rate"] = u.in_omega(r.certified_worst_decay);
+  res["worst_delay"] = u.in_periods(r.worst_delay);
+  res["worst_gain_ratio"] = r.worst_gain_ratio;
+  nlohmann::json ms = nlohmann::json::array();
+  for (const auto& m : r.margins)
+    ms.push_back({{"gain_ratio", m.gain_ratio}, {"critical_delay", u.in_periods(m.critical_delay)},
+                  {"crossing_frequency", u.in_omega(m.crossing_frequency)}});
+  res["margins"] = ms;
+  res["window"] = window_json(win);
+  res["evaluations"] = r.evaluations;
+  res["converged"] = r.converged;
+  res["objective"] = "max over (x, y) of min over tau in [0, delay_max], rho in [gain_ratio_min, gain_ratio_max] "
+                     "of the decay rate -max Re s";
+  res["settings"] = settings_json(c);
+  res["settings_si"] = settings_si_json(c);
+  res["units"] = {{"optimum", "Omega"}, {"worst_decay_rate", "Omega"}, {"certified_worst_decay_rate", "Omega"},
+                  {"worst_delay", "T"}, {"worst_gain_ratio", "dimensionless"}, {"window", "Omega"},
+                  {"evaluations", "count"},
+                  {"margins", {{"gain_ratio", "dimensionless"}, {"critical_delay", "T"}, {"crossing_frequency", "Omega"}}}};
+  out.finish(res, fmt::format("robust optimum {} = {:.5g} Omega, {} = {:.5g} Omega: worst-case decay rate {:.5g} Omega "
+                              "(certified {:.5g})",
+                              s.family.x_name(), u.in_omega(r.x), s.family.y_name(), u.in_omega(r.y),
+                              u.in_omega(r.worst_decay), u.in_omega(r.certified_worst_decay)));
+}
+
+}  // namespace
+
+void add_control_tune(CLI::App& control) {
+  add_command(
+      control, "tune",
+      "robust couplings: maximise the worst-case decay rate over delays [0, delay_max] and gain errors "
+      "rho = K/gamma in [gain_ratio_min, gain_ratio_max] (coarse grid + Nelder-Mead). Cost: per objective evaluation "
+      "O(N^2) per gain ratio (fresh spectrum) plus O(N) per tracked-root Newton step",
+      [](io::ParamSet& p) {
+        add_control_params(p);
+        p.group("Tuning")
+            .real("delay_max", 0.25, "largest delay", Range::non_negative())
+            .unit("T")
+            .integer("delay_points", 6, "delay grid points on [0, delay_max]", 1, 10000)
+            .real("gain_ratio_min", 0.5, "smallest rho = K/gamma", Range::positive())
+            .unit("dimensionless")
+            .real("gain_ratio_max", 2.0, "largest rho = K/gamma", Range::positive())
+            .unit("dimensionless")
+            .integer("gain_points", 3, "rho grid points (geometric)", 1, 10000)
+            .real("x_min", 0.01, "a or alpha lower bound")
+            .unit("Omega")
+            .real("x_max", 0.6, "a or alpha upper bound")
+            .unit("Omega")
+            .default_text("2 single, 0.6 otherwise")
+            .real("y_min", -0.24, "b or beta lower bound")
+            .unit("Omega")
+            .default_text("-2 single, -0.24 otherwise")
+            .real("y_max", 0.3, "b or beta upper bound")
+            .unit("Omega")
+            .default_text("0.9 single, 0.3 otherwise")
+            .integer("coarse_points", 12, "coarse grid points per axis", 2, 10000)
+            .integer("max_evaluations", 150, "Nelder-Mead budget", 0, 1000000)
+            .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024);
+        add_output_params(p, "out/control_tune.csv", "coarse-grid");
+        p.flag("progress", true, "show progress on stderr");
+      },
+      run_tune);
+}
+
+}  // namespace afmkit::cli
