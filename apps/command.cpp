@@ -20,6 +20,12 @@ CLI::App& add_command(CLI::App& parent, const std::string& name, const std::stri
   return *cmd;
 }
 
+CLI::App& add_command_group(CLI::App& parent, const std::string& name, const std::string& help) {
+  CLI::App* group = parent.add_subcommand(name, help);
+  group->require_subcommand(1);
+  return *group;
+}
+
 void add_output_params(io::ParamSet& p, const std::string& default_path, const std::string& what) {
   p.group("Output")
       .flag("json", false, "print the results as JSON to standard output instead of a summary line (with the table "

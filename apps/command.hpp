@@ -33,6 +33,9 @@ using Run = std::function<void(const io::ParamSet&)>;
 CLI::App& add_command(CLI::App& parent, const std::string& name, const std::string& help, const Declare& declare,
                       Run run);
 
+/// Adds a group of subcommands (`afmkit tapping …`, `afmkit control …`): one of them must be given.
+CLI::App& add_command_group(CLI::App& parent, const std::string& name, const std::string& help);
+
 /// The "Output" group every table command has: `output` (CSV path, default `default_path`; empty: no file) and
 /// the `json` flag.
 void add_output_params(io::ParamSet& p, const std::string& default_path, const std::string& what);
