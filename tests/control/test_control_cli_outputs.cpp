@@ -20,24 +20,18 @@
 
 #include <nlohmann/json.hpp>
 
+#include "control_cli_fixture.hpp"
+
 #include "afmkit/control/loop.hpp"
 #include "afmkit/control/settings.hpp"
 
 namespace {
 namespace fs = std::filesystem;
+using afmkit_test::CliResult;
+using afmkit_test::slurp;
 using nlohmann::json;
 
-struct CliResult {
-  int status;
-  std::string out, err;
-};
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // A CSV with a header: column name -> values (numbers; text cells as NaN).
 std::map<std::string, std::vector<double>> read_csv(const fs::path& p) {
@@ -59,36 +53,13 @@ std::map<std::string, std::vector<double>> read_csv(const fs::path& p) {
   return t;
 }
 
-class ControlCliOutputs : public ::testing::Test {
+class ControlCliOutputs : public afmkit_test::ControlCliFixture {
  protected:
-  void SetUp() override {
-    if (!fs::exists(AFMKIT_CLI)) GTEST_SKIP() << "afmkit CLI not built: " << AFMKIT_CLI;
-    dir_ = fs::temp_directory_path() / ("afmkit_control_outputs_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    if (!dir_.empty()) fs::remove_all(dir_, ec);
-  }
-  CliResult run(const std::string& args) const {
-    const std::string cmd = "cd '" + dir_.string() + "' && '" + std::string(AFMKIT_CLI) + "' " + args +
-                            " > stdout.txt 2> stderr.txt";
-    const int raw = std::system(cmd.c_str());
-    return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir_ / "stdout.txt"), slurp(dir_ / "stderr.txt")};
-  }
   json run_json(const std::string& args) const {
     const CliResult r = run(args);
     EXPECT_EQ(r.status, 0) << args << "\n" << r.err;
     return r.status == 0 ? json::parse(r.out) : json();
   }
-  int files() const {
-    int n = 0;
-    for (auto& e : fs::recursive_directory_iterator(dir_))
-      if (e.is_regular_file() && e.path().filename() != "stdout.txt" && e.path().filename() != "stderr.txt") ++n;
-    return n;
-  }
-  fs::path dir_;
 };
 
 // Small runs of every control command that computes a table.

@@ -18,49 +18,19 @@
 
 #include <nlohmann/json.hpp>
 
+#include "control_cli_fixture.hpp"
+
 #include "test_helpers.hpp"
 
 namespace {
 namespace fs = std::filesystem;
+using afmkit_test::CliResult;
+using afmkit_test::slurp;
 
-struct CliResult {
-  int status;
-  std::string out, err;
-};
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
-class ControlCliSizes : public ::testing::Test {
+class ControlCliSizes : public afmkit_test::ControlCliFixture {
  protected:
-  void SetUp() override {
-    if (!fs::exists(AFMKIT_CLI)) GTEST_SKIP() << "afmkit CLI not built: " << AFMKIT_CLI;
-    dir_ = fs::temp_directory_path() / ("afmkit_control_sizes_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    if (!dir_.empty()) fs::remove_all(dir_, ec);
-  }
-  CliResult run(const std::string& args) const {
-    const std::string cmd = "cd '" + dir_.string() + "' && '" + std::string(AFMKIT_CLI) + "' " + args +
-                            " > stdout.txt 2> stderr.txt";
-    const int raw = std::system(cmd.c_str());
-    return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir_ / "stdout.txt"), slurp(dir_ / "stderr.txt")};
-  }
-  // files written other than the captured streams
-  int outputs() const {
-    int n = 0;
-    for (auto& e : fs::recursive_directory_iterator(dir_))
-      if (e.is_regular_file() && e.path().filename() != "stdout.txt" && e.path().filename() != "stderr.txt") ++n;
-    return n;
-  }
-  fs::path dir_;
 };
 
 // ---- every command answers at N = 1000 (defect 1) ------------------------------------------------------------
