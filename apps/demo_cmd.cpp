@@ -131,7 +131,6 @@ void register_demo(CLI::App& app) {
         p.set_default("approach_adhesion", fmt::format("{}", demo_approach_adhesion));
         p.set_default("departure_adhesion", fmt::format("{}", demo_departure_adhesion));
         p.set_default("frequency_ratio", "0.99");
-        p.default_text("0.99");
         p.group("Sweep")
             .real("separation_min", demo_separation_min, "smallest separation of the sweep", io::Range::any())
             .unit(kLengthUnit)

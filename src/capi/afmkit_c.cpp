@@ -179,10 +179,13 @@ afmkit_filter* afmkit_filter_create_general(double sample_rate, double rotation_
                                             const double* a, const double* b, double gain, const int* rejected,
                                             size_t rejected_count, int form, char* error, size_t error_size) {
   return create(error, error_size, [&] {
-    if (harmonics < 1 || harmonics > RealtimeFilter::kMaxHarmonicsBlock)  // before reading a[], b[]; per form below
+    const SampledForm sampled = form_from(form);
+    const int max_n = sampled == SampledForm::BlockZeroOrderHold ? RealtimeFilter::kMaxHarmonicsBlock
+                                                                 : RealtimeFilter::kMaxHarmonics;
+    if (harmonics < 1 || harmonics > max_n)  // before reading a[], b[]
       throw afmkit::InvalidParameter("harmonics", "harmonics = " + std::to_string(harmonics) +
                                                       " is out of range: must be an integer in [1, " +
-                                                      std::to_string(RealtimeFilter::kMaxHarmonicsBlock) + "]");
+                                                      std::to_string(max_n) + "] for this form");
     if (!a || !b) throw afmkit::InvalidParameter(!a ? "a" : "b", "a and b must point to `harmonics` doubles each");
     std::vector<double> av(a, a + harmonics), bv(b, b + harmonics);
     std::vector<int> rej{1};
@@ -193,7 +196,7 @@ afmkit_filter* afmkit_filter_create_general(double sample_rate, double rotation_
       rej.assign(rejected, rejected + rejected_count);
     }
     return RealtimeFilter(OscillatorBank(rotation_frequency, a0, std::move(av), std::move(bv), gain, std::move(rej)),
-                          sample_rate, form_from(form));
+                          sample_rate, sampled);
   });
 }
 

@@ -3,13 +3,16 @@
 #   2. checks the installed layout and compiles one file that includes every installed header against the
 #      prefix only (a public header that includes a private src/ header or a missing file fails here);
 #   3. configures, builds and runs every examples/<name>/ (a standalone project that does find_package(afmkit)
-#      and builds the program <name>) against the prefix, and checks it exits with 0 and prints a final "ok";
-#   4. compiles and runs examples/delay_margin/delay_margin.cpp with `pkg-config --cflags --libs afmkit` only
-#      (skipped with a message when pkg-config is not installed).
+#      and builds the program <name>; C++ or C, as its project() says) against the prefix, and checks it exits
+#      with 0 and prints a final "ok";
+#   4. compiles and runs examples/delay_margin/delay_margin.cpp with `pkg-config --cflags --libs afmkit` only, and
+#      examples/filter_c/filter_c.c (C99) with `pkg-config --cflags --libs afmkit_c` only (skipped with a message
+#      when pkg-config is not installed).
 # The prefix is removed on success and kept (its path printed) on failure.
 #
-#   cmake -DSOURCE=<source dir> -DBINARY=<build dir> [-DCONFIG=Release] [-DCXX=<compiler>] [-DGENERATOR=<gen>]
-#         [-DEXTRA_FLAGS=<compile and link flags, e.g. sanitizers>] -P tests/install/install_and_build_examples.cmake
+#   cmake -DSOURCE=<source dir> -DBINARY=<build dir> [-DCONFIG=Release] [-DCXX=<C++ compiler>] [-DCC=<C compiler>]
+#         [-DGENERATOR=<gen>] [-DEXTRA_FLAGS=<compile and link flags, e.g. sanitizers>]
+#         -P tests/install/install_and_build_examples.cmake
 cmake_minimum_required(VERSION 3.20)
 
 foreach(_v SOURCE BINARY)
@@ -45,18 +48,30 @@ function(run what out_var)
   set(${out_var} "${_out}" PARENT_SCOPE)
 endfunction()
 
-# Configures and builds the CMake project in `src` against the prefix, in ${WORK}/<name>.
+# Configures and builds the CMake project in `src` against the prefix, in ${WORK}/<name>. The compilers and flags
+# are given for the languages its project() enables (CXX when it names none).
 function(build_against_prefix name src)
   set(_args -S "${src}" -B "${WORK}/${name}" "-DCMAKE_PREFIX_PATH=${PREFIX}" "-DCMAKE_BUILD_TYPE=${CONFIG}"
             "-DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF")
+  file(READ "${src}/CMakeLists.txt" _cml)
+  set(_languages CXX)
+  if(_cml MATCHES "project\\([^)]*LANGUAGES([^)]*)\\)")
+    string(REGEX MATCHALL "[A-Z]+" _languages "${CMAKE_MATCH_1}")
+  endif()
   if(GENERATOR)
     list(APPEND _args -G "${GENERATOR}")
   endif()
-  if(CXX)
+  if(CXX AND "CXX" IN_LIST _languages)
     list(APPEND _args "-DCMAKE_CXX_COMPILER=${CXX}")
   endif()
+  if(CC AND "C" IN_LIST _languages)
+    list(APPEND _args "-DCMAKE_C_COMPILER=${CC}")
+  endif()
   if(EXTRA_FLAGS)
-    list(APPEND _args "-DCMAKE_CXX_FLAGS=${EXTRA_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${EXTRA_FLAGS}")
+    foreach(_lang ${_languages})
+      list(APPEND _args "-DCMAKE_${_lang}_FLAGS=${EXTRA_FLAGS}")
+    endforeach()
+    list(APPEND _args "-DCMAKE_EXE_LINKER_FLAGS=${EXTRA_FLAGS}")
   endif()
   run("configure ${name}" _out ${CMAKE_COMMAND} ${_args})
   # find_package must have found the fresh prefix, not another installed afmkit.
@@ -123,6 +138,16 @@ foreach(_f "${PREFIX}/bin/afmkit" "${PREFIX}/include/afmkit/core/version.hpp" "$
     message(FATAL_ERROR "install_and_build_examples: not installed: ${_f} (files kept in ${WORK})")
   endif()
 endforeach()
+# The C API: its shared library and its own pkg-config file (no C++ dependencies), when it is built.
+file(GLOB_RECURSE _libc "${PREFIX}/*/libafmkit_c.so" "${PREFIX}/*/libafmkit_c.dylib" "${PREFIX}/*/afmkit_c.dll")
+set(_pc_c "")
+if(_libc)
+  get_filename_component(_pc_c "${_pc}" DIRECTORY)
+  set(_pc_c "${_pc_c}/afmkit_c.pc")
+  if(NOT EXISTS "${_pc_c}")
+    message(FATAL_ERROR "install_and_build_examples: not installed: ${_pc_c} (files kept in ${WORK})")
+  endif()
+endif()
 get_filename_component(_cmakedir "${_config}" DIRECTORY)
 foreach(_f afmkitConfigVersion.cmake afmkitTargets.cmake)
   if(NOT EXISTS "${_cmakedir}/${_f}")
@@ -191,6 +216,24 @@ else()
   run("compile delay_margin with pkg-config flags" _out "${_cxx}" -std=c++20 -O2 ${_extra}
       "${SOURCE}/examples/delay_margin/delay_margin.cpp" -o "${_exe}" ${_flags})
   run_example("delay_margin (pkg-config)" "${_exe}")
+
+  # The C API from C99 with its own .pc: the shared library is found at run time through an rpath to libdir.
+  if(_pc_c)
+    run("pkg-config --cflags --libs afmkit_c" _cflags "${PKG_CONFIG_EXECUTABLE}" --cflags --libs afmkit_c)
+    string(STRIP "${_cflags}" _cflags)
+    message(STATUS "pkg-config flags (C API): ${_cflags}")
+    separate_arguments(_cflags UNIX_COMMAND "${_cflags}")
+    run("pkg-config --variable=libdir afmkit_c" _libdir "${PKG_CONFIG_EXECUTABLE}" --variable=libdir afmkit_c)
+    string(STRIP "${_libdir}" _libdir)
+    set(_cc "${CC}")
+    if(NOT _cc)
+      set(_cc cc)
+    endif()
+    set(_exe "${WORK}/pkg_config_filter_c")
+    run("compile filter_c (C99) with pkg-config flags" _out "${_cc}" -std=c99 -O2 ${_extra}
+        "${SOURCE}/examples/filter_c/filter_c.c" -o "${_exe}" ${_cflags} -lm "-Wl,-rpath,${_libdir}")
+    run_example("filter_c (pkg-config)" "${_exe}")
+  endif()
 endif()
 
 file(REMOVE_RECURSE "${WORK}")
