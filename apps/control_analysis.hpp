@@ -21,6 +21,9 @@ struct Window {
 /// The window given by x_min … y_max, each defaulting to `single` or `couplings` by the family's kind; InvalidParameter
 /// when a maximum is not above its minimum.
 Window window_from(const io::ParamSet& params, const control::LoopFamily& family, Window single, Window couplings);
+/// Declares x_min, x_max, y_min, y_max (units of Ω) with the defaults window_from() applies: `single` for the
+/// single oscillator, `couplings` otherwise (both shown in --help where they differ).
+void add_window_params(io::ParamSet& params, const Window& single, const Window& couplings);
 nlohmann::json window_json(const Window& window);
 /// The window parameters as (key, value) pairs, for params_as_run().
 std::vector<std::pair<std::string, double>> window_values(const Window& window);

@@ -38,6 +38,18 @@ Window window_from(const io::ParamSet& p, const control::LoopFamily& f, Window s
   return r;
 }
 
+void add_window_params(io::ParamSet& p, const Window& single, const Window& couplings) {
+  const auto bound = [&](const char* key, double Window::*field, const char* help) {
+    p.real(key, couplings.*field, help).unit("Omega");
+    if (single.*field != couplings.*field)
+      p.default_text(fmt::format("{:g} single, {:g} otherwise", single.*field, couplings.*field));
+  };
+  bound("x_min", &Window::x_min, "a or alpha lower bound");
+  bound("x_max", &Window::x_max, "a or alpha upper bound");
+  bound("y_min", &Window::y_min, "b or beta lower bound");
+  bound("y_max", &Window::y_max, "b or beta upper bound");
+}
+
 nlohmann::json window_json(const Window& w) {
   return {{"x_min", w.x_min}, {"x_max", w.x_max}, {"y_min", w.y_min}, {"y_max", w.y_max}, {"unit", "Omega"}};
 }

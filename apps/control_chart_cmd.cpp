@@ -21,6 +21,11 @@
 namespace afmkit::cli {
 
 namespace {
+
+// The default chart windows (units of Ω): the single oscillator's (a, b) plane, the couplings' (alpha, beta) plane.
+constexpr Window kSingleWindow{-0.5, 2.0, -2.0, 1.5};
+constexpr Window kCouplingsWindow{-0.1, 1.0, -0.4, 1.0};
+
 using io::Range;
 
 // The settings at each delay of the run: `delays` when given (validated entry by entry, naming `delays`), else
@@ -92,7 +97,7 @@ void run_chart(const io::ParamSet& p) {
   const control::ControlSettings c = control_settings_from(p);
   const std::vector<control::ControlSettings> runs = settings_per_delay(p, c);
   const control::LoopFamily first = control::LoopFamily::from_loop(control::loop_from(runs.front()));
-  const Window win = window_from(p, first, {-0.5, 2.0, -2.0, 1.5}, {-0.1, 1.0, -0.4, 1.0});
+  const Window win = window_from(p, first, kSingleWindow, kCouplingsWindow);
   if (p.text("quantity") == "margin") return run_margin_map(p, runs.front(), win);
   const control::RotationUnits u = c.units();
   const int nx = static_cast<int>(p.integer("x_points")), ny = static_cast<int>(p.integer("y_points"));
@@ -217,20 +222,9 @@ void add_control_chart(CLI::App& control) {
             .reals("delays", {}, "several delays: one chart per delay in the same table (column delay), boundaries "
                                  "likewise; replaces delay", Range::non_negative())
             .unit("T")
-            .default_text("= delay")
-            .real("x_min", 0.0, "a or alpha lower bound")
-            .unit("Omega")
-            .default_text("-0.5 single, -0.1 otherwise")
-            .real("x_max", 1.0, "a or alpha upper bound")
-            .unit("Omega")
-            .default_text("2 single, 1 otherwise")
-            .real("y_min", 0.0, "b or beta lower bound")
-            .unit("Omega")
-            .default_text("-2 single, -0.4 otherwise")
-            .real("y_max", 1.0, "b or beta upper bound")
-            .unit("Omega")
-            .default_text("1.5 single, 1 otherwise")
-            .integer("x_points", 200, "grid points along x", 2, 100000)
+            .default_text("= delay");
+        add_window_params(p, kSingleWindow, kCouplingsWindow);
+        p.integer("x_points", 200, "grid points along x", 2, 100000)
             .integer("y_points", 200, "grid points along y", 2, 100000)
             .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024);
         add_output_params(p, "out/control_chart.csv", "grid");

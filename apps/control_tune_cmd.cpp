@@ -17,6 +17,11 @@
 namespace afmkit::cli {
 
 namespace {
+
+// The default search windows (units of Ω): the single oscillator's (a, b), the couplings' (alpha, beta).
+constexpr Window kSingleWindow{0.01, 2.0, -2.0, 0.9};
+constexpr Window kCouplingsWindow{0.01, 0.6, -0.24, 0.3};
+
 using io::Range;
 
 void run_tune(const io::ParamSet& p) {
@@ -25,7 +30,7 @@ void run_tune(const io::ParamSet& p) {
   const control::RotationUnits u = c.units();
   control::RobustTuningSpec s;
   s.family = control::LoopFamily::from_loop(loop);
-  const Window win = window_from(p, s.family, {0.01, 2.0, -2.0, 0.9}, {0.01, 0.6, -0.24, 0.3});
+  const Window win = window_from(p, s.family, kSingleWindow, kCouplingsWindow);
   s.x_min = u.rate(win.x_min);
   s.x_max = u.rate(win.x_max);
   s.y_min = u.rate(win.y_min);
@@ -107,19 +112,9 @@ void add_control_tune(CLI::App& control) {
             .unit("dimensionless")
             .real("gain_ratio_max", 2.0, "largest rho = K/gamma", Range::positive())
             .unit("dimensionless")
-            .integer("gain_points", 3, "rho grid points (geometric)", 1, 10000)
-            .real("x_min", 0.01, "a or alpha lower bound")
-            .unit("Omega")
-            .real("x_max", 0.6, "a or alpha upper bound")
-            .unit("Omega")
-            .default_text("2 single, 0.6 otherwise")
-            .real("y_min", -0.24, "b or beta lower bound")
-            .unit("Omega")
-            .default_text("-2 single, -0.24 otherwise")
-            .real("y_max", 0.3, "b or beta upper bound")
-            .unit("Omega")
-            .default_text("0.9 single, 0.3 otherwise")
-            .integer("coarse_points", 12, "coarse grid points per axis", 2, 10000)
+            .integer("gain_points", 3, "rho grid points (geometric)", 1, 10000);
+        add_window_params(p, kSingleWindow, kCouplingsWindow);
+        p.integer("coarse_points", 12, "coarse grid points per axis", 2, 10000)
             .integer("max_evaluations", 150, "Nelder-Mead budget", 0, 1000000)
             .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024);
         add_output_params(p, "out/control_tune.csv", "coarse-grid");
