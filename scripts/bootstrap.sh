@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev nlohmann-json3-dev
-          libboost-dev libgtest-dev libbenchmark-dev pkg-config
+          libboost-dev libgtest-dev libbenchmark-dev libpng-dev pkg-config
           clang-14 libclang-rt-14-dev libomp-14-dev)   # clang: libFuzzer targets (scripts/fuzz.sh)
 missing=()
 for p in "${packages[@]}"; do
