@@ -106,4 +106,15 @@ void throw_size_mismatch(const BinaryHeader& header, std::size_t file_size, std:
                                found < value_bytes ? "truncated" : "too long"));
 }
 
+std::string header_text(const BinaryHeader& header, std::string_view key, const std::string& origin) {
+  const HeaderField* f = header.find(key);
+  if (!f) return "";
+  for (char ch : f->value) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7F)
+      throw InputError(fmt::format("{}:{}: {} = {} holds a control character", origin, f->line, key, shown(f->value)));
+  }
+  return f->value;
+}
+
 }  // namespace afmkit::scan::detail

@@ -35,6 +35,10 @@ BinaryHeader parse_binary_header(std::string_view bytes, std::string_view magic,
 long header_count(const BinaryHeader& header, std::string_view key, long max, bool mandatory,
                   const std::string& origin);
 
+/// The value of a text field ("" when absent); InputError naming the origin, the field and its line when it holds a
+/// control character.
+std::string header_text(const BinaryHeader& header, std::string_view key, const std::string& origin);
+
 /// InputError for data of the wrong length after the header: names the counts, the bytes expected and found, and
 /// says so when a run of NULs longer than the padding explains it (the padding must be 1 to `alignment` NULs).
 [[noreturn]] void throw_size_mismatch(const BinaryHeader& header, std::size_t file_size, std::size_t alignment,

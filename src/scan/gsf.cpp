@@ -46,17 +46,6 @@ double real_field(const detail::BinaryHeader& h, std::string_view key, double fa
   return *v;
 }
 
-std::string text_field(const detail::BinaryHeader& h, std::string_view key, const std::string& origin) {
-  const detail::HeaderField* f = h.find(key);
-  if (!f) return "";
-  for (char ch : f->value) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c < 0x20 || c == 0x7F)
-      throw InputError(fmt::format("{}:{}: {} = {} holds a control character", origin, f->line, key,
-                                   detail::shown(f->value)));
-  }
-  return f->value;
-}
 
 /// The grid and the raw float values of a GSF file (values as doubles, non-finite ones kept).
 struct RawGsf {
@@ -92,8 +81,8 @@ RawGsf parse_raw(std::string_view bytes, const std::string& origin) {
 }
 
 GsfField make_field(RawGsf raw, std::vector<std::uint8_t> valid, const std::string& origin) {
-  std::string z_unit = text_field(raw.header, "ZUnits", origin);
-  std::string title = text_field(raw.header, "Title", origin);
+  std::string z_unit = detail::header_text(raw.header, "ZUnits", origin);
+  std::string title = detail::header_text(raw.header, "Title", origin);
   std::vector<std::pair<std::string, std::string>> extra;
   for (const detail::HeaderField& f : raw.header.fields)
     if (f.key != "XRes" && f.key != "YRes" && f.key != "XReal" && f.key != "YReal" && f.key != "XOffset" &&

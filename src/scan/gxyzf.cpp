@@ -24,17 +24,6 @@ void check_finite(const std::vector<double>& v, const std::string& name) {
       throw InvalidParameter(name, fmt::format("{}[{}] = {}: must be finite", name, k, v[k]));
 }
 
-std::string text_field(const detail::BinaryHeader& h, const std::string& key, const std::string& origin) {
-  const detail::HeaderField* f = h.find(key);
-  if (!f) return "";
-  for (char ch : f->value) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c < 0x20 || c == 0x7F)
-      throw InputError(fmt::format("{}:{}: {} = {} holds a control character", origin, f->line, key,
-                                   detail::shown(f->value)));
-  }
-  return f->value;
-}
 }  // namespace
 
 XyzField::XyzField(std::vector<double> x, std::vector<double> y, std::vector<XyzChannel> channels, std::string xy_unit)
@@ -83,8 +72,8 @@ XyzField parse_gxyzf(std::string_view bytes, const std::string& origin) {
       detail::parse_binary_header(bytes, gxyzf_magic, alignment, "Gwyddion XYZ Field", origin);
   const long nchannels = detail::header_count(h, "NChannels", max_channels, true, origin);
   const long npoints = detail::header_count(h, "NPoints", max_points, true, origin);
-  const std::string xy_unit = text_field(h, "XYUnits", origin);
-  const std::string common_unit = text_field(h, "ZUnits", origin);
+  const std::string xy_unit = detail::header_text(h, "XYUnits", origin);
+  const std::string common_unit = detail::header_text(h, "ZUnits", origin);
   const auto columns = static_cast<std::size_t>(nchannels) + 2;
   const auto count = static_cast<std::size_t>(npoints);
   const std::size_t data_bytes = count * columns * 8;  // < 2^51: no overflow
@@ -95,8 +84,8 @@ XyzField parse_gxyzf(std::string_view bytes, const std::string& origin) {
   std::vector<double> x(count), y(count);
   std::vector<XyzChannel> channels(static_cast<std::size_t>(nchannels));
   for (std::size_t c = 0; c < channels.size(); ++c) {
-    channels[c].unit = h.find("ZUnits") ? common_unit : text_field(h, fmt::format("ZUnits{}", c + 1), origin);
-    channels[c].title = text_field(h, fmt::format("Title{}", c + 1), origin);
+    channels[c].unit = h.find("ZUnits") ? common_unit : detail::header_text(h, fmt::format("ZUnits{}", c + 1), origin);
+    channels[c].title = detail::header_text(h, fmt::format("Title{}", c + 1), origin);
     channels[c].values.resize(count);
   }
   const char* p = bytes.data() + h.data_start;
