@@ -16,5 +16,6 @@ void register_control_tf(CLI::App& control);        // control_tf_cmd.cpp:      
 void register_control_analysis(CLI::App& control);  // control_analysis_cmd.cpp: control roots|margin|chart|tune
 void register_control_simulate(CLI::App& control);  // control_simulate_cmd.cpp: control simulate
 void register_demo(CLI::App& app);              // demo_cmd.cpp:          afmkit demo (the Quick-start main job)
+void register_scan(CLI::App& app);              // scan_cmd.cpp:          afmkit scan
 
 }  // namespace afmkit::cli

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   afmkit::cli::register_impact(app);
   afmkit::cli::register_tapping(app);
   afmkit::cli::register_control(app);
+  afmkit::cli::register_scan(app);
   // A word that names no command where one is expected (`afmkit frobnicate`, `afmkit tapping orbits`).
   const CLI::App* level = &app;
   for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {

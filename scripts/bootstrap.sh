@@ -6,7 +6,8 @@ cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev nlohmann-json3-dev
           libboost-dev libgtest-dev libbenchmark-dev libpng-dev pkg-config
-          clang-14 libclang-rt-14-dev libomp-14-dev)   # clang: libFuzzer targets (scripts/fuzz.sh)
+          clang-14 libclang-rt-14-dev libomp-14-dev    # clang: libFuzzer targets (scripts/fuzz.sh)
+          gwyddion)   # gwyddion-thumbnailer: test_scan checks that Gwyddion opens the GSF / GXYZF files afmkit writes
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -14,7 +14,8 @@ namespace afmkit_test {
 /// Every leaf command of afmkit (kept explicit so that a new command is a deliberate addition to the tests).
 inline const std::vector<std::string> kCommands = {"demo",          "impact",        "tapping orbit", "tapping hb",
                                                    "tapping sweep", "control tf",    "control roots", "control margin",
-                                                   "control chart", "control tune",  "control simulate"};
+                                                   "control chart", "control tune",  "control simulate",
+                                                   "scan"};
 
 /// A gtest parameter name for a command: "tapping orbit" -> "tapping_orbit".
 inline std::string command_test_name(const ::testing::TestParamInfo<std::string>& info) {

@@ -1,0 +1,196 @@
+// afmkit scan: the virtual rotational-scanning AFM (docs/scan.md, docs/commands.md#scan). A tilted sample spins
+// under the tip, which follows a spiral; the seed-2 controller (through the real-time filter) removes the tilt's
+// first harmonic from the deflection. Writes the per-turn metrics (CSV), the images (GSF + mask, PNG preview) and,
+// on request, the time series (CSV) and the raw point cloud (GXYZF). With `recorded`, a recorded spiral (CSV) is
+// filtered offline instead (scan_recorded.cpp).
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/control/settings.hpp"
+#include "afmkit/control/spectrum.hpp"
+#include "afmkit/core/error.hpp"
+#include "afmkit/core/memory.hpp"
+#include "afmkit/io/progress.hpp"
+#include "afmkit/scan/virtual_scan.hpp"
+#include "command.hpp"
+#include "commands.hpp"
+#include "scan_outputs.hpp"
+#include "scan_params.hpp"
+#include "scan_recorded.hpp"
+
+namespace afmkit::cli {
+
+namespace {
+
+std::vector<io::Column> turn_columns() {
+  return {{"turn", "count", "turn k (spindle angle in [2 pi k, 2 pi (k+1)))"},
+          {"radius", "m", "mean radius over the turn"},
+          {"deflection_first_harmonic", "m", "amplitude of the deflection's first harmonic (residual tilt)"},
+          {"surface_first_harmonic", "m", "amplitude of the first harmonic of the true height (topography + tilt)"},
+          {"tilt_first_harmonic", "m", "tilt amplitude radius x tan(tilt_angle)"},
+          {"samples", "count", "samples in the turn"},
+          {"saturated_samples", "count", "samples of the turn with the detector saturated"}};
+}
+
+// Spectral abscissa of the continuous-time loop at the nominal delay [rad/s] (NaN when it cannot be certified).
+double loop_spectral_abscissa(const scan::InstrumentSpec& s) {
+  if (!s.controller.enabled) return std::numeric_limits<double>::quiet_NaN();
+  control::ControlSettings c;
+  const double omega = s.spiral.rotation_frequency();
+  c.rotation_frequency = omega;
+  c.harmonics = s.controller.harmonics;
+  c.alpha = s.controller.alpha;
+  c.beta = s.controller.beta;
+  c.gain = s.controller_gain() / omega;
+  c.plant = control::PlantKind::FirstOrder;
+  c.plant_rate = s.plant.bandwidth / omega;
+  c.delay = s.plant.delay / (2.0 * std::numbers::pi / omega);
+  try {
+    return control::spectral_abscissa(control::loop_from(c));
+  } catch (const NumericalFailure&) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+void run_simulated(const io::ParamSet& p) {
+  const scan::InstrumentSpec instrument = instrument_from(p);
+  const scan::Surface surface = surface_from(p);
+  const scan::Grid grid = scan::image_grid(instrument, p.integer("image_resolution"));
+  scan::check_scan_geometry(instrument, surface, grid);
+  const std::int64_t total = instrument.spiral.samples();
+  const std::string series_path = p.text("series_output"), points_path = p.text("points_output"), prefix = p.text("image_output");
+  const long series_every = p.integer("series_every"), points_every = p.integer("points_every");
+  const auto expected_points = static_cast<double>(total / points_every + 1);
+  if (!points_path.empty()) memory::require_fits("points_every", expected_points, 4.0 * sizeof(double));
+  const double abscissa = loop_spectral_abscissa(instrument);
+  if (abscissa >= 0.0)
+    fmt::print(stderr, "afmkit scan: warning: the loop is unstable at the nominal delay (spectral abscissa {:.4g} "
+                       "rad/s >= 0; see `afmkit control chart`)\n", abscissa);
+
+  CommandOutput out(p, "scan");
+  out.open(turn_columns());
+  std::optional<SeriesWriter> series;
+  if (!series_path.empty()) series.emplace(series_path, series_every, false);
+  std::optional<PointCloud> points;
+  if (!points_path.empty()) points.emplace(points_every, false, static_cast<std::size_t>(expected_points));
+  std::vector<scan::ScanObserver*> extra;
+  if (series) extra.push_back(&*series);
+  if (points) extra.push_back(&*points);
+  scan::ObserverChain chain(extra);
+
+  io::Progress progress("scan", total, true, 1.0);
+  std::int64_t reported = 0;
+  scan::VirtualScanOptions options;
+  options.extra = &chain;
+  options.on_turn = [&](const scan::TurnRecord& r) {
+    out.row(r.turn, r.radius, r.deflection_first_harmonic, r.surface_first_harmonic, r.tilt_first_harmonic,
+            r.samples, r.saturated_samples);
+  };
+  options.progress = [&](std::int64_t done, std::int64_t) {
+    progress.advance(static_cast<long>(done - reported));
+    reported = done;
+  };
+  options.compare_without_control = instrument.controller.enabled;
+  const scan::VirtualScan result = scan::run_virtual_scan(instrument, surface, grid, options);
+  progress.finish();
+
+  std::vector<std::string> files;
+  if (!prefix.empty())
+    files = write_images(prefix, {{"deflection", "Deflection", &result.deflection, false},
+                                  {"topography", "Topography (reconstructed)", &result.topography, true},
+                                  {"truth", "Ground truth (topography + tilt)", &result.truth, true}});
+  std::size_t n_points = 0;
+  if (points) {
+    n_points = points->write(points_path);
+    files.push_back(points_path);
+  }
+  const nlohmann::json results = {
+      {"samples", result.run.samples},
+      {"turns", result.turns},
+      {"pitch", instrument.spiral.pitch()},
+      {"saturated_fraction", result.saturated_fraction},
+      {"saturates_with_control", result.saturates_with_control},
+      {"max_radius_with_control", result.max_radius_with_control},
+      {"saturates_without_control", result.saturates_without_control},
+      {"max_radius_without_control", result.max_radius_without_control},
+      {"scan_area_gain", result.scan_area_gain},
+      {"scan_area_gain_is_lower_bound", result.scan_area_gain_is_lower_bound},
+      {"topography_rms_error", result.topography_rms_error},
+      {"deflection_rms", result.deflection_rms},
+      {"valid_pixels", result.topography.valid_count()},
+      {"loop_spectral_abscissa", abscissa},
+      {"filter_skipped_samples", result.run.filter_skipped},
+      {"point_cloud_points", n_points},
+      {"files", files},
+      {"units", {{"pitch", "m"}, {"saturated_fraction", "dimensionless"}, {"max_radius_with_control", "m"},
+                 {"max_radius_without_control", "m"}, {"scan_area_gain", "dimensionless"},
+                 {"topography_rms_error", "m"}, {"deflection_rms", "m"}, {"valid_pixels", "count"},
+                 {"loop_spectral_abscissa", "1/s"}, {"samples", "count"}, {"turns", "count"},
+                 {"filter_skipped_samples", "count"}, {"point_cloud_points", "count"}}}};
+  if (series) series->commit(io::make_sidecar("scan (time series)", p, results));
+  const std::string gain =
+      std::isnan(result.scan_area_gain)
+          ? std::string("nan (the uncontrolled scan does not saturate)")
+          : fmt::format("{}{:.3f}", result.scan_area_gain_is_lower_bound ? ">= " : "", result.scan_area_gain);
+  const std::string summary = fmt::format(
+      "afmkit scan: {} samples, {} turns, controller {}; saturated {:.3g} % of samples; largest radius before the "
+      "detector saturates {:.4g} mm in this run{}, {} with the controller off; scan-area gain {}; topography RMS "
+      "error {:.4g} nm (levelled){}",
+      result.run.samples, result.turns, instrument.controller.enabled ? "on" : "off",
+      100.0 * result.saturated_fraction, 1e3 * result.max_radius_with_control,
+      result.saturates_with_control ? "" : " (never saturated)",
+      !instrument.controller.enabled ? std::string("(this run)")
+      : std::isnan(result.max_radius_without_control) ? std::string("nan mm")
+                                                    : fmt::format("{:.4g} mm", 1e3 * result.max_radius_without_control),
+      gain, 1e9 * result.topography_rms_error,
+      files.empty() ? std::string() : fmt::format("; wrote {} files with prefix {}", files.size(), prefix));
+  out.finish(results, summary);
+}
+
+void run_scan(const io::ParamSet& p) {
+  if (!p.text("recorded").empty()) {
+    for (const std::string& key : simulation_only_keys())
+      if (p.was_set(key))
+        throw InvalidParameter(key, fmt::format("{} describes the simulated instrument: it cannot be given with "
+                                                "recorded = {} (the recorded file is the scan)", key,
+                                                p.text("recorded")));
+    run_recorded(p);
+    return;
+  }
+  run_simulated(p);
+}
+
+}  // namespace
+
+void register_scan(CLI::App& app) {
+  add_command(
+      app, "scan",
+      "virtual rotational-scanning AFM: a tilted sample scanned along a spiral with the seed-2 controller in the "
+      "loop; images (GSF, PNG), point cloud (GXYZF), per-turn metrics and the scan-area gain; or a recorded spiral "
+      "filtered offline (recorded = FILE)",
+      [](io::ParamSet& p) {
+        add_scan_params(p);
+        p.group("Recorded data")
+            .file("recorded", "", "recorded spiral CSV (time, radius, deflection, angle or index) to filter offline "
+                                  "instead of simulating (docs/scan.md#recorded-data)");
+        p.group("Images and files")
+            .integer("image_resolution", 512, "pixels per side of the images (square, covering the scanned disc)", 2,
+                     16384)
+            .file("image_output", "out/scan/scan", "prefix of the image files <prefix>_<channel>.gsf/.png (empty: none)")
+            .file("series_output", "", "time-series CSV (empty: none)")
+            .integer("series_every", 1, "write every n-th sample to the series", 1, 1000000000)
+            .file("points_output", "", "raw spiral point cloud, GXYZF (empty: none)")
+            .integer("points_every", 10, "keep every n-th sample in the point cloud", 1, 1000000000);
+        add_output_params(p, "out/scan/turns.csv", "per-turn metrics (residual first harmonic against radius)");
+      },
+      run_scan);
+}
+
+}  // namespace afmkit::cli

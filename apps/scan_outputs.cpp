@@ -1,0 +1,83 @@
+// Outputs of `afmkit scan` (scan_outputs.hpp).
+#include "scan_outputs.hpp"
+
+#include <cmath>
+
+#include "afmkit/scan/gsf.hpp"
+#include "afmkit/scan/levelling.hpp"
+#include "afmkit/scan/png16.hpp"
+
+namespace afmkit::cli {
+
+namespace {
+std::vector<io::Column> series_columns(bool recorded) {
+  if (recorded)
+    return {{"time", "s", "time of the sample"},
+            {"radius", "m", "radius of the tip on the sample"},
+            {"angle", "rad", "spindle angle, unwrapped"},
+            {"deflection", "m", "recorded deflection"},
+            {"control", "m/s", "output u of the real-time filter (virtual static plant, see docs/scan.md)"},
+            {"tilt_free", "m", "deflection + u/K: the signal with its first harmonic removed"}};
+  return {{"time", "s", "time of the sample"},
+          {"radius", "m", "radius r of the tip on the sample"},
+          {"angle", "rad", "spindle angle theta = Omega t, unwrapped"},
+          {"deflection", "m", "detector reading d (clamped to +-detector_range)"},
+          {"control", "m/s", "controller output u (seed 2, eq. 1)"},
+          {"actuator", "m", "calibrated actuator motion (nominal plant response to u)"},
+          {"topography", "m", "reconstructed height: deflection - actuator"},
+          {"surface", "m", "true height under the tip (topography + tilt)"},
+          {"saturated", "boolean", "1 when the detector saturated at this sample"}};
+}
+}  // namespace
+
+SeriesWriter::SeriesWriter(const std::string& path, long every, bool recorded)
+    : writer_(path, series_columns(recorded)), every_(every), recorded_(recorded) {}
+
+bool SeriesWriter::sample(const scan::ScanSample& s) {
+  if (s.index % every_ != 0) return true;
+  if (recorded_)
+    writer_.row(s.time, s.radius, s.angle, s.deflection, s.control, s.topography);
+  else
+    writer_.row(s.time, s.radius, s.angle, s.deflection, s.control, s.actuator, s.topography, s.surface,
+                s.saturated);
+  return true;
+}
+
+PointCloud::PointCloud(long every, bool recorded, std::size_t expected) : every_(every), recorded_(recorded) {
+  for (auto* v : {&x_, &y_, &a_, &b_}) v->reserve(expected);
+}
+
+bool PointCloud::sample(const scan::ScanSample& s) {
+  if (s.index % every_ != 0) return true;
+  if (!std::isfinite(s.deflection) || !std::isfinite(s.topography)) return true;
+  x_.push_back(s.radius * std::cos(s.angle));
+  y_.push_back(s.radius * std::sin(s.angle));
+  a_.push_back(s.deflection);
+  b_.push_back(s.topography);
+  return true;
+}
+
+std::size_t PointCloud::write(const std::string& path) {
+  const std::size_t n = x_.size();
+  std::vector<scan::XyzChannel> channels{{"Deflection", "m", std::move(a_)},
+                                         {recorded_ ? "Tilt-free deflection" : "Topography", "m", std::move(b_)}};
+  scan::write_gxyzf(path, scan::XyzField(std::move(x_), std::move(y_), std::move(channels), "m"));
+  return n;
+}
+
+std::vector<std::string> write_images(const std::string& prefix, const std::vector<NamedImage>& images) {
+  std::vector<std::string> written;
+  for (const NamedImage& image : images) {
+    for (std::string& path : scan::write_gsf(prefix + "_" + image.name + ".gsf", *image.map, image.title))
+      written.push_back(std::move(path));
+    const std::string png = prefix + "_" + image.name + ".png";
+    if (image.level_preview && image.map->valid_count() >= 3)
+      scan::write_png16(png, scan::level(*image.map));
+    else
+      scan::write_png16(png, *image.map);
+    written.push_back(png);
+  }
+  return written;
+}
+
+}  // namespace afmkit::cli

@@ -1,0 +1,224 @@
+// Parameters of `afmkit scan` (scan_params.hpp).
+#include "scan_params.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/scan/ascii_matrix.hpp"
+#include "afmkit/scan/gsf.hpp"
+#include "afmkit/scan/png16.hpp"
+#include "afmkit/scan/sample_generators.hpp"
+
+namespace afmkit::cli {
+
+namespace {
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+std::string lower_extension(const std::string& path) {
+  std::string e = std::filesystem::path(path).extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return e;
+}
+
+// A map read from a file, re-centred on the spindle axis (its centre at (0, 0)).
+scan::HeightMap centred(const scan::Grid& g, std::vector<double> z) {
+  scan::Grid c = g;
+  c.x_offset = -0.5 * g.x_size;
+  c.y_offset = -0.5 * g.y_size;
+  return scan::HeightMap(c, std::move(z), "m");
+}
+
+scan::HeightMap sample_from_file(const io::ParamSet& p) {
+  const std::string path = p.text("sample_file");
+  if (path.empty())
+    throw InvalidParameter("sample_file", "sample = file needs sample_file (a .gsf, .png or ASCII matrix file)");
+  const std::string ext = lower_extension(path);
+  const double size = p.real("sample_size"), scale = p.real("sample_z_scale");
+  if (ext == ".gsf") {
+    scan::GsfField f = scan::read_gsf(path);
+    if (f.map.z_unit() != "m")
+      throw InputError(fmt::format("{}: ZUnits = '{}': a sample height map must be in metres (ZUnits = m)", path,
+                                   f.map.z_unit()));
+    if (f.map.valid_count() != f.map.size())
+      throw InputError(fmt::format("{}: {} of {} pixels are not finite: a sample height map must be complete", path,
+                                   f.map.size() - f.map.valid_count(), f.map.size()));
+    const scan::Grid g = f.map.grid();
+    return centred(g, std::move(f.map).data());
+  }
+  if (!p.was_set("sample_size"))
+    throw InvalidParameter("sample_size", fmt::format("{} holds no physical size: give sample_size [m] (the width of "
+                                                      "the image; pixels are square)", path));
+  std::vector<double> z;
+  long columns = 0, rows = 0;
+  if (ext == ".png") {
+    if (!p.was_set("sample_z_scale"))
+      throw InvalidParameter("sample_z_scale", fmt::format("{} holds grey levels: give sample_z_scale [m] = the "
+                                                           "height of grey level 65535", path));
+    const scan::Grey16 img = scan::read_png16(path);
+    columns = img.width;
+    rows = img.height;
+    z.reserve(img.pixels.size());
+    for (std::uint16_t g : img.pixels) z.push_back(scale * static_cast<double>(g) / 65535.0);
+  } else {
+    scan::AsciiMatrix m = scan::read_ascii_matrix(path);
+    columns = m.columns;
+    rows = m.rows;
+    z = std::move(m.values);
+    for (double& v : z) v *= scale;
+  }
+  const double dx = size / static_cast<double>(columns);
+  return centred(scan::Grid{columns, rows, size, dx * static_cast<double>(rows), 0.0, 0.0}, std::move(z));
+}
+
+}  // namespace
+
+void add_scan_params(io::ParamSet& p) {
+  const auto positive = io::Range::positive();
+  const auto non_negative = io::Range::non_negative();
+  p.group("Sample")
+      .text("sample", "grating", "sample topography: a built-in generator or a file",
+            {"grating", "steps", "particles", "rough", "flat", "file"})
+      .file("sample_file", "", "height map for sample = file: .gsf (metres), .png (16-bit grey) or ASCII matrix")
+      .real("sample_size", 0.0, "sample width (generators: square side; png/ASCII files: image width)",
+            non_negative)
+      .unit("m")
+      .default_text("generators: 2.04 x end_radius")
+      .real("sample_z_scale", 1.0, "height per file unit: ASCII values x scale; png: height of grey 65535", positive)
+      .unit("m")
+      .integer("sample_resolution", 2048, "pixels per side of a generated sample", 16, 16384)
+      .integer("sample_seed", 1, "random seed of the particles and rough generators", 0, 4294967295L)
+      .real("grating_period", 800e-6, "grating period", positive)
+      .unit("m")
+      .real("grating_height", 50e-9, "grating line height", io::Range::any())
+      .unit("m")
+      .real("grating_duty", 0.5, "fraction of a period at the line height", io::Range::closed(0.0, 1.0))
+      .unit("dimensionless")
+      .real("steps_width", 500e-6, "width of one terrace", positive)
+      .unit("m")
+      .real("steps_height", 20e-9, "height of one step", io::Range::any())
+      .unit("m")
+      .integer("particles_count", 60, "number of spherical particles", 1, 1000000)
+      .real("particles_radius", 100e-6, "particle radius", positive)
+      .unit("m")
+      .real("rough_rms", 20e-9, "RMS height of the rough surface", positive)
+      .unit("m")
+      .real("rough_correlation_length", 100e-6, "correlation length of the rough surface", positive)
+      .unit("m")
+      .real("tilt_angle", 0.05, "tilt of the sample normal from the spindle axis, in [0, 90)", non_negative)
+      .unit("deg")
+      .real("tilt_azimuth", 0.0, "direction of the tilt in the sample plane", io::Range::any())
+      .unit("deg")
+      .group("Spiral")
+      .real("spindle_frequency", 50.0, "spindle rotation frequency f_rot (Omega = 2 pi f_rot)", positive)
+      .unit("Hz")
+      .real("start_radius", 0.0, "radius where the scan starts", non_negative)
+      .unit("m")
+      .real("end_radius", 4e-3, "radius where the scan stops (> start_radius)", positive)
+      .unit("m")
+      .real("radial_speed", 400e-6, "outward speed of the tip; pitch = radial_speed / spindle_frequency", positive)
+      .unit("m/s")
+      .real("sample_rate", 50e3, "samples per second (>= 16 per turn)", positive)
+      .unit("Hz")
+      .group("Plant and actuator (seed 2, eq. 1)")
+      .real("bandwidth", 2.0 * std::numbers::pi * 1000.0, "plant rate gamma of the deflection signal", positive)
+      .unit("rad/s")
+      .default_text("2 pi x 1000")
+      .real("delay", 1e-3, "actuator delay tau (below one spindle period)", non_negative)
+      .unit("s")
+      .real("delay_drift", 0.0, "amplitude of the slow delay drift, tau(t) = delay + delay_drift sin(2 pi t / P)",
+            io::Range::closed(0.0, 1e308))
+      .unit("s")
+      .real("delay_drift_period", 10.0, "period P of the delay drift", positive)
+      .unit("s")
+      .real("gain_error", 0.0, "actuator sensitivity error: actual = (1 + gain_error) x calibrated (> -1)",
+            io::Range::any())
+      .unit("dimensionless")
+      .group("Detector")
+      .real("detector_range", 2e-6, "linear range of the deflection detector, +-detector_range", positive)
+      .unit("m")
+      .real("detector_noise", 0.0, "RMS of white Gaussian detector noise", non_negative)
+      .unit("m")
+      .integer("noise_seed", 1, "seed of the detector noise", 0, 4294967295L)
+      .group("Controller (seed 2, eqs. 15, 6, 20)")
+      .text("control", "on", "the harmonic-rejection controller in the loop", {"on", "off"})
+      .integer("harmonics", 10, "oscillators N of the bank (N x spindle_frequency below sample_rate / 2)", 1, 10000)
+      .real("alpha", 0.1, "coupling alpha (eq. 20)", io::Range::any())
+      .unit("Omega")
+      .real("beta", -0.1, "coupling beta (eq. 20)", io::Range::any())
+      .unit("Omega")
+      .real("gain", 0.0, "controller gain K (0: the design rule K = bandwidth)", non_negative)
+      .unit("rad/s")
+      .default_text("= bandwidth");
+}
+
+const std::vector<std::string>& simulation_only_keys() {
+  static const std::vector<std::string> keys{
+      "sample", "sample_file", "sample_size", "sample_z_scale", "sample_resolution", "sample_seed", "grating_period",
+      "grating_height", "grating_duty", "steps_width", "steps_height", "particles_count", "particles_radius",
+      "rough_rms", "rough_correlation_length", "tilt_angle", "tilt_azimuth", "spindle_frequency", "start_radius",
+      "end_radius", "radial_speed", "sample_rate", "bandwidth", "delay", "delay_drift", "delay_drift_period",
+      "gain_error", "detector_range", "detector_noise", "noise_seed", "control", "gain"};
+  return keys;
+}
+
+scan::InstrumentSpec instrument_from(const io::ParamSet& p) {
+  scan::InstrumentSpec s;
+  s.spiral.spindle_frequency = p.real("spindle_frequency");
+  s.spiral.start_radius = p.real("start_radius");
+  s.spiral.end_radius = p.real("end_radius");
+  s.spiral.radial_speed = p.real("radial_speed");
+  s.spiral.sample_rate = p.real("sample_rate");
+  s.plant.bandwidth = p.real("bandwidth");
+  s.plant.delay = p.real("delay");
+  s.plant.delay_drift = p.real("delay_drift");
+  s.plant.delay_drift_period = p.real("delay_drift_period");
+  s.plant.gain_error = p.real("gain_error");
+  s.detector.range = p.real("detector_range");
+  s.detector.noise = p.real("detector_noise");
+  s.detector.seed = static_cast<std::uint64_t>(p.integer("noise_seed"));
+  s.controller.enabled = p.text("control") == "on";
+  s.controller.harmonics = static_cast<int>(p.integer("harmonics"));
+  s.controller.alpha = p.real("alpha");
+  s.controller.beta = p.real("beta");
+  s.controller.gain = p.real("gain");
+  s.validate();
+  return s;
+}
+
+scan::Surface surface_from(const io::ParamSet& p) {
+  const double tilt_angle = p.real("tilt_angle");
+  if (!(tilt_angle < 90.0))
+    throw InvalidParameter("tilt_angle", fmt::format("tilt_angle = {} deg is out of range: must be in [0, 90) deg",
+                                                     tilt_angle));
+  const scan::Tilt tilt(tilt_angle * kDegree, p.real("tilt_azimuth") * kDegree);
+  const std::string kind = p.text("sample");
+  if (kind == "file") return scan::Surface(sample_from_file(p), tilt);
+  if (p.was_set("sample_file"))
+    throw InvalidParameter("sample_file", fmt::format("sample_file is given but sample = {}: set sample = file to "
+                                                      "scan the file, or leave sample_file out", kind));
+
+  const double end_radius = p.real("end_radius");
+  const double size = p.was_set("sample_size") ? p.real("sample_size") : 2.04 * end_radius;
+  if (!(size > 0.0))
+    throw InvalidParameter("sample_size", fmt::format("sample_size = {} m is out of range: must be > 0", size));
+  const long n = p.integer("sample_resolution");
+  const scan::Grid grid{n, n, size, size, -0.5 * size, -0.5 * size};
+  const auto seed = static_cast<unsigned>(p.integer("sample_seed"));
+  scan::HeightMap map = [&] {
+    if (kind == "grating")
+      return scan::grating(grid, {p.real("grating_period"), p.real("grating_height"), p.real("grating_duty"), 0.0});
+    if (kind == "steps") return scan::steps(grid, {p.real("steps_width"), p.real("steps_height"), 0.0});
+    if (kind == "particles")
+      return scan::particles(grid, {static_cast<int>(p.integer("particles_count")), p.real("particles_radius"), seed});
+    if (kind == "rough") return scan::rough(grid, {p.real("rough_rms"), p.real("rough_correlation_length"), seed});
+    return scan::flat(grid);
+  }();
+  return scan::Surface(std::move(map), tilt);
+}
+
+}  // namespace afmkit::cli

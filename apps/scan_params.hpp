@@ -1,0 +1,22 @@
+#pragma once
+// Parameters of `afmkit scan` (docs/commands.md#scan, docs/scan.md): the sample, the spiral, the plant and actuator,
+// the detector, the controller and the images, all in SI units (m, s, Hz, rad/s) except the couplings α, β (units of
+// Ω, as in `afmkit control`) and the tilt (degrees).
+#include <string>
+#include <vector>
+
+#include "afmkit/io/params.hpp"
+#include "afmkit/scan/instrument.hpp"
+#include "afmkit/scan/surface.hpp"
+
+namespace afmkit::cli {
+
+void add_scan_params(io::ParamSet& p);
+/// The instrument given (validated: InvalidParameter naming the parameter).
+scan::InstrumentSpec instrument_from(const io::ParamSet& p);
+/// The sample: a built-in generator or a file (GSF, ASCII matrix, 16-bit PNG) centred on the spindle axis, tilted.
+scan::Surface surface_from(const io::ParamSet& p);
+/// Keys that describe the simulated instrument or sample (refused together with `recorded`).
+const std::vector<std::string>& simulation_only_keys();
+
+}  // namespace afmkit::cli

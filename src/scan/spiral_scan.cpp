@@ -1,0 +1,143 @@
+// Time-domain simulation of the virtual rotational scan (spiral_scan.hpp, docs/scan.md).
+#include "afmkit/scan/spiral_scan.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <random>
+
+#include "afmkit/control/realtime_filter.hpp"
+
+namespace afmkit::scan {
+
+namespace {
+
+// The split of one sample interval by the actuator delay τ = (i + φ) h: the control applied over the first φh is
+// u_{n−i−1}, over the remaining (1 − φ)h it is u_{n−i}; e_first/e_second are the plant's decay factors over them.
+struct DelaySplit {
+  std::int64_t whole = 0;  // i
+  double fraction = 0.0;   // φ
+  double e_first = 1.0, e_second = 1.0;
+  static DelaySplit of(double delay, double sample_rate, double bandwidth) {
+    const double h = 1.0 / sample_rate;
+    const double samples = delay * sample_rate;
+    DelaySplit s;
+    s.whole = static_cast<std::int64_t>(std::floor(samples));
+    s.fraction = samples - static_cast<double>(s.whole);
+    s.e_first = std::exp(-bandwidth * s.fraction * h);
+    s.e_second = std::exp(-bandwidth * (1.0 - s.fraction) * h);
+    return s;
+  }
+};
+
+// Exact step of ẏ = −γ (y − target) over a piece with decay factor e = e^{−γδ}.
+inline double relax(double y, double target, double e) { return target + (y - target) * e; }
+
+// Exact step of ẏ = −γ (y − g(t)) over a piece where g ramps linearly from g_start to g_end at the rate `slope`:
+// the particular solution g(t) − slope/γ plus the decaying homogeneous part.
+inline double relax_ramp(double y, double g_start, double g_end, double lag, double e) {
+  return g_end - lag + (y - g_start + lag) * e;
+}
+
+}  // namespace
+
+ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, ScanObserver& observer,
+                      const std::function<void(std::int64_t, std::int64_t)>& progress) {
+  instrument.validate();
+  const SpiralSpec& spiral = instrument.spiral;
+  const PlantSpec& plant = instrument.plant;
+  const DetectorSpec& detector = instrument.detector;
+  const double fs = spiral.sample_rate, h = 1.0 / fs;
+  const double omega = spiral.rotation_frequency();
+  const double gamma = plant.bandwidth;
+  const std::int64_t total = spiral.samples();
+
+  std::optional<control::RealtimeFilter> filter;
+  if (instrument.controller.enabled)
+    filter.emplace(control::RealtimeFilter::with_couplings(fs, omega, instrument.controller.harmonics,
+                                                           instrument.controller.alpha * omega,
+                                                           instrument.controller.beta * omega,
+                                                           instrument.controller_gain()));
+
+  // Past controller outputs, as far back as the longest delay reaches (a power-of-two ring).
+  const auto reach = static_cast<std::int64_t>(std::floor((plant.delay + plant.delay_drift) * fs)) + 2;
+  const auto ring_size = std::bit_ceil(static_cast<std::uint64_t>(reach));
+  const std::uint64_t mask = ring_size - 1;
+  std::vector<double> history(ring_size, 0.0);
+  const auto past = [&](std::int64_t j) { return j < 0 ? 0.0 : history[static_cast<std::uint64_t>(j) & mask]; };
+
+  const DelaySplit nominal = DelaySplit::of(plant.delay, fs, gamma);
+  const bool drifts = plant.delay_drift > 0.0;
+  const double drift_rate = 2.0 * std::numbers::pi / plant.delay_drift_period;
+  const double actuator_gain = (1.0 + plant.gain_error) / gamma;  // y* = f + (1 + ε) u / γ
+  const double calibrated_gain = 1.0 / gamma;
+
+  std::mt19937_64 rng(detector.seed);
+  std::normal_distribution<double> noise(0.0, detector.noise > 0.0 ? detector.noise : 1.0);
+
+  ScanRun run;
+  const double cos_step = std::cos(omega * h), sin_step = std::sin(omega * h);
+  // tip position of sample n: exact angle now and then, a rotation recurrence in between
+  double cos_theta = 1.0, sin_theta = 0.0;
+  const auto height_at = [&](std::int64_t n) {
+    const double t = static_cast<double>(n) * h;
+    if ((n & 4095) == 0) {
+      cos_theta = std::cos(omega * t);
+      sin_theta = std::sin(omega * t);
+    }
+    const double r = spiral.start_radius + spiral.radial_speed * t;
+    return surface(r * cos_theta, r * sin_theta);
+  };
+  const auto rotate = [&] {
+    const double c = cos_theta * cos_step - sin_theta * sin_step;
+    sin_theta = sin_theta * cos_step + cos_theta * sin_step;
+    cos_theta = c;
+  };
+  double f = height_at(0);
+  double y = f, y_hat = 0.0;  // the deflection settled on the surface before the scan starts; no actuator motion
+  for (std::int64_t n = 0; n < total; ++n) {
+    const double t = static_cast<double>(n) * h;
+    const double theta = omega * t;
+    const double r = spiral.start_radius + spiral.radial_speed * t;
+
+    const double reading = detector.noise > 0.0 ? y + noise(rng) : y;
+    const bool saturated = !(std::abs(reading) <= detector.range);
+    const double d = std::clamp(reading, -detector.range, detector.range);
+    const double u = filter ? filter->step(d) : 0.0;
+    history[static_cast<std::uint64_t>(n) & mask] = u;
+    if (saturated) {
+      if (run.saturated_samples == 0) run.first_saturation_radius = r;
+      ++run.saturated_samples;
+    }
+    ++run.samples;
+    const ScanSample s{n, t, theta, r, f, d, u, y_hat, d - y_hat, saturated};
+    if (!observer.sample(s)) {
+      run.stopped_early = true;
+      break;
+    }
+
+    // advance the plant (eq. 1) and the calibrated actuator model over [t_n, t_n + h); the height under the tip
+    // ramps linearly from f_n to f_{n+1} (first-order hold), the delayed control is piecewise constant
+    rotate();
+    const double f_next = height_at(n + 1);
+    const DelaySplit split = drifts ? DelaySplit::of(plant.delay + plant.delay_drift * std::sin(drift_rate * t),
+                                                     fs, gamma)
+                                    : nominal;
+    const double lag = (f_next - f) * fs / gamma;  // slope / γ
+    const double f_split = f + (f_next - f) * split.fraction;
+    const double before = actuator_gain * past(n - split.whole - 1), after = actuator_gain * past(n - split.whole);
+    y = relax_ramp(y, f + before, f_split + before, lag, split.e_first);
+    y = relax_ramp(y, f_split + after, f_next + after, lag, split.e_second);
+    y_hat = relax(y_hat, calibrated_gain * past(n - nominal.whole - 1), nominal.e_first);
+    y_hat = relax(y_hat, calibrated_gain * past(n - nominal.whole), nominal.e_second);
+    f = f_next;
+    if (progress && (n & 65535) == 65535) progress(n + 1, total);
+  }
+  if (filter) run.filter_skipped = filter->skipped_samples();
+  if (progress) progress(run.samples, total);
+  return run;
+}
+
+}  // namespace afmkit::scan

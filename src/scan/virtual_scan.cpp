@@ -1,0 +1,151 @@
+// The whole virtual rotational scan: simulation, imaging, metrics (virtual_scan.hpp).
+#include "afmkit/scan/virtual_scan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/scan/levelling.hpp"
+#include "afmkit/scan/spiral_imager.hpp"
+
+namespace afmkit::scan {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Feeds the imager: deflection and topography, NaN where the detector saturated.
+class ImagingObserver final : public ScanObserver {
+ public:
+  explicit ImagingObserver(SpiralImager& imager) : imager_(imager) {}
+  bool sample(const ScanSample& s) override {
+    const double values[2] = {s.saturated ? kNaN : s.deflection, s.saturated ? kNaN : s.topography};
+    imager_.add(s.angle, s.radius, values);
+    return true;
+  }
+
+ private:
+  SpiralImager& imager_;
+};
+
+// Stops the scan at the first saturated sample.
+class StopAtSaturation final : public ScanObserver {
+ public:
+  bool sample(const ScanSample& s) override { return !s.saturated; }
+};
+
+HeightMap truth_on(const HeightMap& image, const Surface& surface) {
+  const Grid& g = image.grid();
+  std::vector<double> z(image.size(), kNaN);
+  std::vector<std::uint8_t> valid(image.size(), 0);
+  for (long j = 0; j < g.y_resolution; ++j)
+    for (long i = 0; i < g.x_resolution; ++i) {
+      if (!image.valid(i, j) || !std::isfinite(image(i, j))) continue;
+      const double x = g.x_offset + (static_cast<double>(i) + 0.5) * image.dx();
+      const double y = g.y_offset + (static_cast<double>(j) + 0.5) * image.dy();
+      const auto k = static_cast<std::size_t>(j * g.x_resolution + i);
+      z[k] = surface(x, y);
+      valid[k] = 1;
+    }
+  return HeightMap(g, std::move(z), "m", std::move(valid));
+}
+
+double annulus(double outer, double inner) { return outer * outer - inner * inner; }
+
+}  // namespace
+
+Grid image_grid(const InstrumentSpec& instrument, long resolution) {
+  if (resolution < 2 || resolution > 16384)
+    throw InvalidParameter("image_resolution",
+                           fmt::format("image_resolution = {} is out of range: must be an integer in [2, 16384]",
+                                       resolution));
+  const double r = instrument.spiral.end_radius;
+  return Grid{resolution, resolution, 2.0 * r, 2.0 * r, -r, -r};
+}
+
+void check_scan_geometry(const InstrumentSpec& instrument, const Surface& surface, const Grid& grid) {
+  const SpiralSpec& s = instrument.spiral;
+  const double pixel = std::min(grid.x_size / static_cast<double>(grid.x_resolution),
+                                grid.y_size / static_cast<double>(grid.y_resolution));
+  if (s.pitch() > pixel)
+    throw InvalidParameter(
+        "radial_speed",
+        fmt::format("radial_speed = {} m/s is out of range: the spiral's pitch radial_speed/spindle_frequency = {} m "
+                    "exceeds the image pixel {} m, so neighbouring turns would not overlap at this resolution; must "
+                    "be <= {} m/s (or lower image_resolution)", s.radial_speed, s.pitch(), pixel,
+                    pixel * s.spindle_frequency));
+  const double inscribed = surface.inscribed_radius();
+  if (s.end_radius > inscribed)
+    throw InvalidParameter("end_radius",
+                           fmt::format("end_radius = {} m is out of range: the sample covers the disc of radius {} m "
+                                       "about the spindle axis; must be <= {} m (or give a larger sample)",
+                                       s.end_radius, inscribed, inscribed));
+}
+
+VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& surface, const Grid& grid,
+                             const VirtualScanOptions& options) {
+  instrument.validate();
+  check_scan_geometry(instrument, surface, grid);
+  const SpiralSpec& spiral = instrument.spiral;
+
+  const auto per_turn = static_cast<int>(std::clamp(std::round(spiral.samples_per_turn()), 16.0, 4194304.0));
+  SpiralImager imager(grid, {"m", "m"}, per_turn);
+  ImagingObserver imaging(imager);
+  std::int64_t turns = 0;
+  TurnMetrics metrics(surface.tilt().slope(), [&](const TurnRecord& r) {
+    ++turns;
+    if (options.on_turn) options.on_turn(r);
+  });
+  std::vector<ScanObserver*> chain{&imaging, &metrics};
+  if (options.extra) chain.push_back(options.extra);
+  ObserverChain observers(chain);
+  const ScanRun run = simulate_scan(instrument, surface, observers, options.progress);
+  std::vector<HeightMap> images = imager.finish();
+
+  VirtualScan out{run, std::move(images.at(0)), std::move(images.at(1)),
+                  HeightMap(Grid{}, std::vector<double>{0.0})};
+  out.truth = truth_on(out.topography, surface);
+  out.turns = turns;
+  out.saturated_fraction =
+      run.samples > 0 ? static_cast<double>(run.saturated_samples) / static_cast<double>(run.samples) : 0.0;
+  const double r0 = spiral.start_radius;
+  out.saturates_with_control = run.saturated_samples > 0;
+  out.max_radius_with_control = out.saturates_with_control ? run.first_saturation_radius : spiral.end_radius;
+
+  out.max_radius_without_control = kNaN;
+  out.scan_area_gain = kNaN;
+  if (options.compare_without_control) {
+    InstrumentSpec off = instrument;
+    off.controller.enabled = false;
+    StopAtSaturation stop;
+    const ScanRun uncontrolled = simulate_scan(off, surface, stop);
+    out.saturates_without_control = uncontrolled.saturated_samples > 0;
+    out.max_radius_without_control =
+        out.saturates_without_control ? uncontrolled.first_saturation_radius : spiral.end_radius;
+    if (out.saturates_without_control && out.max_radius_without_control > r0) {
+      out.scan_area_gain = annulus(out.max_radius_with_control, r0) / annulus(out.max_radius_without_control, r0);
+      out.scan_area_gain_is_lower_bound = !out.saturates_with_control;
+    }
+  }
+  if (out.topography.valid_count() >= 3) {
+    out.topography_rms_error = levelled_rms_difference(out.topography, out.truth);
+    const HeightMap flat_deflection = level(out.deflection);
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (double v : flat_deflection.data())
+      if (std::isfinite(v)) {
+        sum += v * v;
+        ++n;
+      }
+    out.deflection_rms = n > 0 ? std::sqrt(sum / static_cast<double>(n)) : kNaN;
+  } else {
+    out.topography_rms_error = kNaN;
+    out.deflection_rms = kNaN;
+  }
+  return out;
+}
+
+}  // namespace afmkit::scan

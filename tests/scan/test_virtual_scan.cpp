@@ -1,0 +1,119 @@
+// The whole virtual scan: images cover the scanned disc with no holes, the reconstructed topography matches the
+// ground truth (evaluated independently on the grid), the controller buys scan area, bad geometry is named.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/scan/levelling.hpp"
+#include "afmkit/scan/sample_generators.hpp"
+#include "afmkit/scan/virtual_scan.hpp"
+
+namespace {
+using namespace afmkit::scan;
+constexpr double kPi = std::numbers::pi;
+
+// 50 Hz, 400 samples per turn, 4 mm disc at 20 µm pitch: 200 turns, 80 000 samples.
+InstrumentSpec small_scan() {
+  InstrumentSpec s;
+  s.spiral.sample_rate = 20e3;
+  s.spiral.end_radius = 4e-3;
+  s.spiral.radial_speed = 1e-3;
+  return s;
+}
+
+Surface rough_tilted(double half, double tilt_deg) {
+  const Grid g{512, 512, 2 * half, 2 * half, -half, -half};
+  return Surface(rough(g, RoughSpec{20e-9, 400e-6, 3}), Tilt(tilt_deg * kPi / 180, 0.3));
+}
+
+TEST(VirtualScan, ImagesCoverTheDiscAndTheReconstructionMatchesTheTruth) {
+  const InstrumentSpec s = small_scan();
+  const Surface surface = rough_tilted(4.1e-3, 0.05);
+  const Grid grid = image_grid(s, 128);
+  const VirtualScan v = run_virtual_scan(s, surface, grid);
+  // every pixel whose centre lies within r_end − pitch is valid, none beyond r_end + pitch
+  long inside = 0, inside_valid = 0, outside_valid = 0;
+  for (long j = 0; j < grid.y_resolution; ++j)
+    for (long i = 0; i < grid.x_resolution; ++i) {
+      const double x = grid.x_offset + (i + 0.5) * v.topography.dx(), y = grid.y_offset + (j + 0.5) * v.topography.dy();
+      const double r = std::hypot(x, y);
+      if (r < s.spiral.end_radius - s.spiral.pitch()) {
+        ++inside;
+        inside_valid += v.topography.valid(i, j) && v.deflection.valid(i, j);
+      }
+      if (r > s.spiral.end_radius + s.spiral.pitch()) outside_valid += v.topography.valid(i, j);
+    }
+  EXPECT_EQ(inside_valid, inside);
+  EXPECT_EQ(outside_valid, 0);
+  // the truth image is the surface at the pixel centres (independent evaluation here)
+  const long i = 70, j = 40;
+  ASSERT_TRUE(v.truth.valid(i, j));
+  EXPECT_DOUBLE_EQ(v.truth(i, j), surface(grid.x_offset + (i + 0.5) * v.truth.dx(),
+                                          grid.y_offset + (j + 0.5) * v.truth.dy()));
+  // reconstruction at 1 kHz plant bandwidth: the plant lags by 1/γ = 0.16 ms, i.e. up to 0.2 mm along the turn at
+  // the 1.26 m/s tip speed of the rim — half the correlation length; so the error is a good part of the roughness
+  EXPECT_LT(v.topography_rms_error, 0.6 * 20e-9);
+  EXPECT_EQ(v.topography_rms_error, levelled_rms_difference(v.topography, v.truth));
+  // with a plant 1000 times faster the image is the sample up to the imaging error (interpolation across 20 µm
+  // turns and 62.5 µm pixels of a surface correlated over 400 µm: (20/400)² · 20 nm ≈ 0.05 nm; and the sample's own
+  // bilinear map at 16 µm pixels)
+  InstrumentSpec fast = s;
+  fast.plant.bandwidth = 2 * kPi * 1e6;
+  fast.controller.enabled = false;
+  fast.detector.range = 1e-3;
+  const VirtualScan w = run_virtual_scan(fast, surface, grid);
+  EXPECT_LT(w.topography_rms_error, 0.02 * 20e-9);
+  EXPECT_LT(w.topography_rms_error, 0.1 * v.topography_rms_error);
+  EXPECT_FALSE(v.saturates_with_control);
+  EXPECT_EQ(v.saturated_fraction, 0.0);
+  EXPECT_GT(v.turns, 195);
+}
+
+TEST(VirtualScan, ControllerBuysScanArea) {
+  const InstrumentSpec s = small_scan();
+  const Surface surface = rough_tilted(4.1e-3, 0.05);
+  const VirtualScan on = run_virtual_scan(s, surface, image_grid(s, 128));
+  ASSERT_TRUE(on.saturates_without_control);
+  // without control: the steady amplitude r tan ψ γ/√(γ² + Ω²) (± the 20 nm roughness) reaches 2 µm
+  const double omega = s.spiral.rotation_frequency(), gamma = s.plant.bandwidth;
+  const double predicted = s.detector.range * std::hypot(gamma, omega) / (gamma * surface.tilt().slope());
+  EXPECT_NEAR(on.max_radius_without_control, predicted, 0.03 * predicted);
+  EXPECT_FALSE(on.saturates_with_control);
+  EXPECT_TRUE(on.scan_area_gain_is_lower_bound);
+  EXPECT_DOUBLE_EQ(on.scan_area_gain, std::pow(s.spiral.end_radius / on.max_radius_without_control, 2));
+  EXPECT_GT(on.scan_area_gain, 2.5);
+
+  InstrumentSpec off = s;
+  off.controller.enabled = false;
+  const VirtualScan v = run_virtual_scan(off, surface, image_grid(off, 128));
+  EXPECT_TRUE(v.saturates_with_control);  // "with control" = as specified (off here)
+  EXPECT_NEAR(v.max_radius_with_control, on.max_radius_without_control, 1e-12);
+  EXPECT_GT(v.saturated_fraction, 0.1);
+  // saturated samples carry no height: fewer valid pixels than the controlled scan
+  EXPECT_LT(v.topography.valid_count(), on.topography.valid_count());
+}
+
+TEST(VirtualScan, TurnsMustOverlapAtTheImageResolution) {
+  InstrumentSpec s = small_scan();
+  const Surface surface = rough_tilted(4.1e-3, 0.05);
+  // pitch 20 µm; 1024 pixels over 8 mm are 7.8 µm
+  try {
+    run_virtual_scan(s, surface, image_grid(s, 1024));
+    FAIL() << "no error";
+  } catch (const afmkit::InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "radial_speed");
+    EXPECT_NE(std::string(e.what()).find("<= 0.00039"), std::string::npos) << e.what();
+  }
+  s.spiral.end_radius = 5e-3;  // beyond the sample
+  try {
+    run_virtual_scan(s, surface, image_grid(s, 128));
+    FAIL() << "no error";
+  } catch (const afmkit::InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "end_radius");
+  }
+  EXPECT_THROW(image_grid(s, 1), afmkit::InvalidParameter);
+}
+
+}  // namespace
