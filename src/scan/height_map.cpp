@@ -12,14 +12,18 @@
 
 namespace afmkit::scan {
 
+void validate_grid(const Grid& grid) {
+  validate::require(grid.x_resolution >= 1, "x_resolution", static_cast<double>(grid.x_resolution), "an integer >= 1");
+  validate::require(grid.y_resolution >= 1, "y_resolution", static_cast<double>(grid.y_resolution), "an integer >= 1");
+  validate::positive("x_size", grid.x_size);
+  validate::positive("y_size", grid.y_size);
+  validate::finite("x_offset", grid.x_offset);
+  validate::finite("y_offset", grid.y_offset);
+}
+
 HeightMap::HeightMap(const Grid& grid, std::vector<double> data, std::string z_unit, std::vector<std::uint8_t> valid)
     : grid_(grid), data_(std::move(data)), z_unit_(std::move(z_unit)), valid_(std::move(valid)) {
-  validate::require(grid_.x_resolution >= 1, "x_resolution", static_cast<double>(grid_.x_resolution), "an integer >= 1");
-  validate::require(grid_.y_resolution >= 1, "y_resolution", static_cast<double>(grid_.y_resolution), "an integer >= 1");
-  validate::positive("x_size", grid_.x_size);
-  validate::positive("y_size", grid_.y_size);
-  validate::finite("x_offset", grid_.x_offset);
-  validate::finite("y_offset", grid_.y_offset);
+  validate_grid(grid_);
   detail::check_header_text("z_unit", z_unit_);
   const auto columns = static_cast<unsigned long>(grid_.x_resolution);
   const auto rows = static_cast<unsigned long>(grid_.y_resolution);

@@ -31,7 +31,7 @@ Plane fit_over(const HeightMap& map, const char* pixels, Use&& use) {
       sum_z += z[k];
     }
   if (count < 3)
-    throw InvalidParameter("map", fmt::format("a plane fit needs at least 3 {}; there are {}", pixels, count));
+    throw InvalidParameter("map", fmt::format("map: a plane fit needs at least 3 {}; there are {}", pixels, count));
   const double mean_i = sum_i / count, mean_j = sum_j / count, mean_z = sum_z / count;
   // Pass 2: centred second moments.
   double s_ii = 0, s_jj = 0, s_ij = 0, s_iz = 0, s_jz = 0;
@@ -54,7 +54,7 @@ Plane fit_over(const HeightMap& map, const char* pixels, Use&& use) {
   // non-degenerate set (e.g. 3 pixels in an L give 0.75).
   const double determinant = s_ii * s_jj - s_ij * s_ij;
   if (!(determinant > 1e-9 * s_ii * s_jj))
-    throw InvalidParameter("map", fmt::format("a plane fit needs {} that are not all on one straight line; "
+    throw InvalidParameter("map", fmt::format("map: a plane fit needs {} that are not all on one straight line; "
                                               "the {} there are lie on one line",
                                               pixels, count));
   const double slope_i = (s_iz * s_jj - s_jz * s_ij) / determinant;  // B, per column
@@ -100,7 +100,7 @@ HeightMap level(const HeightMap& map) { return subtract_plane(map, fit_plane(map
 double levelled_rms_difference(const HeightMap& image, const HeightMap& truth) {
   if (!same_grid(image.grid(), truth.grid()))
     throw InvalidParameter(
-        "map", fmt::format("the image grid ({} × {} pixels, {:g} m × {:g} m at ({:g}, {:g}) m) differs from the truth "
+        "map", fmt::format("map: the image grid ({} × {} pixels, {:g} m × {:g} m at ({:g}, {:g}) m) differs from the truth "
                            "grid ({} × {}, {:g} m × {:g} m at ({:g}, {:g}) m): they must be the same",
                            image.x_resolution(), image.y_resolution(), image.x_size(), image.y_size(),
                            image.x_offset(), image.y_offset(), truth.x_resolution(), truth.y_resolution(),

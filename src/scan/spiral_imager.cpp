@@ -26,12 +26,7 @@ constexpr int kMinTable = 16;
 constexpr int kMaxTable = 1 << 22;
 
 Grid checked(const Grid& grid) {
-  validate::require(grid.x_resolution >= 1, "x_resolution", static_cast<double>(grid.x_resolution), "an integer >= 1");
-  validate::require(grid.y_resolution >= 1, "y_resolution", static_cast<double>(grid.y_resolution), "an integer >= 1");
-  validate::positive("x_size", grid.x_size);
-  validate::positive("y_size", grid.y_size);
-  validate::finite("x_offset", grid.x_offset);
-  validate::finite("y_offset", grid.y_offset);
+  validate_grid(grid);
   constexpr long kMaxPixels = std::numeric_limits<std::uint32_t>::max();
   if (grid.x_resolution > kMaxPixels / grid.y_resolution)
     throw InvalidParameter("x_resolution",

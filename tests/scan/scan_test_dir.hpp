@@ -1,9 +1,14 @@
 #pragma once
-// A temporary folder for one test program's files, removed at the end; and helpers to read / write raw bytes.
+// A temporary folder for one test program's files, removed at the end; helpers to read / write raw bytes; and the
+// parameter an InvalidParameter names.
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+
+#include <gtest/gtest.h>
+
+#include "afmkit/core/error.hpp"
 
 #include <unistd.h>
 
@@ -29,6 +34,19 @@ inline std::string slurp(const std::string& path) {
 
 inline void spit(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
+}
+
+/// The parameter named by the InvalidParameter that `make()` throws (checking that its message names it too), or
+/// "(accepted)" when it throws nothing.
+template <class F>
+std::string rejected(F&& make) {
+  try {
+    make();
+  } catch (const afmkit::InvalidParameter& e) {
+    EXPECT_NE(std::string(e.what()).find(e.parameter()), std::string::npos) << e.what();
+    return e.parameter();
+  }
+  return "(accepted)";
 }
 
 }  // namespace scan_test

@@ -9,21 +9,14 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/scan/levelling.hpp"
+#include "scan_test_dir.hpp"
 
 using afmkit::InvalidParameter;
 using namespace afmkit::scan;
 
 namespace {
 
-template <class F>
-std::string rejected(F&& make) {
-  try {
-    make();
-  } catch (const InvalidParameter& e) {
-    return e.parameter();
-  }
-  return "(accepted)";
-}
+using scan_test::rejected;
 
 double centre_x(const Grid& g, long i) { return g.x_offset + (i + 0.5) * g.x_size / static_cast<double>(g.x_resolution); }
 double centre_y(const Grid& g, long j) { return g.y_offset + (j + 0.5) * g.y_size / static_cast<double>(g.y_resolution); }

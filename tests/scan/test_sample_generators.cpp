@@ -10,22 +10,14 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/scan/levelling.hpp"
 #include "afmkit/scan/sample_generators.hpp"
+#include "scan_test_dir.hpp"
 
 using afmkit::InvalidParameter;
 using namespace afmkit::scan;
 
 namespace {
 
-template <class F>
-std::string rejected(F&& make) {
-  try {
-    make();
-  } catch (const InvalidParameter& e) {
-    EXPECT_NE(std::string(e.what()).find(e.parameter()), std::string::npos) << e.what();
-    return e.parameter();
-  }
-  return "(accepted)";
-}
+using scan_test::rejected;
 
 // Centred grid of nx × ny square pixels of side `pixel`.
 Grid centred(long nx, long ny, double pixel) {

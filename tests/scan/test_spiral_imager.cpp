@@ -12,6 +12,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/scan/spiral_imager.hpp"
+#include "scan_test_dir.hpp"
 
 using afmkit::InvalidParameter;
 using afmkit::scan::Grid;
@@ -477,18 +478,7 @@ TEST(SpiralImager, LessThanOneTurnGivesNoImage) {
   EXPECT_TRUE(maps[1].has_mask());
 }
 
-namespace {
-template <class F>
-std::string rejected(F&& f) {
-  try {
-    f();
-  } catch (const InvalidParameter& e) {
-    EXPECT_NE(std::string(e.what()).find(e.parameter()), std::string::npos) << e.what();
-    return e.parameter();
-  }
-  return "(accepted)";
-}
-}  // namespace
+using scan_test::rejected;
 
 TEST(SpiralImager, BadInputIsNamed) {
   const Grid g{8, 8, 1e-6, 1e-6, -5e-7, -5e-7};

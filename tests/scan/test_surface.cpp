@@ -11,21 +11,14 @@
 #include "afmkit/scan/levelling.hpp"
 #include "afmkit/scan/sample_generators.hpp"
 #include "afmkit/scan/surface.hpp"
+#include "scan_test_dir.hpp"
 
 using afmkit::InvalidParameter;
 using namespace afmkit::scan;
 
 namespace {
 
-template <class F>
-std::string rejected(F&& make) {
-  try {
-    make();
-  } catch (const InvalidParameter& e) {
-    return e.parameter();
-  }
-  return "(accepted)";
-}
+using scan_test::rejected;
 
 // Values of f at the pixel centres of `grid`.
 template <class F>

@@ -27,6 +27,10 @@ struct Grid {
   double y_offset = 0.0;  ///< y of the top edge [m]
 };
 
+/// InvalidParameter naming the field: x_resolution / y_resolution < 1; x_size / y_size not positive and finite;
+/// x_offset / y_offset not finite.
+void validate_grid(const Grid& grid);
+
 class HeightMap {
  public:
   /// Validates and stores. InvalidParameter naming the field: x_resolution / y_resolution < 1; x_size / y_size not
