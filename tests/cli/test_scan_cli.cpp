@@ -4,6 +4,7 @@
 // input writes nothing.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -13,6 +14,7 @@
 #include "../scan/gwyddion_client.hpp"
 #include "afmkit/scan/gsf.hpp"
 #include "afmkit/scan/gxyzf.hpp"
+#include "afmkit/scan/png16.hpp"
 #include "cli_run.hpp"
 
 using afmkit_test::run_cli;
@@ -54,8 +56,8 @@ TEST(ScanCli, WritesImagesGwyddionOpensAndTheControllerBuysArea) {
   const std::string thumbnailer = gwyddion_client::find_thumbnailer();
   ASSERT_FALSE(thumbnailer.empty()) << gwyddion_client::missing_thumbnailer_message;
   int gsf_files = 0;
-  for (const std::string& name : {"deflection", "topography", "truth"})
-    for (const std::string& suffix : {"", "_mask"}) {
+  for (const std::string name : {"deflection", "topography", "truth"})
+    for (const std::string suffix : {"", "_mask"}) {
       const std::string path = dir.file("out/scan/scan_" + name + suffix + ".gsf");
       ASSERT_TRUE(std::filesystem::exists(path)) << path;
       const auto t = gwyddion_client::render(thumbnailer, path, dir.file("gwy_" + name + suffix));
@@ -100,7 +102,7 @@ TEST(ScanCli, WithoutControlTheDetectorSaturatesAndTheImageHasHoles) {
 TEST(ScanCli, RecordedSpiralRunsThroughTheFilter) {
   TempDir dir;
   const std::string source = std::string(AFMKIT_SOURCE_DIR) + "/examples/recorded/";
-  for (const std::string& file : {"spiral.csv", "spiral_index.csv"}) {
+  for (const std::string file : {"spiral.csv", "spiral_index.csv"}) {
     const auto r = run_cli("scan --recorded '" + source + file + "' --image-resolution 64 --image-output out/" + file +
                                " --output out/" + file + "_turns.csv --json",
                            dir);
@@ -123,12 +125,53 @@ TEST(ScanCli, RecordedSpiralRunsThroughTheFilter) {
 TEST(ScanCli, BadInputWritesNothing) {
   TempDir dir;
   dir.write("bad.gsf", "Gwyddion Simple Field 1.0\nXRes = 4\n");
-  for (const std::string& args :
+  for (const std::string args :
        {"scan --tilt-angle 95", "scan --radial-speed 0.1", "scan --sample file --sample-file bad.gsf",
         "scan --recorded missing.csv", "scan --recorded missing.csv --bandwidth 10"}) {
     const auto r = run_cli(args + " --output out/t.csv --image-output out/img --series-output out/s.csv", dir);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir.file("out"))) << args;
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// The sample from a file: a GSF (metres, its own size), an ASCII matrix and a 16-bit PNG (size and height scale
+// given): a constant height h comes back in the ground-truth image as h + the tilt plane (no tilt here: h).
+TEST(ScanCli, SampleFromGsfAsciiOrPng) {
+  TempDir dir;
+  const long n = 64;
+  const afmkit::scan::Grid g{n, n, 2e-3, 2e-3, 5.0, 7.0};  // offsets are ignored: the map is centred on the axis
+  afmkit::scan::write_gsf(dir.file("sample.gsf"), afmkit::scan::HeightMap(g, std::vector<double>(n * n, 3e-8)));
+  std::string ascii;
+  for (long j = 0; j < n; ++j) {
+    for (long i = 0; i < n; ++i) ascii += i ? " 30" : "30";
+    ascii += "\n";
+  }
+  dir.write("sample.txt", ascii);
+  afmkit::scan::Grey16 grey{n, n, std::vector<std::uint16_t>(n * n, 65535)};
+  {
+    std::ofstream png(dir.file("sample.png"), std::ios::binary);
+    png << afmkit::scan::format_png16(grey);
+  }
+  const std::string common = " --tilt-angle 0 --end-radius 0.9e-3 --sample-rate 20000 --image-resolution 32 "
+                             "--output \"\" --json --image-output out/";
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"gsf", "scan --sample file --sample-file sample.gsf"},
+      {"txt", "scan --sample file --sample-file sample.txt --sample-size 2e-3 --sample-z-scale 1e-9"},
+      {"png", "scan --sample file --sample-file sample.png --sample-size 2e-3 --sample-z-scale 3e-8"}};
+  for (const auto& [name, args] : runs) {
+    const auto r = run_cli(args + common + name, dir);
+    ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
+    const auto truth = afmkit::scan::read_gsf_with_mask(dir.file("out/" + name + "_truth.gsf"),
+                                                        dir.file("out/" + name + "_truth_mask.gsf"));
+    ASSERT_GT(truth.map.valid_count(), 100u) << name;
+    for (double z : truth.map.data())
+      if (std::isfinite(z)) {
+        ASSERT_NEAR(z, 3e-8, 1e-7 * 3e-8) << name;  // float32 (2^-24 relative) in the files
+      }
   }
 }
 
