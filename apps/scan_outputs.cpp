@@ -23,8 +23,8 @@ std::vector<io::Column> series_columns(bool recorded) {
           {"angle", "rad", "spindle angle theta = Omega t, unwrapped"},
           {"deflection", "m", "detector reading d (clamped to +-detector_range)"},
           {"control", "m/s", "controller output u (seed 2, eq. 1)"},
-          {"actuator", "m", "calibrated actuator motion (nominal plant response to u)"},
-          {"topography", "m", "reconstructed height: deflection - actuator"},
+          {"actuator", "m", "calibrated actuator displacement (minus the nominal plant response to u)"},
+          {"topography", "m", "reconstructed height: deflection + actuator"},
           {"surface", "m", "true height under the tip (topography + tilt)"},
           {"saturated", "boolean", "1 when the detector saturated at this sample"}};
 }

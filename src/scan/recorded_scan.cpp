@@ -127,7 +127,7 @@ RecordedScan filter_recorded_scan(const std::string& path, const RecordedSurvey&
     const double m = in.deflection + previous_u / gain;
     const double u = filter.step(m);
     previous_u = u;
-    const ScanSample s{n, in.time, in.angle, in.radius, in.deflection, in.deflection, u, -u / gain, m, false};
+    const ScanSample s{n, in.time, in.angle, in.radius, in.deflection, in.deflection, u, m - in.deflection, m, false};
     const double values[2] = {in.deflection, m};
     imager.add(in.angle, in.radius, values);
     swapped.sample(s);

@@ -112,7 +112,7 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
       ++run.saturated_samples;
     }
     ++run.samples;
-    const ScanSample s{n, t, theta, r, f, d, u, y_hat, d - y_hat, saturated};
+    const ScanSample s{n, t, theta, r, f, d, u, -y_hat, d - y_hat, saturated};
     if (!observer.sample(s)) {
       run.stopped_early = true;
       break;

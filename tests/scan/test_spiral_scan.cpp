@@ -89,7 +89,7 @@ TEST(SpiralScan, ReconstructionEqualsTheUncontrolledDeflectionAndGainErrorShowsE
     ASSERT_EQ(on.samples.size(), reference.samples.size());
     double worst = 0, scale = 0, actuator = 0;
     for (std::size_t i = 0; i < on.samples.size(); ++i) {
-      const double predicted = reference.samples[i].deflection + eps * on.samples[i].actuator;
+      const double predicted = reference.samples[i].deflection - eps * on.samples[i].actuator;  // z_a = −ŷ_u
       worst = std::max(worst, std::abs(on.samples[i].topography - predicted));
       scale = std::max(scale, std::abs(reference.samples[i].deflection));
       actuator = std::max(actuator, std::abs(on.samples[i].actuator));

@@ -11,8 +11,8 @@
 // The deflection detector reads d = clamp(y + n, −R_d, R_d) (n: white Gaussian noise of RMS σ_d; beyond the linear
 // range ±R_d the reading saturates). The controller of seed 2 (bank of N oscillators, couplings (20), gain K;
 // eqs. 15, 6, 20) runs on the samples d_n through control::RealtimeFilter, exactly as it would be embedded.
-// The topography is reconstructed as d − ŷ_u, ŷ_u the calibrated actuator motion: the response of the nominal
-// plant (γ, τ, ε = 0, no drift) to u.
+// The topography is reconstructed as d + z_a: the deflection plus the calibrated actuator displacement z_a = −ŷ_u,
+// ŷ_u the response of the nominal plant (γ, τ, ε = 0, no drift) to u.
 #include <cstdint>
 
 namespace afmkit::scan {

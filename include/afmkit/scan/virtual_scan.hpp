@@ -39,7 +39,7 @@ struct VirtualScanOptions {
 struct VirtualScan {
   ScanRun run;
   HeightMap deflection;   ///< image of the detector reading d [m]
-  HeightMap topography;   ///< image of the reconstruction d − ŷ_u [m]
+  HeightMap topography;   ///< image of the reconstruction d + z_a (deflection + actuator displacement) [m]
   HeightMap truth;        ///< the surface (tilt included) at the pixel centres, valid where `topography` is [m]
   std::int64_t turns = 0;
   double saturated_fraction = 0.0;        ///< saturated samples / samples of the main run
