@@ -1,7 +1,6 @@
 #pragma once
 // Outputs of `afmkit scan` shared by the simulated and the recorded scan: the optional time series (CSV), the
 // optional point cloud (GXYZF) and the images (GSF + mask, PNG preview). Every file is written atomically.
-#include <optional>
 #include <string>
 #include <vector>
 

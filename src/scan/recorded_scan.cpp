@@ -107,7 +107,6 @@ RecordedScan filter_recorded_scan(const std::string& path, const RecordedFilterS
 RecordedScan filter_recorded_scan(const std::string& path, const RecordedSurvey& survey, const Grid& grid,
                                   const RecordedFilterSpec& spec, const RecordedScanOptions& options) {
   const double omega = survey.rotation_frequency;
-  constexpr double gain = kGain;
   control::RealtimeFilter filter = filter_for(survey, spec);
 
   const auto per_turn = static_cast<int>(std::clamp(std::round(kTwoPi * survey.sample_rate / omega), 16.0, 4194304.0));
@@ -124,7 +123,7 @@ RecordedScan filter_recorded_scan(const std::string& path, const RecordedSurvey&
   double previous_u = 0.0;
   std::int64_t n = 0;
   while (reader.next(in)) {
-    const double m = in.deflection + previous_u / gain;
+    const double m = in.deflection + previous_u / kGain;
     const double u = filter.step(m);
     previous_u = u;
     const ScanSample s{n, in.time, in.angle, in.radius, in.deflection, in.deflection, u, m - in.deflection, m, false};
