@@ -1,9 +1,12 @@
 // Speed of the seed-2 real-time filter and closed-loop simulation.
 // Targets: RealtimeFilter::step ≥ 20 million samples/s at N = 10 (≤ 50 ns/sample) on one core;
+//          RealtimeFilter::step_block ≥ 100 MS/s at N = 10 and ≥ 20 MS/s at N = 50 (BM_RealtimeFilterBlockVsStep
+//          prints both paths and their ratio, measured in the same run);
 //          100-period closed loop, 2000 steps per period, N = 10: ≤ 50 ms;
 //          filter set-up at N = 1000: ≤ 0.1 s.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -54,7 +57,40 @@ void BM_RealtimeFilterStepBlock(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * static_cast<long>(in.size()));  // ns/sample = 1e9/items_per_second
 }
-BENCHMARK(BM_RealtimeFilterStepBlock)->Arg(10);
+BENCHMARK(BM_RealtimeFilterStepBlock)->Arg(1)->Arg(10)->Arg(50);
+
+// The block path against the per-sample path, interleaved in the same iterations (same machine state): counters
+// block_MSps, step_MSps and speedup = step time / block time (they give the same bits, test_realtime_block.cpp).
+void BM_RealtimeFilterBlockVsStep(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const double fs = std::max(2000.0, 40.0 * n) / kT;
+  auto fb = RealtimeFilter::with_couplings(fs, 1.0, n, 0.1, -0.1, 20.0);
+  if (state.range(1) == 1) fb.set_vectorisation(RealtimeFilter::Vectorisation::Portable);  // 16-byte vectors only
+  auto fstep = fb;
+  const auto in = input_signal(4096);
+  std::vector<double> out(in.size()), out_step(in.size());
+  using clock = std::chrono::steady_clock;
+  double t_block = 0.0, t_step = 0.0;
+  for (auto _ : state) {
+    const auto t0 = clock::now();
+    fb.step_block(in, out);
+    benchmark::ClobberMemory();
+    const auto t1 = clock::now();
+    for (std::size_t i = 0; i < in.size(); ++i) out_step[i] = fstep.step(in[i]);
+    benchmark::ClobberMemory();
+    const auto t2 = clock::now();
+    t_block += std::chrono::duration<double>(t1 - t0).count();
+    t_step += std::chrono::duration<double>(t2 - t1).count();
+    benchmark::DoNotOptimize(out.data());
+    benchmark::DoNotOptimize(out_step.data());
+  }
+  const double samples = static_cast<double>(state.iterations()) * static_cast<double>(in.size());
+  state.counters["block_MSps"] = samples / t_block * 1e-6;
+  state.counters["step_MSps"] = samples / t_step * 1e-6;
+  state.counters["speedup"] = t_step / t_block;
+  state.counters["wide"] = fb.uses_wide_vectors() ? 1 : 0;
+}
+BENCHMARK(BM_RealtimeFilterBlockVsStep)->ArgsProduct({{1, 10, 50, 200}, {0, 1}})->ArgNames({"N", "portable"});
 
 // Set-up of the zero-order-hold filter (what afmkit_filter_create does): O(N²) time, O(N) memory, modal form.
 // Target (issue 12): N = 1000 in under 0.1 s.

@@ -59,6 +59,28 @@
 
 namespace afmkit::control {
 
+/// The ZeroOrderHold filter in real modal coordinates, as the per-sample recursion runs it (for exporters such as
+/// the embedded C core). With the input m_n, per sample:
+///   u_n = Σ_pairs (w1 q1 + w2 q2) + Σ_reals w q                     (output from the old state)
+///   pair:  q1 ← c1 q1 + s1 q2 + g1 m,   q2 ← c2 q2 + s2 q1 + g2 m    (a damped rotation, c1 = c2 = Re e^{μh},
+///          s2 = −s1 = Im e^{μh}, μ = conj λ)
+///   real:  q ← r q + g m
+/// A skipped sample is replaced by the coasting input m = Σ_pairs (e1 q1 + e2 q2) + Σ_reals e q.
+struct ModalCoefficients {
+  struct Pair {
+    double c1, s1, c2, s2, g1, g2, w1, w2, e1, e2;
+    std::complex<double> eigenvalue;  // λ of the continuous controller [rad/s], Im λ > 0
+    int rejected_harmonic;            // k when λ = ikΩ is the exact mode of a rejected oscillator, else 0
+  };
+  struct Real {
+    double r, g, w, e;
+    double eigenvalue;  // λ [1/s]
+  };
+  std::vector<Pair> pairs;
+  std::vector<Real> reals;
+  double sample_rate = 0.0;  // f_s [samples/s]
+};
+
 class RealtimeFilter {
  public:
   /// sample_rate f_s [samples/s] with Ω in rad/s. Validated: f_s finite and N Ω < π f_s (Nyquist for the highest
@@ -76,8 +98,18 @@ class RealtimeFilter {
 
   /// Output u_n for the measured sample m_n (see above). noexcept, O(N).
   double step(double measured) noexcept;
-  /// step() for each sample; in and out may alias; processes min(in.size(), out.size()) samples.
+  /// step() for each sample, with the same result bit for bit; in and out may alias; processes
+  /// min(in.size(), out.size()) samples. For the modal form the state stays in registers across the block
+  /// (N ≤ 11) and the modes are updated four lanes at a time (bench/bench_control_sim.cpp).
   void step_block(std::span<const double> in, std::span<double> out) noexcept;
+
+  /// Vector width of the modal kernel: Auto = 32-byte vectors (AVX2) where the processor has them, else 16-byte
+  /// ones; Portable = 16-byte vectors always. Every lane does the same operations in the same order, so the outputs
+  /// are the same bits either way (tests/control_sim/test_realtime_block.cpp); for timing and for such checks.
+  enum class Vectorisation { Auto, Portable };
+  void set_vectorisation(Vectorisation v) noexcept;
+  /// Whether step_block() runs the 32-byte build (step() always runs the 16-byte one, inlined).
+  bool uses_wide_vectors() const noexcept { return wide_; }
 
   /// Bumpless change of all parameters (see above).
   void reconfigure(const OscillatorBank& controller, double sample_rate);
@@ -118,6 +150,11 @@ class RealtimeFilter {
   SampledForm form() const noexcept { return form_; }
   /// ZeroOrderHold form running in modal coordinates (O(N)); false for the dense fallback and for the block form.
   bool uses_modal_form() const noexcept { return disc_.kind == Kind::Modal; }
+  /// The modal recursion's coefficients (see ModalCoefficients). Throws InvalidParameter("form") unless
+  /// uses_modal_form().
+  ModalCoefficients modal_coefficients() const;
+  /// The internal modal state (pairs (q1, q2), then reals), the q of ModalCoefficients; same precondition.
+  std::vector<double> modal_state() const;
 
   /// The sampled controller in the oscillator coordinates, z_{n+1} = Φ z_n + Γ m_n, u_n = C z_n (dense Φ, Γ, C),
   /// reconstructed from the internal form; for tests and inspection (O(N³) time, O(N²) memory).
@@ -147,23 +184,32 @@ class RealtimeFilter {
       int rejected = 0;                // k for the exact mode ikΩ of a rejected oscillator, else 0
     };
     std::vector<Mode> modes;    // modal: pairs, then reals (physical z = V q, V never stored)
+    // modal, as the per-sample kernel runs it (src/control/sim/modal_kernel.hpp): the modes in groups of four lanes,
+    // 40 coefficients per group; the state q_ is then q1 of every lane, then q2 (8·groups doubles)
+    int groups = 0;
+    std::vector<double> packed;
     std::uint64_t fingerprint = 0;
   };
   static Discretisation discretise(const OscillatorBank& bank, double sample_rate, SampledForm form);
   static Discretisation modal(const OscillatorBank& bank, double sample_rate, bool& ok);
   static Eigen::VectorXd to_physical(const OscillatorBank& bank, const Discretisation& d, const double* q);
   static Eigen::VectorXd to_internal(const OscillatorBank& bank, const Discretisation& d, const Eigen::VectorXd& z);
-  double advance(double m) noexcept;
+  double advance(double m) noexcept;             // block form and dense fallback, one sample
+  void run_modal(const double* in, double* out, std::size_t n) noexcept;  // modal form, n samples
   double coast_input() const noexcept;
   void load_physical(const Eigen::VectorXd& z);  // q = V⁻¹ z
+  // internal coordinates in the documented order (pairs (q1, q2), then reals) ↔ the kernel's layout of q_
+  static std::vector<double> pack(const Discretisation& d, const double* internal);
+  std::vector<double> internal_state() const;
 
   OscillatorBank bank_;
   double sample_rate_;
   SampledForm form_;
   Discretisation disc_;
-  std::vector<double> q_, q_tmp_;  // internal coordinates: modal ((q1, q2) per pair, then reals) or physical
+  std::vector<double> q_, q_tmp_;  // internal coordinates: modal (the kernel's layout, see pack()) or physical
   double held_ = 0.0;
   double input_limit_ = kDefaultInputLimit;
+  bool wide_ = false;  // modal kernel: the AVX2 build (x86-64 with AVX2; the same bits as the portable one)
   std::uint64_t skipped_ = 0, samples_ = 0;
 };
 

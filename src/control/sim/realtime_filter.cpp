@@ -11,6 +11,7 @@
 #include "afmkit/control/discretisation.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
+#include "modal_kernel.hpp"
 #include "pair_kernels.hpp"
 
 namespace afmkit::control {
@@ -305,6 +306,24 @@ RealtimeFilter::Discretisation RealtimeFilter::modal(const OscillatorBank& bank,
       d.e.push_back(e.real());
     }
   }
+  // the kernel's layout: mode j (pairs, then reals) in group j/4, lane j%4 (modal_kernel.hpp)
+  const int modes = d.pairs + d.reals;
+  d.groups = (modes + 3) / 4;
+  d.packed.assign(static_cast<std::size_t>(d.groups) * detail::kGroupDoubles, 0.0);
+  for (int j = 0; j < modes; ++j) {
+    double* g = d.packed.data() + static_cast<std::size_t>(j / 4) * detail::kGroupDoubles + j % 4;
+    auto put = [&](detail::Coef k, double v) { g[4 * k] = v; };
+    if (j < d.pairs) {  // c = c1 = c2 and s = s2 = −s1 exactly (a damped rotation): q1 ← c q1 − s q2, q2 ← c q2 + s q1
+      put(detail::kC, d.c[2 * j]), put(detail::kS, d.s[2 * j + 1]);
+      put(detail::kG1, d.g[2 * j]), put(detail::kG2, d.g[2 * j + 1]);
+      put(detail::kW1, d.w[2 * j]), put(detail::kW2, d.w[2 * j + 1]);
+      put(detail::kE1, d.e[2 * j]), put(detail::kE2, d.e[2 * j + 1]);
+    } else {  // a real mode in q1 (its q2, s, g2, w2, e2 stay 0)
+      const int i = j - d.pairs;
+      put(detail::kC, d.r[i]), put(detail::kG1, d.gr[i]);
+      put(detail::kW1, d.w[2 * d.pairs + i]), put(detail::kE1, d.e[2 * d.pairs + i]);
+    }
+  }
   const double cond = std::sqrt(v_frob2 * u_frob2);  // ‖V‖_F ‖V⁻¹‖_F, as for a dense eigenvector basis
   ok = std::isfinite(cond) && cond < 1e8 && cond * worst_residual < 1e-10;
   for (const auto* v : {&d.c, &d.s, &d.g, &d.w, &d.e, &d.r, &d.gr})
@@ -352,8 +371,35 @@ Eigen::VectorXd RealtimeFilter::to_internal(const OscillatorBank& bank, const Di
 
 RealtimeFilter::RealtimeFilter(const OscillatorBank& controller, double sample_rate, SampledForm form)
     : bank_(controller), sample_rate_(sample_rate), form_(form), disc_(discretise(controller, sample_rate, form)) {
-  q_.assign(static_cast<std::size_t>(disc_.n), 0.0);
-  q_tmp_ = q_;
+  q_ = pack(disc_, std::vector<double>(static_cast<std::size_t>(disc_.n), 0.0).data());
+  q_tmp_.assign(static_cast<std::size_t>(disc_.n), 0.0);
+  wide_ = detail::modal_wide_available();
+}
+
+std::vector<double> RealtimeFilter::pack(const Discretisation& d, const double* internal) {
+  if (d.kind != Kind::Modal) return std::vector<double>(internal, internal + d.n);
+  std::vector<double> q(static_cast<std::size_t>(8 * d.groups), 0.0);
+  const std::size_t second = static_cast<std::size_t>(4 * d.groups);  // q2 of lane j at second + j
+  for (int j = 0; j < d.pairs; ++j) {
+    q[static_cast<std::size_t>(j)] = internal[2 * j];
+    q[second + static_cast<std::size_t>(j)] = internal[2 * j + 1];
+  }
+  for (int i = 0; i < d.reals; ++i) q[static_cast<std::size_t>(d.pairs + i)] = internal[2 * d.pairs + i];
+  return q;
+}
+
+std::vector<double> RealtimeFilter::internal_state() const {
+  const Discretisation& d = disc_;
+  if (d.kind != Kind::Modal) return q_;
+  std::vector<double> z(static_cast<std::size_t>(d.n));
+  const std::size_t second = static_cast<std::size_t>(4 * d.groups);
+  for (int j = 0; j < d.pairs; ++j) {
+    z[static_cast<std::size_t>(2 * j)] = q_[static_cast<std::size_t>(j)];
+    z[static_cast<std::size_t>(2 * j + 1)] = q_[second + static_cast<std::size_t>(j)];
+  }
+  for (int i = 0; i < d.reals; ++i)
+    z[static_cast<std::size_t>(2 * d.pairs + i)] = q_[static_cast<std::size_t>(d.pairs + i)];
+  return z;
 }
 
 RealtimeFilter RealtimeFilter::with_couplings(double fs, double omega, int n, double alpha, double beta,
@@ -364,18 +410,7 @@ RealtimeFilter RealtimeFilter::with_couplings(double fs, double omega, int n, do
 double RealtimeFilter::advance(double m) noexcept {
   const Discretisation& d = disc_;
   double* q = q_.data();
-  if (d.kind == Kind::Modal) {
-    const int p = d.pairs, np = 2 * p;
-    // output from the old state, damped rotation of every modal pair, then the real modes
-    double u = detail::rotate_pairs_dot(q, d.c.data(), d.s.data(), d.g.data(), d.w.data(), m, p);
-    for (int j = 0; j < d.reals; ++j) {
-      const double x = q[np + j];
-      u += d.w[np + j] * x;
-      q[np + j] = d.r[j] * x + d.gr[j] * m;
-    }
-    return u;
-  }
-  if (d.kind == Kind::Block) {
+  if (d.kind == Kind::Block) {  // (the modal form runs in run_modal)
     double kept_sum, u;
     detail::accumulate_first(d.kw.data(), q + 1, d.pairs, kept_sum, u);  // Σ_kept x_k, −K Σ_rej x_k
     const double e = m - q[0] - kept_sum;                               // e_n, held over the step
@@ -400,12 +435,7 @@ double RealtimeFilter::advance(double m) noexcept {
 double RealtimeFilter::coast_input() const noexcept {
   const Discretisation& d = disc_;
   const double* q = q_.data();
-  if (d.kind == Kind::Modal) {
-    double m = detail::dot_pairs(d.e.data(), q, d.pairs);
-    for (int j = 0; j < d.reals; ++j) m += d.e[2 * d.pairs + j] * q[2 * d.pairs + j];
-    return m;
-  }
-  if (d.kind == Kind::Block) {
+  if (d.kind == Kind::Block) {  // (the modal form coasts in run_modal)
     double kept_sum, u;
     detail::accumulate_first(d.kw.data(), q + 1, d.pairs, kept_sum, u);
     return q[0] + kept_sum;
@@ -415,7 +445,21 @@ double RealtimeFilter::coast_input() const noexcept {
   return m;
 }
 
+void RealtimeFilter::run_modal(const double* in, double* out, std::size_t n) noexcept {
+  detail::ModalRun run{disc_.packed.data(), disc_.groups, input_limit_, held_, skipped_};
+  if (n == 1 && !wide_) detail::modal_block_portable(run, q_.data(), in, out, 1);  // inlined, state in memory
+  else detail::modal_block_dispatch(wide_, run, q_.data(), in, out, n);
+  held_ = run.held;
+  skipped_ = run.skipped;
+  samples_ += n;
+}
+
 double RealtimeFilter::step(double measured) noexcept {
+  if (disc_.kind == Kind::Modal) {
+    double u;
+    run_modal(&measured, &u, 1);
+    return u;
+  }
   ++samples_;
   if (!(std::abs(measured) <= input_limit_)) {  // NaN, ±inf and |m| > input_limit(): skipped
     ++skipped_;
@@ -428,17 +472,21 @@ double RealtimeFilter::step(double measured) noexcept {
 
 void RealtimeFilter::step_block(std::span<const double> in, std::span<double> out) noexcept {
   const std::size_t n = std::min(in.size(), out.size());
+  if (disc_.kind == Kind::Modal) {
+    run_modal(in.data(), out.data(), n);
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) out[i] = step(in[i]);
 }
 
 Eigen::VectorXd RealtimeFilter::controller_state() const {
-  return to_physical(bank_, disc_, q_.data());
+  return to_physical(bank_, disc_, internal_state().data());
 }
 
 void RealtimeFilter::load_physical(const Eigen::VectorXd& z) {
   const Eigen::VectorXd q = to_internal(bank_, disc_, z);
-  q_.assign(q.data(), q.data() + q.size());
-  q_tmp_.assign(q_.size(), 0.0);
+  q_ = pack(disc_, q.data());
+  q_tmp_.assign(static_cast<std::size_t>(disc_.n), 0.0);
 }
 
 void RealtimeFilter::set_controller_state(const Eigen::VectorXd& z) {
@@ -463,7 +511,7 @@ void RealtimeFilter::reconfigure(const OscillatorBank& controller, double sample
     }
   }
   const Eigen::VectorXd q = to_internal(controller, d, z);
-  std::vector<double> qv(q.data(), q.data() + q.size()), tmp(qv.size(), 0.0);
+  std::vector<double> qv = pack(d, q.data()), tmp(static_cast<std::size_t>(d.n), 0.0);
   OscillatorBank bank = controller;
   // commit (no throwing operations below)
   bank_ = std::move(bank);
@@ -475,6 +523,10 @@ void RealtimeFilter::reconfigure(const OscillatorBank& controller, double sample
 }
 
 void RealtimeFilter::set_gain(double gain) { reconfigure(bank_.with_gain(gain), sample_rate_); }
+
+void RealtimeFilter::set_vectorisation(Vectorisation v) noexcept {
+  wide_ = v == Vectorisation::Auto && detail::modal_wide_available();
+}
 
 void RealtimeFilter::set_input_limit(double limit) {
   if (!(limit > 0.0 && limit <= kDefaultInputLimit))
@@ -493,7 +545,7 @@ void RealtimeFilter::reset() noexcept {
   samples_ = 0;
 }
 
-std::size_t RealtimeFilter::state_size() const noexcept { return kHeader + q_.size() + static_cast<std::size_t>(disc_.n); }
+std::size_t RealtimeFilter::state_size() const noexcept { return kHeader + 2 * static_cast<std::size_t>(disc_.n); }
 
 void RealtimeFilter::save_state(std::span<double> out) const {
   if (out.size() < state_size())
@@ -502,16 +554,17 @@ void RealtimeFilter::save_state(std::span<double> out) const {
   out[0] = kMagic;
   out[1] = kLayoutVersion;
   out[2] = bank_.harmonics();
-  out[3] = static_cast<double>(q_.size());
+  out[3] = disc_.n;  // internal coordinates in the documented order (not the kernel's lanes)
   out[4] = static_cast<double>(disc_.fingerprint >> 32);
   out[5] = static_cast<double>(disc_.fingerprint & 0xffffffffULL);
   out[6] = held_;
   out[7] = static_cast<double>(skipped_);
   out[8] = static_cast<double>(samples_);
   out[9] = disc_.n;
-  std::copy(q_.begin(), q_.end(), out.begin() + kHeader);
-  const Eigen::VectorXd z = controller_state();
-  std::copy(z.data(), z.data() + z.size(), out.begin() + kHeader + q_.size());
+  const std::vector<double> q = internal_state();
+  std::copy(q.begin(), q.end(), out.begin() + kHeader);
+  const Eigen::VectorXd z = to_physical(bank_, disc_, q.data());
+  std::copy(z.data(), z.data() + z.size(), out.begin() + kHeader + disc_.n);
 }
 
 std::vector<double> RealtimeFilter::save_state() const {
@@ -535,19 +588,46 @@ void RealtimeFilter::restore_state(std::span<const double> in) {
     if (i > 6 && (in[i] < 0 || in[i] != std::floor(in[i]))) bad("negative or fractional counter");
   const std::uint64_t fp = (static_cast<std::uint64_t>(in[4]) << 32) | static_cast<std::uint64_t>(in[5]);
   std::vector<double> qv;
-  if (fp == disc_.fingerprint && static_cast<std::size_t>(ni) == q_.size()) {
-    qv.assign(in.begin() + kHeader, in.begin() + kHeader + static_cast<std::ptrdiff_t>(ni));  // bit for bit
+  if (fp == disc_.fingerprint && ni == disc_.n) {
+    qv = pack(disc_, in.data() + kHeader);  // bit for bit
   } else {
     const auto off = static_cast<std::ptrdiff_t>(kHeader + static_cast<std::size_t>(ni));
     Eigen::VectorXd z(static_cast<Eigen::Index>(np));
     for (Eigen::Index i = 0; i < z.size(); ++i) z(i) = in[off + i];
     const Eigen::VectorXd q = to_internal(bank_, disc_, map_state(z, bank_.harmonics()));
-    qv.assign(q.data(), q.data() + q.size());
+    qv = pack(disc_, q.data());
   }
   q_.swap(qv);
   held_ = in[6];
   skipped_ = static_cast<std::uint64_t>(in[7]);
   samples_ = static_cast<std::uint64_t>(in[8]);
+}
+
+ModalCoefficients RealtimeFilter::modal_coefficients() const {
+  const Discretisation& d = disc_;
+  if (d.kind != Kind::Modal)
+    throw InvalidParameter("form", "modal coefficients exist only for the zero-order-hold form in modal coordinates "
+                                   "(uses_modal_form() is false: block form or dense fallback)");
+  ModalCoefficients mc;
+  mc.sample_rate = sample_rate_;
+  for (int j = 0; j < d.pairs; ++j) {
+    const auto i = static_cast<std::size_t>(2 * j);
+    mc.pairs.push_back({d.c[i], d.s[i], d.c[i + 1], d.s[i + 1], d.g[i], d.g[i + 1], d.w[i], d.w[i + 1], d.e[i],
+                        d.e[i + 1], d.modes[static_cast<std::size_t>(j)].lambda,
+                        d.modes[static_cast<std::size_t>(j)].rejected});
+  }
+  for (int j = 0; j < d.reals; ++j) {
+    const auto i = static_cast<std::size_t>(2 * d.pairs + j);
+    mc.reals.push_back({d.r[static_cast<std::size_t>(j)], d.gr[static_cast<std::size_t>(j)], d.w[i], d.e[i],
+                        d.modes[static_cast<std::size_t>(d.pairs + j)].lambda.real()});
+  }
+  return mc;
+}
+
+std::vector<double> RealtimeFilter::modal_state() const {
+  if (disc_.kind != Kind::Modal)
+    throw InvalidParameter("form", "the modal state exists only for the zero-order-hold form in modal coordinates");
+  return internal_state();
 }
 
 Eigen::MatrixXd RealtimeFilter::transition_matrix() const {

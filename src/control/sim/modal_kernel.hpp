@@ -1,0 +1,269 @@
+#pragma once
+// Internal: the per-sample recursion of RealtimeFilter's modal (ZeroOrderHold) form, vectorised across modes.
+//
+// The modes (damped rotations, then real modes) sit in lanes of four: mode j in group j/4, lane j%4. A group holds
+// the coefficients of its four modes as ten four-lane vectors and its state as two (q1, q2); a real mode uses q1
+// only (c2 = s1 = s2 = g2 = w2 = e2 = 0, so its q2 stays 0), unused lanes are all zero. Per sample, with the input m:
+//   acc += w1 q1 + w2 q2                                   (output from the old state)
+//   q1 ← (c1 q1 + s1 q2) + g1 m,   q2 ← (c2 q2 + s2 q1) + g2 m
+//   u = (acc0 + acc2) + (acc1 + acc3)
+// Every lane does the same IEEE operations in the same order whatever the vector width the compiler uses (two SSE2
+// halves, one AVX register, NEON pairs) and the floating-point contraction is off (ISO C++), so the block path
+// (state in registers across samples) and the per-sample path (state in memory) give the same bits.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+namespace afmkit::control::detail {
+
+#if !(defined(__GNUC__) || defined(__clang__))
+#error "modal_kernel.hpp needs the GCC/Clang vector extensions"
+#endif
+#define AFMKIT_ALWAYS_INLINE [[gnu::always_inline]] inline
+#if !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // 32-byte vectors pass between inlined helpers only, never across an ABI
+#endif
+
+// Coefficients of group g: kGroupDoubles doubles from 32·g, eight runs of four lanes in this order.
+enum Coef { kC, kS, kG1, kG2, kW1, kW2, kE1, kE2, kCoefs };
+inline constexpr int kGroupDoubles = 4 * kCoefs;
+
+// Four lanes of doubles, in two spellings with the same per-lane arithmetic and the same lane sum
+// (a0 + a2) + (a1 + a3): Pair2 = two 16-byte halves (SSE2 on any x86-64, NEON on 64-bit ARM), Wide4 = one 32-byte
+// register (AVX; used when the processor has AVX2, chosen at run time).
+typedef double v2d __attribute__((vector_size(16)));
+typedef double v4d __attribute__((vector_size(32)));
+struct Pair2 {
+  v2d lo, hi;
+  AFMKIT_ALWAYS_INLINE static Pair2 load(const double* p) noexcept {
+    Pair2 v;
+    std::memcpy(&v.lo, p, sizeof v.lo);
+    std::memcpy(&v.hi, p + 2, sizeof v.hi);
+    return v;
+  }
+  AFMKIT_ALWAYS_INLINE void store(double* p) const noexcept {
+    std::memcpy(p, &lo, sizeof lo);
+    std::memcpy(p + 2, &hi, sizeof hi);
+  }
+  AFMKIT_ALWAYS_INLINE static Pair2 broadcast(double x) noexcept {
+    Pair2 v;
+    v.lo = v2d{x, x};
+    v.hi = v.lo;
+    return v;
+  }
+  AFMKIT_ALWAYS_INLINE friend Pair2 operator+(Pair2 a, Pair2 b) noexcept {
+    a.lo += b.lo;
+    a.hi += b.hi;
+    return a;
+  }
+  AFMKIT_ALWAYS_INLINE friend Pair2 operator-(Pair2 a, Pair2 b) noexcept {
+    a.lo -= b.lo;
+    a.hi -= b.hi;
+    return a;
+  }
+  AFMKIT_ALWAYS_INLINE friend Pair2 operator*(Pair2 a, Pair2 b) noexcept {
+    a.lo *= b.lo;
+    a.hi *= b.hi;
+    return a;
+  }
+  AFMKIT_ALWAYS_INLINE double lane_sum() const noexcept {
+    const v2d t = lo + hi;  // (a0 + a2, a1 + a3)
+    return t[0] + t[1];
+  }
+};
+struct Wide4 {
+  v4d v;
+  AFMKIT_ALWAYS_INLINE static Wide4 load(const double* p) noexcept {
+    Wide4 x;
+    std::memcpy(&x.v, p, sizeof x.v);
+    return x;
+  }
+  AFMKIT_ALWAYS_INLINE void store(double* p) const noexcept { std::memcpy(p, &v, sizeof v); }
+  AFMKIT_ALWAYS_INLINE static Wide4 broadcast(double x) noexcept {
+    Wide4 w;
+    w.v = v4d{x, x, x, x};
+    return w;
+  }
+  AFMKIT_ALWAYS_INLINE friend Wide4 operator+(Wide4 a, Wide4 b) noexcept {
+    a.v += b.v;
+    return a;
+  }
+  AFMKIT_ALWAYS_INLINE friend Wide4 operator-(Wide4 a, Wide4 b) noexcept {
+    a.v -= b.v;
+    return a;
+  }
+  AFMKIT_ALWAYS_INLINE friend Wide4 operator*(Wide4 a, Wide4 b) noexcept {
+    a.v *= b.v;
+    return a;
+  }
+  AFMKIT_ALWAYS_INLINE double lane_sum() const noexcept { return (v[0] + v[2]) + (v[1] + v[3]); }
+};
+
+struct ModalRun {  // the coefficients, and what one call updates (held output, skipped count)
+  const double* groups;  // group_count · kGroupDoubles coefficients
+  int group_count;
+  double input_limit;
+  double held;
+  std::uint64_t skipped;
+};
+
+AFMKIT_ALWAYS_INLINE double lane_sum(v4d a) noexcept { return (a[0] + a[2]) + (a[1] + a[3]); }
+
+/// The state of the groups, q1 of every group first, then q2 (8·G doubles), read and written group by group.
+template <class V>
+struct MemoryState {
+  double* s;
+  int groups;
+  AFMKIT_ALWAYS_INLINE V a(int g) const noexcept { return V::load(s + 4 * g); }
+  AFMKIT_ALWAYS_INLINE V b(int g) const noexcept { return V::load(s + 4 * (groups + g)); }
+  AFMKIT_ALWAYS_INLINE void set(int g, V x, V y) noexcept {
+    x.store(s + 4 * g);
+    y.store(s + 4 * (groups + g));
+  }
+};
+
+template <class V>
+AFMKIT_ALWAYS_INLINE V coef(const double* cf, int g, Coef k) noexcept {
+  return V::load(cf + kGroupDoubles * g + 4 * k);
+}
+
+/// Σ e·q of the current state (the coasting input for a skipped sample).
+template <class V, class State>
+AFMKIT_ALWAYS_INLINE double coast_input(const double* cf, const State& st, int groups) noexcept {
+  V acc = V::broadcast(0.0);
+  for (int g = 0; g < groups; ++g) acc = acc + (coef<V>(cf, g, kE1) * st.a(g) + coef<V>(cf, g, kE2) * st.b(g));
+  return acc.lane_sum();
+}
+
+/// One sample: returns u_n from the old state and advances the state with the input m.
+template <class V, class State>
+AFMKIT_ALWAYS_INLINE double modal_sample(const double* cf, State& st, int groups, double m) noexcept {
+  const V mv = V::broadcast(m);
+  V acc = V::broadcast(0.0);
+  for (int g = 0; g < groups; ++g) {
+    const V a = st.a(g), b = st.b(g), c = coef<V>(cf, g, kC), s = coef<V>(cf, g, kS);
+    acc = acc + (coef<V>(cf, g, kW1) * a + coef<V>(cf, g, kW2) * b);
+    st.set(g, (c * a - s * b) + coef<V>(cf, g, kG1) * mv, (c * b + s * a) + coef<V>(cf, g, kG2) * mv);
+  }
+  return acc.lane_sum();
+}
+
+/// n samples from in to out (may alias), with the skip rule of RealtimeFilter::step (a non-finite sample or one
+/// beyond the input limit is replaced by the coasting input and the previous output is held).
+template <class V, class State>
+AFMKIT_ALWAYS_INLINE void modal_block(ModalRun& run, State& st, const double* in, double* out,
+                                      std::size_t n) noexcept {
+  const int groups = run.group_count;
+  double held = run.held;
+  std::uint64_t skipped = run.skipped;
+  for (std::size_t i = 0; i < n; ++i) {
+    double m = in[i];
+    const bool skip = !(std::abs(m) <= run.input_limit);  // NaN, ±inf, |m| > limit
+    if (skip) m = coast_input<V>(run.groups, st, groups);
+    const double u = modal_sample<V>(run.groups, st, groups, m);
+    if (skip) ++skipped;
+    else held = u;
+    out[i] = held;
+  }
+  run.held = held;
+  run.skipped = skipped;
+}
+
+/// The state of G groups (G known at compile time) in local vectors, so that it can stay in registers.
+template <int G, class V>
+struct LocalState {
+  V s1[G], s2[G];
+  AFMKIT_ALWAYS_INLINE V a(int g) const noexcept { return s1[g]; }
+  AFMKIT_ALWAYS_INLINE V b(int g) const noexcept { return s2[g]; }
+  AFMKIT_ALWAYS_INLINE void set(int g, V x, V y) noexcept {
+    s1[g] = x;
+    s2[g] = y;
+  }
+};
+
+template <int G, class V>
+AFMKIT_ALWAYS_INLINE void modal_block_local(ModalRun& run, double* state, const double* in, double* out,
+                                            std::size_t n) noexcept {
+  LocalState<G, V> st;
+#pragma GCC unroll 8
+  for (int g = 0; g < G; ++g) {
+    st.s1[g] = V::load(state + 4 * g);
+    st.s2[g] = V::load(state + 4 * (G + g));
+  }
+  ModalRun r = run;
+  r.group_count = G;
+  modal_block<V>(r, st, in, out, n);
+#pragma GCC unroll 8
+  for (int g = 0; g < G; ++g) {
+    st.s1[g].store(state + 4 * g);
+    st.s2[g].store(state + 4 * (G + g));
+  }
+  run.held = r.held;
+  run.skipped = r.skipped;
+}
+
+/// n samples on the state in memory (8·groups doubles).
+template <class V>
+AFMKIT_ALWAYS_INLINE void modal_block_memory(ModalRun& run, double* state, const double* in, double* out,
+                                             std::size_t n) noexcept {
+  MemoryState<V> st{state, run.group_count};
+  modal_block<V>(run, st, in, out, n);
+}
+
+// Entry points: the portable spelling (inlined into the caller) and, on x86-64 with GCC, the AVX2 build.
+inline void modal_block_portable(ModalRun& run, double* state, const double* in, double* out, std::size_t n) noexcept {
+  modal_block_memory<Pair2>(run, state, in, out, n);
+}
+[[gnu::noinline]] inline void modal_block_portable_registers(ModalRun& run, double* state, const double* in,
+                                                             double* out, std::size_t n) noexcept {
+  switch (run.group_count) {  // two 16-byte registers per four lanes: up to 2 groups in registers
+    case 1: modal_block_local<1, Pair2>(run, state, in, out, n); return;
+    case 2: modal_block_local<2, Pair2>(run, state, in, out, n); return;
+    case 3: modal_block_local<3, Pair2>(run, state, in, out, n); return;
+    default: modal_block_memory<Pair2>(run, state, in, out, n);
+  }
+}
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define AFMKIT_MODAL_AVX2 1
+[[gnu::target("avx2"), gnu::noinline]] inline void modal_block_avx2(ModalRun& run, double* state, const double* in,
+                                                                    double* out, std::size_t n) noexcept {
+  switch (run.group_count) {  // up to 4 groups (8 of the 16 registers) the state stays in registers
+    case 1: modal_block_local<1, Wide4>(run, state, in, out, n); return;
+    case 2: modal_block_local<2, Wide4>(run, state, in, out, n); return;
+    case 3: modal_block_local<3, Wide4>(run, state, in, out, n); return;
+    case 4: modal_block_local<4, Wide4>(run, state, in, out, n); return;
+    default: modal_block_memory<Wide4>(run, state, in, out, n);
+  }
+}
+#endif
+
+/// Whether this processor runs the AVX2 build.
+inline bool modal_wide_available() noexcept {
+#ifdef AFMKIT_MODAL_AVX2
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+/// A block through the AVX2 build when `wide` (and it exists), else the portable one: the same bits either way.
+inline void modal_block_dispatch(bool wide, ModalRun& run, double* state, const double* in, double* out,
+                                 std::size_t n) noexcept {
+#ifdef AFMKIT_MODAL_AVX2
+  if (wide) {
+    modal_block_avx2(run, state, in, out, n);
+    return;
+  }
+#else
+  (void)wide;
+#endif
+  modal_block_portable_registers(run, state, in, out, n);
+}
+
+#if !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+}  // namespace afmkit::control::detail
