@@ -15,6 +15,7 @@ void register_control(CLI::App& app);           // control_cmd.cpp:       afmkit
 void register_control_tf(CLI::App& control);        // control_tf_cmd.cpp:       control tf
 void register_control_analysis(CLI::App& control);  // control_analysis_cmd.cpp: control roots|margin|chart|tune
 void register_control_simulate(CLI::App& control);  // control_simulate_cmd.cpp: control simulate
+void register_control_export(CLI::App& control);    // control_export_cmd.cpp:   control export (C header)
 void register_demo(CLI::App& app);              // demo_cmd.cpp:          afmkit demo (the Quick-start main job)
 void register_scan(CLI::App& app);              // scan_cmd.cpp:          afmkit scan
 

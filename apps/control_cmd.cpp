@@ -10,6 +10,7 @@ void register_control(CLI::App& app) {
   register_control_tf(control);
   register_control_analysis(control);
   register_control_simulate(control);
+  register_control_export(control);
 }
 
 }  // namespace afmkit::cli

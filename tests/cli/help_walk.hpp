@@ -15,7 +15,7 @@ namespace afmkit_test {
 inline const std::vector<std::string> kCommands = {"demo",          "impact",        "tapping orbit", "tapping hb",
                                                    "tapping sweep", "control tf",    "control roots", "control margin",
                                                    "control chart", "control tune",  "control simulate",
-                                                   "scan"};
+                                                   "control export", "scan"};
 
 /// A gtest parameter name for a command: "tapping orbit" -> "tapping_orbit".
 inline std::string command_test_name(const ::testing::TestParamInfo<std::string>& info) {

@@ -447,7 +447,7 @@ double RealtimeFilter::coast_input() const noexcept {
 
 void RealtimeFilter::run_modal(const double* in, double* out, std::size_t n) noexcept {
   detail::ModalRun run{disc_.packed.data(), disc_.groups, input_limit_, held_, skipped_};
-  if (n == 1 && !wide_) detail::modal_block_portable(run, q_.data(), in, out, 1);  // inlined, state in memory
+  if (n == 1) detail::modal_block_portable(run, q_.data(), in, out, 1);  // step(): inlined, state in memory
   else detail::modal_block_dispatch(wide_, run, q_.data(), in, out, n);
   held_ = run.held;
   skipped_ = run.skipped;
