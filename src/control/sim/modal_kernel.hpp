@@ -109,8 +109,6 @@ struct ModalRun {  // the coefficients, and what one call updates (held output, 
   std::uint64_t skipped;
 };
 
-AFMKIT_ALWAYS_INLINE double lane_sum(v4d a) noexcept { return (a[0] + a[2]) + (a[1] + a[3]); }
-
 /// The state of the groups, q1 of every group first, then q2 (8·G doubles), read and written group by group.
 template <class V>
 struct MemoryState {
@@ -153,9 +151,8 @@ AFMKIT_ALWAYS_INLINE double modal_sample(const double* cf, State& st, int groups
 /// n samples from in to out (may alias), with the skip rule of RealtimeFilter::step (a non-finite sample or one
 /// beyond the input limit is replaced by the coasting input and the previous output is held).
 template <class V, class State>
-AFMKIT_ALWAYS_INLINE void modal_block(ModalRun& run, State& st, const double* in, double* out,
+AFMKIT_ALWAYS_INLINE void modal_block(ModalRun& run, State& st, int groups, const double* in, double* out,
                                       std::size_t n) noexcept {
-  const int groups = run.group_count;
   double held = run.held;
   std::uint64_t skipped = run.skipped;
   for (std::size_t i = 0; i < n; ++i) {
@@ -192,16 +189,12 @@ AFMKIT_ALWAYS_INLINE void modal_block_local(ModalRun& run, double* state, const 
     st.s1[g] = V::load(state + 4 * g);
     st.s2[g] = V::load(state + 4 * (G + g));
   }
-  ModalRun r = run;
-  r.group_count = G;
-  modal_block<V>(r, st, in, out, n);
+  modal_block<V>(run, st, G, in, out, n);  // G a constant: the group loops unroll and the state stays in registers
 #pragma GCC unroll 8
   for (int g = 0; g < G; ++g) {
     st.s1[g].store(state + 4 * g);
     st.s2[g].store(state + 4 * (G + g));
   }
-  run.held = r.held;
-  run.skipped = r.skipped;
 }
 
 /// n samples on the state in memory (8·groups doubles).
@@ -209,7 +202,7 @@ template <class V>
 AFMKIT_ALWAYS_INLINE void modal_block_memory(ModalRun& run, double* state, const double* in, double* out,
                                              std::size_t n) noexcept {
   MemoryState<V> st{state, run.group_count};
-  modal_block<V>(run, st, in, out, n);
+  modal_block<V>(run, st, run.group_count, in, out, n);
 }
 
 // Entry points: the portable spelling (inlined into the caller) and, on x86-64 with GCC, the AVX2 build.
@@ -218,7 +211,7 @@ inline void modal_block_portable(ModalRun& run, double* state, const double* in,
 }
 [[gnu::noinline]] inline void modal_block_portable_registers(ModalRun& run, double* state, const double* in,
                                                              double* out, std::size_t n) noexcept {
-  switch (run.group_count) {  // two 16-byte registers per four lanes: up to 2 groups in registers
+  switch (run.group_count) {  // two 16-byte registers per four lanes: up to 3 groups in registers
     case 1: modal_block_local<1, Pair2>(run, state, in, out, n); return;
     case 2: modal_block_local<2, Pair2>(run, state, in, out, n); return;
     case 3: modal_block_local<3, Pair2>(run, state, in, out, n); return;
