@@ -1,4 +1,5 @@
 #include "command.hpp"
+#include "program.hpp"
 
 #include <memory>
 
@@ -13,9 +14,17 @@ CLI::App& add_command(CLI::App& parent, const std::string& name, const std::stri
   declare(*params);
   CLI::App* cmd = parent.add_subcommand(name, help);
   params->add_options(*cmd);
+  const CLI::App* root = cmd;
+  std::string path = name;
+  for (const CLI::App* up = cmd->get_parent(); up != nullptr; up = up->get_parent()) {
+    root = up;
+    if (up->get_parent() != nullptr) path = up->get_name() + " " + path;
+  }
+  if (auto* program = dynamic_cast<Program*>(const_cast<CLI::App*>(root)))
+    program->commands.push_back({path, help, declare, run});
   cmd->callback([params, run = std::move(run)] {
     params->resolve();
-    run(*params);
+    run(*params, nullptr);
   });
   return *cmd;
 }
@@ -33,9 +42,11 @@ void add_output_params(io::ParamSet& p, const std::string& default_path, const s
       .file("output", default_path, what + " CSV path (JSON sidecar describing every column next to it); empty: no file");
 }
 
-CommandOutput::CommandOutput(const io::ParamSet& params, std::string command, const std::string& output_key)
-    : params_(params), command_(std::move(command)), path_(params.text(output_key)), json_(params.flag("json")) {
-  keep_rows_ = json_ && path_.empty();
+CommandOutput::CommandOutput(const io::ParamSet& params, Captured* capture, std::string command,
+                             const std::string& output_key)
+    : params_(params), capture_(capture), command_(std::move(command)), path_(params.text(output_key)),
+      json_(params.flag("json")) {
+  keep_rows_ = capture_ != nullptr || (json_ && path_.empty());
 }
 
 void CommandOutput::open(std::vector<io::Column> columns) {
@@ -45,6 +56,12 @@ void CommandOutput::open(std::vector<io::Column> columns) {
 
 void CommandOutput::finish(const nlohmann::json& results, const std::string& summary) {
   if (file_) file_->commit(io::make_sidecar(command_, params_, results));
+  if (capture_ != nullptr) {
+    capture_->results = results;
+    capture_->columns = columns_;
+    capture_->rows = std::move(rows_);
+    return;
+  }
   if (json_) {
     nlohmann::json document = results;
     if (keep_rows_) document["table"] = {{"columns", io::columns_json(columns_)}, {"rows", rows_}};

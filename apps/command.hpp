@@ -26,10 +26,33 @@ class App;
 
 namespace afmkit::cli {
 
-using Declare = std::function<void(io::ParamSet&)>;
-using Run = std::function<void(const io::ParamSet&)>;
+/// What a command hands back when a program runs it rather than a person (the Python module): the summary document
+/// (what --json prints, without the table), the table's columns and its rows. Nothing is printed; the table file is
+/// written only when its path is given.
+struct Captured {
+  nlohmann::json results = nlohmann::json::object();
+  std::vector<io::Column> columns;
+  nlohmann::json rows = nlohmann::json::array();
+};
 
-/// Adds subcommand `name` to `parent` (see above); returns it.
+using Declare = std::function<void(io::ParamSet&)>;
+/// Runs a command on resolved parameters; `capture` is nullptr on the command line.
+using Run = std::function<void(const io::ParamSet&, Captured* capture)>;
+
+/// One leaf command: its path ("tapping orbit"), help, parameters and what it runs.
+struct CommandSpec {
+  std::string path;
+  std::string help;
+  Declare declare;
+  Run run;
+};
+
+/// Every leaf command registered under `app` by register_all (commands.hpp), in registration order, for front ends
+/// other than the command line (the Python module). Declared in program.cpp.
+std::vector<CommandSpec> command_specs();
+
+/// Adds subcommand `name` to `parent` (see above) and, when the root of `parent` is a Program (program.hpp), records
+/// it in the program's command list; returns it.
 CLI::App& add_command(CLI::App& parent, const std::string& name, const std::string& help, const Declare& declare,
                       Run run);
 
@@ -44,7 +67,9 @@ void add_output_params(io::ParamSet& p, const std::string& default_path, const s
 /// document. finish() commits the file and prints the summary.
 class CommandOutput {
  public:
-  CommandOutput(const io::ParamSet& params, std::string command, const std::string& output_key = "output");
+  /// `capture`: nullptr on the command line; else the results, columns and rows go there instead of being printed.
+  CommandOutput(const io::ParamSet& params, Captured* capture, std::string command,
+                const std::string& output_key = "output");
 
   /// Opens the table (file or memory) with its columns; call once before adding rows.
   void open(std::vector<io::Column> columns);
@@ -58,6 +83,9 @@ class CommandOutput {
   std::size_t rows() const { return count_; }
   const std::string& path() const& { return path_; }
   bool writes_file() const { return !path_.empty(); }
+  /// The rows are wanted (a file, a capture, or --json without a file): commands skip recording a history nobody
+  /// will read.
+  bool keeps_rows() const { return writes_file() || keep_rows_; }
 
   /// Commits the file with the sidecar (parameters, `results`, columns). Then prints `results` as JSON (--json;
   /// with the rows when no file was written), or `summary` (if not empty) and where the table went.
@@ -70,6 +98,7 @@ class CommandOutput {
     else return v;
   }
   const io::ParamSet& params_;
+  Captured* capture_ = nullptr;
   std::string command_;
   std::string path_;
   bool json_ = false;

@@ -18,5 +18,6 @@ void register_control_simulate(CLI::App& control);  // control_simulate_cmd.cpp:
 void register_control_export(CLI::App& control);    // control_export_cmd.cpp:   control export (C header)
 void register_demo(CLI::App& app);              // demo_cmd.cpp:          afmkit demo (the Quick-start main job)
 void register_scan(CLI::App& app);              // scan_cmd.cpp:          afmkit scan
+void register_report(CLI::App& app);            // report_cmd.cpp:        afmkit report (the Python report)
 
 }  // namespace afmkit::cli

@@ -98,7 +98,7 @@ nlohmann::json tau0_summary(const control::ControlSettings& c) {
 }
 
 // ------------------------------------------------------------------------------------------------ roots
-void run_roots(const io::ParamSet& p) {
+void run_roots(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   const control::LoopSpec loop = control::loop_from(c);
   const control::RotationUnits u = c.units();
@@ -108,7 +108,7 @@ void run_roots(const io::ParamSet& p) {
   o.count = static_cast<int>(p.integer("count"));
   o.collocation_nodes = static_cast<int>(p.integer("nodes"));
   const io::ParamSet as_run = params_as_run(p, c);
-  CommandOutput out(as_run, "control roots");
+  CommandOutput out(as_run, capture, "control roots");
   const control::Spectrum sp = control::rightmost_roots(loop, o);
 
   nlohmann::json res;
@@ -181,10 +181,10 @@ const nlohmann::json& margin_units() {
 }
 
 // τ_c of variants of the loop (beyond the paper): other rejected harmonics, N = ∞, Smith predictor.
-void run_margin_compare(const io::ParamSet& p, const control::ControlSettings& base) {
+void run_margin_compare(const io::ParamSet& p, const control::ControlSettings& base, Captured* capture) {
   const control::RotationUnits u = base.units();
   const io::ParamSet as_run = params_as_run(p, base);
-  CommandOutput out(as_run, "control margin --compare");
+  CommandOutput out(as_run, capture, "control margin --compare");
   out.open({{"variant", "label", "controller of the row"},
             {"critical_delay", "T", "upper end tau_c of the stability interval of delays (inf: no crossing)"},
             {"crossing_frequency", "Omega", "crossing frequency nu at the critical delay (roots at +-i nu)"},
@@ -232,16 +232,16 @@ void run_margin_compare(const io::ParamSet& p, const control::ControlSettings& b
   out.finish(res, fmt::format("delay margins of {} variants", out.rows()));
 }
 
-void run_margin(const io::ParamSet& p) {
+void run_margin(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
-  if (p.flag("compare")) return run_margin_compare(p, c);
+  if (p.flag("compare")) return run_margin_compare(p, c, capture);
   const control::LoopSpec loop = control::loop_from(c);
   const control::RotationUnits u = c.units();
   control::MarginOptions o;
   if (p.was_set("reference_delay")) o.reference_delay = u.delay(p.real("reference_delay"));
   o.grid_points_per_omega = static_cast<int>(p.integer("points_per_omega"));
   const io::ParamSet as_run = params_as_run(p, c);
-  CommandOutput out(as_run, "control margin");
+  CommandOutput out(as_run, capture, "control margin");
   const control::DelayMargin m = control::delay_margin(loop, o);
   nlohmann::json res = margin_json(m, u);
   res["loop"] = control::describe_in_rotation_units(loop);

@@ -58,12 +58,12 @@ std::string axis_text(const control::LoopFamily& f, char axis) {
   return single ? "coupling b (eq. 5) of the grid point" : "coupling beta (eq. 20) of the grid point";
 }
 
-void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, const Window& win) {
+void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, const Window& win, Captured* capture) {
   const control::RotationUnits u = c.units();
   const control::LoopFamily family = control::LoopFamily::from_loop(control::loop_from(c));
   const int nx = static_cast<int>(p.integer("x_points")), ny = static_cast<int>(p.integer("y_points"));
   const io::ParamSet as_run = params_as_run(p, c, window_values(win));
-  CommandOutput out(as_run, "control chart --quantity margin");
+  CommandOutput out(as_run, capture, "control chart --quantity margin");
   require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * (out.writes_file() ? 64.0 : 320.0));
   out.open({{"x", "Omega", axis_text(family, 'x')},
             {"y", "Omega", axis_text(family, 'y')},
@@ -93,12 +93,12 @@ void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, co
   out.finish(res, fmt::format("the {}x{} delay-margin map", nx, ny));
 }
 
-void run_chart(const io::ParamSet& p) {
+void run_chart(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   const std::vector<control::ControlSettings> runs = settings_per_delay(p, c);
   const control::LoopFamily first = control::LoopFamily::from_loop(control::loop_from(runs.front()));
   const Window win = window_from(p, first, kSingleWindow, kCouplingsWindow);
-  if (p.text("quantity") == "margin") return run_margin_map(p, runs.front(), win);
+  if (p.text("quantity") == "margin") return run_margin_map(p, runs.front(), win, capture);
   const control::RotationUnits u = c.units();
   const int nx = static_cast<int>(p.integer("x_points")), ny = static_cast<int>(p.integer("y_points"));
   std::vector<std::pair<std::string, double>> values = window_values(win);
@@ -106,7 +106,7 @@ void run_chart(const io::ParamSet& p) {
   std::string delays_text;
   for (const auto& r : runs) delays_text += fmt::format("{}{}", delays_text.empty() ? "" : ",", r.delay);
   as_run.set_from_string("delays", delays_text);
-  CommandOutput out(as_run, "control chart");
+  CommandOutput out(as_run, capture, "control chart");
   const bool json = p.flag("json");
   const std::string bout = p.text("boundaries_output");
   // memory of one chart (values, counts, labels and the tracked roots of each point), and of the rows --json keeps

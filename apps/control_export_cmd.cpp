@@ -55,7 +55,7 @@ embed::ExportSpec export_spec_from(const io::ParamSet& p, const control::Control
   return s;
 }
 
-void run_export(const io::ParamSet& p) {
+void run_export(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   const std::string path = p.text("output");
   if (path.empty()) throw InvalidParameter("output", "output is required: the path of the C header to write (FILE.h)");
@@ -83,6 +83,10 @@ void run_export(const io::ParamSet& p) {
   j["test_vectors"] = samples;
   j["units"] = {{"state_size", "count"}, {"memory_bytes", "bytes"}, {"spectral_abscissa", "Omega"},
                 {"smallest_decay_per_sample", "dimensionless"}, {"test_vectors", "count"}};
+  if (capture != nullptr) {
+    capture->results = j;
+    return;
+  }
   if (p.flag("json")) {
     fmt::print("{}\n", j.dump(2));
     return;

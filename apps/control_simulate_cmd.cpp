@@ -105,7 +105,7 @@ nlohmann::json report_json(const control::SimulationReport& r, const control::Cl
   return j;
 }
 
-void run_simulate(const io::ParamSet& p) {
+void run_simulate(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   if (c.controller == ControllerKind::Smith)
     throw InvalidParameter("controller", "controller = smith is not simulated in the time domain: must be single, "
@@ -135,7 +135,7 @@ void run_simulate(const io::ParamSet& p) {
                                                     "(below half of steps_per_period = {})",
                                                     o.report_max_order, nyquist_order, o.steps_per_period));
   const io::ParamSet as_run = params_as_run(p, c, {{"max_order", o.report_max_order}});
-  CommandOutput out(as_run, "control simulate");
+  CommandOutput out(as_run, capture, "control simulate");
   const bool keep_rows = p.flag("json") && !out.writes_file();
   o.record_every = out.writes_file() || keep_rows ? static_cast<int>(p.integer("record_every")) : 0;
   // memory: the per-period tables of the run (about 14 doubles per step of a period) and the controller's modes

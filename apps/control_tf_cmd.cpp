@@ -118,7 +118,7 @@ nlohmann::json summary(const control::ControlSettings& c, const control::LoopSpe
   return j;
 }
 
-void run_tf(const io::ParamSet& p) {
+void run_tf(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   const control::LoopSpec loop = control::loop_from(c);
   const double fmin = p.real("frequency_min"), fmax = p.real("frequency_max");
@@ -131,7 +131,7 @@ void run_tf(const io::ParamSet& p) {
                                                         "log_spacing (or set --log-spacing false)", fmin));
   const long points = p.integer("points");
   const io::ParamSet as_run = params_as_run(p, c);
-  CommandOutput out(as_run, "control tf");
+  CommandOutput out(as_run, capture, "control tf");
   // without a file, --json holds the rows in memory (a few hundred bytes each)
   if (!out.writes_file() && p.flag("json")) require_memory("points", static_cast<double>(points), 256.0);
   nlohmann::json res = summary(c, loop);

@@ -24,7 +24,7 @@ constexpr Window kCouplingsWindow{0.01, 0.6, -0.24, 0.3};
 
 using io::Range;
 
-void run_tune(const io::ParamSet& p) {
+void run_tune(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   const control::LoopSpec loop = control::loop_from(c);
   const control::RotationUnits u = c.units();
@@ -47,7 +47,7 @@ void run_tune(const io::ParamSet& p) {
   s.max_evaluations = static_cast<int>(p.integer("max_evaluations"));
   s.threads = static_cast<int>(p.integer("threads"));
   const io::ParamSet as_run = params_as_run(p, c, window_values(win));
-  CommandOutput out(as_run, "control tune");
+  CommandOutput out(as_run, capture, "control tune");
   require_memory("coarse_points", static_cast<double>(s.coarse_points),
                  s.coarse_points * (out.writes_file() ? 32.0 : 256.0));
   out.open({{"x", "Omega", std::string(s.family.x_name()) + " of the coarse grid point"},

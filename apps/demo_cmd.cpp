@@ -1,4 +1,4 @@
-// afmkit demo: the Quick-start main job. A tapping-mode demonstration on the repulsive–attractive hysteresis
+// afmkit demo: the quick command-line demonstration of the README. A tapping-mode demonstration on the repulsive–attractive hysteresis
 // law of seed 1 (eq. 26) where attraction makes the separation–amplitude curve fold: an instrument-like
 // approach–retract sweep (with its jumps and hysteresis) and the harmonic-balance curve, written to out/.
 #include <cmath>
@@ -56,7 +56,7 @@ io::ParamSet with_demo_defaults(const io::ParamSet& given) {
   return p;
 }
 
-void run_demo(const io::ParamSet& given) {
+void run_demo(const io::ParamSet& given, Captured* capture) {
   const io::ParamSet p = with_demo_defaults(given);
   const double l_min = p.real("separation_min"), l_max = p.real("separation_max");
   if (!(l_min < l_max))
@@ -102,6 +102,10 @@ void run_demo(const io::ParamSet& given) {
   write_sweep_rows(table, sweep.retract, scales);
   hb.commit(io::make_sidecar("demo (harmonic balance)", p, results));
   table.commit(io::make_sidecar("demo (sweep)", p, results));
+  if (capture != nullptr) {
+    capture->results = results;
+    return;
+  }
 
   const std::string unit = std::string(" ") + scales.length_unit;
   fmt::print("afmkit demo: tapping cantilever, law '{}', Q = {}, drive at {} x resonance ({} units)\n",
@@ -123,7 +127,7 @@ void register_demo(CLI::App& app) {
   add_command(
       app, "demo",
       "tapping-mode demonstration: approach-retract sweep with jumps and the harmonic-balance curve, written to out/ "
-      "(the Quick-start main job)",
+      "(the README's quick command-line look)",
       [](io::ParamSet& p) {
         add_tapping_model_params(p);
         // The demonstration case (with_demo_defaults above; physical defaults follow the cantilever).

@@ -183,7 +183,7 @@ void print_summary(const impact::ImpactResult& r, const impact::ForceLaw& law) {
   fmt::print("  after: v1 = {}, v2 = {} nm/s\n", num(r.body1_after.velocity), num(r.body2_after.velocity));
 }
 
-void run_impact(const io::ParamSet& p) {
+void run_impact(const io::ParamSet& p, Captured* capture) {
   const impact::ImpactProblem problem = problem_from(p);
   impact::ImpactOptions options;
   const std::string& method = p.text("method");
@@ -192,13 +192,13 @@ void run_impact(const io::ParamSet& p) {
                                             : impact::ImpactMethod::automatic;
   options.relative_tolerance = p.real("relative_tolerance");
   options.absolute_tolerance = p.real("absolute_tolerance");
-  CommandOutput out(p, "impact");
-  options.history_points = out.writes_file() ? p.integer("points") : 0;
+  CommandOutput out(p, capture, "impact");
+  options.history_points = out.keeps_rows() ? p.integer("points") : 0;
   if (out.writes_file()) check_disk_space(out.path(), options.history_points);
 
   // The history is streamed row by row into the CSV (memory does not grow with --points).
   out.open(history_columns());
-  if (out.writes_file())
+  if (out.keeps_rows())
     options.on_sample = [&out](const impact::ImpactSample& s) {
       out.row(s.time, s.gap, s.gap_rate, s.force, s.position1, s.velocity1, s.position2, s.velocity2);
     };

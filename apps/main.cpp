@@ -9,21 +9,12 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
-#include "afmkit/core/version.hpp"
 #include "afmkit/io/output.hpp"
-#include "commands.hpp"
+#include "program.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"afmkit: dynamics and control of atomic force microscopes (tapping-mode impact dynamics, "
-               "first-harmonic rejection for rotational scanning)"};
+  afmkit::cli::Program app;                    // every command (program.cpp)
   afmkit::io::remove_temporaries_on_signal();  // Ctrl-C or a kill leaves no half-written output behind
-  app.require_subcommand(1);
-  app.set_version_flag("--version", std::string(afmkit::version));
-  afmkit::cli::register_demo(app);
-  afmkit::cli::register_impact(app);
-  afmkit::cli::register_tapping(app);
-  afmkit::cli::register_control(app);
-  afmkit::cli::register_scan(app);
   // A word that names no command where one is expected (`afmkit frobnicate`, `afmkit tapping orbits`).
   const CLI::App* level = &app;
   for (int i = 1; i < argc && argv[i][0] != '-'; ++i) {

@@ -59,7 +59,7 @@ double loop_spectral_abscissa(const scan::InstrumentSpec& s) {
   }
 }
 
-void run_simulated(const io::ParamSet& p) {
+void run_simulated(const io::ParamSet& p, Captured* capture) {
   const scan::InstrumentSpec instrument = instrument_from(p);
   const scan::Surface surface = surface_from(p);
   const scan::Grid grid = scan::image_grid(instrument, p.integer("image_resolution"));
@@ -74,7 +74,7 @@ void run_simulated(const io::ParamSet& p) {
     fmt::print(stderr, "afmkit scan: warning: the loop is unstable at the nominal delay (spectral abscissa {:.4g} "
                        "rad/s >= 0; see `afmkit control chart`)\n", abscissa);
 
-  CommandOutput out(p, "scan");
+  CommandOutput out(p, capture, "scan");
   out.open(turn_columns());
   std::optional<SeriesWriter> series;
   if (!series_path.empty()) series.emplace(series_path, series_every, false);
@@ -154,17 +154,17 @@ void run_simulated(const io::ParamSet& p) {
   out.finish(results, summary);
 }
 
-void run_scan(const io::ParamSet& p) {
+void run_scan(const io::ParamSet& p, Captured* capture) {
   if (!p.text("recorded").empty()) {
     for (const std::string& key : simulation_only_keys())
       if (p.was_set(key))
         throw InvalidParameter(key, fmt::format("{} describes the simulated instrument: it cannot be given with "
                                                 "recorded = {} (the recorded file is the scan)", key,
                                                 p.text("recorded")));
-    run_recorded(p);
+    run_recorded(p, capture);
     return;
   }
-  run_simulated(p);
+  run_simulated(p, capture);
 }
 
 }  // namespace

@@ -15,7 +15,7 @@
 
 namespace afmkit::cli {
 
-void run_recorded(const io::ParamSet& p) {
+void run_recorded(const io::ParamSet& p, Captured* capture) {
   const std::string path = p.text("recorded"), prefix = p.text("image_output"), series_path = p.text("series_output"),
                     points_path = p.text("points_output");
   scan::RecordedFilterSpec spec;
@@ -28,7 +28,7 @@ void run_recorded(const io::ParamSet& p) {
   const scan::Grid grid = scan::recorded_image_grid(survey, p.integer("image_resolution"));
   scan::check_recorded_filter(survey, spec);
 
-  CommandOutput out(p, "scan (recorded)");
+  CommandOutput out(p, capture, "scan (recorded)");
   out.open({{"turn", "count", "turn k (spindle angle in [2 pi k, 2 pi (k+1)))"},
             {"radius", "m", "mean radius over the turn"},
             {"tilt_free_first_harmonic", "m", "amplitude of the first harmonic of the tilt-free signal"},

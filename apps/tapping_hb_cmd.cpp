@@ -33,7 +33,7 @@ nlohmann::json point_json(const tapping::HbPoint& p, const TappingScales& s) {
           {"branch", tapping::branch_name(p.branch)}};
 }
 
-void run_hb(const io::ParamSet& p) {
+void run_hb(const io::ParamSet& p, Captured* capture) {
   const double q_min = p.real("q_min");
   const double q_max = p.real("q_max");
   if (!(q_min < q_max))
@@ -51,7 +51,7 @@ void run_hb(const io::ParamSet& p) {
   options.include_minus = p.flag("minus_branch");
   // The curve is held in memory (both branches: 2 points per q sample) before it is streamed out.
   memory::require_fits("points", static_cast<double>(options.points), 2.0 * sizeof(tapping::HbPoint));
-  CommandOutput out(p, "tapping hb");
+  CommandOutput out(p, capture, "tapping hb");
   out.open(hb_columns(scales));
   const std::vector<tapping::HbPoint> curve = tapping::harmonic_balance_curve(model, options);
   write_hb_rows(out, curve, scales);

@@ -92,7 +92,7 @@ nlohmann::json orbit_json(const tapping::FoundOrbit& f, const tapping::OrbitSear
           {"shooting_residual", o.residual}};
 }
 
-void run_orbit(const io::ParamSet& p) {
+void run_orbit(const io::ParamSet& p, Captured* capture) {
   const tapping::TappingModel model = tapping_model_from(p);
   const TappingScales scales = tapping_scales_from(p);
   tapping::OrbitSearchOptions options;
@@ -126,7 +126,7 @@ void run_orbit(const io::ParamSet& p) {
       {"search", search_json(r.report, scales)},
       {"units", {{"length", length}, {"velocity", velocity}, {"force", scales.force_unit},
                  {"energy", scales.energy_unit}, {"time", scales.time_unit}, {"phase", "rad"}, {"seconds", "s"}}}};
-  CommandOutput out(p, "tapping orbit");
+  CommandOutput out(p, capture, "tapping orbit");
   out.open({{"source", "label", "how the orbit was found first (harmonic_balance, transient, grid, contact, continuation)"},
             {"period_multiple", "count", "n of a period-n orbit (1: the drive period)"},
             {"stable", "boolean (0/1)", "1: all Floquet multipliers inside the unit circle"},

@@ -58,7 +58,7 @@ std::vector<double> sweep_separations(const io::ParamSet& p, double length_scale
   return list;
 }
 
-void run_sweep(const io::ParamSet& p) {
+void run_sweep(const io::ParamSet& p, Captured* capture) {
   const tapping::TappingModel base = tapping_model_from(p);
   const TappingScales scales = tapping_scales_from(p);
   const std::vector<double> list = sweep_separations(p, scales.length);
@@ -79,7 +79,7 @@ void run_sweep(const io::ParamSet& p) {
   const bool continuation = mode == "continuation" || mode == "both";
   const bool quiet = p.flag("json") || p.flag("quiet");
 
-  CommandOutput out(p, "tapping sweep");
+  CommandOutput out(p, capture, "tapping sweep");
   out.open(sweep_columns(scales));
   const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) { write_sweep_rows(out, points, scales); };
   nlohmann::json results = nlohmann::json::object();

@@ -9,7 +9,9 @@ packages=(build-essential cmake libeigen3-dev libcli11-dev libtomlplusplus-dev l
           clang-14 libclang-rt-14-dev libomp-14-dev    # clang: libFuzzer targets (scripts/fuzz.sh)
           gwyddion    # gwyddion-thumbnailer: test_scan checks that Gwyddion opens the GSF / GXYZF files afmkit writes
           gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm   # the embedded filter core on a Cortex-M4F (MPS2)
-          gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user)      # … and on 64-bit ARM Linux (scripts/cross.sh)
+          gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user       # … and on 64-bit ARM Linux (scripts/cross.sh)
+          python3-dev pybind11-dev python3-numpy python3-matplotlib python3-pytest   # the Python module and its tests
+          chromium chromium-driver python3-selenium)                  # the report opened in headless Chromium
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -278,6 +278,47 @@ void ParamSet::set_from_string(const std::string& key, const std::string& text) 
   check(key, e, "");
 }
 
+void ParamSet::set_value(const std::string& key, Value value, const std::string& origin) {
+  auto it = entries_.find(key);
+  if (it == entries_.end()) {
+    std::vector<std::string> known(order_.begin(), order_.end());
+    throw InputError(fmt::format("{}{}unknown parameter '{}' (allowed: {})", origin, origin.empty() ? "" : ": ", key,
+                                 fmt::join(known, ", ")));
+  }
+  Entry& e = it->second;
+  if (std::holds_alternative<double>(e.value) && std::holds_alternative<long>(value))
+    value = static_cast<double>(std::get<long>(value));
+  if (value.index() != e.value.index()) {
+    static constexpr const char* want[] = {"a number", "an integer", "a string", "true or false", "a list of numbers"};
+    throw InvalidParameter(key, fmt::format("{}{}{} must be {}", origin, origin.empty() ? "" : ": ", key,
+                                            want[e.value.index()]));
+  }
+  e.value = std::move(value);
+  e.set = true;
+  check(key, e, origin);
+}
+
+std::vector<ParamSet::Description> ParamSet::describe() const {
+  std::vector<Description> out;
+  for (const auto& key : order_) {
+    const Entry& e = entries_.at(key);
+    Description d{key, "", e.value, e.default_text, e.help, e.unit, "", e.group, e.choices};
+    switch (e.value.index()) {
+      case 0: d.kind = "real"; d.allowed = e.range.describe(); break;
+      case 1: d.kind = "integer"; d.allowed = fmt::format("integer in [{}, {}]", e.ilo, e.ihi); break;
+      case 2:
+        d.kind = e.is_file ? "file" : "text";
+        if (!e.choices.empty()) d.allowed = fmt::format("one of {}", fmt::join(e.choices, ", "));
+        break;
+      case 3: d.kind = "flag"; d.unit.clear(); break;
+      default: d.kind = "reals"; d.allowed = "each " + e.range.describe(); break;
+    }
+    if (d.kind == "text" || d.kind == "file") d.unit.clear();
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
 void ParamSet::set_default(const std::string& key, const std::string& text) {
   set_from_string(key, text);
   entries_.at(key).set = false;

@@ -15,7 +15,14 @@ namespace afmkit_test {
 inline const std::vector<std::string> kCommands = {"demo",          "impact",        "tapping orbit", "tapping hb",
                                                    "tapping sweep", "control tf",    "control roots", "control margin",
                                                    "control chart", "control tune",  "control simulate",
-                                                   "control export", "scan"};
+                                                   "control export", "scan",          "report"};
+
+/// Whether this build has the Python module (`afmkit report` needs it; the sanitizer build has none).
+#ifdef AFMKIT_TEST_HAS_PYTHON
+inline constexpr bool kHasPython = true;
+#else
+inline constexpr bool kHasPython = false;
+#endif
 
 /// A gtest parameter name for a command: "tapping orbit" -> "tapping_orbit".
 inline std::string command_test_name(const ::testing::TestParamInfo<std::string>& info) {

@@ -11,8 +11,8 @@
 using namespace afmkit_test;
 
 namespace {
-// options whose value is free text (none today: paths are FILE, choices NAME)
-const std::set<std::string> kTextOptions = {};
+// options whose value is free text (paths are FILE, choices NAME): report's comma-separated list of figure ids
+const std::set<std::string> kTextOptions = {"figures"};
 }  // namespace
 
 class HelpText : public ::testing::TestWithParam<std::string> {};

@@ -7,11 +7,13 @@
 #      with 0 and prints a final "ok";
 #   4. compiles and runs examples/delay_margin/delay_margin.cpp with `pkg-config --cflags --libs afmkit` only, and
 #      examples/filter_c/filter_c.c (C99) with `pkg-config --cflags --libs afmkit_c` only (skipped with a message
-#      when pkg-config is not installed).
+#      when pkg-config is not installed);
+#   5. imports the installed Python package (when built: -DPYTHON=<interpreter>) and runs the installed
+#      `afmkit report` on one figure.
 # The prefix is removed on success and kept (its path printed) on failure.
 #
 #   cmake -DSOURCE=<source dir> -DBINARY=<build dir> [-DCONFIG=Release] [-DCXX=<C++ compiler>] [-DCC=<C compiler>]
-#         [-DGENERATOR=<gen>] [-DEXTRA_FLAGS=<compile and link flags, e.g. sanitizers>]
+#         [-DGENERATOR=<gen>] [-DEXTRA_FLAGS=<compile and link flags, e.g. sanitizers>] [-DPYTHON=<python3>]
 #         -P tests/install/install_and_build_examples.cmake
 cmake_minimum_required(VERSION 3.20)
 
@@ -233,6 +235,26 @@ else()
     run("compile filter_c (C99) with pkg-config flags" _out "${_cc}" -std=c99 -O2 ${_extra}
         "${SOURCE}/examples/filter_c/filter_c.c" -o "${_exe}" ${_cflags} -lm "-Wl,-rpath,${_libdir}")
     run_example("filter_c (pkg-config)" "${_exe}")
+  endif()
+endif()
+
+# ---- 5. the Python package (when the build has it: -DPYTHON=<interpreter>) ------------------------------------------
+file(GLOB _pkg LIST_DIRECTORIES true "${PREFIX}/lib/python3*/dist-packages/afmkit")
+if(PYTHON AND NOT _pkg)
+  message(FATAL_ERROR "install_and_build_examples: the Python package afmkit was not installed under ${PREFIX}/lib")
+elseif(_pkg)
+  get_filename_component(_site "${_pkg}" DIRECTORY)
+  run("import the installed afmkit" _out ${CMAKE_COMMAND} -E env "PYTHONPATH=${_site}" PYTHONDONTWRITEBYTECODE=1
+      "${PYTHON}" -c "import afmkit; r = afmkit.tapping.hb(points=50); assert len(r) > 0; print(afmkit.__file__)")
+  string(FIND "${_out}" "${_site}/afmkit/" _at)
+  if(NOT _at EQUAL 0)
+    message(FATAL_ERROR "install_and_build_examples: python imported afmkit from ${_out}, not from ${_site}")
+  endif()
+  # the installed program finds its installed package (no PYTHONPATH)
+  run("installed afmkit report" _out "${PREFIX}/bin/afmkit" report --figures beyond-impact
+      --output-dir "${WORK}/report")
+  if(NOT EXISTS "${WORK}/report/index.html" OR NOT EXISTS "${WORK}/report/figures/beyond-impact.png")
+    message(FATAL_ERROR "install_and_build_examples: the installed afmkit report wrote no page")
   endif()
 endif()
 

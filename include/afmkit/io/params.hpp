@@ -72,6 +72,29 @@ class ParamSet {
   void set_default(const std::string& key, const std::string& text);
   /// Set one value from its textual form (as a flag would), validating it.
   void set_from_string(const std::string& key, const std::string& text);
+  /// Set one value given typed (the Python module), validated as a TOML value is; `origin` prefixes messages ("" for
+  /// none). An integer is accepted for a real. InvalidParameter naming the key: wrong type or out of range;
+  /// InputError: unknown key.
+  void set_value(const std::string& key, Value value, const std::string& origin = "");
+  /// A TOML file to load at resolve() (what --config does).
+  void set_config_path(const std::string& path) { config_path_ = path; }
+
+  /// One parameter as --help describes it, for other front ends (Python signatures and docstrings).
+  struct Description {
+    std::string key;
+    std::string kind;  ///< real, integer, text, file, flag, reals
+    Value default_value;
+    std::string default_text;  ///< shown instead of default_value when not empty ("automatic", …)
+    std::string help;
+    std::string unit;     ///< numbers only
+    std::string allowed;  ///< range or choices in words ("> 0", "integer in [1, 100]", "one of a, b")
+    std::string group;
+    std::vector<std::string> choices;
+  };
+  /// Every parameter in declaration order.
+  std::vector<Description> describe() const;
+  /// The value of any parameter.
+  const Value& value(const std::string& key) const& { return entry(key).value; }
 
   double real(const std::string& key) const;
   long integer(const std::string& key) const;

@@ -1,0 +1,8 @@
+"""The afmkit report: every figure of both papers and the figures beyond them, computed with afmkit, in one HTML
+page with captions and a table of key numbers (``afmkit report``, or ``python3 -m afmkit.report``).
+
+:func:`build` does the work; figure modules are listed in :data:`FIGURE_MODULES`.
+"""
+from .build import FIGURE_MODULES, build, figure_ids
+
+__all__ = ["build", "figure_ids", "FIGURE_MODULES"]

@@ -1,0 +1,11 @@
+#pragma once
+// The parts of the compiled module _afmkit (module.cpp assembles them).
+#include <pybind11/pybind11.h>
+
+namespace afmkit::python {
+
+void bind_errors(pybind11::module_& m);           // errors.cpp: InvalidParameter, InputError, NumericalFailure
+void bind_commands(pybind11::module_& m);         // commands.cpp: every command as run(path, kwargs)
+void bind_realtime_filter(pybind11::module_& m);  // realtime_filter.cpp: the streaming filter on NumPy buffers
+
+}  // namespace afmkit::python

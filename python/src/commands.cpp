@@ -1,0 +1,142 @@
+// The commands of the `afmkit` program as Python functions (python/afmkit/_commands.py builds the public functions
+// from `commands()`): keyword arguments are the TOML keys, validated by the same ParamSet with the same messages;
+// results come back as the summary document, the column descriptions and the table as NumPy arrays.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/params.hpp"
+#include "bindings.hpp"
+#include "command.hpp"
+#include "params_from_python.hpp"
+
+namespace py = pybind11;
+
+namespace afmkit::python {
+
+namespace {
+
+using cli::CommandSpec;
+
+py::object value_to_python(const io::ParamSet::Value& v) {
+  return std::visit([](const auto& x) -> py::object { return py::cast(x); }, v);
+}
+
+py::object json_to_python(const nlohmann::json& j) {
+  switch (j.type()) {
+    case nlohmann::json::value_t::null: return py::none();
+    case nlohmann::json::value_t::boolean: return py::bool_(j.get<bool>());
+    case nlohmann::json::value_t::number_integer: return py::int_(j.get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned: return py::int_(j.get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float: return py::float_(j.get<double>());
+    case nlohmann::json::value_t::string: return py::str(j.get<std::string>());
+    case nlohmann::json::value_t::array: {
+      py::list l;
+      for (const auto& x : j) l.append(json_to_python(x));
+      return l;
+    }
+    case nlohmann::json::value_t::object: {
+      py::dict d;
+      for (const auto& [k, x] : j.items()) d[py::str(k)] = json_to_python(x);
+      return d;
+    }
+    default: return py::none();
+  }
+}
+
+/// Column `c` of the rows: float64 when every cell is a number, a boolean or null (NaN), else an array of str.
+py::object column_array(const nlohmann::json& rows, std::size_t c) {
+  bool numeric = true;
+  for (const auto& r : rows)
+    if (!(r[c].is_number() || r[c].is_boolean() || r[c].is_null())) numeric = false;
+  if (numeric) {
+    py::array_t<double> a(static_cast<py::ssize_t>(rows.size()));
+    auto w = a.mutable_unchecked<1>();
+    py::ssize_t i = 0;
+    for (const auto& r : rows) {
+      const auto& x = r[c];
+      w(i++) = x.is_boolean() ? (x.get<bool>() ? 1.0 : 0.0) : x.is_null() ? std::nan("") : x.get<double>();
+    }
+    return a;
+  }
+  py::list l;
+  for (const auto& r : rows) l.append(r[c].is_string() ? py::str(r[c].get<std::string>()) : py::str(r[c].dump()));
+  return py::module_::import("numpy").attr("array")(l, "str");
+}
+
+py::list describe(const CommandSpec& s) {
+  io::ParamSet p;
+  s.declare(p);
+  py::list out;
+  for (const auto& d : p.describe()) {
+    py::dict e;
+    e["key"] = d.key;
+    e["kind"] = d.kind;
+    e["default"] = value_to_python(d.default_value);
+    e["default_text"] = d.default_text;
+    e["help"] = d.help;
+    e["unit"] = d.unit;
+    e["allowed"] = d.allowed;
+    e["group"] = d.group;
+    e["choices"] = d.choices;
+    out.append(e);
+  }
+  return out;
+}
+
+/// Runs command `path` with `kwargs` (TOML keys; `config`: a TOML file loaded first, as --config).
+py::dict run(const std::string& path, const py::dict& kwargs) {
+  std::string name = "afmkit." + path;
+  std::replace(name.begin(), name.end(), ' ', '.');
+  const CommandSpec& s = command_spec(path);
+  const io::ParamSet p = params_from_python(path, name, kwargs);
+  cli::Captured captured;
+  {
+    py::gil_scoped_release release;
+    s.run(p, &captured);
+  }
+  py::dict out;
+  out["results"] = json_to_python(captured.results);
+  py::list columns;
+  py::dict table;
+  for (std::size_t c = 0; c < captured.columns.size(); ++c) {
+    const io::Column& col = captured.columns[c];
+    columns.append(py::make_tuple(col.name, col.unit, col.description));
+    table[py::str(col.name)] = column_array(captured.rows, c);
+  }
+  out["columns"] = columns;
+  out["table"] = table;
+  out["params"] = json_to_python(p.to_json());
+  return out;
+}
+
+}  // namespace
+
+void bind_commands(py::module_& m) {
+  m.def(
+      "commands",
+      [] {
+        py::list out;
+        for (const CommandSpec& s : specs()) {
+          py::dict d;
+          d["path"] = s.path;
+          d["help"] = s.help;
+          d["params"] = describe(s);
+          out.append(d);
+        }
+        return out;
+      },
+      "Every command of the afmkit program: path, help and parameters (key, kind, default, unit, allowed range).");
+  m.def("run", &run, py::arg("path"), py::arg("kwargs"),
+        "Runs one command with keyword arguments named as its TOML keys; returns results, columns, table, params.");
+}
+
+}  // namespace afmkit::python

@@ -1,0 +1,13 @@
+// The compiled part of the Python package afmkit (python/afmkit/__init__.py is the public face; docs/python.md).
+#include <pybind11/pybind11.h>
+
+#include "afmkit/core/version.hpp"
+#include "bindings.hpp"
+
+PYBIND11_MODULE(_afmkit, m) {
+  m.doc() = "afmkit compiled core: the commands of the afmkit program and the real-time filter";
+  m.attr("__version__") = std::string(afmkit::version);
+  afmkit::python::bind_errors(m);
+  afmkit::python::bind_commands(m);
+  afmkit::python::bind_realtime_filter(m);
+}

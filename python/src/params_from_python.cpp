@@ -1,0 +1,115 @@
+// Keyword arguments → io::ParamSet (params_from_python.hpp).
+#include "params_from_python.hpp"
+
+#include <algorithm>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <pybind11/stl.h>
+
+#include "afmkit/core/error.hpp"
+
+namespace py = pybind11;
+
+namespace afmkit::python {
+
+namespace {
+
+/// Every command but `report`, which from Python is afmkit.report.build (the command only starts Python on it).
+std::vector<cli::CommandSpec> python_commands() {
+  std::vector<cli::CommandSpec> out = cli::command_specs();
+  std::erase_if(out, [](const cli::CommandSpec& s) { return s.path == "report"; });
+  return out;
+}
+
+/// A Python value as the parameter's type; TypeError naming the parameter otherwise.
+io::ParamSet::Value value_from_python(const std::string& name, const io::ParamSet::Description& d,
+                                      const py::handle& obj) {
+  auto fail = [&](const char* want) {
+    throw py::type_error(name + "(): " + d.key + " must be " + want + ", not " +
+                         std::string(py::str(py::type::of(obj).attr("__name__"))));
+  };
+  const bool is_bool = py::isinstance<py::bool_>(obj) ||
+                       (py::hasattr(obj, "dtype") && py::str(obj.attr("dtype").attr("kind")).cast<std::string>() == "b");
+  if (d.kind == "flag") {
+    if (!is_bool) fail("True or False");
+    return py::bool_(py::reinterpret_borrow<py::object>(obj)).cast<bool>();
+  }
+  if (d.kind == "text" || d.kind == "file") {
+    if (d.kind == "file" && py::hasattr(obj, "__fspath__")) return py::str(obj.attr("__fspath__")()).cast<std::string>();
+    if (!py::isinstance<py::str>(obj)) fail(d.kind == "file" ? "a path (str or os.PathLike)" : "a str");
+    return obj.cast<std::string>();
+  }
+  auto number = [&](const py::handle& x) -> double {
+    const bool b = py::isinstance<py::bool_>(x) ||
+                   (py::hasattr(x, "dtype") && py::str(x.attr("dtype").attr("kind")).cast<std::string>() == "b");
+    if (b || py::isinstance<py::str>(x) || !PyNumber_Check(x.ptr()) || PyComplex_Check(x.ptr()))
+      fail(d.kind == "reals" ? "a sequence of real numbers" : "a real number");
+    return py::float_(py::reinterpret_borrow<py::object>(x)).cast<double>();
+  };
+  if (d.kind == "integer") {
+    if (is_bool || !PyIndex_Check(obj.ptr())) fail("an int");
+    return py::int_(py::reinterpret_borrow<py::object>(obj)).cast<long>();
+  }
+  if (d.kind == "real") {
+    if (PyIndex_Check(obj.ptr()) && !is_bool) return static_cast<double>(py::int_(py::reinterpret_borrow<py::object>(obj)).cast<long>());
+    return number(obj);
+  }
+  if (py::isinstance<py::str>(obj) || !(py::isinstance<py::sequence>(obj) || py::hasattr(obj, "__array__")))
+    fail("a sequence of real numbers");
+  std::vector<double> out;
+  for (const py::handle& x : py::iter(obj)) out.push_back(number(x));
+  return out;
+}
+
+}  // namespace
+
+const std::vector<cli::CommandSpec>& specs() {
+  static const std::vector<cli::CommandSpec> all = python_commands();  // built once, read-only afterwards
+  return all;
+}
+
+const cli::CommandSpec& command_spec(const std::string& path) {
+  for (const cli::CommandSpec& s : specs())
+    if (s.path == path) return s;
+  throw py::value_error("no afmkit command '" + path + "'");
+}
+
+io::ParamSet params_from_python(const std::string& path, const std::string& name, const py::dict& kwargs,
+                                const std::vector<std::string>& hidden) {
+  const cli::CommandSpec& s = command_spec(path);
+  io::ParamSet p;
+  s.declare(p);
+  const std::vector<io::ParamSet::Description> described = p.describe();
+  for (const auto& d : described) {
+    if (d.key == "output" && d.kind == "file") p.set_default("output", "");
+    if (d.key == "json" && d.kind == "flag") p.set_default("json", "true");
+  }
+  auto visible = [&](const std::string& key) { return std::find(hidden.begin(), hidden.end(), key) == hidden.end(); };
+  if (kwargs.contains("config")) {
+    const py::object c = kwargs["config"];
+    if (!py::isinstance<py::str>(c) && !py::hasattr(c, "__fspath__"))
+      throw py::type_error(name + "(): config must be a path (str or os.PathLike) of a TOML file");
+    p.set_config_path(py::str(py::hasattr(c, "__fspath__") ? c.attr("__fspath__")() : c).cast<std::string>());
+  }
+  p.resolve();  // the TOML file, if any; the keyword arguments come on top
+  for (const auto& [k, v] : kwargs) {
+    const std::string key = py::str(k);
+    if (key == "config") continue;
+    const io::ParamSet::Description* d = nullptr;
+    for (const auto& x : described)
+      if (x.key == key && visible(key)) d = &x;
+    if (d == nullptr) {
+      std::string allowed;
+      for (const auto& x : described)
+        if (visible(x.key)) allowed += (allowed.empty() ? "" : ", ") + x.key;
+      throw py::type_error(name + "() got an unexpected keyword argument '" + key + "' (allowed: config, " + allowed +
+                           ")");
+    }
+    p.set_value(key, value_from_python(name, *d, v));
+  }
+  return p;
+}
+
+}  // namespace afmkit::python

@@ -1,0 +1,28 @@
+#pragma once
+// Keyword arguments → the parameters of one command (io::ParamSet): the same keys, types, ranges and messages as
+// the TOML file and the flags of the `afmkit` program.
+#include <string>
+#include <vector>
+
+#include <pybind11/pybind11.h>
+
+#include "afmkit/io/params.hpp"
+#include "command.hpp"
+
+namespace afmkit::python {
+
+/// The commands Python runs: every leaf command of the program but `report` (from Python: afmkit.report.build).
+const std::vector<cli::CommandSpec>& specs();
+
+/// The leaf command `path` ("tapping orbit"); ValueError for an unknown one.
+const cli::CommandSpec& command_spec(const std::string& path);
+
+/// The parameters of command `path` with `kwargs` applied on top of the defaults (and of the TOML file given as
+/// keyword `config`, as --config). `name` ("afmkit.tapping.orbit") prefixes TypeErrors (unexpected keyword, wrong
+/// Python type); a value out of range raises afmkit.InvalidParameter with the command line's message. Keys in
+/// `hidden` are refused like unknown ones (they mean nothing to this caller). "output" defaults to "" (no file)
+/// and "json" to true (nothing printed).
+io::ParamSet params_from_python(const std::string& path, const std::string& name, const pybind11::dict& kwargs,
+                                const std::vector<std::string>& hidden = {});
+
+}  // namespace afmkit::python

@@ -1,0 +1,201 @@
+"""The Python module afmkit against the command line it shares its code with: the same keys, the same numbers,
+the same messages (docs/python.md)."""
+import inspect
+import json
+import math
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import afmkit
+
+CLI = os.environ["AFMKIT_CLI"]
+
+
+def cli(*args, cwd=None):
+    return subprocess.run([CLI, *args], capture_output=True, text=True, cwd=cwd)
+
+
+def cli_table(*args):
+    """The table of `afmkit <args> --json --output ""`: columns and rows, as the command line prints them."""
+    r = cli(*args, "--json", "--output", "")
+    assert r.returncode == 0, r.stderr
+    doc = json.loads(r.stdout)
+    return doc
+
+
+def test_every_command_of_the_program_is_a_function_with_its_toml_keys():
+    from afmkit import _afmkit
+
+    paths = {s["path"] for s in _afmkit.commands()}
+    functions = {"impact": afmkit.impact, "scan": afmkit.scan, "demo": afmkit.demo,
+                 "tapping orbit": afmkit.tapping.orbit, "tapping hb": afmkit.tapping.hb,
+                 "tapping sweep": afmkit.tapping.sweep, "control tf": afmkit.control.tf,
+                 "control roots": afmkit.control.roots, "control margin": afmkit.control.margin,
+                 "control chart": afmkit.control.chart, "control tune": afmkit.control.tune,
+                 "control simulate": afmkit.control.simulate, "control export": afmkit.control.export}
+    assert paths == set(functions)  # `report` is afmkit.report.build, not a command function
+    for path, fn in functions.items():
+        help_text = cli(*path.split(), "--help").stdout + cli(*path.split(), "--units", "physical", "--help").stdout
+        keys = [p for p in inspect.signature(fn).parameters if p != "config"]
+        for key in keys:  # every keyword is an option of the command line (key with '-' for '_')
+            assert "--" + key.replace("_", "-") in help_text, (path, key)
+        assert fn.__doc__ and "quality_factor" in afmkit.tapping.hb.__doc__
+
+
+@pytest.mark.parametrize("command,args", [
+    ("tapping hb", {"quality_factor": 150.0, "points": 300}),
+    ("control tf", {"harmonics": 4, "points": 200}),
+    ("tapping sweep", {"points": 15}),
+    ("impact", {"restitution": 0.7, "points": 300}),
+])
+def test_result_equals_the_command_lines_table_bit_for_bit(command, args):
+    module, _, name = command.rpartition(" ")
+    fn = getattr(getattr(afmkit, module) if module else afmkit, name)
+    r = fn(**args)
+    flags = [x for k, v in args.items() for x in ("--" + k.replace("_", "-"), repr(v) if isinstance(v, float) else str(v))]
+    doc = cli_table(*command.split(), *flags)["table"]
+    names = [c["name"] if isinstance(c, dict) else c for c in doc["columns"]]
+    assert names == r.columns
+    rows = doc["rows"]
+    assert len(rows) == len(r) > 0
+    for i, col in enumerate(names):
+        cells = [row[i] for row in rows]
+        if r[col].dtype.kind == "f":
+            want = np.array([math.nan if c is None else float(c) for c in cells])
+            np.testing.assert_array_equal(r[col], want, err_msg=col)
+        else:
+            assert list(r[col]) == [str(c) for c in cells], col
+        assert r.units[col] == doc["columns"][i]["unit"] and r.meaning[col] == doc["columns"][i]["description"]
+
+
+def test_numpy_scalars_are_accepted():
+    a = afmkit.tapping.hb(quality_factor=np.float64(150), points=np.int64(300))
+    b = afmkit.tapping.hb(quality_factor=150.0, points=300)
+    np.testing.assert_array_equal(a["amplitude"], b["amplitude"])
+
+
+@pytest.mark.parametrize("call,argument,exc", [
+    (lambda: afmkit.tapping.hb(quality_factor="high"), "quality_factor", TypeError),
+    (lambda: afmkit.tapping.hb(points=2.5), "points", TypeError),
+    (lambda: afmkit.tapping.hb(points=True), "points", TypeError),
+    (lambda: afmkit.tapping.hb(quality_factor=-1.0), "quality_factor", ValueError),
+    (lambda: afmkit.tapping.hb(quality_factor=math.nan), "quality_factor", ValueError),
+    (lambda: afmkit.tapping.hb(qualityfactor=100.0), "qualityfactor", TypeError),
+    (lambda: afmkit.control.tf(harmonics=0), "harmonics", ValueError),
+    (lambda: afmkit.tapping.hb(law="no-such-law"), "law", ValueError),
+])
+def test_bad_arguments_raise_naming_the_argument(call, argument, exc):
+    with pytest.raises(exc) as e:
+        call()
+    assert argument in str(e.value)
+
+
+def test_value_errors_carry_the_command_lines_message():
+    for kwargs, flags in [({"quality_factor": -1.0}, ["--quality-factor", "-1"]),
+                          ({"approach_stiffness": 1.0, "departure_stiffness": 2.0},
+                           ["--approach-stiffness", "1", "--departure-stiffness", "2"])]:
+        with pytest.raises(ValueError) as e:
+            afmkit.tapping.hb(**kwargs)
+        r = cli("tapping", "hb", *flags, "--output", "")
+        assert r.returncode == 2
+        assert str(e.value) in r.stderr, (str(e.value), r.stderr)
+        assert isinstance(e.value, afmkit.InvalidParameter)
+        assert e.value.parameter in kwargs
+
+
+def test_config_file_then_keywords(tmp_path):
+    cfg = tmp_path / "run.toml"
+    cfg.write_text("quality_factor = 250.0\npoints = 120\n")
+    r = afmkit.tapping.hb(config=str(cfg))
+    assert r.params["quality_factor"] == 250.0 and len(r) > 0
+    r2 = afmkit.tapping.hb(config=cfg, points=80)  # os.PathLike, and a keyword over the file
+    assert r2.params["points"] == 80 and r2.params["quality_factor"] == 250.0
+    bad = tmp_path / "bad.toml"
+    bad.write_text("quality_factor = [1, 2]\n")
+    with pytest.raises(ValueError) as e:
+        afmkit.tapping.hb(config=str(bad))
+    assert "quality_factor" in str(e.value)
+
+
+def test_result_describes_its_columns():
+    r = afmkit.tapping.hb(points=100)
+    assert "amplitude" in r and r.units["amplitude"] and r.meaning["amplitude"]
+    assert r["amplitude"].dtype == np.float64
+    with pytest.raises(KeyError, match="no column 'nope'"):
+        r["nope"]
+    assert "afmkit.Result of tapping hb" in repr(r)
+
+
+def test_realtime_filter_block_equals_sample_loop():
+    kw = dict(rotation_frequency=2 * np.pi * 50.0, harmonics=4, sample_rate=20000.0)
+    m = np.random.default_rng(7).standard_normal(5001)
+    block = afmkit.control.RealtimeFilter(**kw)
+    u_block = block.step_block(m)
+    loop = afmkit.control.RealtimeFilter(**kw)
+    np.testing.assert_array_equal(u_block, [loop.step(x) for x in m])
+    out = np.empty_like(m)
+    again = afmkit.control.RealtimeFilter(**kw)
+    assert again.step_block(m, out) is out
+    np.testing.assert_array_equal(out, u_block)
+    with pytest.raises(ValueError, match="out must be"):
+        again.step_block(m, np.empty(len(m), dtype=np.float32))  # never a silently converted copy
+    with pytest.raises(ValueError, match="out must be"):
+        again.step_block(m, np.empty(len(m) - 1))
+
+
+def test_realtime_filter_in_a_closed_loop_removes_the_first_harmonic_and_keeps_the_third():
+    # the loop of docs/embedding.md: static plant with one sample of latency, m_n = d_n + u_{n-1}/K, K = gain * Omega
+    omega, rate, gain = 2 * np.pi * 50.0, 20000.0, 20.0
+    f = afmkit.control.RealtimeFilter(rotation_frequency=omega, harmonics=4, sample_rate=rate, gain=gain)
+    t = np.arange(40000) / rate
+    d = 1.0 * np.sin(omega * t + 0.3) + 0.4 * np.cos(3 * omega * t)  # tilt + a third harmonic
+    m = np.empty_like(d)
+    u = 0.0
+    for i in range(len(d)):
+        m[i] = d[i] + u / (gain * omega)
+        u = f.step(m[i])
+    # independent check: a direct Fourier projection over the last 20 whole turns
+    y, tt = m[-8000:], t[-8000:]
+    first = abs(2 / len(y) * np.sum(y * np.exp(-1j * omega * tt)))
+    third = abs(2 / len(y) * np.sum(y * np.exp(-3j * omega * tt)))
+    assert first < 1e-9
+    assert third == pytest.approx(0.4, rel=1e-4)
+
+
+def test_realtime_filter_bad_arguments():
+    omega = 2 * np.pi * 50.0
+    with pytest.raises(ValueError, match="sample_rate"):
+        afmkit.control.RealtimeFilter(rotation_frequency=omega, harmonics=4)
+    with pytest.raises(ValueError, match="sample_rate"):
+        afmkit.control.RealtimeFilter(rotation_frequency=omega, harmonics=4, sample_rate=-1.0)
+    with pytest.raises(TypeError, match="output"):
+        afmkit.control.RealtimeFilter(rotation_frequency=omega, harmonics=4, sample_rate=1e4, output="x.h")
+    with pytest.raises(TypeError, match="harmonics"):
+        afmkit.control.RealtimeFilter(rotation_frequency=omega, harmonics="ten", sample_rate=1e4)
+
+
+def test_realtime_filter_state_round_trip():
+    kw = dict(rotation_frequency=2 * np.pi * 50.0, harmonics=3, sample_rate=10000.0)
+    m = np.sin(np.linspace(0, 60, 5000))
+    a = afmkit.control.RealtimeFilter(**kw)
+    a.step_block(m[:2500])
+    saved = a.save_state()
+    rest = a.step_block(m[2500:])
+    b = afmkit.control.RealtimeFilter(**kw)
+    b.restore_state(saved)
+    np.testing.assert_array_equal(b.step_block(m[2500:]), rest)
+
+
+def test_solver_runs_release_the_interpreter():
+    import threading
+
+    results = []
+    threads = [threading.Thread(target=lambda: results.append(len(afmkit.tapping.hb(points=500)))) for _ in range(2)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert len(results) == 2 and results[0] == results[1] > 0

@@ -1,0 +1,80 @@
+"""`afmkit report` on bad input and when interrupted (the whole report, in a browser: test_report_browser.py)."""
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+from afmkit.report import figure_ids
+
+CLI = os.environ["AFMKIT_CLI"]
+QUICK = "seed000-fig3,beyond-impact"  # two figures of a few seconds
+
+
+def report(*args, cwd):
+    return subprocess.run([CLI, "report", *args], capture_output=True, text=True, cwd=cwd, timeout=300)
+
+
+def leftovers(folder: Path):
+    return [p.name for p in folder.iterdir() if p.name.startswith(".")] if folder.exists() else []
+
+
+def test_figure_ids_are_unique_and_cover_both_papers_and_beyond():
+    ids = figure_ids()
+    assert len(ids) == len(set(ids))
+    for wanted in ["seed000-fig3", "seed000-fig4", "seed000-attractive", "seed003-fig2", "seed003-fig3",
+                   "seed003-fig4", "seed003-fig5", "seed003-fig7", "beyond-hb-vs-orbits", "beyond-chart-spotchecks",
+                   "beyond-tuning", "beyond-scan-images"]:
+        assert wanted in ids
+
+
+def test_a_selection_writes_a_page_with_just_those_figures(tmp_path):
+    r = report("--output-dir", "rep", "--figures", QUICK, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "[ 1/2]" in r.stderr and "[ 2/2]" in r.stderr  # progress, one line per figure
+    page = (tmp_path / "rep" / "index.html").read_text()
+    assert page.count("<img ") == 2
+    for fid in QUICK.split(","):
+        assert f'id="{fid}"' in page
+        assert (tmp_path / "rep" / "figures" / f"{fid}.png").stat().st_size > 1000
+    assert "restitution" in page  # the impact figure's key number
+    assert leftovers(tmp_path / "rep") == []
+
+
+@pytest.mark.parametrize("args,names", [
+    (["--output-dir", "file/sub"], "output_dir"),          # below a regular file: cannot be created
+    (["--output-dir", "file"], "output_dir"),              # a regular file, not a folder
+    (["--figures", "seed000-fig3,no-such-figure"], "figures"),
+    (["--figures", ""], "figures"),
+    (["--jobs", "0"], "jobs"),
+    (["--jobs", "nan"], "jobs"),
+])
+def test_bad_input_is_refused_before_anything_is_computed(tmp_path, args, names):
+    (tmp_path / "file").write_text("not a folder")
+    start = time.monotonic()
+    r = report(*args, cwd=tmp_path)
+    assert r.returncode == 2, r.stderr
+    assert names in r.stderr
+    assert "figures with" not in r.stderr  # no figure was started
+    assert time.monotonic() - start < 30
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_an_interrupted_report_leaves_the_old_page_and_no_temporary(tmp_path, sig):
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "index.html").write_text("the previous report")
+    proc = subprocess.Popen([CLI, "report", "--output-dir", str(out), "--figures", QUICK + ",seed003-fig4"],
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+    first = proc.stderr.readline()  # "afmkit report: 3 figures with 2 process(es) …": computing has started
+    assert "figures with" in first
+    time.sleep(1.0)
+    os.killpg(proc.pid, sig)
+    rest = proc.communicate(timeout=60)[1]
+    assert proc.returncode != 0
+    assert "index.html was not changed" in rest
+    assert (out / "index.html").read_text() == "the previous report"
+    assert leftovers(out) == []
