@@ -2,6 +2,8 @@
 #include "program.hpp"
 
 #include <memory>
+#include <stdexcept>
+#include <system_error>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -62,15 +64,20 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
     capture_->rows = std::move(rows_);
     return;
   }
-  if (json_) {
-    nlohmann::json document = results;
-    if (keep_rows_) document["table"] = {{"columns", io::columns_json(columns_)}, {"rows", rows_}};
-    else if (!path_.empty()) document["output"] = path_;
-    fmt::print("{}\n", io::json_text(document));
-    return;
+  try {
+    if (json_) {
+      nlohmann::json document = results;
+      if (keep_rows_) document["table"] = {{"columns", io::columns_json(columns_)}, {"rows", rows_}};
+      else if (!path_.empty()) document["output"] = path_;
+      fmt::print("{}\n", io::json_text(document));
+      return;
+    }
+    if (!summary.empty()) fmt::print("{}\n", summary);
+    if (!path_.empty())
+      fmt::print("wrote {} rows to {} (columns, units and results in {}.json)\n", count_, path_, path_);
+  } catch (const std::system_error& e) {  // a full disk, a closed pipe (exit 1, as main's final check)
+    throw std::runtime_error(fmt::format("cannot write the results to standard output: {}", e.code().message()));
   }
-  if (!summary.empty()) fmt::print("{}\n", summary);
-  if (!path_.empty()) fmt::print("wrote {} rows to {} (columns, units and results in {}.json)\n", count_, path_, path_);
 }
 
 }  // namespace afmkit::cli

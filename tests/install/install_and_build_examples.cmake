@@ -244,8 +244,11 @@ if(PYTHON AND NOT _pkg)
   message(FATAL_ERROR "install_and_build_examples: the Python package afmkit was not installed under ${PREFIX}/lib")
 elseif(_pkg)
   get_filename_component(_site "${_pkg}" DIRECTORY)
+  # (a script file: a semicolon in an argument would split it into a CMake list)
+  file(WRITE "${WORK}/import_afmkit.py"
+       "import afmkit\nr = afmkit.tapping.hb(points=50)\nassert len(r) > 0\nprint(afmkit.__file__)\n")
   run("import the installed afmkit" _out ${CMAKE_COMMAND} -E env "PYTHONPATH=${_site}" PYTHONDONTWRITEBYTECODE=1
-      "${PYTHON}" -c "import afmkit; r = afmkit.tapping.hb(points=50); assert len(r) > 0; print(afmkit.__file__)")
+      "${PYTHON}" "${WORK}/import_afmkit.py")
   string(FIND "${_out}" "${_site}/afmkit/" _at)
   if(NOT _at EQUAL 0)
     message(FATAL_ERROR "install_and_build_examples: python imported afmkit from ${_out}, not from ${_site}")
