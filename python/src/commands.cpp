@@ -73,10 +73,10 @@ py::object column_array(const nlohmann::json& rows, std::size_t c) {
 }
 
 py::list describe(const CommandSpec& s) {
-  io::ParamSet p;
-  s.declare(p);
+  const io::ParamSet p = python_params(s);
   py::list out;
   for (const auto& d : p.describe()) {
+    if (d.key == "json") continue;  // always on from Python (nothing printed)
     py::dict e;
     e["key"] = d.key;
     e["kind"] = d.kind;

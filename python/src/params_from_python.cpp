@@ -2,6 +2,7 @@
 #include "params_from_python.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <variant>
 #include <vector>
@@ -44,16 +45,42 @@ io::ParamSet::Value value_from_python(const std::string& name, const io::ParamSe
   auto number = [&](const py::handle& x) -> double {
     const bool b = py::isinstance<py::bool_>(x) ||
                    (py::hasattr(x, "dtype") && py::str(x.attr("dtype").attr("kind")).cast<std::string>() == "b");
-    if (b || py::isinstance<py::str>(x) || !PyNumber_Check(x.ptr()) || PyComplex_Check(x.ptr()))
-      fail(d.kind == "reals" ? "a sequence of real numbers" : "a real number");
-    return py::float_(py::reinterpret_borrow<py::object>(x)).cast<double>();
+    const bool array = py::hasattr(x, "ndim") && py::int_(x.attr("ndim")).cast<int>() != 0;  // not a scalar
+    const char* want = d.kind == "reals" ? "a sequence of real numbers" : "a real number";
+    if (b || array || py::isinstance<py::str>(x) || !PyNumber_Check(x.ptr()) || PyComplex_Check(x.ptr())) fail(want);
+    const double v = PyFloat_AsDouble(x.ptr());
+    if (v == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      fail(want);
+    }
+    return v;
   };
+  // an int beyond the range of long: out of range (every integer parameter's range is far inside it)
+  auto whole = [&](const py::handle& x) -> long {
+    int overflow = 0;
+    const py::int_ i(py::reinterpret_borrow<py::object>(x));
+    const long v = PyLong_AsLongAndOverflow(i.ptr(), &overflow);
+    if (overflow != 0)
+      throw InvalidParameter(d.key, d.key + " = " + py::repr(i).cast<std::string>() + " is out of range: must be " +
+                                        (d.allowed.starts_with("integer") ? "an " : "") + d.allowed);
+    return v;
+  };
+  const bool scalar = !py::hasattr(obj, "ndim") || py::int_(obj.attr("ndim")).cast<int>() == 0;  // not an array
   if (d.kind == "integer") {
-    if (is_bool || !PyIndex_Check(obj.ptr())) fail("an int");
-    return py::int_(py::reinterpret_borrow<py::object>(obj)).cast<long>();
+    if (is_bool || !scalar || !PyIndex_Check(obj.ptr())) fail("an int");
+    return whole(obj);
   }
   if (d.kind == "real") {
-    if (PyIndex_Check(obj.ptr()) && !is_bool) return static_cast<double>(py::int_(py::reinterpret_borrow<py::object>(obj)).cast<long>());
+    if (!scalar) fail("a real number");
+    if (PyIndex_Check(obj.ptr()) && !is_bool) {
+      const py::int_ i(py::reinterpret_borrow<py::object>(obj));
+      const double v = PyLong_AsDouble(i.ptr());  // inf beyond the double range: refused by the range check
+      if (v == -1.0 && PyErr_Occurred()) {
+        PyErr_Clear();
+        return py::repr(i).cast<std::string>().front() == '-' ? -HUGE_VAL : HUGE_VAL;
+      }
+      return v;
+    }
     return number(obj);
   }
   if (py::isinstance<py::str>(obj) || !(py::isinstance<py::sequence>(obj) || py::hasattr(obj, "__array__")))
@@ -76,17 +103,25 @@ const cli::CommandSpec& command_spec(const std::string& path) {
   throw py::value_error("no afmkit command '" + path + "'");
 }
 
+io::ParamSet python_params(const cli::CommandSpec& spec) {
+  io::ParamSet p;
+  spec.declare(p);
+  for (const auto& d : p.describe()) {
+    const bool table_file = d.key == "output" || (d.key.size() > 7 && d.key.ends_with("_output"));
+    if (table_file && d.kind == "file") p.set_default(d.key, "");
+    if (d.key == "json" && d.kind == "flag") p.set_default("json", "true");
+  }
+  return p;
+}
+
 io::ParamSet params_from_python(const std::string& path, const std::string& name, const py::dict& kwargs,
                                 const std::vector<std::string>& hidden) {
   const cli::CommandSpec& s = command_spec(path);
-  io::ParamSet p;
-  s.declare(p);
+  io::ParamSet p = python_params(s);
   const std::vector<io::ParamSet::Description> described = p.describe();
-  for (const auto& d : described) {
-    if (d.key == "output" && d.kind == "file") p.set_default("output", "");
-    if (d.key == "json" && d.kind == "flag") p.set_default("json", "true");
-  }
-  auto visible = [&](const std::string& key) { return std::find(hidden.begin(), hidden.end(), key) == hidden.end(); };
+  auto visible = [&](const std::string& key) {
+    return key != "json" && std::find(hidden.begin(), hidden.end(), key) == hidden.end();
+  };
   if (kwargs.contains("config")) {
     const py::object c = kwargs["config"];
     if (!py::isinstance<py::str>(c) && !py::hasattr(c, "__fspath__"))

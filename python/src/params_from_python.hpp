@@ -17,11 +17,14 @@ const std::vector<cli::CommandSpec>& specs();
 /// The leaf command `path` ("tapping orbit"); ValueError for an unknown one.
 const cli::CommandSpec& command_spec(const std::string& path);
 
+/// The parameters of `spec` with Python's defaults: no file written (output and every *_output ""), json on (nothing
+/// printed). `json` is not a keyword from Python.
+io::ParamSet python_params(const cli::CommandSpec& spec);
+
 /// The parameters of command `path` with `kwargs` applied on top of the defaults (and of the TOML file given as
 /// keyword `config`, as --config). `name` ("afmkit.tapping.orbit") prefixes TypeErrors (unexpected keyword, wrong
 /// Python type); a value out of range raises afmkit.InvalidParameter with the command line's message. Keys in
-/// `hidden` are refused like unknown ones (they mean nothing to this caller). "output" defaults to "" (no file)
-/// and "json" to true (nothing printed).
+/// `hidden` (and `json`) are refused like unknown ones (they mean nothing to this caller).
 io::ParamSet params_from_python(const std::string& path, const std::string& name, const pybind11::dict& kwargs,
                                 const std::vector<std::string>& hidden = {});
 

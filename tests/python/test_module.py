@@ -86,6 +86,14 @@ def test_numpy_scalars_are_accepted():
     (lambda: afmkit.tapping.hb(qualityfactor=100.0), "qualityfactor", TypeError),
     (lambda: afmkit.control.tf(harmonics=0), "harmonics", ValueError),
     (lambda: afmkit.tapping.hb(law="no-such-law"), "law", ValueError),
+    (lambda: afmkit.tapping.hb(points=10**30), "points", ValueError),          # beyond any C integer
+    (lambda: afmkit.tapping.hb(quality_factor=10**400), "quality_factor", ValueError),  # beyond double
+    (lambda: afmkit.tapping.hb(quality_factor=np.array([3.0])), "quality_factor", TypeError),  # an array
+    (lambda: afmkit.tapping.sweep(separations=np.ones((2, 2))), "separations", TypeError),
+    (lambda: afmkit.tapping.sweep(separations="10,9"), "separations", TypeError),
+    (lambda: afmkit.tapping.sweep(separations=[10.0, math.nan]), "separations", ValueError),
+    (lambda: afmkit.tapping.hb(json=False), "json", TypeError),                # not a keyword from Python
+    (lambda: afmkit.tapping.hb(config=3), "config", TypeError),
 ])
 def test_bad_arguments_raise_naming_the_argument(call, argument, exc):
     with pytest.raises(exc) as e:
@@ -104,6 +112,31 @@ def test_value_errors_carry_the_command_lines_message():
         assert str(e.value) in r.stderr, (str(e.value), r.stderr)
         assert isinstance(e.value, afmkit.InvalidParameter)
         assert e.value.parameter in kwargs
+
+
+def test_lists_take_numpy_arrays():
+    a = afmkit.tapping.sweep(separations=np.array([10.0, 9.0, 8.0]))
+    b = afmkit.tapping.sweep(separations=[10, 9, 8])
+    assert len(a) == len(b) > 0
+    for c in a.columns:
+        np.testing.assert_array_equal(a[c], b[c])
+
+
+def test_python_calls_write_no_file_unless_asked(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    for fn in [afmkit.tapping.hb, afmkit.control.chart, afmkit.control.tf]:
+        sig = inspect.signature(fn).parameters
+        assert "json" not in sig
+        for key, p in sig.items():
+            if key == "output" or key.endswith("_output"):
+                assert p.default == "", (fn.__name__, key)
+    afmkit.control.chart(x_points=6, y_points=5, progress=False)
+    afmkit.tapping.hb(points=50)
+    assert list(tmp_path.iterdir()) == []
+    r = afmkit.tapping.hb(points=50, output="hb.csv")  # asked: the CSV and its sidecar, as the command line writes
+    assert (tmp_path / "hb.csv").is_file() and (tmp_path / "hb.csv.json").is_file()
+    header = (tmp_path / "hb.csv").read_text().splitlines()[0].split(",")
+    assert header == r.columns
 
 
 def test_config_file_then_keywords(tmp_path):
