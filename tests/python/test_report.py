@@ -78,3 +78,16 @@ def test_an_interrupted_report_leaves_the_old_page_and_no_temporary(tmp_path, si
     assert "index.html was not changed" in rest
     assert (out / "index.html").read_text() == "the previous report"
     assert leftovers(out) == []
+
+
+def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(tmp_path):
+    out = tmp_path / "rep"
+    out.mkdir()
+    dead = subprocess.Popen(["true"])
+    dead.wait()  # a process id that no longer exists
+    stale = out / f".staging-{dead.pid}-abc"
+    stale.mkdir()
+    (stale / "seed000-fig3.png").write_bytes(b"half")
+    r = report("--output-dir", str(out), "--figures", "beyond-impact", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert leftovers(out) == []

@@ -40,6 +40,19 @@ def figure_ids() -> list:
     return [figure_id for _, _, figure_id in _figure_list()]
 
 
+def _remove_stale_staging(out: Path) -> None:
+    """Removes the staging folders of earlier runs that were killed outright (SIGKILL, power loss): those whose
+    process no longer exists (a run still going on keeps its own)."""
+    for folder in out.glob(".staging-*-*"):
+        try:
+            pid = int(folder.name.split("-")[1])
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            shutil.rmtree(folder, ignore_errors=True)
+        except (ValueError, PermissionError):
+            pass
+
+
 def _figure_list():
     tasks = []
     for module in FIGURE_MODULES:
@@ -130,7 +143,8 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all") -> Path:
     out = Path(output_dir)
     _check_writable(out)
     started = time.perf_counter()
-    staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
+    _remove_stale_staging(out)
+    staging = Path(tempfile.mkdtemp(prefix=f".staging-{os.getpid()}-", dir=out))
     try:
         print(f"afmkit report: {len(tasks)} figures with {jobs} process(es) into {out}/", file=sys.stderr, flush=True)
         done = {}
