@@ -48,7 +48,7 @@ CommandOutput::CommandOutput(const io::ParamSet& params, Captured* capture, std:
                              const std::string& output_key)
     : params_(params), capture_(capture), command_(std::move(command)), path_(params.text(output_key)),
       json_(params.flag("json")) {
-  keep_rows_ = capture_ != nullptr || (json_ && path_.empty());
+  keep_rows_ = capture_ != nullptr ? capture_->want_rows : json_ && path_.empty();
 }
 
 void CommandOutput::open(std::vector<io::Column> columns) {

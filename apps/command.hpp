@@ -30,6 +30,7 @@ namespace afmkit::cli {
 /// (what --json prints, without the table), the table's columns and its rows. Nothing is printed; the table file is
 /// written only when its path is given.
 struct Captured {
+  bool want_rows = true;  ///< false: the caller reads only results and columns (no rows kept, no history recorded)
   nlohmann::json results = nlohmann::json::object();
   std::vector<io::Column> columns;
   nlohmann::json rows = nlohmann::json::array();

@@ -11,6 +11,7 @@ packages=(build-essential cmake libeigen3-dev libcli11-dev libtomlplusplus-dev l
           gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm   # the embedded filter core on a Cortex-M4F (MPS2)
           gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user       # … and on 64-bit ARM Linux (scripts/cross.sh)
           python3-dev pybind11-dev python3-numpy python3-matplotlib python3-pytest   # the Python module and its tests
+          python3-xarray python3-zarr python3-distributed python3-netcdf4   # parameter studies (docs/study.md)
           chromium chromium-driver python3-selenium)                  # the report opened in headless Chromium
 missing=()
 for p in "${packages[@]}"; do

@@ -10,4 +10,5 @@ PYBIND11_MODULE(_afmkit, m) {
   afmkit::python::bind_errors(m);
   afmkit::python::bind_commands(m);
   afmkit::python::bind_realtime_filter(m);
+  afmkit::python::bind_study(m);
 }

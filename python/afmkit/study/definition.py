@@ -1,0 +1,197 @@
+"""What a study is: named axes over parameters of one afmkit command, fixed parameters, the outputs wanted.
+
+A study is a value: validated when made, compared by its fingerprint (the store it writes remembers it and refuses
+another study's results).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+#: computations a study can run at each point: the afmkit command behind each
+COMPUTATIONS = {
+    "tapping.orbit": "tapping orbit",
+    "tapping.sweep": "tapping sweep",
+    "tapping.hb": "tapping hb",
+    "control.roots": "control roots",
+    "control.margin": "control margin",
+    "control.simulate": "control simulate",
+}
+
+
+class StudyError(ValueError):
+    """A study that cannot be run as described; `field` names the part that is wrong."""
+
+    def __init__(self, field_name: str, message: str):
+        super().__init__(message)
+        self.field = field_name
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One named axis: a numeric parameter of the computation's command and its values (in the command's units)."""
+
+    name: str
+    values: tuple
+
+    @staticmethod
+    def make(name: str, spec) -> "Axis":
+        """From a list of values, or {start, stop, points} (evenly spaced, both ends included), or
+        {values = [...]}."""
+        values = spec
+        if isinstance(spec, dict):
+            spec = dict(spec)
+            if "values" in spec:
+                values = spec.pop("values")
+            else:
+                try:
+                    start, stop, points = spec.pop("start"), spec.pop("stop"), spec.pop("points")
+                except KeyError as e:
+                    raise StudyError(f"axes.{name}", f"axes.{name}: needs values = [...] or start, stop and points "
+                                                     f"(missing {e.args[0]})") from None
+                if not isinstance(points, int) or isinstance(points, bool) or points < 1:
+                    raise StudyError(f"axes.{name}", f"axes.{name}: points = {points!r} must be an integer >= 1")
+                _finite(name, [start, stop])
+                values = np.linspace(float(start), float(stop), points).tolist()
+            if spec:
+                raise StudyError(f"axes.{name}", f"axes.{name}: unknown field(s) {', '.join(sorted(spec))} "
+                                                 f"(allowed: values, or start, stop, points)")
+        try:
+            values = [float(v) for v in np.asarray(values, dtype=float).ravel()]
+        except (TypeError, ValueError):
+            raise StudyError(f"axes.{name}", f"axes.{name}: values must be numbers") from None
+        if not values:
+            raise StudyError(f"axes.{name}", f"axes.{name} is empty: an axis needs at least one value")
+        _finite(name, values)
+        if len(set(values)) != len(values):
+            raise StudyError(f"axes.{name}", f"axes.{name} repeats a value: every value must be distinct")
+        return Axis(name, tuple(values))
+
+
+def _finite(name, values):
+    for v in values:
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
+            raise StudyError(f"axes.{name}", f"axes.{name} contains {v!r}: every value must be a finite number")
+
+
+@dataclass(frozen=True)
+class Study:
+    """A parameter study: `computation` (see COMPUTATIONS) at every point of the grid of `axes`, with the fixed
+    `parameters` (TOML keys of the command), recording `outputs` (selectors, docs/study.md)."""
+
+    computation: str
+    axes: tuple
+    outputs: tuple
+    parameters: dict = field(default_factory=dict)
+    name: str = "study"
+
+    @staticmethod
+    def make(computation: str, axes: dict, outputs, parameters: dict | None = None, name: str = "study") -> "Study":
+        if computation not in COMPUTATIONS:
+            raise StudyError("computation", f"computation = {computation!r} is not allowed: must be one of "
+                                            f"{', '.join(COMPUTATIONS)}")
+        if not isinstance(axes, dict) or not axes:
+            raise StudyError("axes", "axes: a study needs at least one axis (name = values)")
+        made = tuple(a if isinstance(a, Axis) else Axis.make(n, a) for n, a in axes.items())
+        if isinstance(outputs, str):
+            outputs = [outputs]
+        outputs = tuple(outputs or ())
+        if not outputs or not all(isinstance(o, str) and o.strip() for o in outputs):
+            raise StudyError("outputs", "outputs: a study needs at least one output (a results key or agg(column))")
+        if len(set(outputs)) != len(outputs):
+            raise StudyError("outputs", "outputs: an output is listed twice")
+        parameters = dict(parameters or {})
+        for a in made:
+            if a.name in parameters:
+                raise StudyError(f"axes.{a.name}", f"axes.{a.name} is also a fixed parameter: give it in one place")
+        for key in ("output", "json", "config"):
+            if key in parameters or any(a.name == key for a in made):
+                raise StudyError(f"parameters.{key}", f"parameters.{key}: not a study parameter (the study writes "
+                                                      f"its own store)")
+        study = Study(computation, made, outputs, parameters, name)
+        study._check_names()
+        return study
+
+    @staticmethod
+    def from_toml(path) -> "Study":
+        """A study file (docs/study.md):
+
+            name = "..."
+            computation = "tapping.orbit"
+            outputs = ["max(amplitude | stable)", ...]
+            [parameters]   # fixed, TOML keys of the command
+            [axes]         # name = [values] or { start, stop, points }
+        """
+        path = Path(path)
+        try:
+            doc = tomllib.loads(path.read_text(encoding="utf-8"))
+        except OSError as e:
+            raise StudyError("file", f"study file '{path}': {e.strerror or e}") from None
+        except tomllib.TOMLDecodeError as e:
+            raise StudyError("file", f"study file '{path}' is not valid TOML: {e}") from None
+        allowed = {"name", "computation", "outputs", "parameters", "axes", "run"}
+        unknown = sorted(set(doc) - allowed)
+        if unknown:
+            raise StudyError(unknown[0], f"{path}: unknown field '{unknown[0]}' (allowed: {', '.join(sorted(allowed))})")
+        for required in ("computation", "axes", "outputs"):
+            if required not in doc:
+                raise StudyError(required, f"{path}: '{required}' is required")
+        return Study.make(doc["computation"], doc["axes"], doc["outputs"], doc.get("parameters", {}),
+                          doc.get("name", path.stem))
+
+    # ---- derived -------------------------------------------------------------------------------------------------
+    @property
+    def command(self) -> str:
+        return COMPUTATIONS[self.computation]
+
+    @property
+    def shape(self) -> tuple:
+        return tuple(len(a.values) for a in self.axes)
+
+    @property
+    def size(self) -> int:
+        return int(np.prod(self.shape))
+
+    def definition(self) -> dict:
+        """The study as plain data (what the fingerprint covers)."""
+        return {"computation": self.computation, "parameters": self.parameters,
+                "axes": [[a.name, list(a.values)] for a in self.axes], "outputs": list(self.outputs)}
+
+    def fingerprint(self) -> str:
+        text = json.dumps(self.definition(), sort_keys=True, allow_nan=False)
+        return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+    def _check_names(self) -> None:
+        from .. import _afmkit
+
+        spec = next(s for s in _afmkit.commands() if s["path"] == self.command)
+        params = {p["key"]: p for p in spec["params"]}
+        for a in self.axes:
+            p = params.get(a.name)
+            if p is None:
+                raise StudyError(f"axes.{a.name}", f"axes.{a.name}: unknown parameter '{a.name}' of afmkit "
+                                                   f"{self.command} (numeric parameters: "
+                                                   f"{', '.join(k for k, q in params.items() if q['kind'] in ('real', 'integer'))})")
+            if p["kind"] not in ("real", "integer"):
+                raise StudyError(f"axes.{a.name}", f"axes.{a.name}: '{a.name}' is a {p['kind']} parameter; an axis "
+                                                   f"must be a real or integer parameter")
+            if p["kind"] == "integer" and any(v != int(v) for v in a.values):
+                raise StudyError(f"axes.{a.name}", f"axes.{a.name}: '{a.name}' takes integers")
+        for key in self.parameters:
+            if key not in params:
+                raise StudyError(f"parameters.{key}", f"parameters.{key}: unknown parameter '{key}' of afmkit "
+                                                      f"{self.command} (allowed: {', '.join(params)})")
+
+    def units(self) -> dict:
+        """The unit of every axis (the command's parameter units)."""
+        from .. import _afmkit
+
+        spec = next(s for s in _afmkit.commands() if s["path"] == self.command)
+        params = {p["key"]: p for p in spec["params"]}
+        return {a.name: params[a.name]["unit"] for a in self.axes}

@@ -1,0 +1,220 @@
+"""Parameter studies (afmkit.study, docs/study.md): the same numbers serially and on a Dask LocalCluster with two
+worker processes (loopback only), a worker killed mid-study, an interrupted study resumed, and bad input."""
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+import xarray as xr
+import zarr
+
+import afmkit
+from afmkit.study import Study, StudyError, run
+
+distributed = pytest.importorskip("distributed")
+
+ORBIT = dict(computation="tapping.orbit",
+             axes={"separation": {"start": 8.5, "stop": 10.5, "points": 9}, "frequency_ratio": [0.99, 1.0, 1.005]},
+             outputs=["max(amplitude | stable)", "min(amplitude | stable)", "count(amplitude | stable)",
+                      "free_amplitude"],
+             parameters={"law": "attractive", "approach_adhesion": 0.5, "departure_adhesion": 1.0})
+
+
+def orbit_study(**changes):
+    return Study.make(**{**ORBIT, **changes})
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                 host="127.0.0.1", env={"OMP_NUM_THREADS": "1"})
+    client = distributed.Client(c)
+    yield client
+    client.close()
+    c.close()
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    path = tmp_path_factory.mktemp("serial") / "s.zarr"
+    return run(orbit_study(), path, scheduler="serial", chunk_points=4, progress=False).load()
+
+
+def same(a: xr.Dataset, b: xr.Dataset):
+    assert list(a.data_vars) == list(b.data_vars)
+    for v in a.data_vars:
+        np.testing.assert_array_equal(a[v].values, b[v].values, err_msg=v)  # bit for bit (NaN where NaN)
+
+
+def test_results_are_labelled_arrays_with_units(serial):
+    assert serial.sizes == {"separation": 9, "frequency_ratio": 3}
+    assert serial["separation"].attrs["units"] == "nm (physical) or L (normalised)"
+    assert serial["max_amplitude_stable"].attrs["selector"] == "max(amplitude | stable)"
+    assert serial["max_amplitude_stable"].attrs["units"]
+    assert serial["count_amplitude_stable"].attrs["units"] == "count"
+    assert serial.attrs["failed_points"] == 0
+    # independent check of one point: the orbit command itself at that point
+    r = afmkit.tapping.orbit(separation=9.5, frequency_ratio=1.0, **ORBIT["parameters"])
+    stable = r["stable"] == 1
+    point = serial.sel(separation=9.5, frequency_ratio=1.0)
+    assert float(point["max_amplitude_stable"]) == r["amplitude"][stable].max()
+    assert float(point["min_amplitude_stable"]) == r["amplitude"][stable].min()
+    assert int(point["count_amplitude_stable"]) == stable.sum()
+
+
+def test_local_cluster_gives_the_serial_numbers_bit_for_bit(cluster, serial, tmp_path):
+    ds = run(orbit_study(), tmp_path / "d.zarr", scheduler=cluster, chunk_points=2, progress=False)
+    same(ds.load(), serial)
+
+
+def test_a_worker_killed_mid_study_and_the_study_still_completes(cluster, serial, tmp_path):
+    path = tmp_path / "k.zarr"
+    pids = list(cluster.run(os.getpid).values())
+    killed = []
+
+    def kill_when_started():
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            try:
+                done = zarr.open_group(str(path), mode="r")["chunk_done"][:]
+            except Exception:  # noqa: BLE001 - the store is not created yet
+                time.sleep(0.02)
+                continue
+            if 2 <= done.sum() < len(done):
+                os.kill(pids[0], signal.SIGKILL)  # the worker process ends; its chunks go to the other
+                killed.append(int(done.sum()))
+                return
+            time.sleep(0.005)
+
+    watcher = threading.Thread(target=kill_when_started)
+    watcher.start()
+    ds = run(orbit_study(), path, scheduler=cluster, chunk_points=1, progress=False)
+    watcher.join()
+    assert killed, "the study ended before a worker could be killed"
+    same(ds.load(), serial)
+    cluster.wait_for_workers(2, timeout=60)  # the nanny restarted it
+
+
+def test_an_interrupted_study_resumes_and_recomputes_only_missing_chunks(serial, tmp_path):
+    path = tmp_path / "r.zarr"
+    code = ("import sys; from afmkit.study import Study, run; "
+            f"s = Study.make(**{ORBIT!r}); "
+            f"run(s, {str(path)!r}, scheduler='serial', chunk_points=1, progress=False)")
+    proc = subprocess.Popen([sys.executable, "-c", code], env=os.environ.copy())
+    deadline = time.monotonic() + 60
+    done = None
+    while time.monotonic() < deadline:
+        if path.exists():
+            done = zarr.open_group(str(path), mode="r")["chunk_done"][:]
+            if done.sum() >= 3:
+                break
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGINT)
+    proc.wait(timeout=60)
+    done = zarr.open_group(str(path), mode="r")["chunk_done"][:]
+    assert 3 <= done.sum() < len(done), done
+    # the files of finished chunks: they must not be written again
+    name = "max_amplitude_stable"
+    stamps = {p: p.stat().st_mtime_ns for p in (path / name).iterdir() if not p.name.startswith(".")}
+    before = int(done.sum())
+    ds = run(orbit_study(), path, scheduler="serial", progress=False)
+    same(ds.load(), serial)
+    rewritten = [p for p, t in stamps.items() if p.stat().st_mtime_ns != t]
+    assert rewritten == [], f"finished chunks were recomputed: {rewritten}"
+    after = zarr.open_group(str(path), mode="r")["chunk_done"][:]
+    assert after.all() and before < len(after)
+
+
+def test_a_store_of_another_study_is_refused(serial, tmp_path):
+    path = tmp_path / "o.zarr"
+    run(orbit_study(), path, scheduler="serial", chunk_points=30, progress=False)
+    other = orbit_study(parameters={**ORBIT["parameters"], "quality_factor": 200.0})
+    with pytest.raises(StudyError, match="different study .*parameters") as e:
+        run(other, path, scheduler="serial", progress=False)
+    assert e.value.field == "store"
+
+
+@pytest.mark.parametrize("make,field", [
+    (lambda: orbit_study(axes={"separatoin": [1.0, 2.0]}), "axes.separatoin"),
+    (lambda: orbit_study(axes={"separation": []}), "axes.separation"),
+    (lambda: orbit_study(axes={"separation": [1.0, float("nan")]}), "axes.separation"),
+    (lambda: orbit_study(axes={"separation": [1.0, float("inf")]}), "axes.separation"),
+    (lambda: orbit_study(axes={"law": [1.0]}), "axes.law"),
+    (lambda: orbit_study(axes={}), "axes"),
+    (lambda: orbit_study(outputs=[]), "outputs"),
+    (lambda: orbit_study(computation="tapping.orbits"), "computation"),
+    (lambda: orbit_study(parameters={"qualityfactor": 3.0}), "parameters.qualityfactor"),
+])
+def test_bad_definitions_name_the_field(make, field):
+    with pytest.raises(StudyError) as e:
+        make()
+    assert e.value.field == field
+    assert field.split(".")[-1] in str(e.value)
+
+
+def test_bad_run_arguments_name_the_field(tmp_path):
+    with pytest.raises(StudyError, match="chunk_points = 0") as e:
+        run(orbit_study(), tmp_path / "z.zarr", scheduler="serial", chunk_points=0)
+    assert e.value.field == "chunk_points"
+    with pytest.raises(ValueError, match="outputs: 'max\\(amplitde \\| stable\\)': the table has no column 'amplitde'"):
+        run(orbit_study(outputs=["max(amplitde | stable)"]), tmp_path / "y.zarr", scheduler="serial")
+    with pytest.raises(ValueError, match="the command reports no 'critical_delay'"):
+        run(orbit_study(outputs=["critical_delay"]), tmp_path / "x.zarr", scheduler="serial")
+    assert not any(tmp_path.iterdir())  # nothing created for a study that cannot run
+
+
+def test_a_scheduler_that_does_not_answer_is_an_error_within_seconds(tmp_path):
+    start = time.monotonic()
+    with pytest.raises(StudyError, match="scheduler 'tcp://127.0.0.1:9' does not answer") as e:
+        run(orbit_study(), tmp_path / "w.zarr", scheduler="tcp://127.0.0.1:9", progress=False)
+    assert e.value.field == "scheduler"
+    assert time.monotonic() - start < 20
+
+
+def test_netcdf_on_request(serial, tmp_path):
+    ds = run(orbit_study(), tmp_path / "n.zarr", scheduler="serial", chunk_points=30, progress=False,
+             netcdf=tmp_path / "n.nc")
+    back = xr.open_dataset(tmp_path / "n.nc")
+    same(back, serial)
+    assert back["separation"].attrs["units"] == ds["separation"].attrs["units"]
+
+
+def test_the_example_study_runs_from_the_command_line_and_finds_the_hb_hysteresis_bands(tmp_path):
+    source = os.environ["AFMKIT_SOURCE_DIR"]
+    store = tmp_path / "jumps.zarr"
+    r = subprocess.run([sys.executable, "-m", "afmkit.study", "run", f"{source}/examples/studies/attractive_jumps.toml",
+                        "--store", str(store), "--scheduler", "serial"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "chunks" in r.stderr  # progress lines
+    ds = xr.open_zarr(store)
+    assert ds.attrs["study_name"] == "attractive_jumps"
+    # independent check: two stable orbits coexist exactly between the HB curve's jump points — the free
+    # amplitude (the grazing separation, where the free oscillation starts to touch) and the fold of largest l
+    parameters = {"law": "attractive", "quality_factor": 100.0, "approach_adhesion": 0.5, "departure_adhesion": 1.0}
+    for ratio in (0.99, 0.995):
+        hb = afmkit.tapping.hb(frequency_ratio=ratio, **parameters)
+        upper = max(f["separation"] for f in hb.results["folds"])
+        lower = hb.results["free_amplitude"]
+        l = ds["separation"].values
+        two = ds["count_amplitude_stable"].sel(frequency_ratio=ratio).values > 1
+        inside = (l > lower + 0.05) & (l < upper - 0.05)  # a margin for HB's error against exact orbits (< 1 %)
+        outside = (l < lower - 0.2) | (l > upper + 0.2)
+        assert two[inside].all(), (ratio, l[inside], two[inside])
+        assert not two[outside].any(), (ratio, l[outside][two[outside]])
+
+
+def test_the_command_line_names_the_field_of_a_bad_file(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('computation = "tapping.orbit"\noutputs = ["free_amplitude"]\n[axes]\nseparation = []\n')
+    r = subprocess.run([sys.executable, "-m", "afmkit.study", "run", str(bad), "--store", str(tmp_path / "s.zarr")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2
+    assert "axes.separation is empty" in r.stderr
+    bad.write_text('computation = "tapping.orbit"\noutputs = ["free_amplitude"]\ncolour = 3\n[axes]\nseparation = [1]\n')
+    r = subprocess.run([sys.executable, "-m", "afmkit.study", "run", str(bad)], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 2 and "unknown field 'colour'" in r.stderr
