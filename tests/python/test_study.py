@@ -187,7 +187,7 @@ def test_the_example_study_runs_from_the_command_line_and_finds_the_hb_hysteresi
     source = os.environ["AFMKIT_SOURCE_DIR"]
     store = tmp_path / "jumps.zarr"
     r = subprocess.run([sys.executable, "-m", "afmkit.study", "run", f"{source}/examples/studies/attractive_jumps.toml",
-                        "--store", str(store), "--scheduler", "serial"], capture_output=True, text=True, timeout=300)
+                        "--store", str(store), "--workers", "2"], capture_output=True, text=True, timeout=300)  # local
     assert r.returncode == 0, r.stderr
     assert "chunks" in r.stderr  # progress lines
     ds = xr.open_zarr(store)

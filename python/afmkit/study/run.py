@@ -116,6 +116,7 @@ def _client(scheduler, workers: int | None):
     if scheduler in (None, "local"):
         n = workers or os.cpu_count() or 1
         cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                           host="127.0.0.1",
                                            env={"OMP_NUM_THREADS": "1"})
         return distributed.Client(cluster), cluster
     if not isinstance(scheduler, str) or "://" not in scheduler:
