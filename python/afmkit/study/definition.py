@@ -5,6 +5,7 @@ another study's results).
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -23,6 +24,15 @@ COMPUTATIONS = {
     "control.margin": "control margin",
     "control.simulate": "control simulate",
 }
+
+
+@functools.lru_cache(maxsize=None)
+def parameters_of(command: str) -> dict:
+    """The parameters of afmkit `command` (key -> kind, unit, default, …), as the module describes them."""
+    from .. import _afmkit
+
+    spec = next(s for s in _afmkit.commands() if s["path"] == command)
+    return {p["key"]: p for p in spec["params"]}
 
 
 class StudyError(ValueError):
@@ -168,10 +178,7 @@ class Study:
         return hashlib.sha256(text.encode()).hexdigest()[:32]
 
     def _check_names(self) -> None:
-        from .. import _afmkit
-
-        spec = next(s for s in _afmkit.commands() if s["path"] == self.command)
-        params = {p["key"]: p for p in spec["params"]}
+        params = parameters_of(self.command)
         for a in self.axes:
             p = params.get(a.name)
             if p is None:
@@ -190,8 +197,5 @@ class Study:
 
     def units(self) -> dict:
         """The unit of every axis (the command's parameter units)."""
-        from .. import _afmkit
-
-        spec = next(s for s in _afmkit.commands() if s["path"] == self.command)
-        params = {p["key"]: p for p in spec["params"]}
+        params = parameters_of(self.command)
         return {a.name: params[a.name]["unit"] for a in self.axes}

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from . import store as zstore
-from .definition import Study, StudyError
+from .definition import Study, StudyError, parameters_of
 
 
 def _points(study: Study, slices: tuple) -> np.ndarray:
@@ -73,13 +73,13 @@ def _pilot(study: Study):
     """Runs the first point: checks parameters and outputs, measures the cost of a point, finds the units."""
     from .. import _afmkit
 
-    first = {a.name: (int(a.values[0]) if float(a.values[0]).is_integer() and _is_integer(study, a.name)
-                      else a.values[0]) for a in study.axes}
+    params = parameters_of(study.command)
+    first = {a.name: int(a.values[0]) if params[a.name]["kind"] == "integer" else a.values[0] for a in study.axes}
     raw = _afmkit.run(study.command, {**study.parameters, **first})
     start = time.perf_counter()
     n = 0
-    points = _points(study, tuple(slice(0, len(a.values)) for a in study.axes))
-    while n < min(len(points), 64):
+    points = _points(study, zstore.chunk_slices(study.shape, zstore.chunk_shape(study.shape, 64), 0))  # the first ≤ 64
+    while n < len(points):
         _afmkit.evaluate_points(study.command, dict(study.parameters), [a.name for a in study.axes],
                                 points[n:n + 1], list(study.outputs))
         n += 1
@@ -98,13 +98,6 @@ def _pilot(study: Study):
             key = o.strip().strip("/").split("/")
             out_units.append(units.get(key[0]) or units.get(key[-1]) or "")
     return cost, out_units
-
-
-def _is_integer(study: Study, name: str) -> bool:
-    from .. import _afmkit
-
-    spec = next(s for s in _afmkit.commands() if s["path"] == study.command)
-    return next(p for p in spec["params"] if p["key"] == name)["kind"] == "integer"
 
 
 def _client(scheduler, workers: int | None):
