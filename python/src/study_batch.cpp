@@ -38,6 +38,7 @@ struct Selector {
   std::string text;
   Aggregate aggregate = Aggregate::none;
   nlohmann::json::json_pointer pointer;  // results path (aggregate none)
+  std::string first_key;                 // its first key (must be reported by the command)
   std::string column, flag;              // table column and optional row filter
   long column_index = -1, flag_index = -1;
 };
@@ -56,6 +57,7 @@ Selector parse_selector(const std::string& text) {
     if (trim(text).empty()) throw InvalidParameter("outputs", "outputs: an output is empty");
     std::string path = trim(text);
     if (path.front() != '/') path = "/" + path;
+    s.first_key = path.substr(1, path.find('/', 1) - 1);
     try {
       s.pointer = nlohmann::json::json_pointer(path);
     } catch (const nlohmann::json::exception&) {
@@ -108,7 +110,7 @@ long column_index(const std::vector<io::Column>& columns, const std::string& nam
 void bind_selectors(std::vector<Selector>& selectors, const cli::Captured& c) {
   for (Selector& s : selectors) {
     if (s.aggregate == Aggregate::none) {
-      const std::string first = s.pointer.empty() ? "" : s.pointer.to_string().substr(1, s.pointer.to_string().find('/', 1) - 1);
+      const std::string& first = s.first_key;
       if (!c.results.contains(first)) {
         std::string known;
         for (const auto& [k, v] : c.results.items())
@@ -162,13 +164,13 @@ ChunkResult evaluate_points(const std::string& path, const py::dict& base, const
   const io::ParamSet prepared = params_from_python(path, fn, base);
   if (values.ndim() != 2 || values.shape(1) != static_cast<py::ssize_t>(names.size()))
     throw py::value_error("evaluate_points: values must be an array of shape (points, axes)");
-  std::vector<io::ParamSet::Description> kinds;
+  std::vector<bool> integer;  // per axis: an integer parameter (else real)
   const auto described = prepared.describe();
   for (const std::string& n : names) {
     const auto it = std::find_if(described.begin(), described.end(), [&](const auto& d) { return d.key == n; });
     if (it == described.end() || (it->kind != "real" && it->kind != "integer"))
       throw InvalidParameter("axes", "axes: '" + n + "' is not a numeric parameter of afmkit " + path);
-    kinds.push_back(*it);
+    integer.push_back(it->kind == "integer");
   }
   std::vector<Selector> selectors;
   for (const std::string& o : outputs) selectors.push_back(parse_selector(o));
@@ -189,7 +191,7 @@ ChunkResult evaluate_points(const std::string& path, const py::dict& base, const
       io::ParamSet p = prepared;
       for (std::size_t j = 0; j < names.size(); ++j) {
         const double x = v[i * names.size() + j];
-        if (kinds[j].kind == "integer") {
+        if (integer[j]) {
           if (!(std::isfinite(x) && x == std::floor(x) && std::abs(x) < 9.0e15))
             throw InvalidParameter(names[j], "axes: " + names[j] + " = " + std::to_string(x) + " is not an integer");
           p.set_value(names[j], static_cast<long>(x));
