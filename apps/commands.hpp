@@ -19,5 +19,6 @@ void register_control_export(CLI::App& control);    // control_export_cmd.cpp:  
 void register_demo(CLI::App& app);              // demo_cmd.cpp:          afmkit demo (the Quick-start main job)
 void register_scan(CLI::App& app);              // scan_cmd.cpp:          afmkit scan
 void register_report(CLI::App& app);            // report_cmd.cpp:        afmkit report (the Python report)
+void register_study(CLI::App& app);             // study_cmd.cpp:         afmkit study run (Python + Dask)
 
 }  // namespace afmkit::cli

@@ -23,6 +23,7 @@ void register_all(CLI::App& app) {
   register_tapping(app);
   register_control(app);
   register_scan(app);
+  register_study(app);
 }
 
 std::vector<CommandSpec> command_specs() { return Program().commands; }

@@ -123,6 +123,14 @@ ParamSet& ParamSet::default_text(const std::string& text) {
   entries_[last_].default_text = text;
   return *this;
 }
+ParamSet& ParamSet::positional() {
+  if (last_.empty() || !std::holds_alternative<std::string>(entries_[last_].value))
+    throw std::logic_error("ParamSet::positional: the last declared parameter is not a text or file");
+  for (const auto& [key, e] : entries_)
+    if (e.positional && key != last_) throw std::logic_error("ParamSet::positional: only one positional parameter");
+  entries_[last_].positional = true;
+  return *this;
+}
 ParamSet& ParamSet::unit(const std::string& unit) {
   if (last_.empty()) throw std::logic_error("ParamSet::unit before any parameter");
   Entry& e = entries_[last_];
@@ -212,6 +220,11 @@ void ParamSet::add_options(CLI::App& app) {
     // a flag (empty type): `--json` turns it on, `--json=false` off (TOML: json = true / false)
     if (type.empty()) opt->expected(0, 1);
     opt->type_name(type)->group(e.group);
+    if (e.positional) {
+      CLI::Option* pos = app.add_option_function<std::string>(
+          key, [&e](const std::string& s) { e.cli_text = s; }, fmt::format("the same as --{}", dashed(key)));
+      pos->type_name(type)->excludes(opt);
+    }
   }
 }
 

@@ -15,9 +15,11 @@ namespace afmkit_test {
 inline const std::vector<std::string> kCommands = {"demo",          "impact",        "tapping orbit", "tapping hb",
                                                    "tapping sweep", "control tf",    "control roots", "control margin",
                                                    "control chart", "control tune",  "control simulate",
-                                                   "control export", "scan",          "report"};
+                                                   "control export", "scan",          "report",
+                                                   "study run"};
 
-/// Whether this build has the Python module (`afmkit report` needs it; the sanitizer build has none).
+/// Whether this build has the Python module (`afmkit report` and `afmkit study run` need it; the sanitizer build has
+/// none).
 #ifdef AFMKIT_TEST_HAS_PYTHON
 inline constexpr bool kHasPython = true;
 #else

@@ -47,9 +47,10 @@ std::string command_of(const std::string& name) {
   return "";
 }
 
-/// Keys of a config that name files or folders the command writes: output, *_output, output_dir.
+/// Keys of a config that name files or folders the command writes: output, *_output, output_dir, and a study's
+/// store and netcdf.
 bool is_output_key(const std::string& key) {
-  return key == "output" || key == "output_dir" ||
+  return key == "output" || key == "output_dir" || key == "store" || key == "netcdf" ||
          (key.size() > 7 && key.compare(key.size() - 7, 7, "_output") == 0);
 }
 
@@ -103,10 +104,13 @@ std::vector<std::vector<std::string>> csv_records(const std::string& text) {
   return records;
 }
 
-/// Runs the example config `name` with every output key redirected into `dir`/redirected/; returns the result.
+/// Runs the example config `name` with every output key redirected into `dir`/redirected/ and its input `file` (a
+/// path relative to the source tree, as the header's command runs there) made absolute; returns the result.
 RunResult run_config(const std::string& name, const TempDir& dir) {
   const fs::path config = kConfigDir / (name + ".toml");
   std::string args = command_of(name) + " --config '" + config.string() + "'";
+  if (const auto input = toml::parse_file(config.string())["file"].value<std::string>())
+    args += " --file '" + (fs::path(AFMKIT_SOURCE_DIR) / *input).string() + "'";
   for (const auto& [key, value] : output_keys(config)) {
     std::string flag = key;
     std::replace(flag.begin(), flag.end(), '_', '-');
@@ -159,10 +163,11 @@ struct NonTableOutput {
 const std::map<std::string, NonTableOutput> kNonTable = {
     {"control_export", {".h", "#define AFMKIT_EXPORT_STATE_SIZE"}},  // a C header (docs/embedding.md)
     {"report", {".html", "<img "}},                                   // an HTML page with its figures
+    {"study_run", {".nc", "HDF"}},  // a Zarr store (a folder) and, asked for here, the same results in NetCDF-4
 };
 
-/// `afmkit report` runs the Python package, which the sanitizer build does not build.
-static bool runnable_here(const std::string& name) { return name != "report" || kHasPython; }
+/// `afmkit report` and `afmkit study run` run the Python package, which the sanitizer build does not build.
+static bool runnable_here(const std::string& name) { return (name != "report" && name != "study_run") || kHasPython; }
 
 std::vector<fs::path> files_with_extension(const fs::path& dir, const std::string& ext) {
   std::vector<fs::path> out;

@@ -222,3 +222,30 @@ def test_the_command_line_names_the_field_of_a_bad_file(tmp_path):
     r = subprocess.run([sys.executable, "-m", "afmkit.study", "run", str(bad)], capture_output=True, text=True,
                        timeout=60)
     assert r.returncode == 2 and "unknown field 'colour'" in r.stderr
+
+
+def test_afmkit_study_run_is_a_command_of_the_program_with_exact_coordinates(tmp_path):
+    source = os.environ["AFMKIT_SOURCE_DIR"]
+    store = tmp_path / "margin.zarr"
+    r = subprocess.run([os.environ["AFMKIT_CLI"], "study", "run", f"{source}/examples/studies/delay_margin.toml",
+                        "--store", str(store), "--quiet"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr == ""  # --quiet: no progress lines
+    ds = xr.open_zarr(store)
+    # coordinates read back exactly, 0.0 included (not taken for a fill value)
+    np.testing.assert_array_equal(ds["beta"].values, np.linspace(-0.4, 0.0, 9))
+    np.testing.assert_array_equal(ds["alpha"].values, np.linspace(0.05, 0.4, 8))
+    assert ds["critical_delay"].attrs["units"] == "T"
+    # independent check of two points, one on beta = 0: the margin command itself there
+    for i, j in ((1, 8), (6, 3)):
+        point = ds.isel(alpha=i, beta=j)
+        m = afmkit.control.margin(alpha=float(point["alpha"]), beta=float(point["beta"]), harmonics=10, gain=20.0)
+        assert float(point["critical_delay"]) == m.results["critical_delay"]
+    # the options the program checks itself: exit 2 naming the parameter, before Python starts
+    for args, name in ((["study", "run"], "file"), (["study", "run", str(tmp_path / "none.toml")], "file"),
+                       (["study", "run", f"{source}/examples/studies/delay_margin.toml", "--scheduler", "8786"],
+                        "scheduler"),
+                       (["study", "run", f"{source}/examples/studies/delay_margin.toml", "--chunk-points", "0"],
+                        "chunk_points")):
+        r = subprocess.run([os.environ["AFMKIT_CLI"], *args], capture_output=True, text=True, timeout=60)
+        assert r.returncode == 2 and name in r.stderr, (args, r.stderr)

@@ -60,6 +60,9 @@ class ParamSet {
   /// shown in --help and written to sidecars. Every real parameter needs one (add_options throws
   /// std::logic_error otherwise); integers default to "count".
   ParamSet& unit(const std::string& unit);
+  /// The last declared text or file parameter may also be given as the command's first positional argument
+  /// (`afmkit study run FILE`); the flag and TOML key stay.
+  ParamSet& positional();
   const std::string& unit_of(const std::string& key) const&;
 
   /// Adds `--config FILE` and one `--<key-with-dashes>` option per parameter to `app`.
@@ -126,6 +129,7 @@ class ParamSet {
     std::string default_text;             // shown instead of the value in --help, if set
     std::string unit;                     // numbers only (docs/units.md)
     bool is_file = false;                 // a path: FILE in --help
+    bool positional = false;              // also accepted as a positional argument
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;

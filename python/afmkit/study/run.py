@@ -53,32 +53,34 @@ class _Progress:
 
     def __init__(self, total: int, points_per_chunk: int, points: int, enabled: bool):
         self.total, self.ppc, self.points, self.enabled = total, points_per_chunk, points, enabled
-        self.done, self.started, self.last = 0, time.monotonic(), 0.0
+        self.done, self.started, self.last, self.shown = 0, time.monotonic(), 0.0, -1
 
     def step(self, final: bool = False) -> None:
-        if not self.enabled:
+        if not self.enabled or (final and self.shown == self.done):
             return
         now = time.monotonic()
         if not final and now - self.last < 1.0:
             return
-        self.last = now
+        self.last, self.shown = now, self.done
         elapsed = now - self.started
         left = elapsed / self.done * (self.total - self.done) if self.done else math.nan
-        eta = f", about {left:.0f} s left" if self.done and not final else ""
+        eta = f", about {left:.0f} s left" if 0 < self.done < self.total else ""
         print(f"afmkit study: {self.done}/{self.total} chunks (~{min(self.done * self.ppc, self.points)} points), "
               f"{elapsed:.1f} s{eta}", file=sys.stderr, flush=True)
 
 
-def _pilot(study: Study):
-    """Runs the first point: checks parameters and outputs, measures the cost of a point, finds the units."""
+def _pilot(study: Study, measure: bool = True):
+    """Runs the first point: checks parameters and outputs, finds the units, and (measure) the cost of a point."""
     from .. import _afmkit
 
     params = parameters_of(study.command)
     first = {a.name: int(a.values[0]) if params[a.name]["kind"] == "integer" else a.values[0] for a in study.axes}
     raw = _afmkit.run(study.command, {**study.parameters, **first})
+    # the first ≤ 64 points of the grid, for up to 0.3 s (only the first when the cost is not wanted): checks
+    # the output selectors and measures the cost of a point
+    points = _points(study, zstore.chunk_slices(study.shape, zstore.chunk_shape(study.shape, 64 if measure else 1), 0))
     start = time.perf_counter()
     n = 0
-    points = _points(study, zstore.chunk_slices(study.shape, zstore.chunk_shape(study.shape, 64), 0))  # the first ≤ 64
     while n < len(points):
         _afmkit.evaluate_points(study.command, dict(study.parameters), [a.name for a in study.axes],
                                 points[n:n + 1], list(study.outputs))
@@ -148,7 +150,7 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
     else:
         if not path.parent.is_dir():
             raise StudyError("store", f"store '{path}': folder '{path.parent}' does not exist")
-        cost, units = _pilot(study)
+        cost, units = _pilot(study, measure=chunk_points is None)
         target = chunk_points or max(1, round(chunk_seconds / max(cost, 1e-9)))
         chunks = zstore.chunk_shape(study.shape, target)
         zstore.create(path, study, chunks, units, __version__)
@@ -168,8 +170,8 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
         else:
             _run_dask(study, path, definition, pending, scheduler, workers, bar)
     bar.step(final=True)
+    failed = int(root["chunk_failed"][:].sum())  # read here: not a Dask computation on the study's cluster
     ds = xr.open_zarr(str(path), consolidated=True)
-    failed = int(ds["chunk_failed"].sum())
     ds = ds.drop_vars(["chunk_done", "chunk_failed"])
     ds.attrs["failed_points"] = failed
     if netcdf is not None:

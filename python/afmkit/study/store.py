@@ -68,7 +68,8 @@ def create(path: Path, study: Study, chunks: tuple, output_units: list, version:
         units = study.units()
         dims = [a.name for a in study.axes]
         for a in study.axes:
-            c = root.create_dataset(a.name, data=np.asarray(a.values, dtype="f8"), compressor=None)
+            # no fill value: xarray would read a coordinate equal to it (0.0 by default) as missing
+            c = root.create_dataset(a.name, data=np.asarray(a.values, dtype="f8"), compressor=None, fill_value=None)
             c.attrs.update({"_ARRAY_DIMENSIONS": [a.name], "units": units[a.name]})
         for name, selector, unit in zip(output_names(study.outputs), study.outputs, output_units):
             v = root.create_dataset(name, shape=study.shape, chunks=chunks, dtype="f8", fill_value=np.nan,
