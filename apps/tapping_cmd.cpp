@@ -9,6 +9,7 @@ void register_tapping(CLI::App& app) {
   register_tapping_orbit(tapping);
   register_tapping_hb(tapping);
   register_tapping_sweep(tapping);
+  register_tapping_grid(tapping);
 }
 
 }  // namespace afmkit::cli

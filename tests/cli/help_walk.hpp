@@ -12,11 +12,10 @@
 namespace afmkit_test {
 
 /// Every leaf command of afmkit (kept explicit so that a new command is a deliberate addition to the tests).
-inline const std::vector<std::string> kCommands = {"demo",          "impact",        "tapping orbit", "tapping hb",
-                                                   "tapping sweep", "control tf",    "control roots", "control margin",
-                                                   "control chart", "control tune",  "control simulate",
-                                                   "control export", "scan",          "report",
-                                                   "study run"};
+inline const std::vector<std::string> kCommands = {
+    "demo",          "impact",         "tapping orbit", "tapping hb",    "tapping sweep", "tapping grid",
+    "control tf",    "control roots",  "control margin", "control chart", "control tune",  "control simulate",
+    "control export", "scan",          "report",         "study run"};
 
 /// Whether this build has the Python module (`afmkit report` and `afmkit study run` need it; the sanitizer build has
 /// none).

@@ -66,9 +66,10 @@ def test_results_are_labelled_arrays_with_units(serial):
     assert int(point["count_amplitude_stable"]) == stable.sum()
 
 
-def test_local_cluster_gives_the_serial_numbers_bit_for_bit(cluster, serial, tmp_path):
-    ds = run(orbit_study(), tmp_path / "d.zarr", scheduler=cluster, chunk_points=2, progress=False)
+def test_local_cluster_gives_the_serial_numbers_bit_for_bit(cluster, serial, tmp_path, capsys):
+    ds = run(orbit_study(), tmp_path / "d.zarr", scheduler=cluster, chunk_points=2, progress="dask")
     same(ds.load(), serial)
+    assert "100% Completed" in capsys.readouterr().out  # Dask's progress bar (text, outside a notebook)
 
 
 def test_a_worker_killed_mid_study_and_the_study_still_completes(cluster, serial, tmp_path):
@@ -164,6 +165,9 @@ def test_bad_run_arguments_name_the_field(tmp_path):
     with pytest.raises(StudyError, match="chunk_points = 0") as e:
         run(orbit_study(), tmp_path / "z.zarr", scheduler="serial", chunk_points=0)
     assert e.value.field == "chunk_points"
+    with pytest.raises(StudyError, match="progress = 'yes' is not allowed") as e:
+        run(orbit_study(), tmp_path / "z.zarr", scheduler="serial", progress="yes")
+    assert e.value.field == "progress"
     with pytest.raises(ValueError, match="outputs: 'max\\(amplitde \\| stable\\)': the table has no column 'amplitde'"):
         run(orbit_study(outputs=["max(amplitde | stable)"]), tmp_path / "y.zarr", scheduler="serial")
     with pytest.raises(ValueError, match="the command reports no 'critical_delay'"):
@@ -249,3 +253,44 @@ def test_afmkit_study_run_is_a_command_of_the_program_with_exact_coordinates(tmp
                         "chunk_points")):
         r = subprocess.run([os.environ["AFMKIT_CLI"], *args], capture_output=True, text=True, timeout=60)
         assert r.returncode == 2 and name in r.stderr, (args, r.stderr)
+
+
+def test_tapping_grid_writes_the_layout_of_the_equivalent_study_with_the_same_numbers(tmp_path):
+    """`afmkit tapping grid` (C++, OpenMP, no Python) against the study runner over the same axis: the same arrays,
+    coordinates and numbers bit for bit, opened by xarray; the store is replaced only when it is afmkit's."""
+    parameters = {"law": "attractive", "quality_factor": 100.0, "approach_adhesion": 0.5, "departure_adhesion": 1.0,
+                  "frequency_ratio": 0.99}
+    store = tmp_path / "grid.zarr"
+    flags = [f"--{k.replace('_', '-')}={v}" for k, v in parameters.items()]
+    r = subprocess.run([os.environ["AFMKIT_CLI"], "tapping", "grid", *flags, "--separation-min", "8",
+                        "--separation-max", "16", "--points", "17", "--store", str(store), "--quiet"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    grid = xr.open_zarr(store).load()
+    study = Study.make("tapping.orbit", axes={"separation": {"start": 8.0, "stop": 16.0, "points": 17}},
+                       outputs=["max(amplitude | stable)", "min(amplitude | stable)", "count(amplitude | stable)",
+                                "count(amplitude)"], parameters=parameters)
+    ref = run(study, tmp_path / "study.zarr", scheduler="serial", chunk_points=5, progress=False).load()
+    np.testing.assert_array_equal(grid["separation"].values, ref["separation"].values)
+    for name in ref.data_vars:
+        np.testing.assert_array_equal(grid[name].values, ref[name].values, err_msg=name)
+        assert grid[name].attrs["selector"] == ref[name].attrs["selector"]
+    assert (grid["count_amplitude_stable"] == 2).any()  # the hysteresis band is inside the grid
+    assert grid.attrs["command"] == "afmkit tapping grid" and grid["chunk_done"].values.all()
+    # the study runner does not take a grid's store for its own study
+    with pytest.raises(StudyError) as e:
+        run(study, store, scheduler="serial", progress=False)
+    assert e.value.field == "store"
+    # written again: replaced (an afmkit store); a folder that is not one is refused, untouched
+    r = subprocess.run([os.environ["AFMKIT_CLI"], "tapping", "grid", "--points", "3", "--store", str(store),
+                        "--quiet"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert xr.open_zarr(store).sizes["separation"] == 3
+    other = tmp_path / "photos"
+    other.mkdir()
+    (other / "a.jpg").write_bytes(b"x")
+    r = subprocess.run([os.environ["AFMKIT_CLI"], "tapping", "grid", "--points", "3", "--store", str(other)],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "store" in r.stderr and "not an afmkit store" in r.stderr
+    assert sorted(p.name for p in other.iterdir()) == ["a.jpg"]
+    assert not [p for p in tmp_path.iterdir() if ".tmp." in p.name or ".old." in p.name]

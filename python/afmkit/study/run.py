@@ -124,12 +124,14 @@ def _client(scheduler, workers: int | None):
 
 
 def run(study: Study, store, *, scheduler=None, workers: int | None = None, chunk_seconds: float = 1.0,
-        chunk_points: int | None = None, progress: bool = True, netcdf=None):
+        chunk_points: int | None = None, progress: bool | str = True, netcdf=None):
     """Computes `study` into the Zarr store `store` and returns its results as an xarray Dataset.
 
     scheduler: "serial" (this process), None or "local" (a LocalCluster, `workers` processes, default one per
     core), an address "tcp://host:8786" of a running Dask scheduler, or a distributed.Client. chunk_seconds: the
-    computation per chunk (measured on a pilot point), or chunk_points points per chunk. A store that exists must
+    computation per chunk (measured on a pilot point), or chunk_points points per chunk. progress: True (a line
+    per second on standard error), False, or "dask" (Dask's progress bar: a widget in a notebook, a text bar in a
+    terminal; lines when serial). A store that exists must
     hold this study (resumed: only chunks not done are computed); netcdf: also write the results there.
     """
     import xarray as xr
@@ -144,6 +146,8 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
                                           f"finite")
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise StudyError("workers", f"workers = {workers!r} is out of range: must be an integer >= 1")
+    if progress not in (True, False, "dask"):
+        raise StudyError("progress", f"progress = {progress!r} is not allowed: must be True, False or 'dask'")
     path = Path(store)
     if path.exists():
         root, chunks = zstore.open_existing(path, study)
@@ -158,7 +162,8 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
     done = root["chunk_done"][:]
     pending = [int(i) for i in np.flatnonzero(done == 0)]
     total = len(done)
-    bar = _Progress(total, int(np.prod(chunks)), study.size, progress)
+    bar = _Progress(total, int(np.prod(chunks)), study.size, progress is True or
+                    (progress == "dask" and scheduler == "serial"))
     bar.done = total - len(pending)
     definition = study.definition()
     if pending:
@@ -168,7 +173,7 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
                 bar.done += 1
                 bar.step()
         else:
-            _run_dask(study, path, definition, pending, scheduler, workers, bar)
+            _run_dask(study, path, definition, pending, scheduler, workers, bar, dask_bar=progress == "dask")
     bar.step(final=True)
     failed = int(root["chunk_failed"][:].sum())  # read here: not a Dask computation on the study's cluster
     ds = xr.open_zarr(str(path), consolidated=True)
@@ -185,7 +190,7 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
     return ds
 
 
-def _run_dask(study, path, definition, pending, scheduler, workers, bar) -> None:
+def _run_dask(study, path, definition, pending, scheduler, workers, bar, dask_bar=False) -> None:
     import distributed
 
     client, cluster = _client(scheduler, workers)
@@ -194,6 +199,8 @@ def _run_dask(study, path, definition, pending, scheduler, workers, bar) -> None
         futures = [client.submit(compute_chunk, str(path.resolve()), definition, i, key=f"{key}-{i}", pure=False,
                                  retries=3) for i in pending]
         try:
+            if dask_bar:
+                distributed.progress(futures)  # a notebook widget (returns at once), or a text bar until done
             for f in distributed.as_completed(futures):
                 f.result()  # a chunk that failed (not a lost worker: those are retried) stops the study
                 bar.done += 1

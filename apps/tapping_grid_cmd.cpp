@@ -1,0 +1,155 @@
+// afmkit tapping grid: every periodic orbit at each of `points` separations, the separations computed in parallel
+// (tapping::sweep_grid, OpenMP), written as a Zarr store in the layout of a parameter study (docs/study.md#the-store):
+// the same arrays as the study `tapping.orbit` over the axis `separation` with the outputs
+// max/min(amplitude | stable), count(amplitude | stable) and count(amplitude), for machines without Python.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/core/memory.hpp"
+#include "afmkit/core/version.hpp"
+#include "afmkit/io/params.hpp"
+#include "afmkit/io/progress.hpp"
+#include "afmkit/io/zarr_store.hpp"
+#include "afmkit/tapping/sweep.hpp"
+#include "command.hpp"
+#include "commands.hpp"
+#include "tapping_params.hpp"
+#include "tapping_sim_params.hpp"
+
+namespace afmkit::cli {
+
+namespace {
+
+constexpr int kStudyFormat = 1;         // afmkit_study_format of the store (docs/study.md#the-store)
+constexpr std::size_t kChunk = 256;     // separations per chunk of the stored arrays
+
+/// `points` values from `start` to `stop` inclusive, computed as numpy.linspace does (start + i·step, the last
+/// exactly stop), so that a study over the same axis has the same coordinates bit for bit.
+std::vector<double> linspace(double start, double stop, std::size_t points) {
+  std::vector<double> v(points);
+  const double step = (stop - start) / static_cast<double>(points - 1);
+  for (std::size_t i = 0; i < points; ++i) v[i] = static_cast<double>(i) * step + start;
+  v.back() = stop;
+  return v;
+}
+
+/// FNV-1a (64 bit) of the definition's text, in hex: names the definition (a store of `tapping grid` is not
+/// resumed by the study runner, whose fingerprint is a SHA-256 of its own definition).
+std::string fingerprint(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  return fmt::format("tapping-grid-{:016x}", h);
+}
+
+void run_grid(const io::ParamSet& p, Captured*) {
+  const TappingScales scales = tapping_scales_from(p);
+  const double lo = p.real("separation_min"), hi = p.real("separation_max");
+  if (!(lo < hi))
+    throw InvalidParameter("separation_min", fmt::format("separation_min = {} is out of range: must be < "
+                                                         "separation_max = {}", lo, hi));
+  const auto points = static_cast<std::size_t>(p.integer("points"));
+  memory::require_fits("points", static_cast<double>(points), 4096.0);
+  io::ZarrStoreWriter store(p.text("store"), "store");  // checked before anything is computed
+  const tapping::TappingModel base = tapping_model_from(p);
+  const std::vector<double> separations = linspace(lo, hi, points);
+  std::vector<double> normalised(points);
+  for (std::size_t i = 0; i < points; ++i) normalised[i] = separations[i] / scales.length;
+
+  tapping::OrbitSearchOptions options;
+  options.shooting = shooting_options_from(p);
+  options.transient = transient_options_from(p);
+  io::Progress progress("tapping grid", static_cast<long>(points), !p.flag("quiet"));
+  const std::vector<tapping::OrbitSearchResult> results =
+      tapping::sweep_grid(base, normalised, options, [&](long n) { progress.advance(n); });
+  progress.finish();
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> max_stable(points, nan), min_stable(points, nan), stable(points, 0.0), all(points, 0.0);
+  for (std::size_t i = 0; i < points; ++i)
+    for (const tapping::FoundOrbit& f : results[i].orbits) {
+      const double amplitude = f.metrics.amplitude * scales.length;
+      all[i] += 1;
+      if (!f.orbit.stable) continue;
+      max_stable[i] = stable[i] == 0 ? amplitude : std::max(max_stable[i], amplitude);
+      min_stable[i] = stable[i] == 0 ? amplitude : std::min(min_stable[i], amplitude);
+      stable[i] += 1;
+    }
+
+  const std::string length = scales.length_unit;
+  const std::vector<std::string> selectors = {"max(amplitude | stable)", "min(amplitude | stable)",
+                                              "count(amplitude | stable)", "count(amplitude)"};
+  nlohmann::json parameters = p.to_json();
+  parameters.erase("store");
+  parameters.erase("quiet");
+  parameters.erase("separation");  // the axis
+  const nlohmann::json definition = {{"computation", "tapping.orbit"},
+                                     {"parameters", parameters},
+                                     {"axes", {{"separation", separations}}},
+                                     {"outputs", selectors}};
+  store.attribute("afmkit_study_format", kStudyFormat);
+  store.attribute("study_name", "tapping_grid");
+  store.attribute("study_definition", definition.dump());
+  store.attribute("study_fingerprint", fingerprint(definition.dump()));
+  store.attribute("computation", "tapping.orbit");
+  store.attribute("command", "afmkit tapping grid");
+  store.attribute("afmkit_version", afmkit::version);
+  store.coordinate("separation", separations,
+                   {{"units", length}, {"description", "separation l: sample surface at x = -l"}});
+  const std::vector<std::size_t> shape = {points}, chunks = {std::min(points, kChunk)};
+  const std::vector<std::vector<double>*> values = {&max_stable, &min_stable, &stable, &all};
+  const std::vector<std::string> names = {"max_amplitude_stable", "min_amplitude_stable", "count_amplitude_stable",
+                                          "count_amplitude"};
+  for (std::size_t k = 0; k < names.size(); ++k)
+    store.variable(names[k], {"separation"}, shape, chunks, *values[k],
+                   {{"units", k < 2 ? length : "count"},
+                    {"selector", selectors[k]},
+                    {"description", selectors[k] + " of afmkit tapping orbit at each point"}});
+  const std::size_t chunk_count = (points + chunks[0] - 1) / chunks[0];
+  store.integer_variable("chunk_done", {"chunk"}, {chunk_count}, {1}, std::vector<std::int64_t>(chunk_count, 1), "<i1",
+                         {{"units", "count"}, {"description", "1 when the chunk's outputs are written"}});
+  store.integer_variable("chunk_failed", {"chunk"}, {chunk_count}, {1}, std::vector<std::int64_t>(chunk_count, 0),
+                         "<i4", {{"units", "count"},
+                                 {"description", "points of the chunk whose computation failed numerically"}});
+  store.commit();
+  const auto bands = std::count_if(stable.begin(), stable.end(), [](double n) { return n > 1; });
+  fmt::print("tapping grid: {} separations in [{}, {}] {}, {} with more than one stable orbit; written to {} "
+             "(Zarr; xarray: xr.open_zarr)\n",
+             points, lo, hi, length, bands, store.path());
+}
+
+}  // namespace
+
+void register_tapping_grid(CLI::App& tapping) {
+  add_command(
+      tapping, "grid",
+      "every periodic orbit at each separation of a grid, computed in parallel (OpenMP) without Python; a Zarr "
+      "store in the layout of a parameter study (largest/smallest stable amplitude, stable and all orbits)",
+      [](io::ParamSet& p) {
+        add_tapping_model_params(p);
+        add_tapping_sim_params(p);
+        p.group("Grid")
+            .real("separation_min", 5.0, "smallest separation of the grid", io::Range::closed(-1e6, 1e6))
+            .unit(kLengthUnit)
+            .real("separation_max", 15.0, "largest separation of the grid, > separation_min",
+                  io::Range::closed(-1e6, 1e6))
+            .unit(kLengthUnit)
+            .integer("points", 41, "separations, equally spaced from separation_min to separation_max", 2, 100000000);
+        p.group("Output")
+            .file("store", "out/tapping_grid.zarr",
+                  "Zarr store the grid is written to (a folder, complete or not at all; an existing afmkit store "
+                  "there is replaced, anything else refused)")
+            .flag("quiet", false, "no progress output");
+      },
+      run_grid);
+}
+
+}  // namespace afmkit::cli
