@@ -17,10 +17,13 @@ namespace afmkit::python {
 
 namespace {
 
-/// Every command but `report`, which from Python is afmkit.report.build (the command only starts Python on it).
+/// Every command but those that are Python already or write a store rather than a table: `report` (from Python
+/// afmkit.report.build), `study run` (afmkit.study.run) and `tapping grid` (a study of tapping.orbit, afmkit.study).
 std::vector<cli::CommandSpec> python_commands() {
   std::vector<cli::CommandSpec> out = cli::command_specs();
-  std::erase_if(out, [](const cli::CommandSpec& s) { return s.path == "report"; });
+  std::erase_if(out, [](const cli::CommandSpec& s) {
+    return s.path == "report" || s.path == "study run" || s.path == "tapping grid";
+  });
   return out;
 }
 

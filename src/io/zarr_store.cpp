@@ -107,7 +107,7 @@ void ZarrStoreWriter::add(Array a) {
 
 void ZarrStoreWriter::coordinate(const std::string& name, const std::vector<double>& values, nlohmann::json attrs) {
   Array a{name, zarray_json({values.size()}, {std::max<std::size_t>(values.size(), 1)}, "<f8", nullptr),
-          std::move(attrs), {values.size()}, {std::max<std::size_t>(values.size(), 1)}};
+          std::move(attrs), {values.size()}, {std::max<std::size_t>(values.size(), 1)}, 8, {}, {}};
   a.zattrs["_ARRAY_DIMENSIONS"] = {name};
   a.data.resize(values.size() * 8);
   if (!values.empty()) std::memcpy(a.data.data(), values.data(), a.data.size());
@@ -118,7 +118,7 @@ void ZarrStoreWriter::coordinate(const std::string& name, const std::vector<doub
 void ZarrStoreWriter::variable(const std::string& name, const std::vector<std::string>& dims,
                                const std::vector<std::size_t>& shape, const std::vector<std::size_t>& chunks,
                                const std::vector<double>& values, nlohmann::json attrs) {
-  Array a{name, zarray_json(shape, chunks, "<f8", "NaN"), std::move(attrs), shape, chunks};
+  Array a{name, zarray_json(shape, chunks, "<f8", "NaN"), std::move(attrs), shape, chunks, 8, {}, {}};
   a.zattrs["_ARRAY_DIMENSIONS"] = dims;
   a.data.resize(values.size() * 8);
   if (!values.empty()) std::memcpy(a.data.data(), values.data(), a.data.size());
@@ -137,7 +137,7 @@ void ZarrStoreWriter::integer_variable(const std::string& name, const std::vecto
   else if (dtype == "<i4") item = 4;
   else if (dtype == "<i8") item = 8;
   else throw std::logic_error("ZarrStoreWriter: integer dtype must be <i1, <i4 or <i8");
-  Array a{name, zarray_json(shape, chunks, dtype, 0), std::move(attrs), shape, chunks, item};
+  Array a{name, zarray_json(shape, chunks, dtype, 0), std::move(attrs), shape, chunks, item, {}, {}};
   a.zattrs["_ARRAY_DIMENSIONS"] = dims;
   a.data.resize(values.size() * item);
   for (std::size_t i = 0; i < values.size(); ++i) {
