@@ -52,7 +52,9 @@ def same(a: xr.Dataset, b: xr.Dataset):
 
 def test_results_are_labelled_arrays_with_units(serial):
     assert serial.sizes == {"separation": 9, "frequency_ratio": 3}
-    assert serial["separation"].attrs["units"] == "nm (physical) or L (normalised)"
+    assert serial["separation"].attrs["units"] == "L"  # normalised units (docs/units.md)
+    assert orbit_study(parameters={"units": "physical"}).units() == {"separation": "nm", "frequency_ratio":
+                                                                     "dimensionless"}
     assert serial["max_amplitude_stable"].attrs["selector"] == "max(amplitude | stable)"
     assert serial["max_amplitude_stable"].attrs["units"]
     assert serial["count_amplitude_stable"].attrs["units"] == "count"
@@ -275,6 +277,8 @@ def test_tapping_grid_writes_the_layout_of_the_equivalent_study_with_the_same_nu
     for name in ref.data_vars:
         np.testing.assert_array_equal(grid[name].values, ref[name].values, err_msg=name)
         assert grid[name].attrs["selector"] == ref[name].attrs["selector"]
+        assert grid[name].attrs["units"] == ref[name].attrs["units"]
+    assert grid["separation"].attrs["units"] == ref["separation"].attrs["units"] == "L"
     assert (grid["count_amplitude_stable"] == 2).any()  # the hysteresis band is inside the grid
     assert grid.attrs["command"] == "afmkit tapping grid" and grid["chunk_done"].values.all()
     # the study runner does not take a grid's store for its own study

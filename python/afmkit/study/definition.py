@@ -9,6 +9,7 @@ import functools
 import hashlib
 import json
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -196,6 +197,13 @@ class Study:
                                                       f"{self.command} (allowed: {', '.join(params)})")
 
     def units(self) -> dict:
-        """The unit of every axis (the command's parameter units)."""
+        """The unit of every axis (the command's parameter units; "nm (physical) or L (normalised)" resolved by the
+        study's `units` parameter)."""
         params = parameters_of(self.command)
-        return {a.name: params[a.name]["unit"] for a in self.axes}
+        system = self.parameters.get("units", params["units"]["default"] if "units" in params else None)
+        out = {}
+        for a in self.axes:
+            unit = params[a.name]["unit"]
+            both = re.fullmatch(r"(.+) \(physical\) or (.+) \(normalised\)", unit)
+            out[a.name] = (both.group(1) if system == "physical" else both.group(2)) if both and system else unit
+        return out
