@@ -41,8 +41,8 @@ void check_scheduler(const std::string& s) {
                                                   s));
 }
 
-/// The folder a file or store would be created in must exist... or be creatable; the path itself must not be an
-/// existing item of the wrong kind.
+/// A file (netcdf) or folder (store) the study will write: its folder must exist or be creatable and writable, and
+/// the path itself must not be an existing item of the other kind.
 void check_output(const std::string& key, const std::string& path, bool is_folder) {
   std::error_code ec;
   if (fs::exists(path, ec) && fs::is_directory(path, ec) != is_folder)
