@@ -57,7 +57,9 @@ void run_grid(const io::ParamSet& p, Captured*) {
     throw InvalidParameter("separation_min", fmt::format("separation_min = {} is out of range: must be < "
                                                          "separation_max = {}", lo, hi));
   const auto points = static_cast<std::size_t>(p.integer("points"));
-  memory::require_fits("points", static_cast<double>(points), 4096.0);
+  // every point's search result is kept until the store is written: ~50 seeds, its orbits and transients, about
+  // 6 kB measured; 16 kB each leaves room
+  memory::require_fits("points", static_cast<double>(points), 16384.0);
   io::ZarrStoreWriter store(p.text("store"), "store");  // checked before anything is computed
   const tapping::TappingModel base = tapping_model_from(p);
   const std::vector<double> separations = linspace(lo, hi, points);
