@@ -60,18 +60,4 @@ void exec_python_module(const std::string& module, const std::vector<std::string
   throw InputError(fmt::format("cannot start the Python interpreter {}: {}", AFMKIT_PYTHON, std::strerror(errno)));
 }
 
-void check_writable_folder(const std::string& key, const std::string& dir) {
-  auto refuse = [&](const std::string& why) {
-    throw InvalidParameter(key, fmt::format("{} '{}' cannot be written: {}: must be a writable folder", key, dir, why));
-  };
-  if (dir.empty()) refuse("empty");
-  std::error_code ec;
-  fs::path existing = dir;  // the folder itself, or the nearest ancestor that exists (where it would be created)
-  while (!existing.empty() && !fs::exists(existing, ec)) existing = existing.parent_path();
-  if (existing.empty()) existing = ".";
-  if (!fs::is_directory(existing, ec)) refuse(fmt::format("'{}' is not a folder", existing.string()));
-  if (::access(existing.c_str(), W_OK | X_OK) != 0)
-    refuse(fmt::format("'{}': {}", existing.string(), std::strerror(errno)));
-}
-
 }  // namespace afmkit::cli

@@ -12,8 +12,4 @@ namespace afmkit::cli {
 /// cannot be started.
 [[noreturn]] void exec_python_module(const std::string& module, const std::vector<std::string>& args);
 
-/// Refuses a folder that cannot be created or written, before anything starts and without creating it (the
-/// Python program creates it, and checks again). `key` names the parameter in the message.
-void check_writable_folder(const std::string& key, const std::string& dir);
-
 }  // namespace afmkit::cli

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "command.hpp"
 #include "commands.hpp"
@@ -17,7 +18,7 @@ namespace afmkit::cli {
 namespace {
 
 void run_report(const io::ParamSet& p, Captured*) {
-  check_writable_folder("output_dir", p.text("output_dir"));
+  io::require_writable_folder("output_dir", p.text("output_dir"), p.text("output_dir"));  // Python creates it
   exec_python_module("report", {"--output-dir", p.text("output_dir"), "--jobs", std::to_string(p.integer("jobs")),
                                 "--figures", p.text("figures")});
 }

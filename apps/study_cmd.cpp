@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "command.hpp"
 #include "commands.hpp"
@@ -49,7 +50,7 @@ void check_output(const std::string& key, const std::string& path, bool is_folde
     throw InvalidParameter(key, fmt::format("{} '{}' cannot be written: it exists and is {}", key, path,
                                             is_folder ? "not a folder" : "a folder"));
   const fs::path parent = fs::path(path).parent_path();
-  check_writable_folder(key, parent.empty() ? "." : parent.string());
+  io::require_writable_folder(key, path, parent.empty() ? "." : parent.string());
 }
 
 void run_study(const io::ParamSet& p, Captured*) {

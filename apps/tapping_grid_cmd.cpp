@@ -3,6 +3,7 @@
 // the same arrays as the study `tapping.orbit` over the axis `separation` with the outputs
 // max/min(amplitude | stable), count(amplitude | stable) and count(amplitude), for machines without Python.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -74,47 +75,58 @@ void run_grid(const io::ParamSet& p, Captured*) {
       tapping::sweep_grid(base, normalised, options, [&](long n) { progress.advance(n); });
   progress.finish();
 
+  // the outputs, as the study tapping.orbit names them (docs/study.md#outputs), each at every separation
+  struct Output {
+    const char* name;
+    const char* selector;
+    bool length;  // in the length unit, else a count
+    std::vector<double> values;
+  };
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  std::vector<double> max_stable(points, nan), min_stable(points, nan), stable(points, 0.0), all(points, 0.0);
+  std::array<Output, 4> outputs = {{{"max_amplitude_stable", "max(amplitude | stable)", true, {}},
+                                    {"min_amplitude_stable", "min(amplitude | stable)", true, {}},
+                                    {"count_amplitude_stable", "count(amplitude | stable)", false, {}},
+                                    {"count_amplitude", "count(amplitude)", false, {}}}};
+  auto& [max_stable, min_stable, stable, all] = outputs;
+  for (Output& o : outputs) o.values.assign(points, o.length ? nan : 0.0);
   for (std::size_t i = 0; i < points; ++i)
     for (const tapping::FoundOrbit& f : results[i].orbits) {
       const double amplitude = f.metrics.amplitude * scales.length;
-      all[i] += 1;
+      all.values[i] += 1;
       if (!f.orbit.stable) continue;
-      max_stable[i] = stable[i] == 0 ? amplitude : std::max(max_stable[i], amplitude);
-      min_stable[i] = stable[i] == 0 ? amplitude : std::min(min_stable[i], amplitude);
-      stable[i] += 1;
+      const bool first = stable.values[i] == 0;
+      max_stable.values[i] = first ? amplitude : std::max(max_stable.values[i], amplitude);
+      min_stable.values[i] = first ? amplitude : std::min(min_stable.values[i], amplitude);
+      stable.values[i] += 1;
     }
 
   const std::string length = scales.length_unit;
-  const std::vector<std::string> selectors = {"max(amplitude | stable)", "min(amplitude | stable)",
-                                              "count(amplitude | stable)", "count(amplitude)"};
   nlohmann::json parameters = p.to_json();
   parameters.erase("store");
   parameters.erase("quiet");
   parameters.erase("separation");  // the axis
-  const nlohmann::json definition = {{"computation", "tapping.orbit"},
-                                     {"parameters", parameters},
-                                     {"axes", {{"separation", separations}}},
-                                     {"outputs", selectors}};
+  nlohmann::json selectors = nlohmann::json::array();
+  for (const Output& o : outputs) selectors.push_back(o.selector);
+  const std::string definition = nlohmann::json{{"computation", "tapping.orbit"},
+                                                {"parameters", parameters},
+                                                {"axes", {{"separation", separations}}},
+                                                {"outputs", selectors}}
+                                     .dump();
   store.attribute("afmkit_study_format", kStudyFormat);
   store.attribute("study_name", "tapping_grid");
-  store.attribute("study_definition", definition.dump());
-  store.attribute("study_fingerprint", fingerprint(definition.dump()));
+  store.attribute("study_definition", definition);
+  store.attribute("study_fingerprint", fingerprint(definition));
   store.attribute("computation", "tapping.orbit");
   store.attribute("command", "afmkit tapping grid");
   store.attribute("afmkit_version", afmkit::version);
   store.coordinate("separation", separations,
                    {{"units", length}, {"description", "separation l: sample surface at x = -l"}});
   const std::vector<std::size_t> shape = {points}, chunks = {std::min(points, kChunk)};
-  const std::vector<std::vector<double>*> values = {&max_stable, &min_stable, &stable, &all};
-  const std::vector<std::string> names = {"max_amplitude_stable", "min_amplitude_stable", "count_amplitude_stable",
-                                          "count_amplitude"};
-  for (std::size_t k = 0; k < names.size(); ++k)
-    store.variable(names[k], {"separation"}, shape, chunks, *values[k],
-                   {{"units", k < 2 ? length : "count"},
-                    {"selector", selectors[k]},
-                    {"description", selectors[k] + " of afmkit tapping orbit at each point"}});
+  for (const Output& o : outputs)
+    store.variable(o.name, {"separation"}, shape, chunks, o.values,
+                   {{"units", o.length ? length : "count"},
+                    {"selector", o.selector},
+                    {"description", std::string(o.selector) + " of afmkit tapping orbit at each point"}});
   const std::size_t chunk_count = (points + chunks[0] - 1) / chunks[0];
   store.integer_variable("chunk_done", {"chunk"}, {chunk_count}, {1}, std::vector<std::int64_t>(chunk_count, 1), "<i1",
                          {{"units", "count"}, {"description", "1 when the chunk's outputs are written"}});
@@ -122,7 +134,7 @@ void run_grid(const io::ParamSet& p, Captured*) {
                          "<i4", {{"units", "count"},
                                  {"description", "points of the chunk whose computation failed numerically"}});
   store.commit();
-  const auto bands = std::count_if(stable.begin(), stable.end(), [](double n) { return n > 1; });
+  const auto bands = std::count_if(stable.values.begin(), stable.values.end(), [](double n) { return n > 1; });
   fmt::print("tapping grid: {} separations in [{}, {}] {}, {} with more than one stable orbit; written to {} "
              "(Zarr; xarray: xr.open_zarr)\n",
              points, lo, hi, length, bands, store.path());

@@ -307,4 +307,19 @@ nlohmann::json make_sidecar(const std::string& command, const ParamSet& paramete
   return make_sidecar(command, parameters.to_json(), results, parameters.units_json());
 }
 
+void require_writable_folder(const std::string& parameter, const std::string& shown, const std::string& dir) {
+  auto refuse = [&](const std::string& why) {
+    throw InvalidParameter(parameter, fmt::format("{} '{}' cannot be written: {}: must be a writable folder",
+                                                  parameter, shown, why));
+  };
+  if (dir.empty()) refuse("empty");
+  std::error_code ec;
+  fs::path existing = dir;
+  while (!existing.empty() && !fs::exists(existing, ec)) existing = existing.parent_path();
+  if (existing.empty()) existing = ".";
+  if (!fs::is_directory(existing, ec)) refuse(fmt::format("'{}' is not a folder", existing.string()));
+  if (::access(existing.c_str(), W_OK | X_OK) != 0)
+    refuse(fmt::format("'{}': {}", existing.string(), std::strerror(errno)));
+}
+
 }  // namespace afmkit::io

@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
 
 namespace afmkit::io {
 
@@ -82,11 +83,7 @@ ZarrStoreWriter::ZarrStoreWriter(std::string path, std::string parameter)
     if (!is_afmkit_store(target)) refuse("it exists and is not an afmkit store (it is never replaced: remove it or "
                                          "choose another path)");
   }
-  fs::path existing = target.parent_path();  // the nearest ancestor that exists, where folders would be created
-  while (!existing.empty() && !fs::exists(existing, ec)) existing = existing.parent_path();
-  if (!fs::is_directory(existing, ec)) refuse(fmt::format("'{}' is not a folder", existing.string()));
-  if (::access(existing.c_str(), W_OK | X_OK) != 0)
-    refuse(fmt::format("'{}': {}", existing.string(), std::strerror(errno)));
+  require_writable_folder(parameter_, path_, target.parent_path().string());
 }
 
 void ZarrStoreWriter::attribute(const std::string& key, nlohmann::json value) { attrs_[key] = std::move(value); }
@@ -210,14 +207,14 @@ void ZarrStoreWriter::commit() {
     if (replacing) fs::rename(target, old);
     fs::rename(tmp, target);
     if (replacing) fs::remove_all(old);
-  } catch (const fs::filesystem_error& e) {
+  } catch (...) {  // the target as it was: the new store's folder removed, a replaced store put back
     fs::remove_all(tmp, ec);
     if (fs::exists(old, ec) && !fs::exists(target, ec)) fs::rename(old, target, ec);
-    throw InputError(fmt::format("{} '{}' cannot be written: {}", parameter_, path_, e.code().message()));
-  } catch (...) {
-    fs::remove_all(tmp, ec);
-    if (fs::exists(old, ec) && !fs::exists(target, ec)) fs::rename(old, target, ec);
-    throw;
+    try {
+      throw;
+    } catch (const fs::filesystem_error& e) {
+      throw InputError(fmt::format("{} '{}' cannot be written: {}", parameter_, path_, e.code().message()));
+    }
   }
 }
 

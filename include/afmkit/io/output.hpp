@@ -100,6 +100,12 @@ class TableWriter {
 /// followed (its target is replaced); a path that exists but is not a regular file is refused (InputError).
 void write_file_atomic(const std::string& path, const std::string& content);
 
+/// Refuses, before anything is computed and without creating anything, an output that could not be created in the
+/// folder `dir`: that folder, or its nearest ancestor that exists (where it would be created), must be a writable
+/// folder. InvalidParameter naming `parameter`: "<parameter> '<shown>' cannot be written: <why>: must be a
+/// writable folder" (`shown`: the path the user gave).
+void require_writable_folder(const std::string& parameter, const std::string& shown, const std::string& dir);
+
 /// Installs SIGINT/SIGTERM/SIGHUP handlers that remove the temporaries of outputs being written, then end the
 /// process by the same signal (the command-line program calls it once at start).
 void remove_temporaries_on_signal();
