@@ -3,7 +3,6 @@
 // in units of T, gain ratios dimensionless).
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 

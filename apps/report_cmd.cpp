@@ -3,7 +3,6 @@
 // command validates its parameters and hands over to the Python interpreter afmkit was built with.
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"

@@ -19,8 +19,11 @@ while [ $# -gt 0 ]; do
 done
 if ! command -v clang++-14 >/dev/null; then echo "fuzz.sh: clang++-14 missing: run scripts/bootstrap.sh" >&2; exit 2; fi
 
-CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAFMKIT_BUILD_FUZZ=ON \
-  -DAFMKIT_BUILD_TESTS=OFF -DAFMKIT_BUILD_BENCH=OFF >/dev/null
+generator=()
+[ -f build-fuzz/CMakeCache.txt ] || { command -v ninja >/dev/null && generator=(-G Ninja); }
+CC=clang-14 CXX=clang++-14 cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
+  -DAFMKIT_BUILD_FUZZ=ON -DAFMKIT_BUILD_TESTS=OFF -DAFMKIT_BUILD_BENCH=OFF >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target fuzz_all
 
 status=0
