@@ -16,11 +16,18 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "control_params.hpp"
+#include "work_budget.hpp"
+#include "afmkit/io/progress.hpp"
 
 namespace afmkit::cli {
 
 namespace {
 using control::ControllerKind;
+
+// Time of one oscillator term of the frequency response: measured 1.2e-7 … 2.3e-7 s (N = 10 … 1e5, 2-core test
+// machine under load, Release), taken as 5e-8 s: the work estimate is a lower bound, so only requests that
+// cannot fit are refused.
+constexpr double kTermSeconds = 5e-8;
 
 control::LoopSystem system_from(const std::string& s) {
   if (s == "plant") return control::LoopSystem::Plant;
@@ -133,6 +140,13 @@ void run_tf(const io::ParamSet& p, Captured* capture) {
   CommandOutput out(as_run, capture, "control tf");
   // without a file, --json holds the rows in memory (a few hundred bytes each)
   if (!out.writes_file() && p.flag("json")) require_memory("points", static_cast<double>(points), 256.0);
+  // cost model: one evaluation of the loop per frequency, each a sum over the N oscillators (measured ≈ kTermSeconds
+  // per oscillator term, docs/development.md#work-and-time); bank-free systems count as one term
+  const double terms = static_cast<double>(c.harmonics) + 8.0;
+  const double estimate = require_work(
+      "points", static_cast<double>(points), terms * kTermSeconds,
+      fmt::format("points x (harmonics + 8) oscillator terms of about {:.2g} s each, harmonics = {}", kTermSeconds,
+                  c.harmonics));
   nlohmann::json res = summary(c, loop);
   const double w = c.rotation_frequency;
   const std::string system = p.text("system");
@@ -148,13 +162,16 @@ void run_tf(const io::ParamSet& p, Captured* capture) {
             {"imag", unit.unit, "Im G(i omega)"}});
   // each frequency is computed and its row written at once: memory is bounded by a row, not by the file
   control::PhaseUnwrapper unwrap;
+  io::Progress progress("control tf (frequencies)", points, estimate > kProgressAfterSeconds && !p.flag("json"));
   for (long i = 0; i < points; ++i) {
+    if ((i & 1023) == 1023) progress.advance(1024);
     const double omega = control::frequency_grid_point(fmin * w, fmax * w, points, log_spacing, i);
     const std::complex<double> g = control::evaluate(loop, which, {0.0, omega});
     double magnitude, phase;
     control::magnitude_phase(g, magnitude, phase);
     out.row(omega / w, magnitude * unit.factor, unwrap(phase), g.real() * unit.factor, g.imag() * unit.factor);
   }
+  progress.finish();
   out.finish(res, fmt::format("{} frequencies of the {} ({})", points, system, res["loop"].get<std::string>()));
 }
 

@@ -12,8 +12,16 @@
 #include "command.hpp"
 #include "control_analysis.hpp"
 #include "control_params.hpp"
+#include "work_budget.hpp"
 
 namespace afmkit::cli {
+
+namespace {
+// Time of one objective evaluation per gain point per (harmonics + 1): measured 3.5e-4 … 7.5e-4 s (N = 20 … 200,
+// default delay_points, one thread, 2-core test machine under load, Release; it grows faster than N), taken as
+// 1e-4 s: the estimate is a lower bound, so only requests that cannot fit are refused.
+constexpr double kEvaluationSeconds = 1e-4;
+}  // namespace
 
 namespace {
 
@@ -49,6 +57,21 @@ void run_tune(const io::ParamSet& p, Captured* capture) {
   CommandOutput out(as_run, capture, "control tune");
   require_memory("coarse_points", static_cast<double>(s.coarse_points),
                  s.coarse_points * (out.writes_file() ? 32.0 : 256.0));
+  {
+    // cost model (docs/development.md#work-and-time): coarse_points² + max_evaluations objective evaluations, each
+    // gain_points spectra of the (2N + 2)-dimensional loop with its tracked roots, at least kEvaluationSeconds·(N + 1)
+    const double n = static_cast<double>(c.harmonics) + 1.0;
+    const double evaluation = static_cast<double>(s.gain_points) * kEvaluationSeconds * n;
+    require_work("coarse_points", static_cast<double>(s.coarse_points), evaluation,
+                 fmt::format("coarse_points^2 objective evaluations of gain_points = {} spectra each, with harmonics "
+                             "= {}: at least {:.2g} s per evaluation",
+                             s.gain_points, c.harmonics, evaluation),
+                 2.0);
+    require_work("max_evaluations", static_cast<double>(s.max_evaluations), evaluation,
+                 fmt::format("objective evaluations of gain_points = {} spectra each, with harmonics = {}: at least "
+                             "{:.2g} s per evaluation",
+                             s.gain_points, c.harmonics, evaluation));
+  }
   out.open({{"x", "Omega", std::string(s.family.x_name()) + " of the coarse grid point"},
             {"y", "Omega", std::string(s.family.y_name()) + " of the coarse grid point"},
             {"worst_decay_rate", "Omega",

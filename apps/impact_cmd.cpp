@@ -18,6 +18,7 @@
 #include "afmkit/impact/impact.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "command.hpp"
 #include "commands.hpp"
 #include "law_params.hpp"
@@ -161,25 +162,29 @@ void check_disk_space(const std::string& output, long points) {
 }
 
 void print_summary(const impact::ImpactResult& r, const impact::ForceLaw& law) {
-  auto num = [](double v) { return fmt::format("{:.10g}", v); };  // undefined: nan (docs/conventions.md)
+  // lengths, times, speeds, forces and energies with the SI prefix of their magnitude (docs/units.md#summaries);
+  // undefined: nan (docs/conventions.md)
+  auto q = [](double v, const char* unit) { return io::quantity(v, unit, 10); };
+  auto num = [](double v) { return std::isnan(v) ? std::string("nan") : fmt::format("{:.10g}", v); };
   fmt::print("impact ({} law, {}): {}\n", law.name(), r.method, impact::to_string(r.outcome));
   if (r.outcome == impact::ImpactOutcome::captured) fmt::print("  capture: {}\n", r.capture_reason);
   fmt::print("  reduced mass               {} kg\n", num(r.reduced_mass));
-  fmt::print("  gap d(t_s) -> minimum      {} -> {} nm (max penetration {} nm)\n", num(r.reference_gap), num(r.minimum_gap),
-             num(r.max_penetration));
-  fmt::print("  times t_s, t_min, t_f      {}, {}, {} s\n", num(r.start_time), num(r.minimum_time), num(r.end_time));
+  fmt::print("  gap d(t_s) -> minimum      {} -> {} (max penetration {})\n", q(r.reference_gap, "nm"),
+             q(r.minimum_gap, "nm"), q(r.max_penetration, "nm"));
+  fmt::print("  times t_s, t_min, t_f      {}, {}, {}\n", q(r.start_time, "s"), q(r.minimum_time, "s"),
+             q(r.end_time, "s"));
   if (r.contact)
-    fmt::print("  contact                    {} .. {} s (duration {} s)\n", num(r.contact_start), num(r.contact_end),
-               num(r.contact_duration));
+    fmt::print("  contact                    {} .. {} (duration {})\n", q(r.contact_start, "s"), q(r.contact_end, "s"),
+               q(r.contact_duration, "s"));
   else
     fmt::print("  contact                    none\n");
-  fmt::print("  gap rate before / after    {} / {} nm/s\n", num(r.approach_gap_rate), num(r.departure_gap_rate));
+  fmt::print("  gap rate before / after    {} / {}\n", q(r.approach_gap_rate, "nm/s"), q(r.departure_gap_rate, "nm/s"));
   fmt::print("  restitution e (eq. 2)      {} (1 - e = {})\n", num(r.restitution), num(r.restitution_deficit));
-  fmt::print("  kinetic energy loss        {} aJ (simulated)\n", num(r.kinetic_energy_loss));
-  fmt::print("                             {} aJ (eq. 3, from e)\n", num(r.energy_loss_restitution));
-  fmt::print("                             {} aJ (eq. 6, area between branches)\n", num(r.energy_loss_area));
-  fmt::print("  peak force / min force     {} / {} nN\n", num(r.peak_force), num(r.min_force));
-  fmt::print("  after: v1 = {}, v2 = {} nm/s\n", num(r.body1_after.velocity), num(r.body2_after.velocity));
+  fmt::print("  kinetic energy loss        {} (simulated)\n", q(r.kinetic_energy_loss, "aJ"));
+  fmt::print("                             {} (eq. 3, from e)\n", q(r.energy_loss_restitution, "aJ"));
+  fmt::print("                             {} (eq. 6, area between branches)\n", q(r.energy_loss_area, "aJ"));
+  fmt::print("  peak force / min force     {} / {}\n", q(r.peak_force, "nN"), q(r.min_force, "nN"));
+  fmt::print("  after: v1 = {}, v2 = {}\n", q(r.body1_after.velocity, "nm/s"), q(r.body2_after.velocity, "nm/s"));
 }
 
 void run_impact(const io::ParamSet& p, Captured* capture) {

@@ -17,6 +17,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "afmkit/scan/virtual_scan.hpp"
 #include "command.hpp"
 #include "commands.hpp"
@@ -60,6 +61,7 @@ double loop_spectral_abscissa(const scan::InstrumentSpec& s) {
 
 void run_simulated(const io::ParamSet& p, Captured* capture) {
   const scan::InstrumentSpec instrument = instrument_from(p);
+  require_scan_memory(p, false);  // before the sample map and the images are allocated
   const scan::Surface surface = surface_from(p);
   const scan::Grid grid = scan::image_grid(instrument, p.integer("image_resolution"));
   scan::check_scan_geometry(instrument, surface, grid);
@@ -140,15 +142,13 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
           : fmt::format("{}{:.3f}", result.scan_area_gain_is_lower_bound ? ">= " : "", result.scan_area_gain);
   const std::string summary = fmt::format(
       "afmkit scan: {} samples, {} turns, controller {}; saturated {:.3g} % of samples; largest radius before the "
-      "detector saturates {:.4g} mm in this run{}, {} with the controller off; scan-area gain {}; topography RMS "
-      "error {:.4g} nm (levelled){}",
+      "detector saturates {} in this run{}, {} with the controller off; scan-area gain {}; topography RMS "
+      "error {} (levelled){}",
       result.run.samples, result.turns, instrument.controller.enabled ? "on" : "off",
-      100.0 * result.saturated_fraction, 1e3 * result.max_radius_with_control,
+      100.0 * result.saturated_fraction, io::quantity(result.max_radius_with_control, "m"),
       result.saturates_with_control ? "" : " (never saturated)",
-      !instrument.controller.enabled ? std::string("(this run)")
-      : std::isnan(result.max_radius_without_control) ? std::string("nan mm")
-                                                    : fmt::format("{:.4g} mm", 1e3 * result.max_radius_without_control),
-      gain, 1e9 * result.topography_rms_error,
+      !instrument.controller.enabled ? std::string("(this run)") : io::quantity(result.max_radius_without_control, "m"),
+      gain, io::quantity(result.topography_rms_error, "m"),
       files.empty() ? std::string() : fmt::format("; wrote {} files with prefix {}", files.size(), prefix));
   out.finish(results, summary);
 }

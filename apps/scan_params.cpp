@@ -3,12 +3,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <numbers>
 
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/memory.hpp"
 #include "afmkit/scan/ascii_matrix.hpp"
 #include "afmkit/scan/gsf.hpp"
 #include "afmkit/scan/png16.hpp"
@@ -23,6 +27,48 @@ std::string lower_extension(const std::string& path) {
   std::string e = std::filesystem::path(path).extension().string();
   std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return e;
+}
+
+// Every sample height, scaled, lies in [−kMaxHeight, kMaxHeight] m (docs/scan.md#samples): far beyond any AFM
+// topography, and far enough inside the double range that the scan's sums and squares stay finite.
+constexpr double kMaxHeight = 1.0;
+
+/// The index of the largest |z| (the first non-finite one if any).
+std::size_t largest_at(const std::vector<double>& z) {
+  std::size_t at = 0;
+  for (std::size_t k = 0; k < z.size(); ++k) {
+    if (!std::isfinite(z[k])) return k;
+    if (std::abs(z[k]) > std::abs(z[at])) at = k;
+  }
+  return at;
+}
+
+/// Refuses file values `raw` (row-major, `columns` per row) whose heights raw · scale leave [−1, 1] m.
+void require_file_heights(const std::vector<double>& raw, long columns, double scale, const std::string& path,
+                          const char* what) {
+  if (raw.empty()) return;
+  const std::size_t at = largest_at(raw);
+  const double v = raw[at], height = v * scale;
+  if (std::abs(height) <= kMaxHeight) return;
+  const auto c = static_cast<std::size_t>(columns);
+  throw InvalidParameter(
+      "sample_z_scale",
+      fmt::format("sample_z_scale = {} m is out of range for {}: its {} {} at row {}, column {} (from 1) gives the "
+                  "height {} m; every sample height must lie in [-{}, {}] m: sample_z_scale must be <= {} m for this "
+                  "file",
+                  scale, path, what, v, at / c + 1, at % c + 1, height, kMaxHeight, kMaxHeight,
+                  std::abs(v) > 0 && std::isfinite(kMaxHeight / std::abs(v)) ? kMaxHeight / std::abs(v) : 0.0));
+}
+
+/// Refuses a generated or GSF map whose heights leave [−1, 1] m, naming `key` (what sets them).
+void require_map_heights(const std::vector<double>& z, long columns, const std::string& key, const std::string& what) {
+  if (z.empty()) return;
+  const std::size_t at = largest_at(z);
+  if (std::abs(z[at]) <= kMaxHeight) return;
+  const auto c = static_cast<std::size_t>(columns);
+  throw InvalidParameter(key, fmt::format("{}: the height {} m at row {}, column {} (from 1) is out of range: every "
+                                          "sample height must lie in [-{}, {}] m",
+                                          what, z[at], at / c + 1, at % c + 1, kMaxHeight, kMaxHeight));
 }
 
 // A map read from a file, re-centred on the spindle axis (its centre at (0, 0)).
@@ -48,6 +94,7 @@ scan::HeightMap sample_from_file(const io::ParamSet& p) {
       throw InputError(fmt::format("{}: {} of {} pixels are not finite: a sample height map must be complete", path,
                                    f.map.size() - f.map.valid_count(), f.map.size()));
     const scan::Grid g = f.map.grid();
+    require_map_heights(f.map.data(), g.x_resolution, "sample_file", path);
     return centred(g, std::move(f.map).data());
   }
   if (!p.was_set("sample_size"))
@@ -62,12 +109,18 @@ scan::HeightMap sample_from_file(const io::ParamSet& p) {
     const scan::Grey16 img = scan::read_png16(path);
     columns = img.width;
     rows = img.height;
+    if (!(scale <= kMaxHeight))
+      throw InvalidParameter("sample_z_scale", fmt::format("sample_z_scale = {} m is out of range for {} (the height "
+                                                           "of grey level 65535): every sample height must lie in "
+                                                           "[-{}, {}] m: must be in (0, {}] m",
+                                                           scale, path, kMaxHeight, kMaxHeight, kMaxHeight));
     z.reserve(img.pixels.size());
     for (std::uint16_t g : img.pixels) z.push_back(scale * static_cast<double>(g) / 65535.0);
   } else {
     scan::AsciiMatrix m = scan::read_ascii_matrix(path);
     columns = m.columns;
     rows = m.rows;
+    require_file_heights(m.values, m.columns, scale, path, "value");
     z = std::move(m.values);
     for (double& v : z) v *= scale;
   }
@@ -156,6 +209,66 @@ void add_scan_params(io::ParamSet& p) {
       .default_text("= bandwidth");
 }
 
+namespace {
+// Peak bytes per pixel (docs/development.md#memory-and-sizes), rounded up: the images of a simulated scan (the
+// imager's two channels with its sorted pixel radii, then deflection, topography and the ground truth with their
+// masks, levelling and the GSF/PNG encoding of one image at a time; measured 55 bytes from the peak resident
+// memory at 1024² and 2048² pixels), of a recorded one (two images: at most that), and a generated sample map
+// (measured 8 bytes, the rough generator's spectrum 18.4 bytes).
+constexpr double kSimulatedImageBytes = 64.0;
+constexpr double kRecordedImageBytes = 64.0;
+constexpr double kSampleBytes = 24.0;
+// A sample file held in memory: its bytes, then the decoded values and the height map (GSF: 4 bytes a value in
+// the file, 8 + 8 in memory; ASCII: at least 2 bytes a value), per byte of the file.
+constexpr double kFileBytesPerByte = 6.0;
+// A PNG's pixels: 2 bytes raw + 2 decoded + 8 scaled + 8 in the map.
+constexpr double kPngBytesPerPixel = 24.0;
+
+/// Width · height of a PNG from its IHDR chunk (0 if the file is not a readable PNG: the reader reports that).
+double png_pixels(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::array<unsigned char, 24> h{};
+  if (!in.read(reinterpret_cast<char*>(h.data()), h.size())) return 0.0;
+  auto be32 = [&](std::size_t at) {
+    return static_cast<double>((std::uint32_t{h[at]} << 24) | (std::uint32_t{h[at + 1]} << 16) |
+                               (std::uint32_t{h[at + 2]} << 8) | std::uint32_t{h[at + 3]});
+  };
+  if (h[12] != 'I' || h[13] != 'H' || h[14] != 'D' || h[15] != 'R') return 0.0;
+  return be32(16) * be32(20);
+}
+
+/// The bytes the sample map needs (0 for a recorded scan); InvalidParameter when the sample alone does not fit.
+double sample_bytes(const io::ParamSet& p) {
+  const double usable = 0.5 * static_cast<double>(memory::available_bytes());
+  const double gib = 1024.0 * 1024.0 * 1024.0;
+  if (p.text("sample") != "file") {
+    const auto n = static_cast<double>(p.integer("sample_resolution"));
+    memory::require_fits_square("sample_resolution", n, kSampleBytes);
+    return n * n * kSampleBytes;
+  }
+  const std::string path = p.text("sample_file");
+  std::error_code error;
+  if (path.empty() || !std::filesystem::is_regular_file(path, error)) return 0.0;  // the reader reports it
+  const double size = static_cast<double>(std::filesystem::file_size(path, error));
+  if (error) return 0.0;
+  const double needed = lower_extension(path) == ".png" ? png_pixels(path) * kPngBytesPerPixel
+                                                        : size * kFileBytesPerByte;
+  if (!(needed <= usable))
+    throw InvalidParameter("sample_file",
+                           fmt::format("sample_file = {} ({:.3g} MiB) needs about {:.2f} GiB of memory as a height map, "
+                                       "more than the {:.2f} GiB usable now (50 % of MemAvailable, capped by ulimit -v "
+                                       "and AFMKIT_MEMORY_LIMIT): use a smaller file",
+                                       path, size / (1024.0 * 1024.0), needed / gib, usable / gib));
+  return needed;
+}
+}  // namespace
+
+void require_scan_memory(const io::ParamSet& p, bool recorded) {
+  const double sample = recorded ? 0.0 : sample_bytes(p);
+  memory::require_fits_square("image_resolution", static_cast<double>(p.integer("image_resolution")),
+                              recorded ? kRecordedImageBytes : kSimulatedImageBytes, sample);
+}
+
 const std::vector<std::string>& simulation_only_keys() {
   static const std::vector<std::string> keys{
       "sample", "sample_file", "sample_size", "sample_z_scale", "sample_resolution", "sample_seed", "grating_period",
@@ -218,6 +331,13 @@ scan::Surface surface_from(const io::ParamSet& p) {
     if (kind == "rough") return scan::rough(grid, {p.real("rough_rms"), p.real("rough_correlation_length"), seed});
     return scan::flat(grid);
   }();
+  const std::string key = kind == "grating" ? "grating_height"
+                          : kind == "steps" ? "steps_height"
+                          : kind == "particles" ? "particles_radius"
+                          : kind == "rough" ? "rough_rms"
+                                            : "sample";
+  require_map_heights(map.data(), n, key, fmt::format("sample = {} with {} = {} m", kind, key,
+                                                      kind == "flat" ? 0.0 : p.real(key)));
   return scan::Surface(std::move(map), tilt);
 }
 

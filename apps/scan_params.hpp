@@ -16,6 +16,10 @@ void add_scan_params(io::ParamSet& p);
 scan::InstrumentSpec instrument_from(const io::ParamSet& p);
 /// The sample: a built-in generator or a file (GSF, ASCII matrix, 16-bit PNG) centred on the spindle axis, tilted.
 scan::Surface surface_from(const io::ParamSet& p);
+/// Refuses (InvalidParameter, before anything is read or allocated) a scan whose sample map and images need more
+/// memory than the machine can give (docs/development.md#memory-and-sizes): names image_resolution,
+/// sample_resolution or sample_file and the largest value that fits. `recorded`: only the images (no sample map).
+void require_scan_memory(const io::ParamSet& p, bool recorded);
 /// Keys that describe the simulated instrument or sample (refused together with `recorded`).
 const std::vector<std::string>& simulation_only_keys();
 

@@ -9,9 +9,11 @@
 #include <nlohmann/json.hpp>
 
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "afmkit/scan/recorded_scan.hpp"
 #include "command.hpp"
 #include "scan_outputs.hpp"
+#include "scan_params.hpp"
 
 namespace afmkit::cli {
 
@@ -23,6 +25,7 @@ void run_recorded(const io::ParamSet& p, Captured* capture) {
   spec.alpha = p.real("alpha");
   spec.beta = p.real("beta");
 
+  require_scan_memory(p, true);  // the images, before the file is read
   // every row of the file is checked (and the grid and filter chosen) before any output is opened
   const scan::RecordedSurvey survey = scan::survey_recorded(path);
   const scan::Grid grid = scan::recorded_image_grid(survey, p.integer("image_resolution"));
@@ -85,10 +88,12 @@ void run_recorded(const io::ParamSet& p, Captured* capture) {
                  {"spindle_frequency", "Hz"}, {"max_radius", "m"}, {"max_pitch", "m"}, {"valid_pixels", "count"},
                  {"filter_skipped_samples", "count"}, {"point_cloud_points", "count"}}}};
   if (series) series->commit(io::make_sidecar("scan (recorded, time series)", p, results));
-  out.finish(results, fmt::format("afmkit scan (recorded {}): {} samples, {} turns at {:.6g} Hz spindle, {:.6g} Hz "
-                                  "sampling; {} samples dropped outside the index pulses{}",
-                                  path, s.samples, result.turns, s.rotation_frequency / (2.0 * std::numbers::pi),
-                                  s.sample_rate, s.dropped_samples,
+  out.finish(results, fmt::format("afmkit scan (recorded {}): {} samples, {} turns at {} spindle, {} sampling, "
+                                  "radius up to {}; {} samples dropped outside the index pulses{}",
+                                  path, s.samples, result.turns,
+                                  io::quantity(s.rotation_frequency / (2.0 * std::numbers::pi), "Hz", 6),
+                                  io::quantity(s.sample_rate, "Hz", 6), io::quantity(s.max_radius, "m"),
+                                  s.dropped_samples,
                                   files.empty() ? std::string()
                                                 : fmt::format("; wrote {} files with prefix {}", files.size(), prefix)));
 }

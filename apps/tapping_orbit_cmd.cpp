@@ -2,6 +2,7 @@
 // (find_orbits: shooting from each HB solution, transients, a phase × amplitude grid, states in contact and the
 // branches continued through l), with Floquet stability and the orbit observables. CSV: one row per orbit;
 // JSON sidecar: HB solutions, transients and the search report (seeds per kind, which seeds found which orbit).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <memory>
@@ -13,12 +14,21 @@
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/tapping/orbit.hpp"
+#include "afmkit/io/progress.hpp"
 #include "command.hpp"
+#include "work_budget.hpp"
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
 
 namespace afmkit::cli {
+
+namespace {
+// Time of one drive period of a transient: measured 4.1e-7 s (closed-form piecewise-linear law, no contact, the
+// fastest) to 3.5e-5 s (in contact every period; 2-core test machine under load, Release), taken as 2e-7 s: the
+// estimate is a lower bound, so only requests that cannot fit are refused.
+constexpr double kPeriodSeconds = 2e-7;
+}  // namespace
 
 namespace {
 
@@ -97,7 +107,21 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   tapping::OrbitSearchOptions options;
   options.shooting = shooting_options_from(p);
   options.transient = transient_options_from(p);
+  // cost model (docs/development.md#work-and-time): at least two full transients (the free response and rest),
+  // each of up to max_transient_periods drive periods; a response decaying at the quality factor Q needs about Q
+  // periods to settle, so min(max_transient_periods, Q) periods of about kPeriodSeconds each is a lower bound
+  const double quality = p.real("quality_factor");
+  const double periods = static_cast<double>(options.transient.max_periods);
+  const double estimate = require_work(
+      "max_transient_periods", periods, 2.0 * kPeriodSeconds * std::min(1.0, quality / periods),
+      fmt::format("2 transients of min(max_transient_periods, quality_factor) drive periods, quality_factor = {}, "
+                  "at least {:.2g} s per period",
+                  quality, kPeriodSeconds));
+  io::Progress progress("tapping orbit (transient drive periods, of at most)", 5L * options.transient.max_periods,
+                        estimate > kProgressAfterSeconds && !p.flag("json"));
+  options.transient.on_periods = [&progress](int n) { progress.advance(n); };
   const tapping::OrbitSearchResult r = tapping::find_orbits(model, options);
+  progress.finish();
 
   nlohmann::json orbits = nlohmann::json::array();
   for (const tapping::FoundOrbit& f : r.orbits) orbits.push_back(orbit_json(f, r.report, scales));

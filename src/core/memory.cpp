@@ -74,4 +74,21 @@ void require_fits(const std::string& parameter, double value, double bytes_per_u
   }
 }
 
+void require_fits_square(const std::string& parameter, double side, double bytes_per_pixel, double other_bytes,
+                         double fraction) {
+  const double needed = side * side * bytes_per_pixel + other_bytes;
+  const double usable = fraction * static_cast<double>(available_bytes());
+  if (!(needed <= usable)) {
+    const double gib = 1024.0 * 1024.0 * 1024.0;
+    const double largest = usable > other_bytes ? std::floor(std::sqrt((usable - other_bytes) / bytes_per_pixel)) : 0.0;
+    throw InvalidParameter(
+        parameter, fmt::format("{} = {} needs about {:.2f} GiB of memory ({} x {} pixels{}), more than the {:.2f} GiB "
+                               "usable now ({:.0f} % of MemAvailable, capped by ulimit -v and AFMKIT_MEMORY_LIMIT): "
+                               "must be <= {:.0f}",
+                               parameter, side, needed / gib, side, side,
+                               other_bytes > 0 ? fmt::format(", with {:.3g} GiB for the rest", other_bytes / gib) : "",
+                               usable / gib, 100.0 * fraction, largest));
+  }
+}
+
 }  // namespace afmkit::memory

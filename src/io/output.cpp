@@ -204,6 +204,11 @@ void TableWriter::separator() {
 
 TableWriter& TableWriter::cell(double value) {
   separator();
+  // docs/conventions.md#undefined-values: one spelling, `nan` (fmt writes a negative NaN as "-nan")
+  if (std::isnan(value)) {
+    buffer_.append(std::string_view("nan"));
+    return *this;
+  }
   fmt::format_to(std::back_inserter(buffer_), "{}", value);
   return *this;
 }

@@ -39,22 +39,38 @@ RecordedSurvey survey_recorded(const std::string& path) {
   s.sample_rate = reader.sample_rate();
   s.rotation_frequency = reader.rotation_frequency();
   s.uses_index_pulse = reader.uses_index_pulse();
+  // The radial spread of every turn — its samples and the first sample of the next turn, the partial first and
+  // last turns included — bounds how far apart neighbouring turns can be: a radius outlier anywhere shows here.
   SpiralSample sample{};
   std::int64_t turn = -1;
-  double turn_start_radius = 0.0;
+  double turn_min = 0.0, turn_max = 0.0, turn_time = 0.0;
+  auto close_turn = [&] {
+    if (turn_max - turn_min > s.max_pitch) {
+      s.max_pitch = turn_max - turn_min;
+      s.max_pitch_turn = turn;
+      s.max_pitch_time = turn_time;
+    }
+  };
   while (reader.next(sample)) {
     ++s.samples;
     s.max_radius = std::max(s.max_radius, sample.radius);
     const auto k = static_cast<std::int64_t>(std::floor(sample.angle / kTwoPi));
-    if (k != turn) {
-      if (turn >= 0) {
-        s.max_pitch = std::max(s.max_pitch, std::abs(sample.radius - turn_start_radius));
+    if (s.samples == 1 || k != turn) {
+      if (s.samples > 1) {
+        turn_min = std::min(turn_min, sample.radius);  // the turn ends where the next one starts
+        turn_max = std::max(turn_max, sample.radius);
+        close_turn();
         ++s.turns;
       }
       turn = k;
-      turn_start_radius = sample.radius;
+      turn_min = turn_max = sample.radius;
+      turn_time = sample.time;
+    } else {
+      turn_min = std::min(turn_min, sample.radius);
+      turn_max = std::max(turn_max, sample.radius);
     }
   }
+  if (s.samples > 0) close_turn();  // the last, partial, turn
   s.dropped_samples = reader.dropped_samples();
   return s;
 }
@@ -70,9 +86,10 @@ Grid recorded_image_grid(const RecordedSurvey& survey, long resolution) {
     const auto largest = static_cast<long>(std::floor(2.0 * r / survey.max_pitch));
     throw InvalidParameter(
         "image_resolution",
-        fmt::format("image_resolution = {} is out of range: the recorded spiral advances up to {} m per turn, more "
-                    "than the pixel {} m, so neighbouring turns would not overlap; must be <= {}", resolution,
-                    survey.max_pitch, pixel, largest));
+        fmt::format("image_resolution = {} is out of range: the recorded spiral advances up to {} m per turn (its "
+                    "radius spans that much in the turn starting at t = {} s, a radius outlier or a gap in the "
+                    "recording), more than the pixel {} m, so neighbouring turns would not overlap; must be <= {}",
+                    resolution, survey.max_pitch, survey.max_pitch_time, pixel, std::max(largest, 1L)));
   }
   return Grid{resolution, resolution, 2.0 * r, 2.0 * r, -r, -r};
 }

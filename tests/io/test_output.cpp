@@ -236,3 +236,20 @@ TEST(TableWriter, TextCellsWithCommasOrQuotesAreQuotedAsRfc4180) {
   EXPECT_EQ(slurp(dir / "t.csv"), "name,x\nplain,1\n\"bank N=10, rejected 1,3\",2\n\"say \"\"hi\"\"\",3\n");
   fs::remove_all(dir);
 }
+
+TEST(TableWriter, EveryNaNIsWrittenNanAndInfinitiesInf) {
+  // A NaN with its sign bit set (what 0·inf or inf − inf give on x86) printed as "-nan" by fmt: the table must
+  // still spell it `nan` (docs/conventions.md#undefined-values).
+  const fs::path dir = fresh_dir("nan");
+  const double negative_nan = -std::numeric_limits<double>::quiet_NaN();
+  ASSERT_TRUE(std::signbit(negative_nan));
+  volatile double inf = std::numeric_limits<double>::infinity();
+  const double computed = inf - inf;  // sign as the hardware gives it
+  {
+    TableWriter out((dir / "t.csv").string(), cols({"a", "b", "c", "d"}));
+    out.row(negative_nan, computed, inf, -static_cast<double>(inf));
+    out.commit(afmkit::io::make_sidecar("test", {{"x", 1}}));
+  }
+  EXPECT_EQ(slurp(dir / "t.csv"), "a,b,c,d\nnan,nan,inf,-inf\n");
+  fs::remove_all(dir);
+}

@@ -165,3 +165,35 @@ TEST(RecordedScan, BadRatesAndGeometryAreNamed) {
 }
 
 }  // namespace
+
+TEST(RecordedScan, EveryTurnsRadialSpreadIsSurveyedTheLastPartialOneToo) {
+  // The regular spiral: every turn spreads one pitch (0.2 µm), the survey finds exactly that. One radius outlier
+  // (1 mm further out) in the middle of a turn, in the first turn, or in the last, partial, turn: the survey's
+  // largest spread is the outlier's distance from that turn's radii, and the image grid is refused.
+  scan_test::TempDir dir("recorded_spread");
+  auto write = [&](const std::string& name, int outlier, int samples) {
+    std::ofstream f(dir.file(name));
+    f << "time,radius,angle,deflection\n";
+    for (int n = 0; n < samples; ++n) {
+      const double t = n / 4000.0, theta = 2 * kPi * 50 * t;
+      const double r = n == outlier ? 2e-3 : 1e-3 + 0.2e-6 * 50 * t;
+      f << fmt::format("{},{},{},{}\n", t, r, std::fmod(theta, 2 * kPi), 0.0);
+    }
+    return dir.file(name);
+  };
+  const int samples = kPerTurn * 10 + kPerTurn / 2;  // 10.5 turns
+  const RecordedSurvey regular = survey_recorded(write("regular.csv", -1, samples));
+  EXPECT_NEAR(regular.max_pitch, 0.2e-6, 1e-12);
+  EXPECT_EQ(regular.turns, 10);
+  for (int outlier : {5, kPerTurn * 4 + 17, samples - 3}) {
+    const std::string path = write("outlier.csv", outlier, samples);
+    const RecordedSurvey s = survey_recorded(path);
+    const double r_turn = 1e-3 + 0.2e-6 * 50 * (outlier / 4000.0);  // the turn's radius near the outlier
+    EXPECT_NEAR(s.max_pitch, 2e-3 - r_turn, 0.3e-6) << outlier;
+    EXPECT_NEAR(static_cast<double>(s.max_pitch_turn), outlier / kPerTurn, 1.0) << outlier;
+    EXPECT_LE(s.max_pitch_time, outlier / 4000.0) << outlier;  // the turn holding the outlier starts before it
+    EXPECT_GT(s.max_pitch_time, outlier / 4000.0 - 1.0 / 50.0 - 1e-9) << outlier;
+    EXPECT_THROW(recorded_image_grid(s, 64), afmkit::InvalidParameter) << outlier;
+  }
+  EXPECT_NO_THROW(recorded_image_grid(regular, 64));
+}

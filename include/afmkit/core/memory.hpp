@@ -17,4 +17,10 @@ std::size_t available_bytes();
 /// the memory needed and the largest value that fits. `bytes_per_unit` (> 0) converts between the two.
 void require_fits(const std::string& parameter, double value, double bytes_per_unit, double fraction = 0.5);
 
+/// The same for a request that grows with the square of `side` (a side × side image): it needs
+/// `bytes_per_pixel` · side² + `other_bytes` (what the rest of the request holds at the same time); the message
+/// names the largest side that fits.
+void require_fits_square(const std::string& parameter, double side, double bytes_per_pixel, double other_bytes = 0.0,
+                         double fraction = 0.5);
+
 }  // namespace afmkit::memory

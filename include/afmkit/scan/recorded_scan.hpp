@@ -30,7 +30,11 @@ struct RecordedSurvey {
   double sample_rate = 0.0;       ///< f_s [Hz]
   double rotation_frequency = 0.0;///< Ω [rad/s] (first revolution)
   double max_radius = 0.0;        ///< [m]
-  double max_pitch = 0.0;         ///< largest radius advance over one turn [m]
+  /// largest radial spread of one turn [m]: max − min of the radius over a turn's samples and the first sample of
+  /// the next turn, over every turn (the partial first and last ones too): the pitch of a regular spiral
+  double max_pitch = 0.0;
+  std::int64_t max_pitch_turn = -1;  ///< the turn k (angle in [2πk, 2π(k+1))) where max_pitch was found
+  double max_pitch_time = 0.0;       ///< the time of that turn's first sample [s]
   std::int64_t turns = 0;         ///< complete turns
   bool uses_index_pulse = false;
 };

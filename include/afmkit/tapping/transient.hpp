@@ -1,6 +1,7 @@
 #pragma once
 // Transients: simulate from a state until the stroboscopic sequence settles, detect its period (1..4 drive
 // periods) and converge it by shooting. What a physical instrument does when an orbit disappears (a jump).
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -15,6 +16,9 @@ struct TransientOptions {
   /// Accept the shooting result once the simulated state is within this distance (relative to the orbit
   /// amplitude) of a stable orbit of matching period, and the distance keeps decreasing.
   double capture_distance = 0.02;
+  /// If set, called after every chunk with the periods just simulated (progress of long transients; settle() may
+  /// run on several threads at once, so it must be thread-safe).
+  std::function<void(int)> on_periods{};
   void validate() const;
 };
 

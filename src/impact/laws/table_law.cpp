@@ -625,28 +625,123 @@ TableLaw::TableLaw(ForceCurve curve, bool allow_energy_gain)
   if (switching_[0] == switching_[1]) switching_.pop_back();
 }
 
+namespace {
+/// The smallest value of the cubic y + t (c1 + t (c2 + t c3)) on [0, len] and where it is taken: the ends and the
+/// zeros of its derivative c1 + 2 c2 t + 3 c3 t² inside (exact up to rounding: no sampling).
+std::pair<double, double> cubic_minimum(double y, double c1, double c2, double c3, double len) {
+  auto value = [&](double t) { return y + t * (c1 + t * (c2 + t * c3)); };
+  std::pair<double, double> best{value(0.0), 0.0};
+  auto consider = [&](double t) {
+    if (!(t > 0.0 && t < len)) return;
+    const double v = value(t);
+    if (v < best.first) best = {v, t};
+  };
+  if (len > 0.0) {
+    const double end = value(len);
+    if (end < best.first) best = {end, len};
+  }
+  const double a = 3.0 * c3, b = 2.0 * c2, c = c1;
+  if (a == 0.0) {
+    if (b != 0.0) consider(-c / b);
+  } else {
+    const double disc = b * b - 4.0 * a * c;
+    if (disc >= 0.0) {
+      // the stable pair of roots: q = −(b + sign(b)√disc)/2, t = q/a and c/q
+      const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+      consider(q / a);
+      if (q != 0.0) consider(c / q);
+    }
+  }
+  return best;
+}
+}  // namespace
+
+TableLaw::Piece TableLaw::Branch::local(double a, double b) const {
+  const std::size_t n = x.size();
+  if (b <= x.front()) {  // the straight-line continuation below the table
+    const Piece& p = piece[0];
+    return {p.y + p.c1 * (a - x.front()), p.c1, 0.0, 0.0};
+  }
+  if (a >= x.back()) return {0.0, 0.0, 0.0, 0.0};  // beyond the table
+  const std::size_t i = locate(a);                  // (a, b) lies inside [x_i, x_{i+1}]
+  const Piece& p = piece[std::min(i, n - 2)];
+  const double s = a - x[i];  // the Taylor shift of the piece to the origin a
+  return {p.y + s * (p.c1 + s * (p.c2 + s * p.c3)), p.c1 + s * (2.0 * p.c2 + 3.0 * s * p.c3), p.c2 + 3.0 * s * p.c3,
+          p.c3};
+}
+
 void TableLaw::require_dissipative() const {
   if (allow_gain_) return;
+  // H_a(d) ≥ H_b(d) − tolerance for every d, as the law is evaluated: the table's cubics between the knots of
+  // either branch, the straight-line continuations below the tables, and 0 beyond each table's end (one branch
+  // may end before the other). Between consecutive knots of the union both branches are polynomials of degree
+  // ≤ 3, so H_a − H_b is a cubic whose minimum is found exactly (ends and stationary points).
   double scale = 0.0;
   for (const auto* f : {&curve_.approach_force, &curve_.retract_force})
     for (double v : *f) scale = std::max(scale, std::abs(v));
   const double tolerance = 1e-9 * scale;
-  const double lo = std::max(approach_.x.front(), retract_.x.front());
-  const double hi = std::min(approach_.x.back(), retract_.x.back());
-  std::vector<double> nodes;
-  for (const auto* xs : {&approach_.x, &retract_.x})
-    for (double d : *xs)
-      if (d >= lo && d <= hi) nodes.push_back(d);
-  std::sort(nodes.begin(), nodes.end());
-  for (double d : nodes) {
-    const double ha = approach_.eval(d), hb = retract_.eval(d);
-    if (hb > ha + tolerance)
+  const std::string prefix = curve_.origin.empty() ? "" : curve_.origin + ": ";
+  const char* remedy =
+      "the curve would create energy (H_a >= H_b is needed for a hysteresis law to dissipate; set "
+      "allow_energy_gain = true to accept it)";
+  const double a_lo = approach_.x.front(), a_hi = approach_.x.back();
+  const double b_lo = retract_.x.front(), b_hi = retract_.x.back();
+  auto region = [&](double d) -> std::string {
+    std::string r;
+    if (d < a_lo && d < b_lo) return "below both tables, where both branches continue as straight lines";
+    if (d < a_lo) r = "below the approach table, where the approach continues as a straight line";
+    if (d < b_lo) r = "below the retract table, where the retract continues as a straight line";
+    if (d > a_hi) r = "beyond the end of the approach table, where the approach force is 0";
+    if (d > b_hi) r = "beyond the end of the retract table, where the retract force is 0";
+    return r.empty() ? "inside both tables" : r;
+  };
+  auto refuse = [&](double ha, double hb, const std::string& at, double d, double inside) {
+    throw InvalidParameter("force_curve", fmt::format("{}the retract force {} nN exceeds the approach force {} nN {} "
+                                                      "distance {} nm ({}): {}",
+                                                      prefix, hb, ha, at, d, region(inside), remedy));
+  };
+
+  std::vector<double> knots = approach_.x;
+  knots.insert(knots.end(), retract_.x.begin(), retract_.x.end());
+  std::sort(knots.begin(), knots.end());
+  knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
+
+  // Below every knot both branches are straight lines: H_a − H_b = g0 + (s_a − s_b)(d − d0), which falls without
+  // bound as d → −∞ when the retract line is steeper (s_a − s_b > 0). Slopes equal to 1e-9 of the larger are
+  // taken as equal (the force error that allows is 1e-9 of the force at that depth).
+  {
+    const double d0 = knots.front();
+    const Piece pa = approach_.local(d0 - 1.0, d0), pb = retract_.local(d0 - 1.0, d0);
+    const double ga = pa.y + pa.c1, gb = pb.y + pb.c1;  // the lines' values at d0
+    const double rise = pa.c1 - pb.c1;
+    if (rise > 1e-9 * std::max(std::abs(pa.c1), std::abs(pb.c1))) {
+      const double onset = d0 - std::max(0.0, ga - gb + tolerance) / rise;  // below it H_b − H_a > tolerance
+      const double d = onset - std::max(1.0, std::abs(onset));
       throw InvalidParameter(
           "force_curve",
-          fmt::format("{}{}the retract force {} nN exceeds the approach force {} nN at distance {} nm: the curve would "
-                      "create energy (H_a >= H_b is needed for a hysteresis law to dissipate; set "
-                      "allow_energy_gain = true to accept it)",
-                      curve_.origin, curve_.origin.empty() ? "" : ": ", hb, ha, d));
+          fmt::format("{}below {} nm, where both branches continue as straight lines with their end slopes, the "
+                      "retract slope {} nN/nm is steeper than the approach slope {} nN/nm, so the retract force "
+                      "exceeds the approach force at every distance below {} nm (e.g. {} nN against {} nN at {} nm): "
+                      "{}",
+                      prefix, d0, pb.c1, pa.c1, onset, retract_.eval(d), approach_.eval(d), d, remedy));
+    }
+  }
+  for (std::size_t k = 0; k < knots.size(); ++k) {
+    const double a = knots[k];
+    {  // the knot itself (at a table's end the branch holds its last value)
+      const double ha = approach_.eval(a), hb = retract_.eval(a);
+      if (hb > ha + tolerance) refuse(ha, hb, "at", a, a);
+    }
+    if (k + 1 == knots.size()) break;  // beyond the last knot both branches are 0
+    const double b = knots[k + 1];
+    const Piece pa = approach_.local(a, b), pb = retract_.local(a, b);
+    const auto [least, t] = cubic_minimum(pa.y - pb.y, pa.c1 - pb.c1, pa.c2 - pb.c2, pa.c3 - pb.c3, b - a);
+    if (least < -tolerance) {
+      const double ha = pa.y + t * (pa.c1 + t * (pa.c2 + t * pa.c3));
+      const double hb = pb.y + t * (pb.c1 + t * (pb.c2 + t * pb.c3));
+      // at t = 0 the open interval's limit: the force of a branch ending at `a` is 0 just above it
+      refuse(ha, hb, t == 0.0 ? "just above" : "at", a + t, a + 0.5 * (b - a));
+    }
   }
 }
 

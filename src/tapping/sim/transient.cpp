@@ -62,6 +62,7 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
   double candidate_distance = 0.0;
   while (k < options.max_periods) {
     advance(options.chunk_periods);
+    if (options.on_periods) options.on_periods(options.chunk_periods);
     const int last = static_cast<int>(strobe.size()) - 1;
     const double scale = std::max(1e-9, magnitude(y, omega));
     if (candidate) {

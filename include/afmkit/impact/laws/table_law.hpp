@@ -42,7 +42,10 @@
 // Evaluation allocates nothing: the interval is found in O(1) on an evenly spaced table (as AFM exports are), by
 // binary search otherwise (measured ≈ 16 ns / 38 ns latency per call for 200 knots, about that of the DMT law).
 // A noisy baseline makes the retract force exceed the approach force somewhere, which require_dissipative()
-// rejects unless allow_energy_gain is set (smooth or trim the baseline, or opt in).
+// rejects unless allow_energy_gain is set (smooth or trim the baseline, or opt in); so do a retract table that
+// ends before an attractive approach (0 above an attraction), an approach table that ends before a repulsive
+// retract, and a retract contact stiffer at the deepest point than the approach (its straight line rises above
+// the approach's below the tables).
 #include <cstddef>
 #include <string>
 #include <string_view>
@@ -83,8 +86,12 @@ class TableLaw final : public ForceLawModel {
   double contact_gap() const override;
   /// Below the highest switching gap the branches may differ; above it both are 0.
   bool branch_dependent(int region) const override { return region < static_cast<int>(switching_.size()); }
-  /// Unless allow_energy_gain: H_a(d) ≥ H_b(d) − 1e-9·max|F| at every table node of both branches inside the
-  /// range both branches tabulate; else InvalidParameter("force_curve", …) naming the smallest such distance.
+  /// Unless allow_energy_gain: H_a(d) ≥ H_b(d) − 1e-9·max|F| for every distance d, as the law is evaluated —
+  /// the cubics between the knots of either branch, the straight lines below the tables (where the difference is
+  /// linear: the retract line may not be steeper than the approach line, slopes within 1e-9 counting as equal)
+  /// and 0 beyond each table's end; exact (the minimum of the cubic difference between consecutive knots of the
+  /// union, no sampling). Else InvalidParameter("force_curve", …) naming the smallest such region, the distance
+  /// of the largest excess in it, both forces and which rule of the law applies there.
   void require_dissipative() const override;
   /// ∫_lo^hi (H_a − H_b) dd, exact for the interpolant and the rules beyond the table (each cubic piece and the
   /// linear continuation integrated in closed form) [nN·nm]. The generic adaptive quadrature of
@@ -108,6 +115,9 @@ class TableLaw final : public ForceLawModel {
     double inverse_mean_step = 0.0;   // (n − 1)/(x_{n−1} − x_0): the interval of an evenly spaced table in O(1)
     double eval(double d) const;
     std::size_t locate(double d) const;  // i with x_i ≤ d < x_{i+1} (binary search), for x_0 ≤ d < x_{n−1}
+    /// The branch on an open interval (a, b) holding no knot, as a cubic in t = d − a: the piece's cubic shifted
+    /// to a, the straight line below the table, or 0 beyond it.
+    Piece local(double a, double b) const;
     double integral(double d) const;  // ∫_{x_0}^{d} of the branch (negative below x_0, constant above x_{n−1})
   };
   static Branch build(const std::vector<double>& x, const std::vector<double>& y, const std::string& what,
