@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/input_file.hpp"
 #include "afmkit/io/output.hpp"
 
 namespace afmkit::io {
@@ -27,9 +28,13 @@ static_assert(std::endian::native == std::endian::little, "Zarr chunks are writt
 
 /// Whether `dir` is a store afmkit wrote (root .zattrs carrying afmkit_study_format).
 bool is_afmkit_store(const fs::path& dir) {
-  std::ifstream in(dir / ".zattrs");
-  if (!in) return false;
-  const nlohmann::json attrs = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  std::string text;
+  try {  // a FIFO or a huge file there is not an afmkit store's attributes
+    text = files::read_input_file((dir / ".zattrs").string(), "store attributes", 16u << 20);
+  } catch (const InputError&) {
+    return false;
+  }
+  const nlohmann::json attrs = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   return attrs.is_object() && attrs.contains("afmkit_study_format");
 }
 
