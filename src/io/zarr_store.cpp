@@ -67,6 +67,28 @@ class SignalsHeld {
   sigset_t old_;
 };
 
+/// Cleans up after an earlier commit to `target` by a process that no longer exists (killed by SIGKILL, a power
+/// cut): its new store's folder `.<name>.tmp.<pid>` is removed, and its moved-aside old store `.<name>.old.<pid>` is
+/// put back when the target is missing (else removed).
+void remove_stale_commits(const fs::path& target) {
+  std::error_code ec;
+  const std::string name = target.filename().string();
+  for (const char* kind : {".tmp.", ".old."}) {
+    const std::string prefix = "." + name + kind;
+    for (fs::directory_iterator it(target.parent_path(), ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string entry = it->path().filename().string();
+      if (entry.size() <= prefix.size() || entry.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string digits = entry.substr(prefix.size());
+      if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      const long pid = std::stol(digits);
+      if (pid <= 0 || pid == ::getpid() || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+      std::error_code ignored;
+      if (std::string(kind) == ".old." && !fs::exists(target, ignored)) fs::rename(it->path(), target, ignored);
+      else fs::remove_all(it->path(), ignored);
+    }
+  }
+}
+
 nlohmann::json zarray_json(const std::vector<std::size_t>& shape, const std::vector<std::size_t>& chunks,
                            const std::string& dtype, nlohmann::json fill) {
   return {{"zarr_format", 2}, {"shape", shape},     {"chunks", chunks},   {"dtype", dtype},
@@ -158,6 +180,7 @@ void ZarrStoreWriter::commit() {
   const fs::path tmp = target.parent_path() / fmt::format(".{}.tmp.{}", target.filename().string(), ::getpid());
   const fs::path old = target.parent_path() / fmt::format(".{}.old.{}", target.filename().string(), ::getpid());
   SignalsHeld held;  // complete or absent: an interrupt is delivered once the store is in place
+  remove_stale_commits(target);
   try {
     fs::remove_all(tmp);
     fs::create_directory(tmp);

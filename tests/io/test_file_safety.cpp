@@ -22,6 +22,7 @@
 #include "afmkit/core/input_file.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
+#include "afmkit/io/zarr_store.hpp"
 
 namespace fs = std::filesystem;
 using afmkit::InputError;
@@ -332,4 +333,20 @@ TEST(OutputSafety, AWriteErrorSaysWhy) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0) << "1: no error, 2: the error without its reason";
   EXPECT_FALSE(fs::exists(dir.path / "t.csv"));
+}
+
+TEST(OutputSafety, TheFoldersOfAKilledStoreCommitAreRemovedByTheNextCommit) {
+  const Folder dir("zarr");
+  const pid_t dead = dead_pid();
+  const fs::path tmp = dir.path / (".s.zarr.tmp." + std::to_string(dead));
+  const fs::path old = dir.path / (".s.zarr.old." + std::to_string(dead));
+  fs::create_directories(tmp / "x");
+  fs::create_directories(old / "x");
+  afmkit::io::ZarrStoreWriter store(dir.file("s.zarr"), "store");
+  store.attribute("afmkit_study_format", 1);
+  store.coordinate("x", {1.0, 2.0}, nlohmann::json::object());
+  store.commit();
+  EXPECT_TRUE(fs::exists(dir.path / "s.zarr" / ".zattrs"));
+  EXPECT_FALSE(fs::exists(tmp));
+  EXPECT_FALSE(fs::exists(old));
 }
