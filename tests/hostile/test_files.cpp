@@ -129,15 +129,31 @@ TEST(HostileFiles, AFailedWriteSaysWhy) {
     EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
 }
 
-TEST(HostileFiles, AReadOnlyFileSystemIsCalledOne) {
-  struct statvfs info {};
-  if (::statvfs("/sys", &info) != 0 || (info.f_flag & ST_RDONLY) == 0) GTEST_SKIP() << "no read-only mount here";
+/// Runs `line` in a private mount namespace where `mnt` (a folder of `dir`) is a tmpfs mounted with `options`
+/// (unshare -rm: no root needed where user namespaces are allowed); status -1 when that is not possible here.
+afmkit_test::RunResult with_mount(const std::string& options, const std::string& line, const TempDir& dir) {
+  if (run_shell("unshare -rm true", dir).status != 0) return {-1, "", ""};
+  fs::create_directories(dir.path / "mnt");
+  return run_shell("unshare -rm bash -c 'mount -t tmpfs -o " + options + " none mnt && afmkit() { \"" +
+                       std::string(AFMKIT_CLI) + "\" \"$@\"; }; " + line + "'",
+                   dir);
+}
+
+TEST(HostileFiles, AReadOnlyOrAFullFileSystemIsCalledOne) {
   TempDir dir;
   dir.write("curve.csv", kCurve);
-  const auto r = run_shell(kImpact + "--output /sys/afmkit_out.csv", dir);
-  EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_NE(r.err.find("read-only file system"), std::string::npos) << r.err;
-  EXPECT_EQ(r.err.find("GB are free"), std::string::npos) << r.err;
+  const auto ro = with_mount("ro,size=1m", kImpact + "--output mnt/x.csv", dir);
+  if (ro.status == -1) GTEST_SKIP() << "no user namespaces here (unshare -rm)";
+  EXPECT_EQ(ro.status, 2) << ro.err;
+  EXPECT_NE(ro.err.find("'" + (dir.path / "mnt").string() + "' is on a read-only file system"), std::string::npos)
+      << ro.err;
+  EXPECT_EQ(ro.err.find("GB are free"), std::string::npos) << ro.err;
+  const auto hb = with_mount("ro,size=1m", "afmkit tapping hb --output mnt/x.csv", dir);
+  EXPECT_EQ(hb.status, 2) << hb.err;
+  EXPECT_NE(hb.err.find("cannot write output file 'mnt/x.csv': Read-only file system"), std::string::npos) << hb.err;
+  const auto full = with_mount("size=64k", "afmkit tapping hb --points 20000 --output mnt/x.csv", dir);
+  EXPECT_EQ(full.status, 2) << full.err;
+  EXPECT_NE(full.err.find("'mnt/x.csv': No space left on device"), std::string::npos) << full.err;
 }
 
 TEST(HostileFiles, AValueAnImageCannotHoldNamesTheFileAndThePixel) {
