@@ -41,7 +41,8 @@ void add_output_params(io::ParamSet& p, const std::string& default_path, const s
   p.group("Output")
       .flag("json", false, "print the results as JSON to standard output instead of a summary line (with the table "
                            "itself when no file is written)")
-      .file("output", default_path, what + " CSV path (JSON sidecar describing every column next to it); empty: no file");
+      .file("output", default_path, what + " CSV path (JSON sidecar describing every column next to it); empty: no file")
+      .writes(io::table_and_sidecar);
 }
 
 CommandOutput::CommandOutput(const io::ParamSet& params, Captured* capture, std::string command,
@@ -57,7 +58,8 @@ void CommandOutput::open(std::vector<io::Column> columns) {
 }
 
 void CommandOutput::finish(const nlohmann::json& results, const std::string& summary) {
-  if (file_) file_->commit(io::make_sidecar(command_, params_, results));
+  if (file_) file_->stage(io::make_sidecar(command_, params_, results), outputs_);
+  outputs_.commit();
   if (capture_ != nullptr) {
     capture_->results = results;
     capture_->columns = columns_;

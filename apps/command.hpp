@@ -88,8 +88,13 @@ class CommandOutput {
   /// will read.
   bool keeps_rows() const { return writes_file() || keep_rows_; }
 
-  /// Commits the file with the sidecar (parameters, `results`, columns). Then prints `results` as JSON (--json;
-  /// with the rows when no file was written), or `summary` (if not empty) and where the table went.
+  /// The other files of the command's result (images, a series, a point cloud): staged there, they are committed
+  /// with the table by finish(), all of them or none (io::OutputSet).
+  io::OutputSet& outputs() & { return outputs_; }
+
+  /// Commits the file with the sidecar (parameters, `results`, columns) and the files of outputs(), as one set.
+  /// Then prints `results` as JSON (--json; with the rows when no file was written), or `summary` (if not empty) and
+  /// where the table went.
   void finish(const nlohmann::json& results, const std::string& summary);
 
  private:
@@ -106,6 +111,7 @@ class CommandOutput {
   bool keep_rows_ = false;
   std::vector<io::Column> columns_;
   std::optional<io::TableWriter> file_;
+  io::OutputSet outputs_;
   nlohmann::json rows_ = nlohmann::json::array();
   std::size_t count_ = 0;
 };

@@ -197,7 +197,7 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
     bres["window"] = window_json(win);
     bres["delays"] = res["delays"];
     bres["grid_file"] = out.path();
-    boundaries->commit(io::make_sidecar("control chart (D-subdivision boundaries)", as_run, bres));
+    boundaries->stage(io::make_sidecar("control chart (D-subdivision boundaries)", as_run, bres), out.outputs());
   } else if (json) {
     res["boundaries"] = {{"columns", io::columns_json(boundary_columns)}, {"rows", boundary_rows}};
   }
@@ -230,7 +230,8 @@ void add_control_chart(CLI::App& control) {
         p.flag("progress", true, "show progress on stderr")
             .file("boundaries_output", "out/control_chart_boundaries.csv",
                   "boundary curves CSV path (JSON sidecar next to it); empty: no file (with --json: in the printed "
-                  "document)");
+                  "document)")
+            .writes(io::table_and_sidecar);
       },
       run_chart);
 }

@@ -119,6 +119,7 @@ void register_control_export(CLI::App& control) {
         p.group("Export")
             .text("format", "c-header", "output format", {"c-header"})
             .file("output", "", "path of the C header to write (written atomically)")
+            .writes()
             .default_text("required")
             .text("precision", "float", "precision of the embedded core: float (32-bit) or double (64-bit)",
                   {"float", "double"})

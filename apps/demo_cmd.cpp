@@ -99,8 +99,10 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
   io::TableWriter table(dir + "/demo_sweep.csv", sweep_columns(scales));
   write_sweep_rows(table, sweep.approach, scales);
   write_sweep_rows(table, sweep.retract, scales);
-  hb.commit(io::make_sidecar("demo (harmonic balance)", p, results));
-  table.commit(io::make_sidecar("demo (sweep)", p, results));
+  io::OutputSet set;  // both tables and their sidecars, or none
+  hb.stage(io::make_sidecar("demo (harmonic balance)", p, results), set);
+  table.stage(io::make_sidecar("demo (sweep)", p, results), set);
+  set.commit();
   if (capture != nullptr) {
     capture->results = results;
     return;
@@ -144,7 +146,12 @@ void register_demo(CLI::App& app) {
             .default_text("12 normalised; physical: the same case scaled to free_amplitude")
             .integer("points", 101, "separations per direction (>= 2)", 2, 1000000)
             .group("Output")
-            .file("output_dir", "out", "folder for demo_sweep.csv and demo_hb.csv (+ .json sidecars)");
+            .file("output_dir", "out", "folder for demo_sweep.csv and demo_hb.csv (+ .json sidecars)")
+            .writes([](const std::string& dir) {
+              std::vector<io::WrittenPath> files = io::table_and_sidecar(dir + "/demo_sweep.csv");
+              for (io::WrittenPath& f : io::table_and_sidecar(dir + "/demo_hb.csv")) files.push_back(std::move(f));
+              return files;
+            });
       },
       run_demo);
 }

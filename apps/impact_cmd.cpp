@@ -5,6 +5,8 @@
 // Units (docs/units.md): gaps and positions in nm, forces in nN, masses in kg, speeds in nm/s, times in s, energies
 // in aJ (1 nN · 1 nm = 1e-18 J; 1 nN / 1 kg = 1 nm/s², so the set is consistent), stiffnesses in N/m (= nN/nm).
 // The piecewise-linear laws work in any consistent set; the others need this one (E* in GPa, R in nm, A_H in J).
+#include <sys/statvfs.h>
+
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -153,6 +155,10 @@ void check_disk_space(const std::string& output, long points) {
   const double need = (static_cast<double>(points) + 16.0) * 8.0 * 25.0;
   fs::path dir = fs::absolute(fs::path(output)).parent_path();
   while (!dir.empty() && !fs::exists(dir) && dir != dir.root_path()) dir = dir.parent_path();  // created later
+  struct statvfs fsinfo {};
+  if (::statvfs(dir.c_str(), &fsinfo) == 0 && (fsinfo.f_flag & ST_RDONLY) != 0)  // not "0 GB free"
+    throw InvalidParameter("output", fmt::format("output '{}' cannot be written: '{}' is on a read-only file system",
+                                                 output, dir.string()));
   std::error_code ec;
   const fs::space_info space = fs::space(dir, ec);
   if (!ec && need > static_cast<double>(space.available))

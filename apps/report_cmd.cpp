@@ -33,6 +33,9 @@ void register_report(CLI::App& app) {
         p.group("Report")
             .file("output_dir", "out/report", "folder the report is written to (index.html and the figures' PNG "
                                               "files); index.html is replaced only when the report is complete")
+            .writes([](const std::string& dir) {
+              return std::vector<io::WrittenPath>{{dir + "/index.html"}, {dir + "/figures", true}};
+            })
             .integer("jobs", 2, "figures computed at the same time (processes)", 1, 64)
             .text("figures", "all",
                   "'all', or a comma-separated list of figure ids (seed000-fig3, seed003-fig2, beyond-tuning, …: "

@@ -104,12 +104,13 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
 
   std::vector<std::string> files;
   if (!prefix.empty())
-    files = write_images(prefix, {{"deflection", "Deflection", &result.deflection, false},
+    files = stage_images(prefix, {{"deflection", "Deflection", &result.deflection, false},
                                   {"topography", "Topography (reconstructed)", &result.topography, true},
-                                  {"truth", "Ground truth (topography + tilt)", &result.truth, true}});
+                                  {"truth", "Ground truth (topography + tilt)", &result.truth, true}},
+                         out.outputs());
   std::size_t n_points = 0;
   if (points) {
-    n_points = points->write(points_path);
+    n_points = points->stage(points_path, out.outputs());
     files.push_back(points_path);
   }
   const nlohmann::json results = {
@@ -135,7 +136,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
                  {"topography_rms_error", "m"}, {"deflection_rms", "m"}, {"valid_pixels", "count"},
                  {"loop_spectral_abscissa", "1/s"}, {"samples", "count"}, {"turns", "count"},
                  {"filter_skipped_samples", "count"}, {"point_cloud_points", "count"}}}};
-  if (series) series->commit(io::make_sidecar("scan (time series)", p, results));
+  if (series) series->stage(io::make_sidecar("scan (time series)", p, results), out.outputs());
   const std::string gain =
       std::isnan(result.scan_area_gain)
           ? std::string("nan (the uncontrolled scan does not saturate)")
@@ -183,9 +184,12 @@ void register_scan(CLI::App& app) {
             .integer("image_resolution", 512, "pixels per side of the images (square, covering the scanned disc)", 2,
                      16384)
             .file("image_output", "out/scan/scan", "prefix of the image files <prefix>_<channel>.gsf/.png (empty: none)")
+            .writes(image_paths)
             .file("series_output", "", "time-series CSV (empty: none)")
+            .writes(io::table_and_sidecar)
             .integer("series_every", 1, "write every n-th sample to the series", 1, 1000000000)
             .file("points_output", "", "raw spiral point cloud, GXYZF (empty: none)")
+            .writes()
             .integer("points_every", 10, "keep every n-th sample in the point cloud", 1, 1000000000);
         add_output_params(p, "out/scan/turns.csv", "per-turn metrics (residual first harmonic against radius)");
       },

@@ -3,6 +3,10 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
+#include "afmkit/core/error.hpp"
+
 #include "afmkit/scan/gsf.hpp"
 #include "afmkit/scan/levelling.hpp"
 #include "afmkit/scan/png16.hpp"
@@ -57,27 +61,50 @@ bool PointCloud::sample(const scan::ScanSample& s) {
   return true;
 }
 
-std::size_t PointCloud::write(const std::string& path) {
+std::size_t PointCloud::stage(const std::string& path, io::OutputSet& set) {
   const std::size_t n = x_.size();
   std::vector<scan::XyzChannel> channels{{"Deflection", "m", std::move(a_)},
                                          {recorded_ ? "Tilt-free deflection" : "Topography", "m", std::move(b_)}};
-  scan::write_gxyzf(path, scan::XyzField(std::move(x_), std::move(y_), std::move(channels), "m"));
+  set.add(path, scan::format_gxyzf(scan::XyzField(std::move(x_), std::move(y_), std::move(channels), "m")));
   return n;
 }
 
-std::vector<std::string> write_images(const std::string& prefix, const std::vector<NamedImage>& images) {
+namespace {
+constexpr const char* image_channels[] = {"deflection", "topography", "truth", "tilt_free"};  // every scan's names
+}
+
+std::vector<std::string> stage_images(const std::string& prefix, const std::vector<NamedImage>& images,
+                                      io::OutputSet& set) {
   std::vector<std::string> written;
   for (const NamedImage& image : images) {
-    for (std::string& path : scan::write_gsf(prefix + "_" + image.name + ".gsf", *image.map, image.title))
-      written.push_back(std::move(path));
-    const std::string png = prefix + "_" + image.name + ".png";
-    if (image.level_preview && image.map->valid_count() >= 3)
-      scan::write_png16(png, scan::level(*image.map));
-    else
-      scan::write_png16(png, *image.map);
-    written.push_back(png);
+    const std::string gsf = prefix + "_" + image.name + ".gsf", png = prefix + "_" + image.name + ".png";
+    try {
+      set.add(gsf, scan::format_gsf(*image.map, image.title));
+      written.push_back(gsf);
+      if (image.map->has_mask()) {
+        set.add(scan::gsf_mask_path(gsf), scan::format_gsf_mask(*image.map, image.title));
+        written.push_back(scan::gsf_mask_path(gsf));
+      }
+      const scan::HeightMap& shown =
+          image.level_preview && image.map->valid_count() >= 3 ? scan::level(*image.map) : *image.map;
+      set.add(png, scan::format_png16(scan::to_grey16(shown)));
+      written.push_back(png);
+    } catch (const InvalidParameter& e) {  // a value the file format cannot hold: name the file and the image
+      throw InputError(fmt::format("cannot write the {} image '{}': {}", image.name, gsf, e.what()));
+    }
   }
   return written;
+}
+
+std::vector<io::WrittenPath> image_paths(const std::string& prefix) {
+  std::vector<io::WrittenPath> paths;
+  for (const char* name : image_channels) {
+    const std::string gsf = prefix + "_" + name + ".gsf";
+    paths.push_back({gsf});
+    paths.push_back({scan::gsf_mask_path(gsf)});
+    paths.push_back({prefix + "_" + name + ".png"});
+  }
+  return paths;
 }
 
 }  // namespace afmkit::cli

@@ -1,6 +1,7 @@
 #pragma once
 // Outputs of `afmkit scan` shared by the simulated and the recorded scan: the optional time series (CSV), the
-// optional point cloud (GXYZF) and the images (GSF + mask, PNG preview). Every file is written atomically.
+// optional point cloud (GXYZF) and the images (GSF + mask, PNG preview). Every file is staged into the command's
+// output set and committed with the per-turn table: all of them or none (io::OutputSet).
 #include <string>
 #include <vector>
 
@@ -18,7 +19,7 @@ class SeriesWriter final : public scan::ScanObserver {
  public:
   SeriesWriter(const std::string& path, long every, bool recorded);
   bool sample(const scan::ScanSample& s) override;
-  void commit(const nlohmann::json& sidecar) { writer_.commit(sidecar); }
+  void stage(const nlohmann::json& sidecar, io::OutputSet& set) { writer_.stage(sidecar, set); }
   std::size_t rows() const { return writer_.size(); }
 
  private:
@@ -32,8 +33,8 @@ class PointCloud final : public scan::ScanObserver {
  public:
   PointCloud(long every, bool recorded, std::size_t expected);
   bool sample(const scan::ScanSample& s) override;
-  /// Writes the GXYZF file; returns the number of points.
-  std::size_t write(const std::string& path);
+  /// Stages the GXYZF file for `path` into `set`; returns the number of points.
+  std::size_t stage(const std::string& path, io::OutputSet& set);
 
  private:
   long every_;
@@ -49,7 +50,11 @@ struct NamedImage {
   const scan::HeightMap* map;
   bool level_preview = false;
 };
-/// Writes the images; returns the paths written.
-std::vector<std::string> write_images(const std::string& prefix, const std::vector<NamedImage>& images);
+/// Stages the images into `set`; returns their paths.
+std::vector<std::string> stage_images(const std::string& prefix, const std::vector<NamedImage>& images,
+                                      io::OutputSet& set);
+/// Every file stage_images may write for `prefix` (any channel of the simulated or recorded scan), for the check
+/// that no output replaces an input (io::ParamSet::writes).
+std::vector<io::WrittenPath> image_paths(const std::string& prefix);
 
 }  // namespace afmkit::cli

@@ -115,7 +115,7 @@ scan::HeightMap sample_from_file(const io::ParamSet& p) {
                                                            "[-{}, {}] m: must be in (0, {}] m",
                                                            scale, path, kMaxHeight, kMaxHeight, kMaxHeight));
     z.reserve(img.pixels.size());
-    for (std::uint16_t g : img.pixels) z.push_back(scale * static_cast<double>(g) / 65535.0);
+    for (std::uint16_t g : img.pixels) z.push_back(scale * (static_cast<double>(g) / 65535.0));
   } else {
     scan::AsciiMatrix m = scan::read_ascii_matrix(path);
     columns = m.columns;
@@ -124,6 +124,13 @@ scan::HeightMap sample_from_file(const io::ParamSet& p) {
     z = std::move(m.values);
     for (double& v : z) v *= scale;
   }
+  for (std::size_t k = 0; k < z.size(); ++k)  // name the file and the pixel, not the map's internal array
+    if (!std::isfinite(z[k]))
+      throw InvalidParameter("sample_z_scale",
+                             fmt::format("{}: the height at pixel (column {}, row {}) times sample_z_scale = {} m is "
+                                         "{}: beyond the range of numbers (use a smaller sample_z_scale)",
+                                         path, k % static_cast<std::size_t>(columns),
+                                         k / static_cast<std::size_t>(columns), scale, z[k]));
   const double dx = size / static_cast<double>(columns);
   return centred(scan::Grid{columns, rows, size, dx * static_cast<double>(rows), 0.0, 0.0}, std::move(z));
 }

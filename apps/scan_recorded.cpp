@@ -63,11 +63,12 @@ void run_recorded(const io::ParamSet& p, Captured* capture) {
 
   std::vector<std::string> files;
   if (!prefix.empty())
-    files = write_images(prefix, {{"deflection", "Deflection (recorded)", &result.deflection},
-                                  {"tilt_free", "Deflection, first harmonic removed", &result.tilt_free}});
+    files = stage_images(prefix, {{"deflection", "Deflection (recorded)", &result.deflection},
+                                  {"tilt_free", "Deflection, first harmonic removed", &result.tilt_free}},
+                         out.outputs());
   std::size_t n_points = 0;
   if (points) {
-    n_points = points->write(points_path);
+    n_points = points->stage(points_path, out.outputs());
     files.push_back(points_path);
   }
   const scan::RecordedSurvey& s = result.survey;
@@ -87,7 +88,7 @@ void run_recorded(const io::ParamSet& p, Captured* capture) {
       {"units", {{"samples", "count"}, {"turns", "count"}, {"dropped_samples", "count"}, {"sample_rate", "Hz"},
                  {"spindle_frequency", "Hz"}, {"max_radius", "m"}, {"max_pitch", "m"}, {"valid_pixels", "count"},
                  {"filter_skipped_samples", "count"}, {"point_cloud_points", "count"}}}};
-  if (series) series->commit(io::make_sidecar("scan (recorded, time series)", p, results));
+  if (series) series->stage(io::make_sidecar("scan (recorded, time series)", p, results), out.outputs());
   out.finish(results, fmt::format("afmkit scan (recorded {}): {} samples, {} turns at {} spindle, {} sampling, "
                                   "radius up to {}; {} samples dropped outside the index pulses{}",
                                   path, s.samples, result.turns,

@@ -93,6 +93,7 @@ void register_study(CLI::App& app) {
         p.group("Run (each overrides the file's [run] table)")
             .file("store", "", "Zarr store the results go to; an existing store of the same study is resumed "
                                "(only chunks not finished are computed), one of another study is refused")
+            .writes([](const std::string& store) { return std::vector<io::WrittenPath>{{store, true}}; })
             .default_text("the file's [run] store, else out/<name>.zarr")
             .text("scheduler", "local",
                   "where the chunks are computed: serial (this process), local (a Dask cluster of one worker process "
@@ -107,6 +108,7 @@ void register_study(CLI::App& app) {
             .integer("chunk_points", 1, "points per chunk, instead of chunk_seconds", 1, 1000000000)
             .default_text("from chunk_seconds")
             .file("netcdf", "", "also write the results to this NetCDF file when the study is complete")
+            .writes()
             .default_text("none")
             .flag("quiet", false, "no progress lines (otherwise one line per second on standard error)");
       },

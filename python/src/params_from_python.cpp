@@ -147,6 +147,7 @@ io::ParamSet params_from_python(const std::string& path, const std::string& name
     }
     p.set_value(key, value_from_python(name, *d, v));
   }
+  p.check_files();  // the keyword arguments came after resolve(): no output may replace an input
   return p;
 }
 

@@ -1,6 +1,13 @@
 #include "afmkit/io/output.hpp"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -25,10 +32,14 @@ constexpr std::size_t flush_threshold = 1 << 16;  // bytes buffered before a wri
 
 // Temporaries being written, for the signal handler (SIGINT, SIGTERM, SIGHUP): fixed slots of fixed-size names so
 // that the handler only reads them and calls unlink (async-signal-safe). Process-wide by nature: a signal is.
-constexpr int temporary_slots = 32;
+// While a set of outputs is being moved into place (commits_running > 0) the handler only notes the signal; the
+// commit delivers it when the set is in place.
+constexpr int temporary_slots = 64;
 constexpr std::size_t temporary_name_size = 4096;
 std::atomic<bool> slot_used[temporary_slots];
 char slot_name[temporary_slots][temporary_name_size];
+std::atomic<int> commits_running{0};
+std::atomic<int> pending_signal{0};
 
 int register_temporary(const std::string& name) {
   if (name.size() >= temporary_name_size) return -1;
@@ -40,7 +51,7 @@ int register_temporary(const std::string& name) {
       return i;
     }
   }
-  return -1;  // more than 32 outputs open at once: not cleaned on a signal (still removed on normal exit paths)
+  return -1;  // more than 64 outputs open at once: not cleaned on a signal (a later run removes them)
 }
 
 void release_temporary(int slot) {
@@ -48,10 +59,70 @@ void release_temporary(int slot) {
 }
 
 extern "C" void remove_temporaries_and_reraise(int signal_number) {
+  if (commits_running.load() > 0) {  // a set is being moved into place: it completes first
+    pending_signal.store(signal_number);
+    return;
+  }
   for (int i = 0; i < temporary_slots; ++i)
     if (slot_used[i].load()) ::unlink(slot_name[i]);
   std::signal(signal_number, SIG_DFL);
   std::raise(signal_number);
+}
+
+/// SIGINT, SIGTERM and SIGHUP held back in this thread, and noted rather than acted on in the others, for the
+/// lifetime of the guard; a signal that came meanwhile is delivered when it ends.
+class CommitGuard {
+ public:
+  CommitGuard() {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, s);
+    pthread_sigmask(SIG_BLOCK, &set, &old_);
+    ++commits_running;
+  }
+  ~CommitGuard() {
+    if (--commits_running == 0)
+      if (const int s = pending_signal.exchange(0)) std::raise(s);
+    pthread_sigmask(SIG_SETMASK, &old_, nullptr);
+  }
+  CommitGuard(const CommitGuard&) = delete;
+  CommitGuard& operator=(const CommitGuard&) = delete;
+
+ private:
+  sigset_t old_;
+};
+
+std::string host_name() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0 || name[0] == '\0') return "host";
+  std::string host(name);
+  for (char& c : host)
+    if (c == '/' || static_cast<unsigned char>(c) < 0x20) c = '_';
+  return host;
+}
+
+/// Removes the temporaries of `target` left by afmkit processes of this host that no longer exist (killed by
+/// SIGKILL, or by a power cut): `<target>.tmp.<pid>.<host>.<tag>` and the older `<target>.tmp.<pid>`.
+void remove_stale_temporaries(const fs::path& target) {
+  std::error_code ec;
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const std::string prefix = target.filename().string() + ".tmp.";
+  static const std::string host = host_name();
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = name.substr(prefix.size());
+    std::size_t digits = 0;
+    while (digits < rest.size() && std::isdigit(static_cast<unsigned char>(rest[digits]))) ++digits;
+    if (digits == 0 || digits > 9) continue;
+    if (digits < rest.size()) {  // .<host>.<tag>: only this host's pids can be checked
+      const std::size_t tag = rest.rfind('.');
+      if (rest[digits] != '.' || tag <= digits || rest.substr(digits + 1, tag - digits - 1) != host) continue;
+    }
+    const long pid = std::stol(rest.substr(0, digits));
+    if (pid <= 0 || pid == ::getpid() || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    if (fs::is_regular_file(fs::symlink_status(it->path(), ec))) fs::remove(it->path(), ec);
+  }
 }
 
 void create_parent(const fs::path& p) {
@@ -65,6 +136,8 @@ void create_parent(const fs::path& p) {
 /// existing path that is not a regular file (device, FIFO, directory, socket) is refused.
 std::string output_target(const std::string& path) {
   if (path.empty()) throw InputError("output path is empty: give a file path");
+  if (path.find('\0') != std::string::npos)
+    throw InputError("output path holds a NUL character: a path cannot contain one");
   std::error_code ec;
   fs::path p(path);
   for (int hops = 0; fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
@@ -79,62 +152,151 @@ std::string output_target(const std::string& path) {
   return p.string();
 }
 
-std::string temporary_name(const std::string& target) { return fmt::format("{}.tmp.{}", target, ::getpid()); }
-
-void move_into_place(const std::string& from, const std::string& to) {
-  std::error_code ec;
-  fs::rename(from, to, ec);
-  if (ec) {
-    fs::remove(from, ec);
-    throw InputError(fmt::format("cannot move output into place at '{}'", to));
-  }
+/// Why writing failed, in words: the C library's reason, and for a full disk or a read-only file system the remedy.
+std::string reason(int error) {
+  if (error == ENOSPC || error == EDQUOT)
+    return fmt::format("{} (free space, or write to another disk)", std::strerror(error));
+  if (error == EROFS) return fmt::format("{} (write to a writable folder)", std::strerror(error));
+  return std::strerror(error == 0 ? EIO : error);
 }
 
-/// Flushes, syncs to disk and closes `file`; false on any failure.
-bool sync_and_close(std::FILE* file) {
-  bool ok = std::fflush(file) == 0;
-  ok = ::fsync(::fileno(file)) == 0 && ok;
-  return std::fclose(file) == 0 && ok;
-}
-
-/// A complete temporary file next to its target, registered for removal on a signal until released.
-struct Temporary {
-  std::string target, name;
-  int slot = -1;
-  void remove() noexcept {
-    std::error_code ec;
-    fs::remove(name, ec);
-    release_temporary(slot);
-    slot = -1;
-  }
-  void move_into_place() {
-    ::afmkit::io::move_into_place(name, target);
-    release_temporary(slot);
-    slot = -1;
-  }
-};
-
-/// Writes `content` to a synced temporary file next to the target of `path`.
-Temporary write_temporary(const std::string& path, const std::string& content) {
-  Temporary t;
-  t.target = output_target(path);
-  create_parent(fs::path(t.target));
-  t.name = temporary_name(t.target);
-  t.slot = register_temporary(t.name);
-  std::FILE* f = std::fopen(t.name.c_str(), "wb");
+/// Creates the unique temporary of `target` (mode 0666 less the umask, as a file created by fopen); returns the
+/// open stream and sets `name`. InputError naming `path` on failure.
+std::FILE* open_temporary(const std::string& path, const std::string& target, std::string& name, int& slot) {
+  create_parent(fs::path(target));
+  remove_stale_temporaries(fs::path(target));
+  static const std::string host = host_name();
+  std::string pattern = fmt::format("{}.tmp.{}.{}.XXXXXX", target, ::getpid(), host);
+  const int fd = ::mkstemp(pattern.data());
+  if (fd < 0) throw InputError(fmt::format("cannot write output file '{}': {}", path, reason(errno)));
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  ::fchmod(fd, 0666 & ~mask);
+  name = pattern;
+  slot = register_temporary(name);
+  std::FILE* f = ::fdopen(fd, "wb");
   if (!f) {
-    release_temporary(t.slot);
-    throw InputError(fmt::format("cannot write output file '{}': {}", path, std::strerror(errno)));
+    const int error = errno;
+    ::close(fd);
+    ::unlink(name.c_str());
+    release_temporary(slot);
+    throw InputError(fmt::format("cannot write output file '{}': {}", path, reason(error)));
   }
-  const bool written = std::fwrite(content.data(), 1, content.size(), f) == content.size();
-  if (!sync_and_close(f) || !written) {
-    t.remove();
-    throw InputError(fmt::format("error while writing output file '{}'", path));
+  return f;
+}
+
+/// Flushes, syncs to disk and closes `file`; 0, or the errno of the first failure.
+int sync_and_close(std::FILE* file) {
+  int error = 0;
+  if (std::fflush(file) != 0) error = errno;
+  if (::fsync(::fileno(file)) != 0 && error == 0 && errno != EINVAL) error = errno;
+  if (std::fclose(file) != 0 && error == 0) error = errno;
+  return error;
+}
+
+void remove_staged(OutputSet::Staged& s) noexcept {
+  ::unlink(s.temporary.c_str());
+  release_temporary(s.slot);
+  s.slot = -1;
+}
+
+/// Writes `content` to a synced temporary next to the target of `path`.
+OutputSet::Staged write_temporary(const std::string& path, const std::string& content) {
+  OutputSet::Staged t;
+  t.path = path;
+  t.target = output_target(path);
+  std::FILE* f = open_temporary(path, t.target, t.temporary, t.slot);
+  int error = std::fwrite(content.data(), 1, content.size(), f) == content.size() ? 0 : errno;
+  const int closed = sync_and_close(f);
+  if (error == 0) error = closed;
+  if (error != 0) {
+    remove_staged(t);
+    throw InputError(fmt::format("error while writing output file '{}': {}", path, reason(error)));
   }
   return t;
 }
 
+/// The folders of `staged`, each opened and locked (flock, exclusive) in name order, unlocked at destruction: two
+/// afmkit processes (or threads) committing into the same folder take turns. A file system without locks: no lock.
+class FolderLocks {
+ public:
+  explicit FolderLocks(const std::vector<OutputSet::Staged>& staged) {
+    std::vector<std::string> folders;
+    for (const auto& s : staged) {
+      const fs::path p(s.target);
+      folders.push_back(p.has_parent_path() ? p.parent_path().string() : ".");
+    }
+    std::sort(folders.begin(), folders.end());
+    folders.erase(std::unique(folders.begin(), folders.end()), folders.end());
+    for (const std::string& f : folders) {
+      const int fd = ::open(f.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+      if (fd < 0) continue;
+      while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+      }
+      fds_.push_back(fd);
+    }
+  }
+  ~FolderLocks() {
+    for (int fd : fds_) ::close(fd);  // closing releases the lock
+  }
+  FolderLocks(const FolderLocks&) = delete;
+  FolderLocks& operator=(const FolderLocks&) = delete;
+
+ private:
+  std::vector<int> fds_;
+};
+
 }  // namespace
+
+OutputSet::~OutputSet() { discard(); }
+
+void OutputSet::discard() noexcept {
+  for (Staged& s : staged_) remove_staged(s);
+  staged_.clear();
+}
+
+void OutputSet::add(const std::string& path, const std::string& content) {
+  staged_.push_back(write_temporary(path, content));
+}
+
+void OutputSet::commit() {
+  if (staged_.empty()) return;
+  std::vector<std::string> backups(staged_.size());  // hard links to the files replaced, to put them back
+  std::size_t moved = 0;
+  int error = 0;
+  {
+    FolderLocks locks(staged_);
+    CommitGuard guard;  // all in place, or none, before a signal is acted on
+    for (std::size_t i = 0; i < staged_.size(); ++i) {
+      const Staged& s = staged_[i];
+      const std::string backup = s.temporary + "-old";
+      if (::link(s.target.c_str(), backup.c_str()) == 0) backups[i] = backup;
+    }
+    for (; moved < staged_.size(); ++moved)
+      if (::rename(staged_[moved].temporary.c_str(), staged_[moved].target.c_str()) != 0) {
+        error = errno;
+        break;
+      }
+    if (error != 0) {
+      for (std::size_t i = moved; i-- > 0;) {  // the files moved so far: the old file back, or none
+        if (!backups[i].empty()) ::rename(backups[i].c_str(), staged_[i].target.c_str()), backups[i].clear();
+        else ::unlink(staged_[i].target.c_str());
+      }
+    }
+    for (const std::string& b : backups)
+      if (!b.empty()) ::unlink(b.c_str());
+    for (std::size_t i = 0; i < moved; ++i) {
+      release_temporary(staged_[i].slot);
+      staged_[i].slot = -1;
+    }
+  }
+  if (error != 0) {
+    const std::string failed = staged_[moved].path;
+    discard();  // the temporaries not moved (those moved are gone: put back or removed above)
+    throw InputError(fmt::format("cannot move output into place at '{}': {}", failed, reason(error)));
+  }
+  staged_.clear();
+}
 
 void remove_temporaries_on_signal() {
   for (int s : {SIGINT, SIGTERM, SIGHUP}) std::signal(s, remove_temporaries_and_reraise);
@@ -168,14 +330,7 @@ TableWriter::TableWriter(std::string path, std::vector<Column> columns)
                                          c.name, path_));
   target_ = output_target(path_);
   output_target(path_ + ".json");  // refuse a bad sidecar path before any work
-  temporary_ = temporary_name(target_);
-  create_parent(fs::path(target_));
-  slot_ = register_temporary(temporary_);
-  file_ = std::fopen(temporary_.c_str(), "wb");
-  if (!file_) {
-    release_temporary(slot_);
-    throw InputError(fmt::format("cannot write output file '{}': {}", path_, std::strerror(errno)));
-  }
+  file_ = open_temporary(path_, target_, temporary_, slot_);
   for (std::size_t i = 0; i < columns_.size(); ++i) {
     if (i) buffer_.push_back(',');
     buffer_.append(std::string_view(columns_[i].name));
@@ -253,24 +408,30 @@ void TableWriter::end_row() {
 void TableWriter::flush() {
   if (!file_) throw std::logic_error("TableWriter: write after commit");
   if (buffer_.size() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
-    const std::string reason = std::strerror(errno);
+    const int error = errno;
     discard();
-    throw InputError(fmt::format("error while writing output file '{}': {}", path_, reason));
+    throw InputError(fmt::format("error while writing output file '{}': {}", path_, reason(error)));
   }
   buffer_.clear();
 }
 
 void TableWriter::commit(const nlohmann::json& sidecar) {
+  OutputSet set;
+  stage(sidecar, set);
+  set.commit();
+}
+
+void TableWriter::stage(const nlohmann::json& sidecar, OutputSet& set) {
   if (cells_in_row_) throw std::logic_error(fmt::format("TableWriter: unfinished row in '{}'", path_));
   flush();
-  const bool ok = sync_and_close(file_);
+  const int error = sync_and_close(file_);
   file_ = nullptr;
-  if (!ok) {
+  if (error != 0) {
     discard();
-    throw InputError(fmt::format("error while writing output file '{}'", path_));
+    throw InputError(fmt::format("error while writing output file '{}': {}", path_, reason(error)));
   }
-  // Both files are complete and synced on disk before either is moved into place.
-  Temporary meta;
+  // Both files are complete and synced on disk before either is moved into place (by the set, together).
+  OutputSet::Staged meta;
   try {
     nlohmann::json described = sidecar;
     described["columns"] = columns_json(columns_);
@@ -280,20 +441,15 @@ void TableWriter::commit(const nlohmann::json& sidecar) {
     throw;
   }
   committed_ = true;
-  try {
-    ::afmkit::io::move_into_place(temporary_, target_);
-  } catch (...) {
-    meta.remove();
-    release_temporary(slot_);
-    throw;
-  }
-  release_temporary(slot_);
+  set.adopt({path_, target_, temporary_, slot_});
   slot_ = -1;
-  meta.move_into_place();
+  set.adopt(std::move(meta));
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {
-  write_temporary(path, content).move_into_place();
+  OutputSet set;
+  set.add(path, content);
+  set.commit();
 }
 
 nlohmann::json make_sidecar(const std::string& command, const nlohmann::json& parameters,

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -14,6 +15,7 @@
 #include <toml++/toml.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/input_file.hpp"
 #include "afmkit/io/number.hpp"
 
 namespace afmkit::io {
@@ -52,6 +54,69 @@ bool valid_utf8(const std::string& text) {
     p += extra + 1;
   }
   return true;
+}
+
+/// Refuses TOML nested deeper than `max_toml_nesting` levels before toml++ parses it: its parser and its tables
+/// recurse once per level of a table header or dotted key (`[a.b.c…]`, `a.b.c… = 1`), so thousands of levels
+/// overflow the stack. Counts, outside strings and comments, the open arrays and inline tables plus the parts of the
+/// key being read (a table header's or a key's dots); afmkit's parameter files are flat (one level).
+constexpr int max_toml_nesting = 100;
+void check_toml_nesting(std::string_view text, const std::string& origin) {
+  std::vector<char> inside;  // the open arrays '[' and inline tables '{' of values
+  int key_parts = 0;         // parts of the key (or table header) being read
+  bool in_key = true, header = false;
+  long line = 1;
+  auto check = [&] {
+    if (static_cast<int>(inside.size()) + key_parts > max_toml_nesting)
+      throw InputError(fmt::format("{}:{}: TOML nested deeper than {} levels (tables, dotted keys, arrays, inline "
+                                   "tables): a parameter file has one level of keys",
+                                   origin, line, max_toml_nesting));
+  };
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+      if (inside.empty()) in_key = true, header = false, key_parts = 0;
+      continue;
+    }
+    if (c == '#') {  // a comment runs to the end of the line
+      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+      continue;
+    }
+    if (c == '"' || c == '\'') {  // a string or quoted key, skipped whole (escapes in basic strings)
+      const std::string_view triple = c == '"' ? R"(""")" : "'''";
+      const std::string_view close = text.substr(i, 3) == triple ? triple : text.substr(i, 1);
+      i += close.size();
+      while (i < text.size() && text.substr(i, close.size()) != close) {
+        if (text[i] == '\n') ++line;
+        if (c == '"' && text[i] == '\\') ++i;
+        ++i;
+      }
+      i += close.size() - 1;
+      if (in_key && key_parts == 0) key_parts = 1;
+      continue;
+    }
+    if (in_key) {
+      if (c == '[' && key_parts == 0 && !header && inside.empty()) {
+        header = true;  // [table] or [[array of tables]]
+        continue;
+      }
+      if (c == '.') ++key_parts;
+      else if (key_parts == 0 && c != ' ' && c != '\t' && c != '\r' && c != '[' && c != ']' && c != '=') key_parts = 1;
+      if (c == '=' || (header && c == ']')) in_key = false;
+      check();
+      continue;
+    }
+    if (c == '[' || c == '{') {
+      inside.push_back(c);
+      if (c == '{') in_key = true, key_parts = 0;  // an inline table's keys
+      check();
+    } else if ((c == ']' || c == '}') && !inside.empty()) {
+      inside.pop_back();
+    } else if (c == ',' && !inside.empty() && inside.back() == '{') {
+      in_key = true, key_parts = 0;
+    }
+  }
 }
 }  // namespace
 
@@ -241,6 +306,9 @@ void ParamSet::check(const std::string& key, const Entry& e, const std::string& 
             throw InvalidParameter(key, fmt::format("{}{}{} = {} is out of range: must be an integer in [{}, {}]",
                                                     origin, origin.empty() ? "" : ": ", key, v, e.ilo, e.ihi));
         } else if constexpr (std::is_same_v<T, std::string>) {
+          if (e.is_file && v.find('\0') != std::string::npos)  // the C library would cut the path there
+            throw InvalidParameter(key, fmt::format("{}{}{} holds a NUL character (\\0): a path cannot contain one",
+                                                    origin, origin.empty() ? "" : ": ", key));
           if (!e.choices.empty() && std::find(e.choices.begin(), e.choices.end(), v) == e.choices.end())
             throw InvalidParameter(key, fmt::format("{}{}{} = '{}' is not allowed: must be one of {}", origin,
                                                     origin.empty() ? "" : ": ", key, v, fmt::join(e.choices, ", ")));
@@ -338,6 +406,7 @@ void ParamSet::set_default(const std::string& key, const std::string& text) {
 }
 
 void ParamSet::load_toml_text(const std::string& text, const std::string& origin) {
+  check_toml_nesting(text, origin);
   toml::table tbl;
   try {
     tbl = toml::parse(text, origin);
@@ -400,20 +469,17 @@ void ParamSet::load_toml_text(const std::string& text, const std::string& origin
 
 void ParamSet::resolve() {
   if (!config_path_.empty()) {
-    std::error_code ec;
-    if (std::filesystem::exists(config_path_, ec) && !std::filesystem::is_regular_file(config_path_, ec))
-      throw InputError(fmt::format("--config: '{}' is not a regular file (a TOML file is expected)", config_path_));
-    std::ifstream in(config_path_);
-    if (!in) throw InputError(fmt::format("--config: cannot open file '{}'", config_path_));
-    std::stringstream buf;
-    buf << in.rdbuf();
-    load_toml_text(buf.str(), config_path_);
+    if (config_path_.find('\0') != std::string::npos)
+      throw InvalidParameter("config", "config holds a NUL character (\\0): a path cannot contain one");
+    constexpr std::uintmax_t max_config_bytes = 16u << 20;  // a parameter file, not data
+    load_toml_text(files::read_input_file(config_path_, "--config file", max_config_bytes), config_path_);
   }
   for (const auto& key : order_) {
     Entry& e = entries_[key];
     if (e.cli_text) set_from_string(key, *e.cli_text);
   }
   for (const auto& key : order_) check(key, entries_.at(key), "");
+  check_files();
 }
 
 const ParamSet::Entry& ParamSet::entry(const std::string& key) const {

@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/input_file.hpp"
 #include "afmkit/io/output.hpp"
 
 namespace afmkit::io {
@@ -27,9 +28,13 @@ static_assert(std::endian::native == std::endian::little, "Zarr chunks are writt
 
 /// Whether `dir` is a store afmkit wrote (root .zattrs carrying afmkit_study_format).
 bool is_afmkit_store(const fs::path& dir) {
-  std::ifstream in(dir / ".zattrs");
-  if (!in) return false;
-  const nlohmann::json attrs = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  std::string text;
+  try {  // a FIFO or a huge file there is not an afmkit store's attributes
+    text = files::read_input_file((dir / ".zattrs").string(), "store attributes", 16u << 20);
+  } catch (const InputError&) {
+    return false;
+  }
+  const nlohmann::json attrs = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
   return attrs.is_object() && attrs.contains("afmkit_study_format");
 }
 
@@ -61,6 +66,28 @@ class SignalsHeld {
  private:
   sigset_t old_;
 };
+
+/// Cleans up after an earlier commit to `target` by a process that no longer exists (killed by SIGKILL, a power
+/// cut): its new store's folder `.<name>.tmp.<pid>` is removed, and its moved-aside old store `.<name>.old.<pid>` is
+/// put back when the target is missing (else removed).
+void remove_stale_commits(const fs::path& target) {
+  std::error_code ec;
+  const std::string name = target.filename().string();
+  for (const char* kind : {".tmp.", ".old."}) {
+    const std::string prefix = "." + name + kind;
+    for (fs::directory_iterator it(target.parent_path(), ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string entry = it->path().filename().string();
+      if (entry.size() <= prefix.size() || entry.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string digits = entry.substr(prefix.size());
+      if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      const long pid = std::stol(digits);
+      if (pid <= 0 || pid == ::getpid() || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+      std::error_code ignored;
+      if (std::string(kind) == ".old." && !fs::exists(target, ignored)) fs::rename(it->path(), target, ignored);
+      else fs::remove_all(it->path(), ignored);
+    }
+  }
+}
 
 nlohmann::json zarray_json(const std::vector<std::size_t>& shape, const std::vector<std::size_t>& chunks,
                            const std::string& dtype, nlohmann::json fill) {
@@ -153,6 +180,7 @@ void ZarrStoreWriter::commit() {
   const fs::path tmp = target.parent_path() / fmt::format(".{}.tmp.{}", target.filename().string(), ::getpid());
   const fs::path old = target.parent_path() / fmt::format(".{}.old.{}", target.filename().string(), ::getpid());
   SignalsHeld held;  // complete or absent: an interrupt is delivered once the store is in place
+  remove_stale_commits(target);
   try {
     fs::remove_all(tmp);
     fs::create_directory(tmp);

@@ -7,27 +7,12 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/input_file.hpp"
 
 namespace afmkit::scan::detail {
 
 std::string read_file_bytes(const std::string& path, std::string_view format, std::uintmax_t max_bytes) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) throw InputError(fmt::format("cannot read {} file '{}': no such file", format, path));
-  if (!fs::is_regular_file(st))
-    throw InputError(fmt::format("{} file '{}' is not a regular file (a directory, FIFO or device)", format, path));
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) throw InputError(fmt::format("cannot read {} file '{}': {}", format, path, ec.message()));
-  if (size > max_bytes)
-    throw InputError(fmt::format("{} file '{}' has {} bytes, more than the {} bytes allowed", format, path, size,
-                                 max_bytes));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(fmt::format("cannot open {} file '{}'", format, path));
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (in.bad()) throw InputError(fmt::format("cannot read {} file '{}'", format, path));
-  return std::move(bytes).str();
+  return files::read_input_file(path, fmt::format("{} file", format), max_bytes);
 }
 
 std::string shown(std::string_view text) {

@@ -106,9 +106,13 @@ std::string format_gsf(const HeightMap& map, const std::string& title) {
   for (std::size_t k = 0; k < map.size(); ++k) {
     const double v = map.data()[k];
     if (!std::isfinite(v)) continue;
-    if (std::fabs(v) > float_max)
-      throw InvalidParameter("data", fmt::format("data[{}] = {} is beyond the float32 range of a GSF file (|z| <= {})",
-                                                 k, v, float_max));
+    if (std::fabs(v) > float_max) {
+      const auto columns = static_cast<std::size_t>(map.x_resolution());
+      throw InvalidParameter("data", fmt::format("{}the value {} {} at pixel (column {}, row {}) is beyond the float32 "
+                                                 "range of a GSF file (|z| <= {:.4g})",
+                                                 title.empty() ? "" : fmt::format("{}: ", title), v, map.z_unit(),
+                                                 k % columns, k / columns, float_max));
+    }
     ++n;
     mean += (v - mean) / static_cast<double>(n);
   }
@@ -137,13 +141,15 @@ std::string gsf_mask_path(const std::string& path) {
 std::vector<std::string> write_gsf(const std::string& path, const HeightMap& map, const std::string& title) {
   std::string data = format_gsf(map, title);
   std::string mask = map.has_mask() ? format_gsf_mask(map, title) : std::string();
-  io::write_file_atomic(path, data);
+  io::OutputSet set;  // the field and its mask: both or neither
+  set.add(path, data);
   std::vector<std::string> written{path};
   if (map.has_mask()) {
     const std::string mask_path = gsf_mask_path(path);
-    io::write_file_atomic(mask_path, mask);
+    set.add(mask_path, mask);
     written.push_back(mask_path);
   }
+  set.commit();
   return written;
 }
 

@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/input_file.hpp"
 #include "afmkit/io/number.hpp"
 #include "file_bytes.hpp"
 
@@ -393,15 +394,7 @@ struct RecordedSpiralReader::State {
 };
 
 RecordedSpiralReader::RecordedSpiralReader(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) throw InputError(fmt::format("{}: cannot read the recorded spiral: no such file", path));
-  if (fs::is_directory(st)) throw InputError(fmt::format("{}: is a directory, not a recorded spiral CSV", path));
-  auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
-  if (!*file)
-    throw InputError(fmt::format("{}: cannot open the recorded spiral: {}", path, std::strerror(errno)));
-  *this = RecordedSpiralReader(std::move(file), path);
+  *this = RecordedSpiralReader(files::open_input_file(path, "recorded spiral"), path);
 }
 
 RecordedSpiralReader::RecordedSpiralReader(std::unique_ptr<std::istream> in, std::string origin)

@@ -219,7 +219,7 @@ TEST(ForceCurveParse, MissingFileIsAnInputErrorNamingIt) {
     read_force_curve("/nonexistent/curve.csv");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("cannot open file '/nonexistent/curve.csv'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cannot open force curve '/nonexistent/curve.csv': No such file or directory"), std::string::npos) << e.what();
   }
 }
 

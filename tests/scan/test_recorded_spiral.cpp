@@ -392,12 +392,12 @@ TEST(RecordedSpiral, FilesByPath) {
     RecordedSpiralReader missing(dir.file("none.csv"));
     ADD_FAILURE() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), dir.file("none.csv") + ": cannot read the recorded spiral: no such file");
+    EXPECT_EQ(std::string(e.what()), "cannot open recorded spiral '" + dir.file("none.csv") + "': No such file or directory");
   }
   try {
     RecordedSpiralReader folder(dir.path.string());
     ADD_FAILURE() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), dir.path.string() + ": is a directory, not a recorded spiral CSV");
+    EXPECT_EQ(std::string(e.what()), "recorded spiral '" + dir.path.string() + "' is a directory, not a regular file");
   }
 }

@@ -3,7 +3,10 @@
 // parameters, the afmkit version and summary results. Tables are streamed: each row is formatted into a small
 // buffer and appended to a temporary file next to the target; commit() renames it into place (atomic), so a
 // failed or interrupted run never leaves a half-written output and memory stays bounded by a buffer, not the
-// file. Every column has a unit and a description, listed in the sidecar's "columns" array (docs/units.md).
+// file. Each writer has its own temporary, `<target>.tmp.<pid>.<host>.<random>` (unique per writer: threads and
+// processes writing the same output never share one; a later run on the same host removes those of a process
+// that no longer exists, e.g. one killed by SIGKILL). Several files of one result (a table and its sidecar, the
+// images of a scan) are committed as a set (OutputSet): all of them or none. Every column has a unit and a description, listed in the sidecar's "columns" array (docs/units.md).
 // Undefined values: `nan` in CSV, `null` in JSON; infinite values: `inf`/`-inf` in CSV, "inf"/"-inf" in JSON
 // (docs/conventions.md#undefined-values).
 #include <cstdio>
@@ -35,6 +38,37 @@ nlohmann::json finite_json(nlohmann::json value);
 /// `finite_json(value)` as indented text (what sidecars and `--json` print).
 std::string json_text(const nlohmann::json& value);
 
+/// Files committed together: each is written completely to its own temporary beside its target first (add, or a
+/// TableWriter's stage), then commit() moves them all into place with SIGINT/SIGTERM/SIGHUP held back and the
+/// target folders locked against other afmkit processes committing there (flock), so that two runs writing the
+/// same outputs leave the files of one run, never a mix; if a move fails, the files already moved are put back
+/// (the old file, or none) and InputError says why. Temporaries not committed are removed at destruction.
+class OutputSet {
+ public:
+  OutputSet() = default;
+  ~OutputSet();
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+
+  /// Writes `content` to a temporary for `path` now (a symbolic link is followed; a path that exists and is not a
+  /// regular file is refused). InputError naming the file and the reason on failure.
+  void add(const std::string& path, const std::string& content);
+  /// Moves every file added into place (see above); the set is empty afterwards.
+  void commit();
+  std::size_t size() const { return staged_.size(); }
+
+  struct Staged {  // (public for the writer in output.cpp; not an interface)
+    std::string path, target, temporary;
+    int slot = -1;
+  };
+  /// Takes a complete temporary written by a writer of output.cpp.
+  void adopt(Staged staged) { staged_.push_back(std::move(staged)); }
+
+ private:
+  std::vector<Staged> staged_;
+  void discard() noexcept;
+};
+
 /// Streams a column-named CSV table to `path` atomically. Cells are numbers (shortest round-trip text),
 /// integers, strings or booleans (0/1); a string holding a comma, a double quote or a line break is quoted as in
 /// RFC 4180 ("a,b" -> "\"a,b\"", a quote doubled). Usage:
@@ -44,7 +78,7 @@ std::string json_text(const nlohmann::json& value);
 /// A writer destroyed without commit() removes its temporary file.
 class TableWriter {
  public:
-  /// Opens `<path>.tmp.<pid>` (creating parent folders). Throws afmkit::InputError when that is impossible, and
+  /// Opens its own temporary beside `path` (creating parent folders). Throws afmkit::InputError when that is impossible, and
   /// std::logic_error when a column has an empty name, unit or description (a programming error).
   TableWriter(std::string path, std::vector<Column> columns);
   ~TableWriter();
@@ -71,6 +105,9 @@ class TableWriter {
   /// Flushes, renames the table into place and writes `<path>.json` (atomically): `sidecar` with the "columns"
   /// array added. Throws InputError on an I/O failure (nothing is left behind then).
   void commit(const nlohmann::json& sidecar);
+  /// The same, but the table and its sidecar join `set`, moved into place by set.commit() with the other files
+  /// of the result.
+  void stage(const nlohmann::json& sidecar, OutputSet& set);
 
   const std::vector<Column>& columns() const& { return columns_; }
   std::vector<Column> columns() const&& { return columns_; }
@@ -96,8 +133,9 @@ class TableWriter {
 };
 
 /// Write `content` to `path` atomically; creates parent directories. Throws afmkit::InputError on failure.
-/// Outputs (tables, sidecars, files): written to `<target>.tmp.<pid>`, synced, then renamed; a symbolic link is
-/// followed (its target is replaced); a path that exists but is not a regular file is refused (InputError).
+/// Outputs (tables, sidecars, files): written to their own temporary, synced, then renamed; a symbolic link is
+/// followed (its target is replaced); a path that exists but is not a regular file is refused (InputError). The
+/// reason of a failure is named ("No space left on device", "Read-only file system").
 void write_file_atomic(const std::string& path, const std::string& content);
 
 /// Refuses, before anything is computed and without creating anything, an output that could not be created in the

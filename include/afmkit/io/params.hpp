@@ -4,6 +4,7 @@
 //   TOML key  `quality_factor = 400`      <->  flag `--quality-factor 400`
 // Unknown TOML keys, malformed TOML, a missing file, a wrong type or a value out of range raise
 // afmkit::InputError / afmkit::InvalidParameter naming the key (or file) and the allowed range.
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -31,6 +32,16 @@ struct Range {
   std::string describe() const;
   bool contains(double v) const;
 };
+
+/// What an output parameter's value writes (ParamSet::writes): a file, or a folder whose whole content counts as
+/// written (a store replaced as a whole).
+struct WrittenPath {
+  std::string path;
+  bool folder = false;
+};
+using WrittenPaths = std::function<std::vector<WrittenPath>(const std::string& value)>;
+/// A table's files: `path` and its sidecar `<path>.json` (io::TableWriter).
+std::vector<WrittenPath> table_and_sidecar(const std::string& path);
 
 class ParamSet {
  public:
@@ -63,6 +74,15 @@ class ParamSet {
   /// The last declared text or file parameter may also be given as the command's first positional argument
   /// (`afmkit study run FILE`); the flag and TOML key stay.
   ParamSet& positional();
+  /// The last declared file parameter is written (an output), not read; `paths` lists what a value writes (default:
+  /// the file itself). Every other file parameter, and --config, is read. See check_files().
+  ParamSet& writes(WrittenPaths paths = {});
+  /// Refuses, before anything is computed, an output that would replace an input or another output: every path an
+  /// output writes is compared with every input (the same file through a symbolic or hard link: st_dev/st_ino; a
+  /// path that does not exist yet: by canonical path; inside a written folder) and with the other outputs.
+  /// InvalidParameter naming the output and the other parameter. resolve() calls it; a front end that sets values
+  /// after resolve() calls it again.
+  void check_files() const;
   const std::string& unit_of(const std::string& key) const&;
 
   /// Adds `--config FILE` and one `--<key-with-dashes>` option per parameter to `app`.
@@ -130,6 +150,8 @@ class ParamSet {
     std::string unit;                     // numbers only (docs/units.md)
     bool is_file = false;                 // a path: FILE in --help
     bool positional = false;              // also accepted as a positional argument
+    bool written = false;                 // a file parameter that is an output (writes())
+    WrittenPaths written_paths;           // what its value writes (empty: the file itself)
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;

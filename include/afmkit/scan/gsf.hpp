@@ -55,7 +55,7 @@ std::string format_gsf_mask(const HeightMap& map, const std::string& title = "")
 std::string gsf_mask_path(const std::string& path);
 
 /// Writes format_gsf(map, title) to `path` atomically and, when the map has a mask, format_gsf_mask to
-/// gsf_mask_path(path) (atomically too; the two files are renamed into place one after the other). Returns the
+/// gsf_mask_path(path) (the two committed as one set: both or neither, io::OutputSet). Returns the
 /// paths written. InputError on an I/O failure.
 std::vector<std::string> write_gsf(const std::string& path, const HeightMap& map, const std::string& title = "");
 

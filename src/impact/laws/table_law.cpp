@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/input_file.hpp"
 
 namespace afmkit::impact {
 
@@ -466,12 +467,7 @@ ForceCurve parse_force_curve(std::string_view text, const std::string& origin) {
 }
 
 ForceCurve read_force_curve(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(fmt::format("cannot open file '{}'", path));
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw InputError(fmt::format("cannot read file '{}'", path));
-  return parse_force_curve(buffer.str(), path);
+  return parse_force_curve(files::read_input_file(path, "force curve"), path);
 }
 
 // ---------------------------------------------------------------------------------------------------------------
