@@ -98,6 +98,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   tapping::OrbitSearchOptions options;
   options.shooting = shooting_options_from(p);
   options.transient = transient_options_from(p);
+  options.cancellation = cancellation_of(capture);
   const tapping::OrbitSearchResult r = tapping::find_orbits(model, options);
 
   nlohmann::json orbits = nlohmann::json::array();
