@@ -56,12 +56,20 @@ struct Filter {
   std::mutex mutex;
 };
 
-/// `self` of a method: refused when Python created the object without running __init__ (RealtimeFilter.__new__).
-Filter& checked(Filter* self) {
-  if (self == nullptr)
+/// `self` of a method. pybind11 hands a method of an object that Python created without running __init__
+/// (RealtimeFilter.__new__(RealtimeFilter), a subclass whose __init__ does not call the base one) uninitialised
+/// memory; such an object is refused here by the holder's flag before anything is read.
+Filter& checked(const py::object& self) {
+  const py::type type = py::type::of<Filter>();
+  if (!py::isinstance(self, type))
+    throw py::type_error("afmkit.control.RealtimeFilter method called on a " +
+                         std::string(py::str(py::type::of(self).attr("__name__"))));
+  auto* inst = reinterpret_cast<py::detail::instance*>(self.ptr());
+  py::detail::value_and_holder vh = inst->get_value_and_holder(py::detail::get_type_info(typeid(Filter)));
+  if (!vh || !vh.holder_constructed())
     throw py::type_error("afmkit.control.RealtimeFilter: this object was not initialised (created by __new__ without "
                          "__init__); create it as RealtimeFilter(rotation_frequency=..., sample_rate=..., ...)");
-  return *self;
+  return *vh.value_ptr<Filter>();  // constructed: the holder owns the value
 }
 
 /// Takes the filter's lock; when another thread holds it, waits with the GIL released (that thread may need it).
@@ -99,7 +107,7 @@ than the very same array) reads a copy of `measured` first, as NumPy does.
       .def(py::init([](const py::kwargs& kwargs) { return std::make_unique<Filter>(make_filter(kwargs)); }))
       .def(
           "step",
-          [](Filter* self, double measured) {
+          [](const py::object& self, double measured) {
             Filter& f = checked(self);
             const auto held = lock(f);
             return f.filter.step(measured);
@@ -107,7 +115,7 @@ than the very same array) reads a copy of `measured` first, as NumPy does.
           py::arg("measured"), "Output u_n for one measured sample m_n.")
       .def(
           "step_block",
-          [](Filter* self, const Array& measured, std::optional<py::array> out_arg) {
+          [](const py::object& self, const Array& measured, std::optional<py::array> out_arg) {
             Filter& f = checked(self);
             if (measured.ndim() != 1) throw py::value_error("step_block: measured must be a 1-D array");
             // `out` is used as given (never converted: a converted copy would silently take the results)
@@ -139,7 +147,7 @@ than the very same array) reads a copy of `measured` first, as NumPy does.
           "otherwise gets the outputs of the original samples).")
       .def(
           "reset",
-          [](Filter* self) {
+          [](const py::object& self) {
             Filter& f = checked(self);
             const auto held = lock(f);
             f.filter.reset();
@@ -147,7 +155,7 @@ than the very same array) reads a copy of `measured` first, as NumPy does.
           "Zero state and counters.")
       .def(
           "save_state",
-          [](Filter* self) {
+          [](const py::object& self) {
             Filter& f = checked(self);
             const auto held = lock(f);
             return py::array_t<double>(py::cast(f.filter.save_state()));
@@ -155,7 +163,7 @@ than the very same array) reads a copy of `measured` first, as NumPy does.
           "The whole state as a float64 array (restore_state takes it back).")
       .def(
           "restore_state",
-          [](Filter* self, const Array& state) {
+          [](const py::object& self, const Array& state) {
             Filter& f = checked(self);
             if (state.ndim() != 1) throw InvalidParameter("state", "state must be a 1-D array (from save_state)");
             const auto held = lock(f);
@@ -166,13 +174,13 @@ than the very same array) reads a copy of `measured` first, as NumPy does.
           "1e270) raises InvalidParameter and leaves the filter unchanged.")
       .def_property_readonly(
           "skipped_samples",
-          [](Filter* self) {
+          [](const py::object& self) {
             Filter& f = checked(self);
             const auto held = lock(f);
             return f.filter.skipped_samples();
           },
           "Samples skipped (NaN, inf or beyond input_limit).")
-      .def_property_readonly("uses_wide_vectors", [](Filter* self) { return checked(self).filter.uses_wide_vectors(); });
+      .def_property_readonly("uses_wide_vectors", [](const py::object& self) { return checked(self).filter.uses_wide_vectors(); });
 }
 
 }  // namespace afmkit::python
