@@ -131,6 +131,8 @@ def test_restore_state_refuses_a_state_no_filter_saved_and_keeps_its_own(index, 
     "afmkit.tapping.sweep(points=20000, separation_min=5, separation_max=25)",
     "afmkit.tapping.sweep(points=20, mode='continuation', max_continuation_points=200000, "
     "separation_min=10, separation_max=40, max_arclength_step=1e-4)",      # 20000 points take 5 s
+    "afmkit.scan(sample_rate=1e6)",                                           # about 30 s
+    "afmkit.tapping.hb(law='dmt', units='physical', points=3000000)",          # about 50 s
 ])
 def test_ctrl_c_stops_a_long_computation_within_a_second_with_keyboard_interrupt(call):
     code = f"""
