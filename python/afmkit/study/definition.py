@@ -9,6 +9,7 @@ import functools
 import hashlib
 import json
 import math
+import os
 import re
 import tomllib
 from dataclasses import dataclass, field
@@ -62,6 +63,8 @@ def require_memory(field_name: str, count: float, bytes_each: float) -> None:
 
 def read_toml(path) -> dict:
     """The TOML document of a study file; StudyError naming the file (and where it is wrong) otherwise."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise StudyError("file", f"study file = {path!r} is not allowed: must be a path (str or os.PathLike)")
     path = Path(path)
     try:
         data = path.read_bytes()
