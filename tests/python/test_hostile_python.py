@@ -361,3 +361,11 @@ def test_a_report_killed_outright_takes_its_workers_with_it(tmp_path):
     for p in left:  # do not leave them to the rest of the test run
         os.kill(p, signal.SIGKILL)
     assert left == [], "workers outlived the report process"
+
+
+def test_a_store_removed_while_the_study_runs_is_named_without_zarrs_template(tmp_path):
+    runner = sys.modules["afmkit.study.run"]
+    study = Study.make(axes={"quality_factor": [50.0, 100.0]}, **BASE)
+    with pytest.raises(StudyError, match="no longer a study store") as e:
+        runner.compute_chunk(str(tmp_path / "gone.zarr"), study.definition(), 0)
+    assert e.value.field == "store" and "%r" not in str(e.value)

@@ -134,7 +134,11 @@ def compute_chunk(store_path: str, definition: dict, index: int):
 
     study = Study.make(definition["computation"], {n: v for n, v in definition["axes"]}, definition["outputs"],
                        definition["parameters"])
-    root = zarr.open_group(store_path, mode="r+")
+    try:
+        root = zarr.open_group(store_path, mode="r+")
+    except ValueError as e:  # removed or replaced while the study runs (Zarr's own text can be a bare template)
+        raise StudyError("store", f"store '{store_path}' is no longer a study store ({type(e).__name__}): it was "
+                                  f"removed or replaced while the study ran") from None
     names = zstore.output_names(study.outputs)
     chunks = tuple(root[names[0]].chunks)
     slices = zstore.chunk_slices(study.shape, chunks, index)
