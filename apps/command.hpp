@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "afmkit/core/cancellation.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 
@@ -34,7 +35,13 @@ struct Captured {
   nlohmann::json results = nlohmann::json::object();
   std::vector<io::Column> columns;
   nlohmann::json rows = nlohmann::json::array();
+  /// Stop request of the caller (Python: Ctrl-C); the long computations check it once per point. The command line
+  /// has no capture and keeps its signal handling.
+  Cancellation cancellation;
 };
+
+/// The caller's stop request (empty on the command line).
+inline Cancellation cancellation_of(const Captured* capture) { return capture ? capture->cancellation : Cancellation{}; }
 
 using Declare = std::function<void(io::ParamSet&)>;
 /// Runs a command on resolved parameters; `capture` is nullptr on the command line.

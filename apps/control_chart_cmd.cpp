@@ -72,7 +72,7 @@ void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, co
   const control::MarginMap m =
       control::delay_margin_map(family, u.rate(win.x_min), u.rate(win.x_max), nx, u.rate(win.y_min), u.rate(win.y_max),
                                 ny, static_cast<int>(p.integer("threads")),
-                                [&progress](long n, long) { progress.advance(n); });
+                                [&progress](long n, long) { progress.advance(n); }, cancellation_of(capture));
   progress.finish();
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
@@ -143,6 +143,7 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
     spec.x_points = nx;
     spec.y_points = ny;
     spec.threads = static_cast<int>(p.integer("threads"));
+    spec.cancellation = cancellation_of(capture);
     const control::StabilityChart chart =
         control::stability_chart(spec, [&progress](long n, long) { progress.advance(n); });
     for (int j = 0; j < ny; ++j)

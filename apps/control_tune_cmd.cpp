@@ -53,6 +53,7 @@ void run_tune(const io::ParamSet& p, Captured* capture) {
   s.coarse_points = static_cast<int>(p.integer("coarse_points"));
   s.max_evaluations = static_cast<int>(p.integer("max_evaluations"));
   s.threads = static_cast<int>(p.integer("threads"));
+  s.cancellation = cancellation_of(capture);
   const io::ParamSet as_run = params_as_run(p, c, window_values(win));
   CommandOutput out(as_run, capture, "control tune");
   require_memory("coarse_points", static_cast<double>(s.coarse_points),

@@ -99,6 +99,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
     reported = done;
   };
   options.compare_without_control = instrument.controller.enabled;
+  options.cancellation = cancellation_of(capture);
   const scan::VirtualScan result = scan::run_virtual_scan(instrument, surface, grid, options);
   progress.finish();
 

@@ -50,6 +50,7 @@ void run_recorded(const io::ParamSet& p, Captured* capture) {
   std::int64_t reported = 0;
   scan::RecordedScanOptions options;
   options.extra = &chain;
+  options.cancellation = cancellation_of(capture);
   options.on_turn = [&](const scan::TurnRecord& r) {
     out.row(r.turn, r.radius, r.deflection_first_harmonic, r.surface_first_harmonic, r.samples);
   };

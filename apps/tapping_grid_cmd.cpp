@@ -50,7 +50,7 @@ std::string fingerprint(const std::string& text) {
   return fmt::format("tapping-grid-{:016x}", h);
 }
 
-void run_grid(const io::ParamSet& p, Captured*) {
+void run_grid(const io::ParamSet& p, Captured* capture) {
   const TappingScales scales = tapping_scales_from(p);
   const double lo = p.real("separation_min"), hi = p.real("separation_max");
   if (!(lo < hi))
@@ -69,6 +69,7 @@ void run_grid(const io::ParamSet& p, Captured*) {
   tapping::OrbitSearchOptions options;
   options.shooting = shooting_options_from(p);
   options.transient = transient_options_from(p);
+  options.cancellation = cancellation_of(capture);
   io::Progress progress("tapping grid", static_cast<long>(points), !p.flag("quiet"));
   const std::vector<tapping::OrbitSearchResult> results =
       tapping::sweep_grid(base, normalised, options, [&](long n) { progress.advance(n); });

@@ -48,6 +48,7 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
                                                    : tapping::HbCurveSpacing::RefinedGrazing;
   options.min_gap = p.real("min_gap");
   options.include_minus = p.flag("minus_branch");
+  options.cancellation = cancellation_of(capture);
   // The curve is held in memory (both branches: 2 points per q sample) before it is streamed out.
   memory::require_fits("points", static_cast<double>(options.points), 2.0 * sizeof(tapping::HbPoint));
   CommandOutput out(p, capture, "tapping hb");

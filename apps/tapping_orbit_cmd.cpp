@@ -120,6 +120,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   io::Progress progress("tapping orbit (transient drive periods, of at most)", 5L * options.transient.max_periods,
                         estimate > kProgressAfterSeconds && !p.flag("json"));
   options.transient.on_periods = [&progress](int n) { progress.advance(n); };
+  options.cancellation = cancellation_of(capture);
   const tapping::OrbitSearchResult r = tapping::find_orbits(model, options);
   progress.finish();
 

@@ -89,6 +89,7 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     options.shooting = shooting_options_from(p);
     options.transient = transient_options_from(p);
     options.progress = [&progress](long n) { progress.advance(n); };
+    options.cancellation = cancellation_of(capture);
     const tapping::SweepResult r = list.empty() ? tapping::sweep_instrument(base, l_min, l_max, points, options)
                                                 : tapping::sweep_instrument(base, list, options);
     progress.finish();
@@ -105,6 +106,7 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     options.max_step = p.real("max_arclength_step") / scales.length;
     options.initial_step = std::min(options.initial_step, options.max_step);
     options.max_points = static_cast<int>(p.integer("max_continuation_points"));
+    options.cancellation = cancellation_of(capture);
     const tapping::ContinuationResult c = tapping::sweep_continuation(base, l_min, l_max, options);
     write_rows(c.points);
     results["folds"] = scaled(c.folds, scales.length);

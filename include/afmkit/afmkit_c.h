@@ -121,7 +121,11 @@ AFMKIT_C_API size_t afmkit_filter_state_size(const afmkit_filter* filter);
 /* Copies the state into buffer[0 .. afmkit_filter_state_size()-1]. */
 AFMKIT_C_API int afmkit_filter_save_state(afmkit_filter* filter, double* buffer, size_t size);
 
-/* Restores a saved state; with the same parameters the future outputs are reproduced bit for bit. */
+/* Restores a saved state; with the same parameters the future outputs are reproduced bit for bit. A buffer that was
+ * not saved by a filter is refused with AFMKIT_INVALID_ARGUMENT and the filter is unchanged: wrong magic or version,
+ * sizes out of range, a non-finite entry, counters that are not whole numbers in 0 ... 2^64 - 1 (or more skipped than
+ * processed samples), a held output or coordinate larger in magnitude than 1e270 (no filter state fed with samples
+ * within the input limit gets there). */
 AFMKIT_C_API int afmkit_filter_restore_state(afmkit_filter* filter, const double* buffer, size_t size);
 
 /* Number of skipped (non-finite or out-of-range) samples since creation or reset (0 for a NULL or invalid handle). */

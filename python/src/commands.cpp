@@ -13,8 +13,10 @@
 #include <pybind11/stl.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/memory.hpp"
 #include "afmkit/io/params.hpp"
 #include "bindings.hpp"
+#include "interrupts.hpp"
 #include "command.hpp"
 #include "params_from_python.hpp"
 
@@ -99,10 +101,9 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   const CommandSpec& s = command_spec(path);
   const io::ParamSet p = params_from_python(path, name, kwargs);
   cli::Captured captured;
-  {
-    py::gil_scoped_release release;
-    s.run(p, &captured);
-  }
+  SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
+  captured.cancellation = interrupts.cancellation();
+  interrupts.run([&] { s.run(p, &captured); });
   py::dict out;
   out["results"] = json_to_python(captured.results);
   py::list columns;
@@ -135,6 +136,14 @@ void bind_commands(py::module_& m) {
         return out;
       },
       "Every command of the afmkit program: path, help and parameters (key, kind, default, unit, allowed range).");
+  m.def(
+      "require_memory",
+      [](const std::string& parameter, double value, double bytes_per_unit) {
+        memory::require_fits(parameter, value, bytes_per_unit);
+      },
+      py::arg("parameter"), py::arg("value"), py::arg("bytes_per_unit"),
+      "InvalidParameter naming `parameter` when value x bytes_per_unit exceeds the memory afmkit may use (half of "
+      "what is available, capped by AFMKIT_MEMORY_LIMIT), as the commands check their sizes.");
   m.def("run", &run, py::arg("path"), py::arg("kwargs"),
         "Runs one command with keyword arguments named as its TOML keys; returns results, columns, table, params.");
 }

@@ -27,6 +27,39 @@ std::vector<cli::CommandSpec> python_commands() {
   return out;
 }
 
+/// A Python str as UTF-8. A str that cannot be encoded (a lone surrogate, e.g. from a file name decoded with
+/// surrogateescape) is the caller's error: InvalidParameter naming `key` (ValueError), never a numerical failure.
+std::string utf8(const std::string& key, const py::handle& s) {
+  Py_ssize_t size = 0;
+  const char* data = PyUnicode_AsUTF8AndSize(s.ptr(), &size);
+  if (data == nullptr) {
+    std::string where;
+    if (PyErr_ExceptionMatches(PyExc_UnicodeEncodeError)) {
+      PyObject *type = nullptr, *value = nullptr, *traceback = nullptr;
+      PyErr_Fetch(&type, &value, &traceback);
+      Py_ssize_t start = 0;
+      if (value != nullptr && PyUnicodeEncodeError_GetStart(value, &start) == 0)
+        where = " (character " + std::to_string(start) + ")";
+      Py_XDECREF(type);
+      Py_XDECREF(value);
+      Py_XDECREF(traceback);
+    }
+    PyErr_Clear();
+    throw InvalidParameter(key, key + " is not valid Unicode text" + where +
+                                    ": a lone surrogate cannot be encoded as UTF-8; must be UTF-8 text");
+  }
+  return std::string(data, static_cast<std::size_t>(size));
+}
+
+/// A path argument: str (UTF-8, as utf8()), bytes (as given) or os.PathLike of either.
+std::string path_text(const std::string& key, const py::handle& obj) {
+  py::object v = py::reinterpret_borrow<py::object>(obj);
+  if (!py::isinstance<py::str>(v) && !py::isinstance<py::bytes>(v) && py::hasattr(v, "__fspath__"))
+    v = v.attr("__fspath__")();
+  if (py::isinstance<py::bytes>(v)) return v.cast<std::string>();
+  return utf8(key, v);
+}
+
 /// A Python value as the parameter's type; TypeError naming the parameter otherwise.
 io::ParamSet::Value value_from_python(const std::string& name, const io::ParamSet::Description& d,
                                       const py::handle& obj) {
@@ -41,9 +74,9 @@ io::ParamSet::Value value_from_python(const std::string& name, const io::ParamSe
     return py::bool_(py::reinterpret_borrow<py::object>(obj)).cast<bool>();
   }
   if (d.kind == "text" || d.kind == "file") {
-    if (d.kind == "file" && py::hasattr(obj, "__fspath__")) return py::str(obj.attr("__fspath__")()).cast<std::string>();
+    if (d.kind == "file" && py::hasattr(obj, "__fspath__")) return path_text(d.key, obj);
     if (!py::isinstance<py::str>(obj)) fail(d.kind == "file" ? "a path (str or os.PathLike)" : "a str");
-    return obj.cast<std::string>();
+    return utf8(d.key, obj);
   }
   auto number = [&](const py::handle& x) -> double {
     const bool b = py::isinstance<py::bool_>(x) ||
@@ -129,11 +162,12 @@ io::ParamSet params_from_python(const std::string& path, const std::string& name
     const py::object c = kwargs["config"];
     if (!py::isinstance<py::str>(c) && !py::hasattr(c, "__fspath__"))
       throw py::type_error(name + "(): config must be a path (str or os.PathLike) of a TOML file");
-    p.set_config_path(py::str(py::hasattr(c, "__fspath__") ? c.attr("__fspath__")() : c).cast<std::string>());
+    p.set_config_path(path_text("config", c));
   }
   p.resolve();  // the TOML file, if any; the keyword arguments come on top
   for (const auto& [k, v] : kwargs) {
-    const std::string key = py::str(k);
+    if (!py::isinstance<py::str>(k)) throw py::type_error(name + "(): keywords must be strings");
+    const std::string key = utf8("keyword", k);
     if (key == "config") continue;
     const io::ParamSet::Description* d = nullptr;
     for (const auto& x : described)

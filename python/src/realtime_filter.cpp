@@ -2,9 +2,12 @@
 // realtime_filter.hpp) on NumPy buffers. Keyword arguments are those of `afmkit control export` (the same filter
 // the C core runs): rotation_frequency [rad/s], harmonics, alpha and beta [Ω], gain [Ω], rejected, sample_rate
 // [samples/s], input_limit.
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -44,22 +47,76 @@ control::RealtimeFilter make_filter(const py::kwargs& kwargs) {
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
+/// The filter as Python holds it: the filter and a lock. Every method takes the lock, so a filter shared by threads
+/// is never corrupted (its outputs then follow the order in which the calls took the lock); step_block waits for
+/// it without the GIL.
+struct Filter {
+  explicit Filter(control::RealtimeFilter f) : filter(std::move(f)) {}
+  control::RealtimeFilter filter;
+  std::mutex mutex;
+};
+
+/// `self` of a method. pybind11 hands a method of an object that Python created without running __init__
+/// (RealtimeFilter.__new__(RealtimeFilter), a subclass whose __init__ does not call the base one) uninitialised
+/// memory; such an object is refused here by the holder's flag before anything is read.
+Filter& checked(const py::object& self) {
+  const py::type type = py::type::of<Filter>();
+  if (!py::isinstance(self, type))
+    throw py::type_error("afmkit.control.RealtimeFilter method called on a " +
+                         std::string(py::str(py::type::of(self).attr("__name__"))));
+  auto* inst = reinterpret_cast<py::detail::instance*>(self.ptr());
+  py::detail::value_and_holder vh = inst->get_value_and_holder(py::detail::get_type_info(typeid(Filter)));
+  if (!vh || !vh.holder_constructed())
+    throw py::type_error("afmkit.control.RealtimeFilter: this object was not initialised (created by __new__ without "
+                         "__init__); create it as RealtimeFilter(rotation_frequency=..., sample_rate=..., ...)");
+  return *vh.value_ptr<Filter>();  // constructed: the holder owns the value
+}
+
+/// Takes the filter's lock; when another thread holds it, waits with the GIL released (that thread may need it).
+std::unique_lock<std::mutex> lock(Filter& f) {
+  std::unique_lock<std::mutex> held(f.mutex, std::try_to_lock);
+  if (!held.owns_lock()) {
+    py::gil_scoped_release release;
+    held.lock();
+  }
+  return held;
+}
+
+/// Whether the byte ranges of two arrays overlap.
+bool overlap(const py::array& a, const py::array& b) {
+  const auto* a0 = static_cast<const char*>(a.data());
+  const auto* b0 = static_cast<const char*>(b.data());
+  return a.nbytes() > 0 && b.nbytes() > 0 && a0 < b0 + b.nbytes() && b0 < a0 + a.nbytes();
+}
+
 }  // namespace
 
 void bind_realtime_filter(py::module_& m) {
-  py::class_<control::RealtimeFilter>(m, "RealtimeFilter", R"doc(
+  py::class_<Filter>(m, "RealtimeFilter", R"doc(
 The real-time first-harmonic rejection filter: one output sample per measured sample, O(N) per sample, exact
 zero-order-hold discretisation of the oscillator bank (seed 2, eqs. 15 and 20). Keyword arguments as the TOML keys
 of `afmkit control export`: rotation_frequency [rad/s], harmonics N, alpha, beta, gain [units of Omega], rejected,
 sample_rate [samples/s] (required, > N*Omega/pi), input_limit. The output u is the control signal; in the loop
 the plant's input is u/K (K = gain*Omega), and the measured signal m loses its first harmonic while keeping the
 others (docs/embedding.md).
+
+Threads: every method takes the filter's lock, so a filter shared by threads stays consistent, but one filter is
+one signal: two streams need two filters. step_block(measured, out=...) with `out` overlapping `measured` (other
+than the very same array) reads a copy of `measured` first, as NumPy does.
 )doc")
-      .def(py::init([](const py::kwargs& kwargs) { return make_filter(kwargs); }))
-      .def("step", &control::RealtimeFilter::step, py::arg("measured"), "Output u_n for one measured sample m_n.")
+      .def(py::init([](const py::kwargs& kwargs) { return std::make_unique<Filter>(make_filter(kwargs)); }))
+      .def(
+          "step",
+          [](const py::object& self, double measured) {
+            Filter& f = checked(self);
+            const auto held = lock(f);
+            return f.filter.step(measured);
+          },
+          py::arg("measured"), "Output u_n for one measured sample m_n.")
       .def(
           "step_block",
-          [](control::RealtimeFilter& f, const Array& measured, std::optional<py::array> out_arg) {
+          [](const py::object& self, const Array& measured, std::optional<py::array> out_arg) {
+            Filter& f = checked(self);
             if (measured.ndim() != 1) throw py::value_error("step_block: measured must be a 1-D array");
             // `out` is used as given (never converted: a converted copy would silently take the results)
             py::array out = out_arg ? *out_arg : py::array_t<double>(measured.size());
@@ -67,29 +124,63 @@ others (docs/embedding.md).
                 !(out.flags() & py::array::c_style) || !out.writeable())
               throw py::value_error("step_block: out must be a writable contiguous float64 array of the same size "
                                     "as measured");
+            // The filter runs in place only on the very same memory; a partial overlap would overwrite samples
+            // before they are read, so the input is copied first (the result of step() on the original samples).
+            std::vector<double> copy;
+            const double* in = measured.data();
+            if (overlap(measured, out) && measured.data() != out.data()) {
+              copy.assign(in, in + measured.size());
+              in = copy.data();
+            }
             {
               py::gil_scoped_release release;
-              f.step_block(std::span<const double>(measured.data(), static_cast<std::size_t>(measured.size())),
-                           std::span<double>(static_cast<double*>(out.mutable_data()), static_cast<std::size_t>(out.size())));
+              const std::lock_guard<std::mutex> held(f.mutex);
+              f.filter.step_block(std::span<const double>(in, static_cast<std::size_t>(measured.size())),
+                                  std::span<double>(static_cast<double*>(out.mutable_data()),
+                                                    static_cast<std::size_t>(out.size())));
             }
             return out;
           },
           py::arg("measured"), py::arg("out") = py::none(),
           "step() for every sample of a 1-D array (vectorised, same bits as step()); returns the outputs (in `out` "
-          "when given: no allocation per block).")
-      .def("reset", &control::RealtimeFilter::reset, "Zero state and counters.")
+          "when given: no allocation per block; `out` may be `measured` itself, and an `out` that overlaps it "
+          "otherwise gets the outputs of the original samples).")
       .def(
-          "save_state", [](const control::RealtimeFilter& f) { return py::array_t<double>(py::cast(f.save_state())); },
+          "reset",
+          [](const py::object& self) {
+            Filter& f = checked(self);
+            const auto held = lock(f);
+            f.filter.reset();
+          },
+          "Zero state and counters.")
+      .def(
+          "save_state",
+          [](const py::object& self) {
+            Filter& f = checked(self);
+            const auto held = lock(f);
+            return py::array_t<double>(py::cast(f.filter.save_state()));
+          },
           "The whole state as a float64 array (restore_state takes it back).")
       .def(
           "restore_state",
-          [](control::RealtimeFilter& f, const Array& state) {
-            f.restore_state(std::span<const double>(state.data(), static_cast<std::size_t>(state.size())));
+          [](const py::object& self, const Array& state) {
+            Filter& f = checked(self);
+            if (state.ndim() != 1) throw InvalidParameter("state", "state must be a 1-D array (from save_state)");
+            const auto held = lock(f);
+            f.filter.restore_state(std::span<const double>(state.data(), static_cast<std::size_t>(state.size())));
           },
-          py::arg("state"))
-      .def_property_readonly("skipped_samples", &control::RealtimeFilter::skipped_samples,
-                             "Samples skipped (NaN, inf or beyond input_limit).")
-      .def_property_readonly("uses_wide_vectors", &control::RealtimeFilter::uses_wide_vectors);
+          py::arg("state"),
+          "Restores a state from save_state(); a buffer that no filter saved (sizes, counters, coordinates beyond "
+          "1e270) raises InvalidParameter and leaves the filter unchanged.")
+      .def_property_readonly(
+          "skipped_samples",
+          [](const py::object& self) {
+            Filter& f = checked(self);
+            const auto held = lock(f);
+            return f.filter.skipped_samples();
+          },
+          "Samples skipped (NaN, inf or beyond input_limit).")
+      .def_property_readonly("uses_wide_vectors", [](const py::object& self) { return checked(self).filter.uses_wide_vectors(); });
 }
 
 }  // namespace afmkit::python

@@ -21,6 +21,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/params.hpp"
 #include "bindings.hpp"
+#include "interrupts.hpp"
 #include "command.hpp"
 #include "params_from_python.hpp"
 
@@ -184,10 +185,11 @@ ChunkResult evaluate_points(const std::string& path, const py::dict& base, const
   out.outputs = py::array_t<double>({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(selectors.size())});
   double* o = out.outputs.mutable_data();
   const double* v = values.data();
-  {
-    py::gil_scoped_release release;
+  SignalPoll interrupts;  // Ctrl-C stops the chunk at the next point (or inside a long point) with KeyboardInterrupt
+  interrupts.run([&] {
     bool bound = false;
     for (std::size_t i = 0; i < n; ++i) {
+      interrupts.cancellation().check();
       io::ParamSet p = prepared;
       for (std::size_t j = 0; j < names.size(); ++j) {
         const double x = v[i * names.size() + j];
@@ -201,6 +203,7 @@ ChunkResult evaluate_points(const std::string& path, const py::dict& base, const
       }
       cli::Captured captured;
       captured.want_rows = rows;
+      captured.cancellation = interrupts.cancellation();
       try {
         spec.run(p, &captured);
       } catch (const NumericalFailure&) {
@@ -214,7 +217,7 @@ ChunkResult evaluate_points(const std::string& path, const py::dict& base, const
       }
       for (std::size_t k = 0; k < selectors.size(); ++k) o[i * selectors.size() + k] = extract(selectors[k], captured);
     }
-  }
+  });
   return out;
 }
 

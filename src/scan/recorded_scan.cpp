@@ -149,7 +149,10 @@ RecordedScan filter_recorded_scan(const std::string& path, const RecordedSurvey&
     swapped.sample(s);
     if (options.extra) options.extra->sample(s);
     ++n;
-    if (options.progress && (n & 65535) == 0) options.progress(n, survey.samples);
+    if ((n & 65535) == 0) {
+      options.cancellation.check();
+      if (options.progress) options.progress(n, survey.samples);
+    }
   }
   if (options.progress) options.progress(n, survey.samples);
   std::vector<HeightMap> images = imager.finish();

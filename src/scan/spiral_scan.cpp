@@ -44,7 +44,8 @@ inline double relax_ramp(double y, double g_start, double g_end, double lag, dou
 }  // namespace
 
 ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, ScanObserver& observer,
-                      const std::function<void(std::int64_t, std::int64_t)>& progress) {
+                      const std::function<void(std::int64_t, std::int64_t)>& progress,
+                      const Cancellation& cancellation) {
   instrument.validate();
   const SpiralSpec& spiral = instrument.spiral;
   const PlantSpec& plant = instrument.plant;
@@ -133,7 +134,10 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
     y_hat = relax(y_hat, calibrated_gain * past(n - nominal.whole - 1), nominal.e_first);
     y_hat = relax(y_hat, calibrated_gain * past(n - nominal.whole), nominal.e_second);
     f = f_next;
-    if (progress && (n & 65535) == 65535) progress(n + 1, total);
+    if ((n & 65535) == 65535) {
+      cancellation.check();
+      if (progress) progress(n + 1, total);
+    }
   }
   if (filter) run.filter_skipped = filter->skipped_samples();
   if (progress) progress(run.samples, total);

@@ -102,7 +102,7 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   std::vector<ScanObserver*> chain{&imaging, &metrics};
   if (options.extra) chain.push_back(options.extra);
   ObserverChain observers(chain);
-  const ScanRun run = simulate_scan(instrument, surface, observers, options.progress);
+  const ScanRun run = simulate_scan(instrument, surface, observers, options.progress, options.cancellation);
   std::vector<HeightMap> images = imager.finish();
 
   VirtualScan out{run, std::move(images.at(0)), std::move(images.at(1)),
@@ -121,7 +121,7 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
     InstrumentSpec off = instrument;
     off.controller.enabled = false;
     StopAtSaturation stop;
-    const ScanRun uncontrolled = simulate_scan(off, surface, stop);
+    const ScanRun uncontrolled = simulate_scan(off, surface, stop, {}, options.cancellation);
     out.saturates_without_control = uncontrolled.saturated_samples > 0;
     out.max_radius_without_control =
         out.saturates_without_control ? uncontrolled.first_saturation_radius : spiral.end_radius;

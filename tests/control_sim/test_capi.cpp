@@ -147,6 +147,51 @@ TEST(CApi, SaveRestoreBitForBit) {
   afmkit_filter_destroy(g);
 }
 
+// A buffer no filter saved is refused whole, the filter unchanged: the overflow-prone values (coordinates near
+// DBL_MAX, counters beyond 2^64 whose conversion to uint64 is undefined) as well as the structural ones.
+TEST(CApi, RestoreRefusesStatesNoFilterCouldHaveSaved) {
+  afmkit_filter* h = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
+  ASSERT_NE(h, nullptr);
+  const auto sig = test_signal(2000);
+  for (int i = 0; i < 1000; ++i) afmkit_filter_step(h, sig[i]);
+  const size_t n = afmkit_filter_state_size(h);
+  std::vector<double> good(n);
+  ASSERT_EQ(afmkit_filter_save_state(h, good.data(), n), AFMKIT_OK);
+  struct Case {
+    size_t index;
+    double value;
+    const char* names;
+  };
+  const Case cases[] = {
+      {10, 1e308, "entry [10]"},            // an internal coordinate near DBL_MAX
+      {n - 1, -1e300, "coordinates"},      // a physical coordinate (used when the configuration differs)
+      {6, 1e300, "held output"},           // the held output
+      {8, 1e300, "counter [8]"},           // samples processed beyond 2^64: the conversion would be undefined
+      {7, 18446744073709551616.0, "counter [7]"},  // exactly 2^64
+      {8, 1000.5, "counter [8]"},          // fractional
+      {7, 1e6, "skipped samples"},         // more skipped than processed (1000)
+      {2, 1e300, "N must be"},             // N: sizes are checked before any conversion
+      {3, -1e300, "inconsistent sizes"},
+      {4, 1e300, "fingerprint"},
+  };
+  for (const Case& c : cases) {
+    std::vector<double> bad = good;
+    bad[c.index] = c.value;
+    EXPECT_EQ(afmkit_filter_restore_state(h, bad.data(), n), AFMKIT_INVALID_ARGUMENT) << c.index;
+    EXPECT_NE(std::string(afmkit_filter_last_error(h)).find(c.names), std::string::npos)
+        << c.index << ": " << afmkit_filter_last_error(h);
+    std::vector<double> now(n);
+    ASSERT_EQ(afmkit_filter_save_state(h, now.data(), n), AFMKIT_OK);
+    EXPECT_EQ(now, good) << c.index;  // unchanged
+  }
+  // the largest values a filter could have saved are still taken
+  std::vector<double> edge = good;
+  edge[7] = 1000.0;
+  edge[8] = 18446744073709549568.0;  // 2^64 - 2048, the largest double below 2^64
+  EXPECT_EQ(afmkit_filter_restore_state(h, edge.data(), n), AFMKIT_OK) << afmkit_filter_last_error(h);
+  afmkit_filter_destroy(h);
+}
+
 TEST(CApi, InputLimitSkipsHugeSamples) {
   afmkit_filter* h = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
   ASSERT_NE(h, nullptr);

@@ -1,5 +1,5 @@
 """Cheap, independent checks of the data behind the seed-003 and scan figures (python/afmkit/figures/seed003.py,
-scan.py): afmkit's charts, margins and simulations against the crossing formulas of shared/spec/MATH.md B.5/B.9
+scan.py): afmkit's charts, margins and simulations against the crossing formulas of docs/theory-control.md (#stability-tau0, #delay-margin)
 computed here in numpy, and the qualitative facts the figures show (decay inside, growth outside, the scan-area
 gain). Units: rates in Ω (= 1), delays in T = 2π/Ω.
 """
@@ -73,7 +73,7 @@ def tau_c_infinite(alpha, beta, rho=1.0, nu_max=12.0):
 
 
 def beta_critical(n):
-    """β_c(N) of MATH.md B.5: Σ_{|k|≤N} 1/(ν − k) = 0 on (0, 1), β_c = [Σ_{0<|k|≤N} 1/(k(ν − k))]^{-1}."""
+    """β_c(N) of docs/theory-control.md#stability-tau0: Σ_{|k|≤N} 1/(ν − k) = 0 on (0, 1), β_c = [Σ_{0<|k|≤N} 1/(k(ν − k))]^{-1}."""
     ks = np.arange(-n, n + 1)
     lo, hi = 1e-12, 1 - 1e-12
     for _ in range(200):
@@ -89,7 +89,7 @@ def beta_critical(n):
 
 # ------------------------------------------------------------------------------------------------ the references work
 def test_references_reproduce_math_md_values():
-    # MATH.md B.9 / B.5 (hand-checked): the references above must be right before they judge afmkit
+    # docs/theory-control.md #delay-margin / #stability-tau0 (hand-checked): the references above must be right before they judge afmkit
     assert tau_c_single(0.5, 0.0) == pytest.approx(0.195, abs=6e-4)
     assert tau_c_single(1.0, -1.0) == pytest.approx(0.096, abs=6e-4)
     assert beta_critical(1) == pytest.approx(-1.0 / 3.0, abs=1e-9)
@@ -98,7 +98,7 @@ def test_references_reproduce_math_md_values():
 
 # ------------------------------------------------------------------------------------------------ Fig. 2 data
 def test_single_oscillator_chart_boundary_is_the_crossing_curve():
-    """Every boundary point of the (a, b) chart at τ = 0.1T lies on the curve of MATH.md B.9 (or on b = γΩ/K)."""
+    """Every boundary point of the (a, b) chart at τ = 0.1T lies on the crossing curve of docs/theory-control.md#delay-margin (or on b = γΩ/K)."""
     tau = 0.1
     r = afmkit.control.chart(controller="single", gain=GAMMA, plant_rate=GAMMA, plant="static", delay=tau,
                              x_min=-0.5, x_max=2.0, y_min=-2.0, y_max=1.5, x_points=6, y_points=6,
@@ -200,7 +200,7 @@ def test_simulation_decays_below_margin_and_grows_above():
         s -= f / df
     assert abs(f) < 1e-10 and s.real == pytest.approx(root, abs=1e-9)
     assert unstable["growth_rate"] == pytest.approx(root, abs=2e-3)
-    # MATH.md B.2's +0.0102 Ω is the root of the static model (eq. 12)
+    # the +0.0102 Ω is the root of the static model (eq. 12)
     assert afmkit.control.roots(plant="static", **one).results["spectral_abscissa"] == pytest.approx(0.0102,
                                                                                                       abs=5e-5)
 

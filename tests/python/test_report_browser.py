@@ -10,6 +10,9 @@ import pytest
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
 
+#: What a citation of a file outside the repository looks like (the report cites the papers and docs/ pages).
+OUTSIDE = ("MATH.md", "shared/", "/work/", "seeds/")
+
 CLI = os.environ["AFMKIT_CLI"]
 BUILD = Path(os.environ["AFMKIT_BUILD_DIR"])
 
@@ -59,6 +62,10 @@ def test_the_report_opens_with_every_image_loaded_and_no_console_error(report_di
     assert browser.execute_script("return document.querySelectorAll('figcaption').length") == len(figure_ids())
     rows = browser.execute_script("return document.querySelectorAll('#numbers + table tr').length")
     assert rows > 10
+    # the page cites the papers and this repository's docs only, never a file outside the repository
+    text = browser.execute_script("return document.body.innerText")
+    for outside in OUTSIDE:
+        assert outside not in text, f"the page cites '{outside}' (a file outside the repository)"
     # a screenshot of the whole page, kept for people to look at
     height = browser.execute_script("return document.documentElement.scrollHeight")
     browser.set_window_size(1280, min(height, 16000))

@@ -92,6 +92,7 @@ class RealtimeFilter {
                                        double beta, double gain, SampledForm form = SampledForm::ZeroOrderHold);
 
   static constexpr double kDefaultInputLimit = 1e150;  // largest accepted |sample| by default (see above)
+  static constexpr double kMaxStateMagnitude = 1e270;  // largest |coordinate| or |output| of a restored state
   static constexpr int kMaxHarmonics = 10000;          // ZeroOrderHold: N range 1 … kMaxHarmonics
   static constexpr int kMaxHarmonicsBlock = 100000;    // BlockZeroOrderHold: N range 1 … kMaxHarmonicsBlock
   static constexpr int kMaxDenseHarmonics = 200;       // dense ZOH fallback only up to this N
@@ -132,8 +133,9 @@ class RealtimeFilter {
   /// Throws InvalidParameter("state") if the buffer is smaller than state_size().
   void save_state(std::span<double> out) const;
   std::vector<double> save_state() const;
-  /// Throws InvalidParameter("state") for a malformed buffer (magic, version, sizes, non-finite values); the filter
-  /// is then unchanged.
+  /// Throws InvalidParameter("state") for a malformed buffer (magic, version, sizes out of range, non-finite values,
+  /// counters that are not whole numbers in 0 … 2^64 − 1 or more skipped than processed samples, a held output or
+  /// coordinate beyond ±kMaxStateMagnitude); the filter is then unchanged.
   void restore_state(std::span<const double> in);
 
   /// Physical controller state (x0, x1, z1, …, xN, zN).

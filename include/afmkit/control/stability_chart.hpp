@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "afmkit/control/loop_family.hpp"
+#include "afmkit/core/cancellation.hpp"
 
 namespace afmkit::control {
 
@@ -37,6 +38,7 @@ struct ChartSpec {
   int tracked_roots = 16;    ///< roots tracked per grid point
   int seed_interval = 8;     ///< add the asymptotic seeds every this many grid points (1 = always)
   long max_recomputed_points = 2000;  ///< mismatched points recomputed with certified spectra (if not more)
+  Cancellation cancellation;  ///< checked once per grid point (core/cancellation.hpp)
 };
 
 struct ChartRegion {
@@ -74,8 +76,10 @@ struct MarginMap {
   std::vector<double> critical_delay;      ///< row-major [iy·nx + ix]
   std::vector<double> crossing_frequency;
 };
+/// `cancellation` is checked once per grid point.
 MarginMap delay_margin_map(const LoopFamily& family, double x_min, double x_max, int x_points, double y_min,
                            double y_max, int y_points, int threads = 0,
-                           const std::function<void(long, long)>& progress = {});
+                           const std::function<void(long, long)>& progress = {},
+                           const Cancellation& cancellation = {});
 
 }  // namespace afmkit::control

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "afmkit/control/loop_family.hpp"
+#include "afmkit/core/cancellation.hpp"
 
 namespace afmkit::control {
 
@@ -24,6 +25,7 @@ struct RobustTuningSpec {
   int max_evaluations = 150;     ///< Nelder–Mead budget
   double tolerance = 1e-4;       ///< stop when the simplex is smaller than tolerance·Ω
   int threads = 0;               ///< OpenMP threads for the coarse grid (0: default)
+  Cancellation cancellation;     ///< checked once per objective evaluation (core/cancellation.hpp)
 };
 
 struct GainMargin {

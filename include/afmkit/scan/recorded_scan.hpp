@@ -48,6 +48,7 @@ struct RecordedScanOptions {
   ScanObserver* extra = nullptr;  ///< every sample: deflection = recorded d, control = u, topography = tilt-free m
   std::function<void(const TurnRecord&)> on_turn;  ///< deflection_first_harmonic = tilt-free, surface_… = recorded
   std::function<void(std::int64_t, std::int64_t)> progress;
+  Cancellation cancellation;  ///< checked every 65536 samples (core/cancellation.hpp)
 };
 
 struct RecordedScan {

@@ -18,6 +18,7 @@
 #include <functional>
 #include <vector>
 
+#include "afmkit/core/cancellation.hpp"
 #include "afmkit/scan/instrument.hpp"
 #include "afmkit/scan/surface.hpp"
 
@@ -68,7 +69,9 @@ struct ScanRun {
 
 /// Runs the scan of `surface` by `instrument` (validated first: InvalidParameter naming the field), calling
 /// `observer` for every sample. `progress(done, total)` (may be empty) is called about every 2^16 samples.
+/// `cancellation` is checked every 65536 samples (core/cancellation.hpp).
 ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, ScanObserver& observer,
-                      const std::function<void(std::int64_t, std::int64_t)>& progress = {});
+                      const std::function<void(std::int64_t, std::int64_t)>& progress = {},
+                      const Cancellation& cancellation = {});
 
 }  // namespace afmkit::scan

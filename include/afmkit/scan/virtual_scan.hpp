@@ -34,6 +34,7 @@ struct VirtualScanOptions {
   ScanObserver* extra = nullptr;        ///< also receives every sample of the main run (e.g. a time-series writer)
   std::function<void(const TurnRecord&)> on_turn;  ///< each complete turn of the main run
   std::function<void(std::int64_t, std::int64_t)> progress;  ///< (samples done, total) of the main run
+  Cancellation cancellation;  ///< checked every 65536 samples of both runs (core/cancellation.hpp)
 };
 
 struct VirtualScan {

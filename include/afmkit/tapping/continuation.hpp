@@ -26,6 +26,7 @@ struct ContinuationOptions {
   bool parallel = true;      // metrics and HB of the points on both cores
   bool analyse_points = true;  // compute the metrics of every point (false: orbits only, metrics left zero)
   ShootingOptions shooting;  // integrator options; tolerance used for the starting orbit
+  Cancellation cancellation;  // checked once per point (core/cancellation.hpp)
   void validate() const;
 };
 

@@ -24,6 +24,7 @@
 #include <optional>
 #include <vector>
 
+#include "afmkit/core/cancellation.hpp"
 #include "afmkit/tapping/hb_branch.hpp"
 #include "afmkit/tapping/model.hpp"
 
@@ -75,6 +76,7 @@ struct HbCurveOptions {
   HbCurveSpacing spacing = HbCurveSpacing::RefinedGrazing;
   double min_gap = 1e-10;        // smallest 1 − q of the log samples (RefinedGrazing), in (0, 1)
   bool include_minus = true;     // also sample the "−" branch where it exists
+  Cancellation cancellation;     // checked every 4096 samples (core/cancellation.hpp)
 };
 
 /// The parametric HB curve (l(q), B(q), A(q), φ(q)) (seed-1 eq. 19) sampled over q: each sample gives the

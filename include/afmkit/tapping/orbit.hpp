@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "afmkit/core/cancellation.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/shooting.hpp"
 #include "afmkit/tapping/transient.hpp"
@@ -98,6 +99,7 @@ struct OrbitSearchOptions {
   bool parallel = true;               // OpenMP over the candidates
   /// Two converged orbits are the same when their initial states differ by less than this (relative).
   double duplicate_tolerance = 1e-6;
+  Cancellation cancellation;  // checked once per candidate and per continuation point (core/cancellation.hpp)
   void validate() const;
 };
 

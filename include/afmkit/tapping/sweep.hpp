@@ -37,6 +37,7 @@ struct SweepOptions {
   bool parallel = true;  // OpenMP where points are independent (HB evaluation, grid sweeps, both directions)
   /// Called with the number of newly finished points (thread-safe callers only: may be called concurrently).
   std::function<void(long)> progress;
+  Cancellation cancellation;  // checked once per point (core/cancellation.hpp)
   void validate() const;
 };
 

@@ -1,8 +1,8 @@
 """Figures of seed 1 (Materassi, Basso, Genesio, IEEE CDC 2003: impact dynamics and tapping-mode AFM) and the
 tapping / impact figures beyond the paper, every number computed by afmkit.
 
-Parameter values of Figs. 3-4 (the paper gives none): docs/theory-tapping.md#large-stiffness and
-shared/spec/MATH.md A.10 -- f0 = 300 kHz, Q = 100, k = 40 N/m, omega = omega_n, free amplitude 20 nm,
+Parameter values of Figs. 3-4 (the paper gives none): docs/theory-tapping.md#large-stiffness
+(the values of seed-1 Figs. 3-4) -- f0 = 300 kHz, Q = 100, k = 40 N/m, omega = omega_n, free amplitude 20 nm,
 K_a/omega_n^2 in {1, 10, 100, 1000}, K_b = 0.64 K_a. The repulsive-attractive figures use the case of `afmkit demo`
 (normalised units: omega_n = 1, Q = 100, Gamma = 0.2, K_a = 10, K_b = 8, F_a = 0.5, F_b = 1).
 """
@@ -25,7 +25,7 @@ COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e"]
 # ---------------------------------------------------------------------------------------------------------------
 # Parameters (inputs only; every plotted or reported number is computed by afmkit from them)
 
-#: Figs. 3-4 in physical units (MATH.md A.10).
+#: Figs. 3-4 in physical units (docs/theory-tapping.md#large-stiffness).
 PHYSICAL = dict(units="physical", spring_constant=40.0, resonance_frequency=300.0, quality_factor=100.0,
                 free_amplitude=20.0, frequency_ratio=1.0, law="hysteresis")
 #: K_a / omega_n^2 of Figs. 3-4 (the sample stiffness in units of the cantilever's k); K_b = RATIO_B * K_a.

@@ -3,7 +3,7 @@ from a periodic signal measured with an unknown delay, for rotational-scanning A
 figures beyond the paper (simulated spot checks of a stability chart; robust tuning).
 
 Every plotted number comes from an afmkit command (``afmkit.control.*``); parameter values are those of
-shared/spec/MATH.md B.11 (γ = 20Ω, K = γ; nondimensional Ω = 1, so rates are in units of Ω and times in units of
+docs/theory-control.md#simulation (γ = 20Ω, K = γ; nondimensional Ω = 1, so rates are in units of Ω and times in units of
 T = 2π/Ω). Conventions (signs of b, of the feedback, scaling of α, β): docs/theory-control.md.
 """
 from __future__ import annotations
@@ -22,9 +22,9 @@ import afmkit  # noqa: E402
 from afmkit.figures import Figure, figure  # noqa: E402
 
 DPI = 110
-GAMMA = 20.0  # plant rate γ [Ω] (MATH.md B.11: γ = 20Ω ≈ 1 kHz at Ω = 2π·50 rad/s)
+GAMMA = 20.0  # plant rate γ [Ω] (docs/theory-control.md#simulation: γ = 20Ω ≈ 1 kHz at Ω = 2π·50 rad/s)
 GAIN = GAMMA  # controller gain K = γ (design rule)
-F_PAPER = [1.0] + [0.3 / k for k in range(2, 9)]  # F_1 = 1, F_k = 0.3/k (k = 2..8), MATH.md B.11 Fig. 5
+F_PAPER = [1.0] + [0.3 / k for k in range(2, 9)]  # F_1 = 1, F_k = 0.3/k (k = 2..8), seed-2 Fig. 5 (docs/theory-control.md#simulation)
 C0_PAPER = 0.2
 ALPHA_U, BETA_U = 0.1, -0.1  # the paper's "universal" couplings [Ω]
 
@@ -112,7 +112,7 @@ def fig2(out_dir: pathlib.Path) -> Figure:
         q = afmkit.control.roots(controller="single", a=float(r["x"][i]), b=float(r["y"][i]), delay=float(r["delay"][i]),
                                  gain=GAIN, plant_rate=GAMMA, plant="static")
         worst = max(worst, abs(q.results["spectral_abscissa"] - r["spectral_abscissa"][i]))
-    # delay margins of the example points of MATH.md B.9 (crossing formula E1)
+    # delay margins of the example points of docs/theory-control.md#delay-margin (crossing formula, seed-2 ext. E1)
     pts = [(0.1, 0.0), (0.5, 0.0), (0.1, 0.5), (1.0, -1.0)]
     margins = [_margin(controller="single", a=a, b=b) for a, b in pts]
     b_limit = margins[0].results["tau0"]["eq13_b_limit"]
@@ -145,7 +145,7 @@ def fig2(out_dir: pathlib.Path) -> Figure:
     for (a, b), mr in zip(pts, margins):
         numbers.append((f"τ_c, one oscillator, (a, b) = ({a:g}, {b:g}) Ω",
                         f"{_g(mr.results['critical_delay'], 4)} T",
-                        f"control margin --controller single (MATH.md B.9: {ref[(a, b)]} T)"))
+                        f"control margin --controller single (docs/theory-control.md#delay-margin: {ref[(a, b)]} T)"))
     for d in delays:
         ch = next(c for c in r.results["charts"] if math.isclose(c["delay"], d))
         stable = sum(g["points"] for g in ch["regions"] if g["unstable_roots"] == 0)
@@ -160,7 +160,7 @@ def fig2(out_dir: pathlib.Path) -> Figure:
                  "τ = 0, 0.05, 0.1, 0.2 T; black lines: exact D-subdivision boundaries, thick line: b = γΩ/K "
                  "(root at s = 0, independent of τ); dashed yellow: zero contour of the grid. The vertical border "
                  "a = 0 of τ = 0 tilts and bends into a parabola-like curve that closes the region as τ grows. "
-                 "Markers: the points of MATH.md B.9 (green o: τ below their delay margin τ_c, magenta x: above)."),
+                 "Markers: the points of docs/theory-control.md#delay-margin (green o: τ below their delay margin τ_c, magenta x: above)."),
         filename=fn, numbers=numbers)
 
 
@@ -212,9 +212,9 @@ def fig3(out_dir: pathlib.Path) -> Figure:
     numbers = [("τ_c, one oscillator (a, b) = (0.5, 0) Ω, first-order plant (eq. 1, simulated)", f"{_g(tc, 4)} T",
                 "control margin --plant first_order"),
                ("τ_c, same, static plant (eq. 12)", f"{_g(ms.results['critical_delay'], 4)} T",
-                "control margin --plant static (MATH.md B.9: 0.195 T)"),
+                "control margin --plant static (docs/theory-control.md#delay-margin: 0.195 T)"),
                ("rightmost root at τ = 0.2 T, static plant (eq. 12)", f"{_g(root_static, 4)} Ω",
-                "control roots --plant static (MATH.md B.2: +0.0102)")]
+                "control roots --plant static (docs/theory-control.md#simulation: +0.0102)")]
     for d, r in runs.items():
         numbers.append((f"residual |y₁| after {periods} periods, τ = {d:g} T",
                         f"{_g(r.results['residual_first_harmonic'])} (units of f)", "control simulate"))
@@ -308,13 +308,13 @@ def fig4(out_dir: pathlib.Path) -> Figure:
     ref = {(0.05, -0.05): 0.337, (0.1, 0.0): 0.215, (0.2, -0.1): 0.202, (0.3, 0.1): 0.121, (0.5, 0.0): 0.089,
            (1.0, 0.5): 0.047}
     numbers = [("τ_c at the universal point (α, β) = (0.1, −0.1)Ω, N = ∞", f"{_g(tc, 4)} T",
-                "control margin --controller infinite (MATH.md B.9: 0.294 T)"),
+                "control margin --controller infinite (docs/theory-control.md#delay-margin: 0.294 T)"),
                ("τ_c at (0.1, −0.1)Ω, N = 10", f"{_g(m10.results['critical_delay'], 4)} T",
                 "control margin --controller bank --harmonics 10"),
                ("β_c(N = ∞) (τ = 0)", f"{_g(mu.results['tau0']['beta_critical'], 5)} Ω",
-                "control margin: tau0.beta_critical (MATH.md eq. 24: −1/4)"),
+                "control margin: tau0.beta_critical (seed-2 eq. 24: −1/4)"),
                ("β_c(N = 10) (τ = 0)", f"{_g(m10.results['tau0']['beta_critical'], 5)} Ω",
-                "control margin: tau0.beta_critical (MATH.md B.5: −0.25993)"),
+                "control margin: tau0.beta_critical (docs/theory-control.md#stability-tau0: −0.25993)"),
                ("grid points stabilised by the delay (unstable at τ = 0, stable at τ; β < −Ω/4)",
                 ", ".join(f"{delay_stabilised[d]} at τ = {d:g} T" for d in delays) + f" (of {nx * ny})",
                 "control chart vs control chart --quantity margin"),
@@ -323,7 +323,7 @@ def fig4(out_dir: pathlib.Path) -> Figure:
                 f"{checked} checked", "control chart vs --quantity margin, settled by control roots")]
     for (a, b), m in zip(more, mm):
         numbers.append((f"τ_c, N = ∞, (α, β) = ({a:g}, {b:g})Ω", f"{_g(m.results['critical_delay'], 4)} T",
-                        f"control margin (MATH.md B.9: {ref[(a, b)]} T)"))
+                        f"control margin (docs/theory-control.md#delay-margin: {ref[(a, b)]} T)"))
     return Figure(
         id="seed003-fig4",
         title="Seed 2, Fig. 4: stability borders in the (α, β) plane for N → ∞ and the universal couplings",
@@ -384,13 +384,13 @@ def fig5(out_dir: pathlib.Path) -> Figure:
     fn = _save(fig, out_dir, "seed003-fig5")
     u1 = res["control_first_harmonic"]["abs"]
     numbers = [(f"residual first harmonic |y₁| after {periods} periods", f"{_g(res['residual_first_harmonic'])}"
-                " (units of f)", "control simulate (MATH.md B.10: 7.15e-8 after 60 periods, h = T/2000)"),
+                " (units of f)", "control simulate (docs/theory-control.md#reference-values: 7.15e-8 after 60 periods, h = T/2000)"),
                ("largest error of harmonics 0, 2..10 against the target", f"{_g(res['max_harmonic_error'])}"
                 " (units of f)", "control simulate: max_harmonic_error"),
                ("convergence rate of |y₁| (fitted over the transient)", f"{_g(res['convergence_rate'], 3)} Ω",
-                "control simulate (MATH.md B.10 envelope 0.70 → 1.0e-2 in 3 periods: 0.225 Ω)"),
+                "control simulate (docs/theory-control.md#reference-values: envelope 0.70 → 1.0e-2 in 3 periods: 0.225 Ω)"),
                ("rightmost closed-loop root (slowest mode)", f"{_g(root, 3)} Ω",
-                "control roots (MATH.md B.9: real part ≈ −α = −0.1Ω)"),
+                "control roots (docs/theory-control.md#reference-values: real part ≈ −α = −0.1Ω)"),
                ("|u₁| (control's first harmonic)", f"{_g(u1, 6)} (units of f·Ω)",
                 "control simulate (expected γF₁ = 20)")]
     return Figure(
@@ -446,9 +446,9 @@ def fig7(out_dir: pathlib.Path) -> Figure:
                                  plant="first_order", delay=0.1)
     structural = roots.results.get("structural_roots", [])
     numbers = [("residual |y₁|, truncated bank N = 10", f"{_g(rb.results['residual_first_harmonic'])} (units of f)",
-                f"control simulate, AB3, {steps} steps/period, {periods} periods (MATH.md B.8: 4.6e-6)"),
+                f"control simulate, AB3, {steps} steps/period, {periods} periods (docs/theory-control.md#reference-values: 4.6e-6)"),
                ("residual |y₁|, neutral N = ∞", f"{_g(ri.results['residual_first_harmonic'])} (units of f)",
-                "control simulate --controller infinite (MATH.md B.8, own phases: 1.04e-3 → 1.27e-3 over 150 periods)"),
+                "control simulate --controller infinite (docs/theory-control.md#reference-values, own phases: 1.04e-3 → 1.27e-3 over 150 periods)"),
                ("min over the run → final |y₁|, neutral N = ∞",
                 f"{_g(float(np.nanmin(env_i)))} → {_g(float(env_i[-1]))} (units of f)",
                 "control simulate: envelope_first_harmonic"),
@@ -604,7 +604,7 @@ def tuning(out_dir: pathlib.Path) -> Figure:
                         "control tune: margins"))
     for g, mm in zip((rmin, 1.0, rmax), mu):
         numbers.append((f"τ_c of (0.1, −0.1)Ω at ρ = {g:g}", f"{_g(mm.results['critical_delay'], 4)} T",
-                        "control margin --gain (MATH.md B.9 (N = ∞): 0.33 / 0.294 / 0.24 T)"))
+                        "control margin --gain (docs/theory-control.md#delay-margin, N = ∞: 0.327 / 0.294 / 0.239 T)"))
     return Figure(
         id="beyond-tuning",
         title="Beyond the paper: robust tuning of the couplings (afmkit control tune)",

@@ -4,7 +4,7 @@ import os
 import signal
 import sys
 
-from .build import ReportError, build
+from .build import ReportError, ReportFailure, build
 
 
 def main(argv=None) -> int:
@@ -21,7 +21,7 @@ def main(argv=None) -> int:
     signal.signal(signal.SIGTERM, terminated)
     try:
         path = build(args.output_dir, jobs=args.jobs, figures=args.figures)
-    except ReportError as e:
+    except (ReportError, ReportFailure) as e:
         print(f"afmkit report: {e}", file=sys.stderr)
         return e.status
     except KeyboardInterrupt:

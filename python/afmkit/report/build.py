@@ -16,12 +16,21 @@ from pathlib import Path
 FIGURE_MODULES = ["seed000", "seed003", "scan"]
 
 
-class ReportError(Exception):
-    """A report that cannot be written; `status` is the exit status (2 bad input, 1 failure)."""
+class ReportError(ValueError):
+    """A report that cannot be made as asked: bad input (an argument out of range, an output folder that cannot be
+    written). A ValueError, like afmkit.InvalidParameter and afmkit.InputError; `status` is the exit status (2)."""
 
-    def __init__(self, message: str, status: int = 1):
+    status = 2
+
+    def __init__(self, message: str, status: int = 2):
         super().__init__(message)
         self.status = status
+
+
+class ReportFailure(RuntimeError):
+    """A figure whose computation failed (not the caller's error: exit status 1), like afmkit.NumericalFailure."""
+
+    status = 1
 
 
 def _check_writable(out: Path) -> None:
@@ -31,8 +40,34 @@ def _check_writable(out: Path) -> None:
         with tempfile.NamedTemporaryFile(dir=out, prefix=".write-test-"):
             pass
     except OSError as e:
-        raise ReportError(f"output_dir '{out}' cannot be written: {e.strerror or e}: must be a writable folder",
-                          status=2) from None
+        raise ReportError(f"output_dir '{out}' cannot be written: {e.strerror or e}: must be a writable folder"
+                          ) from None
+
+
+def _die_with_parent(parent: int) -> None:
+    """In a worker: end when the report process ends, even by SIGKILL (no orphans computing on): the kernel sends
+    SIGKILL on the parent's death (Linux prctl PR_SET_PDEATHSIG); elsewhere, or if the parent is already gone, a
+    watchdog thread polls the parent's pid."""
+    import ctypes
+    import signal
+    import threading
+
+    armed = False
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            armed = libc.prctl(1, int(signal.SIGKILL), 0, 0, 0) == 0  # 1 = PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            armed = False
+    if os.getppid() != parent:  # the parent died before the request took effect
+        os._exit(1)
+    if not armed:
+        def watch():
+            while os.getppid() == parent:
+                time.sleep(0.5)
+            os._exit(1)
+
+        threading.Thread(target=watch, daemon=True).start()
 
 
 def figure_ids() -> list:
@@ -71,7 +106,7 @@ def _select(tasks, figures: str):
     unknown = [w for w in wanted if w not in known]
     if unknown or not wanted:
         raise ReportError(f"figures = '{figures}' is not allowed: must be 'all' or a comma-separated list of "
-                          f"figure ids from: {', '.join(known)}", status=2)
+                          f"figure ids from: {', '.join(known)}")
     return [t for t in tasks if t[2] in wanted]
 
 
@@ -87,7 +122,8 @@ def _run_figure(module: str, name: str, staging: str):
     return fig
 
 
-def _worker_init(threads: int) -> None:
+def _worker_init(threads: int, parent: int) -> None:
+    _die_with_parent(parent)
     os.environ["OMP_NUM_THREADS"] = str(threads)
 
 
@@ -138,7 +174,20 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all") -> Path:
     from . import page
 
     if not isinstance(jobs, int) or isinstance(jobs, bool) or not 1 <= jobs <= 64:
-        raise ReportError(f"jobs = {jobs!r} is out of range: must be an integer in [1, 64]", status=2)
+        raise ReportError(f"jobs = {jobs!r} is out of range: must be an integer in [1, 64]")
+    if not isinstance(figures, str):
+        raise ReportError(f"figures = {figures!r} is not allowed: must be a str, 'all' or a comma-separated list of "
+                          f"figure ids")
+    if not isinstance(output_dir, (str, os.PathLike)):
+        raise ReportError(f"output_dir = {output_dir!r} is not allowed: must be a path (str or os.PathLike)")
+    try:
+        os.fsencode(output_dir)
+    except UnicodeEncodeError:
+        raise ReportError(f"output_dir = {output_dir!r} is not valid text: it cannot be encoded as a file name"
+                          ) from None
+    path = os.fspath(output_dir)
+    if (b"\0" if isinstance(path, bytes) else "\0") in path:
+        raise ReportError("output_dir contains a NUL character: must be a path")
     tasks = _select(_figure_list(), figures)
     out = Path(output_dir)
     _check_writable(out)
@@ -151,7 +200,7 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all") -> Path:
         threads = max(1, (os.cpu_count() or 1) // jobs)
         ctx = multiprocessing.get_context("spawn")  # a clean OpenMP runtime per worker
         with futures.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
-                                         initargs=(threads,)) as pool:
+                                         initargs=(threads, os.getpid())) as pool:
             pending = {pool.submit(_run_figure, m, n, str(staging)): (m, n, i) for m, n, i in tasks}
             try:
                 for fut in futures.as_completed(pending):
@@ -160,9 +209,9 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all") -> Path:
                         fig = fut.result()
                     except Exception as e:  # a figure that fails fails the report (index.html unchanged)
                         detail = "".join(traceback.format_exception(e))
-                        raise ReportError(f"figure {figure_id} ({m}.{n}) failed:\n{detail}") from None
+                        raise ReportFailure(f"figure {figure_id} ({m}.{n}) failed:\n{detail}") from None
                     if fig.id != figure_id:
-                        raise ReportError(f"figure function {m}.{n} returned id {fig.id}, marked {figure_id}")
+                        raise ReportFailure(f"figure function {m}.{n} returned id {fig.id}, marked {figure_id}")
                     done[figure_id] = fig
                     _progress(len(done), len(tasks), fig, started)
             except BaseException:
@@ -173,18 +222,22 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all") -> Path:
         ordered = [done[t[2]] for t in tasks]
         for fig in ordered:
             if not (staging / fig.filename).is_file():
-                raise ReportError(f"figure {fig.id} did not write its file {fig.filename}")
+                raise ReportFailure(f"figure {fig.id} did not write its file {fig.filename}")
         # Move the figures in, then the page last (atomic rename): an interrupted run never leaves a page that
         # points at missing or half-written images.
-        (out / "figures").mkdir(exist_ok=True)
-        for fig in ordered:
-            os.replace(staging / fig.filename, out / "figures" / fig.filename)
-            fig.filename = f"figures/{fig.filename}"
         total = time.perf_counter() - started
-        text = page.render(ordered, speed, version=__version__, seconds=total, jobs=jobs)
         tmp = out / f".index.html.tmp-{os.getpid()}"
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, out / "index.html")
+        try:
+            (out / "figures").mkdir(exist_ok=True)
+            for fig in ordered:
+                os.replace(staging / fig.filename, out / "figures" / fig.filename)
+                fig.filename = f"figures/{fig.filename}"
+            text = page.render(ordered, speed, version=__version__, seconds=total, jobs=jobs)
+            tmp.write_text(text, encoding="utf-8")
+            os.replace(tmp, out / "index.html")
+        except OSError as e:  # a full disk, a folder made read-only or removed meanwhile: say which file and why
+            tmp.unlink(missing_ok=True)
+            raise ReportError(f"cannot write '{e.filename or out / 'index.html'}': {e.strerror or e}") from None
         print(f"afmkit report: {len(ordered)} figures in {total:.1f} s", file=sys.stderr, flush=True)
         return out / "index.html"
     finally:

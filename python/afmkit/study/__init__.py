@@ -11,6 +11,6 @@ results as an xarray Dataset stored in Zarr (docs/study.md).
     ds = run(s, "out/jumps.zarr", scheduler="tcp://head:8786")
 """
 from .definition import COMPUTATIONS, Axis, Study, StudyError
-from .run import run
+from .run import StudyFailure, run
 
-__all__ = ["Study", "Axis", "StudyError", "run", "COMPUTATIONS"]
+__all__ = ["Study", "Axis", "StudyError", "StudyFailure", "run", "COMPUTATIONS"]

@@ -2,14 +2,35 @@
 [--chunk-seconds 1] [--chunk-points N] [--netcdf F] [--quiet]: runs the study described in the TOML file FILE
 (docs/study.md)."""
 import argparse
+import math
 import os
 import signal
 import sys
-import tomllib
-from pathlib import Path
 
-from .definition import StudyError, Study
-from .run import run
+from .definition import StudyError, Study, read_toml
+from .run import StudyFailure, run
+
+#: The [run] table's fields and the Python types each takes (a wrong type is refused naming the file and field).
+RUN_FIELDS = {"store": (str,), "scheduler": (str,), "workers": (int,), "chunk_seconds": (int, float),
+              "chunk_points": (int,), "netcdf": (str,)}
+
+
+def _run_settings(file: str) -> dict:
+    """The [run] table of the study file, each field of its type (else StudyError naming the file and field)."""
+    settings = read_toml(file).get("run", {})
+    if not isinstance(settings, dict):
+        raise StudyError("run", f"{file}: 'run' must be a table ([run])")
+    unknown = sorted(set(settings) - set(RUN_FIELDS))
+    if unknown:
+        raise StudyError(f"run.{unknown[0]}", f"{file}: unknown field 'run.{unknown[0]}' (allowed: "
+                                              f"{', '.join(sorted(RUN_FIELDS))})")
+    for key, value in settings.items():
+        types = RUN_FIELDS[key]
+        if isinstance(value, bool) or not isinstance(value, types) or (
+                isinstance(value, float) and not math.isfinite(value)):
+            want = "a string" if types == (str,) else "an integer" if types == (int,) else "a finite number"
+            raise StudyError(f"run.{key}", f"{file}: run.{key} = {value!r} is not allowed: must be {want}")
+    return settings
 
 
 def main(argv=None) -> int:
@@ -32,28 +53,37 @@ def main(argv=None) -> int:
         raise KeyboardInterrupt
 
     signal.signal(signal.SIGTERM, terminated)
+
+    def where(e) -> str:  # every message names the study file
+        return "" if args.file in str(e) else f"{args.file}: "
+
     try:
         study = Study.from_toml(args.file)
-        settings = tomllib.loads(Path(args.file).read_text(encoding="utf-8")).get("run", {})
-        allowed = {"store", "scheduler", "workers", "chunk_seconds", "chunk_points", "netcdf"}
-        unknown = sorted(set(settings) - allowed)
-        if unknown:
-            raise StudyError(f"run.{unknown[0]}", f"{args.file}: unknown field 'run.{unknown[0]}' (allowed: "
-                                                  f"{', '.join(sorted(allowed))})")
+        settings = _run_settings(args.file)
+
         def pick(name, default=None):
             value = getattr(args, name)
             return value if value is not None else settings.get(name, default)
 
-        store = Path(pick("store", f"out/{study.name}.zarr"))
-        store.parent.mkdir(parents=True, exist_ok=True)
+        store = pick("store", f"out/{study.name}.zarr")
         ds = run(study, store, scheduler=pick("scheduler"), workers=pick("workers"),
                  chunk_seconds=pick("chunk_seconds", 1.0), chunk_points=pick("chunk_points"),
                  progress=not args.quiet, netcdf=pick("netcdf"))
     except (StudyError, ValueError, TypeError) as e:
         field = getattr(e, "field", None) or getattr(e, "parameter", None)
-        print(f"afmkit study: {e}" + (f" [field: {field}]" if field and field not in str(e) else ""),
+        print(f"afmkit study: {where(e)}{e}" + (f" [field: {field}]" if field and field not in str(e) else ""),
               file=sys.stderr)
         return 2
+    except StudyFailure as e:
+        print(f"afmkit study: {where(e)}{e} [field: {e.field}]", file=sys.stderr)
+        return 1
+    except OSError as e:  # not where the study writes (those are StudyError / StudyFailure): the machine's failure
+        print(f"afmkit study: {where(e)}input/output failure" + (f" on '{e.filename}'" if e.filename else "")
+              + f": {e.strerror or e}", file=sys.stderr)
+        return 1
+    except RuntimeError as e:  # afmkit.NumericalFailure of the pilot point, a lost Dask worker, …
+        print(f"afmkit study: {where(e)}failed: {e}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("afmkit study: interrupted; finished chunks are kept, run again to resume", file=sys.stderr)
         return 130

@@ -9,6 +9,7 @@ import functools
 import hashlib
 import json
 import math
+import os
 import re
 import tomllib
 from dataclasses import dataclass, field
@@ -44,6 +45,45 @@ class StudyError(ValueError):
         self.field = field_name
 
 
+#: Memory per value of an axis while the study is made: the float64 of the grid, the Python float of the axis
+#: tuple and its slot, and the value in the study's JSON definition (bytes, rounded up).
+AXIS_BYTES_PER_VALUE = 64
+
+
+def require_memory(field_name: str, count: float, bytes_each: float) -> None:
+    """StudyError naming `field_name` when `count` items of `bytes_each` bytes exceed the memory afmkit may use
+    (half of what is available, capped by AFMKIT_MEMORY_LIMIT; the commands' check), before anything is allocated."""
+    from .. import _afmkit
+
+    try:
+        _afmkit.require_memory(field_name, float(count), float(bytes_each))
+    except _afmkit.InvalidParameter as e:
+        raise StudyError(field_name, str(e)) from None
+
+
+def read_toml(path) -> dict:
+    """The TOML document of a study file; StudyError naming the file (and where it is wrong) otherwise."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise StudyError("file", f"study file = {path!r} is not allowed: must be a path (str or os.PathLike)")
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise StudyError("file", f"study file '{path}' cannot be read: {e.strerror or e}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = data[:e.start].count(b"\n") + 1
+        raise StudyError("file", f"study file '{path}' is not UTF-8 text: byte 0x{data[e.start]:02x} at line {line} "
+                                 f"(offset {e.start}); a study file must be UTF-8") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise StudyError("file", f"study file '{path}' is not valid TOML: {e}") from None
+    except RecursionError:
+        raise StudyError("file", f"study file '{path}' is nested too deeply to be read") from None
+
+
 @dataclass(frozen=True)
 class Axis:
     """One named axis: a numeric parameter of the computation's command and its values (in the command's units)."""
@@ -69,20 +109,50 @@ class Axis:
                 if not isinstance(points, int) or isinstance(points, bool) or points < 1:
                     raise StudyError(f"axes.{name}", f"axes.{name}: points = {points!r} must be an integer >= 1")
                 _finite(name, [start, stop])
+                require_memory(f"axes.{name}", points, AXIS_BYTES_PER_VALUE)  # before the values exist
                 values = np.linspace(float(start), float(stop), points).tolist()
             if spec:
                 raise StudyError(f"axes.{name}", f"axes.{name}: unknown field(s) {', '.join(sorted(spec))} "
                                                  f"(allowed: values, or start, stop, points)")
-        try:
-            values = [float(v) for v in np.asarray(values, dtype=float).ravel()]
-        except (TypeError, ValueError):
-            raise StudyError(f"axes.{name}", f"axes.{name}: values must be numbers") from None
+        values = _numbers(name, values)
         if not values:
             raise StudyError(f"axes.{name}", f"axes.{name} is empty: an axis needs at least one value")
         _finite(name, values)
         if len(set(values)) != len(values):
             raise StudyError(f"axes.{name}", f"axes.{name} repeats a value: every value must be distinct")
         return Axis(name, tuple(values))
+
+
+def _numbers(name, values) -> list:
+    """The values of axis `name` as floats: a flat list, tuple or 1-D array of real numbers. Refused (naming the axis),
+    never coerced: booleans (True is not 1.0), nested lists or arrays (not flattened), strings, complex numbers."""
+    if isinstance(values, np.ndarray):
+        if values.ndim != 1:
+            raise StudyError(f"axes.{name}", f"axes.{name}: values must be a flat list of numbers, not a "
+                                             f"{values.ndim}-D array")
+        if values.dtype.kind not in "iuf":
+            raise StudyError(f"axes.{name}", f"axes.{name}: values must be real numbers, not {values.dtype} "
+                                             f"(booleans and text are not axis values)")
+        return [float(v) for v in values]
+    if not isinstance(values, (list, tuple)):
+        raise StudyError(f"axes.{name}", f"axes.{name} = {values!r}: must be a list of numbers or "
+                                         f"{{start, stop, points}}")
+    out = []
+    for i, v in enumerate(values):
+        if isinstance(v, (bool, np.bool_)):
+            raise StudyError(f"axes.{name}", f"axes.{name}[{i}] = {v!r}: a boolean is not an axis value (must be a "
+                                             f"real number)")
+        if isinstance(v, (list, tuple, dict, np.ndarray)):
+            raise StudyError(f"axes.{name}", f"axes.{name}[{i}] is a nested {type(v).__name__}: an axis is a flat "
+                                             f"list of numbers")
+        if not isinstance(v, (int, float, np.integer, np.floating)):
+            raise StudyError(f"axes.{name}", f"axes.{name}[{i}] = {v!r}: must be a real number, not "
+                                             f"{type(v).__name__}")
+        try:
+            out.append(float(v))
+        except OverflowError:
+            raise StudyError(f"axes.{name}", f"axes.{name}[{i}] = {v!r} is beyond the range of a float") from None
+    return out
 
 
 def _finite(name, values):
@@ -140,12 +210,7 @@ class Study:
             [axes]         # name = [values] or { start, stop, points }
         """
         path = Path(path)
-        try:
-            doc = tomllib.loads(path.read_text(encoding="utf-8"))
-        except OSError as e:
-            raise StudyError("file", f"study file '{path}': {e.strerror or e}") from None
-        except tomllib.TOMLDecodeError as e:
-            raise StudyError("file", f"study file '{path}' is not valid TOML: {e}") from None
+        doc = read_toml(path)
         allowed = {"name", "computation", "outputs", "parameters", "axes", "run"}
         unknown = sorted(set(doc) - allowed)
         if unknown:
@@ -167,7 +232,7 @@ class Study:
 
     @property
     def size(self) -> int:
-        return int(np.prod(self.shape))
+        return math.prod(self.shape)  # exact (np.prod would wrap around beyond 2^63)
 
     def definition(self) -> dict:
         """The study as plain data (what the fingerprint covers)."""

@@ -6,16 +6,118 @@ done. Running the same study on the same store again computes only the chunks no
 """
 from __future__ import annotations
 
+import errno
 import math
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
 from . import store as zstore
-from .definition import Study, StudyError, parameters_of
+from .definition import Study, StudyError, parameters_of, require_memory
+
+
+class StudyFailure(RuntimeError):
+    """A study stopped by a failure that is not the caller's (an I/O error of the machine, a worker lost for good);
+    `field` names what was being written. The command line's exit status 1 (StudyError, bad input: 2)."""
+
+    def __init__(self, field_name: str, message: str):
+        super().__init__(message)
+        self.field = field_name
+
+
+#: Write errors that come from where the caller asked to write (a full or read-only file system, no permission, a
+#: folder that went away): bad input as for the commands (exit 2). Any other OSError is a failure (exit 1).
+_CALLERS_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOENT, errno.ENOTDIR,
+                   errno.EISDIR, errno.EEXIST, errno.ENAMETOOLONG, errno.ELOOP, errno.EFBIG, errno.ENOTEMPTY}
+
+
+def write_error(field_name: str, target, e: OSError) -> Exception:
+    """The StudyError (or StudyFailure) for OSError `e` while writing `target` (the store or the NetCDF file)."""
+    inner = f" ({e.filename})" if e.filename and os.fspath(e.filename) != os.fspath(target) else ""
+    message = f"{field_name} '{target}' cannot be written{inner}: {e.strerror or e}"
+    if e.errno in _CALLERS_ERRNOS:
+        return StudyError(field_name, message + (" (finished chunks are kept: run again to resume)"
+                                                 if field_name == "store" else ""))
+    return StudyFailure(field_name, message)
+
+
+def _path(field_name: str, value) -> Path:
+    """A path argument (str or os.PathLike): refused (naming the field) when it is another type, not encodable as a
+    file name (a lone surrogate) or contains NUL."""
+    if not isinstance(value, (str, bytes, os.PathLike)):
+        raise StudyError(field_name, f"{field_name} = {value!r} is not allowed: must be a path (str or os.PathLike), "
+                                     f"not {type(value).__name__}")
+    text = os.fspath(value)
+    try:
+        raw = os.fsencode(text)
+    except UnicodeEncodeError:
+        raise StudyError(field_name, f"{field_name} = {text!r} is not valid text: it cannot be encoded as a file "
+                                     f"name") from None
+    if b"\0" in raw:
+        raise StudyError(field_name, f"{field_name} contains a NUL character: must be a path")
+    return Path(os.fsdecode(raw))
+
+
+def _writable_folder(field_name: str, target: Path) -> None:
+    """The folder `target` goes to exists and can be written, or can be created (its nearest existing ancestor is a
+    writable folder; the missing folders are made when the study writes): a temporary file is created and removed."""
+    folder = target.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise StudyError(field_name, f"{field_name} '{target}': '{folder}' is not a folder, so the folder of "
+                                     f"'{target.name}' cannot be created")
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".afmkit-write-test-"):
+            pass
+    except OSError as e:
+        raise StudyError(field_name, f"{field_name} '{target}': folder '{folder}' cannot be written: "
+                                     f"{e.strerror or e}") from None
+
+
+def check_store(store) -> Path:
+    """The store's path, checked before anything runs: a folder (an existing one is opened later, a new one is
+    created in a writable folder), never a file."""
+    path = _path("store", store)
+    if path.exists() and not path.is_dir():
+        raise StudyError("store", f"store '{path}' exists and is not a folder: a store is a folder (choose another "
+                                  f"path)")
+    if str(path) in ("", ".") or path.name in ("", ".", ".."):
+        raise StudyError("store", f"store = '{path}': must name the store's own folder (e.g. out/study.zarr)")
+    if not path.exists():
+        _writable_folder("store", path)
+    return path
+
+
+def check_netcdf(netcdf) -> Path:
+    """The NetCDF file's path, checked before anything runs: names a file in a writable folder."""
+    path = _path("netcdf", netcdf)
+    if str(path) in ("", ".") or path.name in ("", ".", ".."):
+        raise StudyError("netcdf", f"netcdf = '{os.fspath(netcdf)}': must name a file (e.g. out/study.nc)")
+    if path.is_dir():
+        raise StudyError("netcdf", f"netcdf '{path}' is a folder: must name a file")
+    _writable_folder("netcdf", path)
+    return path
+
+
+def check_scheduler(scheduler) -> None:
+    """serial, local (or None), an address scheme://host[:port], or a distributed.Client."""
+    if scheduler is None or (isinstance(scheduler, str) and (
+            scheduler in ("serial", "local") or (0 < scheduler.find("://") < len(scheduler) - 3))):
+        return
+    try:
+        import distributed
+
+        if isinstance(scheduler, distributed.Client):
+            return
+    except ImportError:
+        pass
+    raise StudyError("scheduler", f"scheduler = {scheduler!r} is not allowed: must be 'serial', 'local', an address "
+                                  f"such as tcp://host:8786, or a distributed.Client")
 
 
 def _points(study: Study, slices: tuple) -> np.ndarray:
@@ -32,7 +134,11 @@ def compute_chunk(store_path: str, definition: dict, index: int):
 
     study = Study.make(definition["computation"], {n: v for n, v in definition["axes"]}, definition["outputs"],
                        definition["parameters"])
-    root = zarr.open_group(store_path, mode="r+")
+    try:
+        root = zarr.open_group(store_path, mode="r+")
+    except ValueError as e:  # removed or replaced while the study runs (Zarr's own text can be a bare template)
+        raise StudyError("store", f"store '{store_path}' is no longer a study store ({type(e).__name__}): it was "
+                                  f"removed or replaced while the study ran") from None
     names = zstore.output_names(study.outputs)
     chunks = tuple(root[names[0]].chunks)
     slices = zstore.chunk_slices(study.shape, chunks, index)
@@ -103,22 +209,20 @@ def _pilot(study: Study, measure: bool = True):
 
 
 def _client(scheduler, workers: int | None):
-    """A distributed.Client: given, at an address (checked within a few seconds), or a new LocalCluster."""
+    """(client, cluster or None, whether the client is ours to close): the distributed.Client given, one at an
+    address (checked within a few seconds), or one of a new LocalCluster."""
     import distributed
 
     if isinstance(scheduler, distributed.Client):
-        return scheduler, None
+        return scheduler, None, False
     if scheduler in (None, "local"):
         n = workers or os.cpu_count() or 1
         cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                            host="127.0.0.1",
                                            env={"OMP_NUM_THREADS": "1"})
-        return distributed.Client(cluster), cluster
-    if not isinstance(scheduler, str) or "://" not in scheduler:
-        raise StudyError("scheduler", f"scheduler = {scheduler!r} is not allowed: must be 'serial', 'local', an "
-                                      f"address such as tcp://host:8786, or a distributed.Client")
+        return distributed.Client(cluster), cluster, True
     try:
-        return distributed.Client(scheduler, timeout="5s"), None
+        return distributed.Client(scheduler, timeout="5s"), None, True
     except (OSError, TimeoutError) as e:
         raise StudyError("scheduler", f"scheduler '{scheduler}' does not answer within 5 s: {e}") from None
 
@@ -144,37 +248,39 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
     if not (isinstance(chunk_seconds, (int, float)) and math.isfinite(chunk_seconds) and chunk_seconds > 0):
         raise StudyError("chunk_seconds", f"chunk_seconds = {chunk_seconds!r} is out of range: must be > 0 and "
                                           f"finite")
-    if workers is not None and (not isinstance(workers, int) or workers < 1):
+    if workers is not None and (not isinstance(workers, int) or isinstance(workers, bool) or workers < 1):
         raise StudyError("workers", f"workers = {workers!r} is out of range: must be an integer >= 1")
     if progress not in (True, False, "dask"):
         raise StudyError("progress", f"progress = {progress!r} is not allowed: must be True, False or 'dask'")
-    path = Path(store)
-    if path.exists():
-        root, chunks = zstore.open_existing(path, study)
-    else:
-        if not path.parent.is_dir():
-            raise StudyError("store", f"store '{path}': folder '{path.parent}' does not exist")
-        cost, units = _pilot(study, measure=chunk_points is None)
-        target = chunk_points or max(1, round(chunk_seconds / max(cost, 1e-9)))
-        chunks = zstore.chunk_shape(study.shape, target)
-        zstore.create(path, study, chunks, units, __version__)
-        root, chunks = zstore.open_existing(path, study)
-    done = root["chunk_done"][:]
-    pending = [int(i) for i in np.flatnonzero(done == 0)]
-    total = len(done)
-    bar = _Progress(total, int(np.prod(chunks)), study.size, progress is True or
-                    (progress == "dask" and scheduler == "serial"))
-    bar.done = total - len(pending)
-    definition = study.definition()
-    if pending:
-        if scheduler == "serial":
-            for i in pending:
-                compute_chunk(str(path), definition, i)
-                bar.done += 1
-                bar.step()
-        else:
-            _run_dask(study, path, definition, pending, scheduler, workers, bar, dask_bar=progress == "dask")
-    bar.step(final=True)
+    # Everything that can be checked is checked before anything runs or is created (a refused study leaves nothing)
+    check_scheduler(scheduler)
+    path = check_store(store)
+    if netcdf is not None:
+        netcdf = check_netcdf(netcdf)
+        # the NetCDF file is written from memory: every output and coordinate of every point
+        require_memory("netcdf", study.size, 8 * (len(study.outputs) + 1))
+    client = None
+    try:
+        try:
+            if path.exists():
+                root, chunks = zstore.open_existing(path, study)
+            else:
+                cost, units = _pilot(study, measure=chunk_points is None)
+                target = chunk_points or max(1, round(chunk_seconds / max(cost, 1e-9)))
+                chunks = zstore.chunk_shape(study.shape, target)
+                # the chunk bookkeeping (done flags, the list of pending chunks) is held in memory
+                require_memory("axes", math.prod(zstore.chunk_grid(study.shape, chunks)), 64)
+                if scheduler != "serial":
+                    client = _client(scheduler, workers)  # an unreachable scheduler is refused before the store
+                path.parent.mkdir(parents=True, exist_ok=True)
+                zstore.create(path, study, chunks, units, __version__)
+                root, chunks = zstore.open_existing(path, study)
+        except OSError as e:
+            raise write_error("store", path, e) from None
+        _compute(study, path, root, chunks, scheduler, workers, progress, client)
+    finally:
+        if client is not None:
+            _close(client)
     failed = int(root["chunk_failed"][:].sum())  # read here: not a Dask computation on the study's cluster
     ds = xr.open_zarr(str(path), consolidated=True)
     ds = ds.drop_vars(["chunk_done", "chunk_failed"])
@@ -183,32 +289,68 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
         out = Path(netcdf)
         tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}")
         try:
+            out.parent.mkdir(parents=True, exist_ok=True)
             ds.load().to_netcdf(tmp)
             os.replace(tmp, out)
+        except OSError as e:
+            raise write_error("netcdf", out, e) from None
         finally:
             tmp.unlink(missing_ok=True)
     return ds
 
 
-def _run_dask(study, path, definition, pending, scheduler, workers, bar, dask_bar=False) -> None:
+def _compute(study, path, root, chunks, scheduler, workers, progress, client) -> None:
+    """Computes the chunks of the store not done yet."""
+    done = root["chunk_done"][:]
+    pending = [int(i) for i in np.flatnonzero(done == 0)]
+    total = len(done)
+    bar = _Progress(total, int(np.prod(chunks)), study.size, progress is True or
+                    (progress == "dask" and scheduler == "serial"))
+    bar.done = total - len(pending)
+    definition = study.definition()
+    try:
+        if pending:
+            if scheduler == "serial":
+                for i in pending:
+                    compute_chunk(str(path), definition, i)
+                    bar.done += 1
+                    bar.step()
+            else:
+                own = client is None  # resuming a store: the cluster is opened only when chunks are pending
+                if own:
+                    client = _client(scheduler, workers)
+                try:
+                    _run_dask(study, path, definition, pending, client[0], bar, dask_bar=progress == "dask")
+                finally:
+                    if own:
+                        _close(client)
+    except OSError as e:  # writing a chunk: a full or read-only file system, the store removed meanwhile
+        raise write_error("store", path, e) from None
+    bar.step(final=True)
+
+
+def _close(client) -> None:
+    """Closes what _client opened (a Client the caller gave stays open)."""
+    connection, cluster, owned = client
+    if owned:
+        connection.close()
+    if cluster is not None:
+        cluster.close()
+
+
+def _run_dask(study, path, definition, pending, client, bar, dask_bar=False) -> None:
     import distributed
 
-    client, cluster = _client(scheduler, workers)
+    key = f"afmkit-study-{study.fingerprint()[:12]}"
+    futures = [client.submit(compute_chunk, str(path.resolve()), definition, i, key=f"{key}-{i}", pure=False,
+                             retries=3) for i in pending]
     try:
-        key = f"afmkit-study-{study.fingerprint()[:12]}"
-        futures = [client.submit(compute_chunk, str(path.resolve()), definition, i, key=f"{key}-{i}", pure=False,
-                                 retries=3) for i in pending]
-        try:
-            if dask_bar:
-                distributed.progress(futures)  # a notebook widget (returns at once), or a text bar until done
-            for f in distributed.as_completed(futures):
-                f.result()  # a chunk that failed (not a lost worker: those are retried) stops the study
-                bar.done += 1
-                bar.step()
-        except BaseException:
-            client.cancel(futures)
-            raise
-    finally:
-        if cluster is not None:
-            client.close()
-            cluster.close()
+        if dask_bar:
+            distributed.progress(futures)  # a notebook widget (returns at once), or a text bar until done
+        for f in distributed.as_completed(futures):
+            f.result()  # a chunk that failed (not a lost worker: those are retried) stops the study
+            bar.done += 1
+            bar.step()
+    except BaseException:
+        client.cancel(futures)
+        raise

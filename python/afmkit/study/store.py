@@ -100,7 +100,10 @@ def open_existing(path: Path, study: Study):
         root = zarr.open_group(str(path), mode="r+")
         attrs = dict(root.attrs)
     except Exception as e:  # noqa: BLE001 - any unreadable store is refused the same way
-        raise StudyError("store", f"store '{path}' exists but is not an afmkit study store: {e}") from None
+        # Zarr's own text is not shown: some of its messages are unformatted templates ("… %r")
+        why = e.strerror if isinstance(e, OSError) and e.strerror else type(e).__name__
+        raise StudyError("store", f"store '{path}' exists but is not an afmkit study store ({why}): remove it or "
+                                  f"choose another") from None
     if attrs.get("afmkit_study_format") != FORMAT or "study_fingerprint" not in attrs:
         raise StudyError("store", f"store '{path}' exists but is not an afmkit study store (remove it or choose "
                                   f"another)")

@@ -580,12 +580,28 @@ void RealtimeFilter::restore_state(std::span<const double> in) {
   if (in[1] != kLayoutVersion) bad(fmt::format("layout version {} (this build reads {})", in[1], kLayoutVersion));
   for (double x : in)
     if (!std::isfinite(x)) bad("non-finite entry");
+  // Every count is checked against its range before it is converted (a double beyond the range of the integer
+  // type makes the conversion undefined).
+  const auto whole_in = [](double x, double lo, double hi) { return x >= lo && x <= hi && x == std::floor(x); };
   const double n_osc = in[2], ni = in[3], np = in[9];
-  if (n_osc < 1 || n_osc != std::floor(n_osc) || np != 2 * n_osc + 1 || ni < 0 || ni != std::floor(ni) ||
-      in.size() != kHeader + static_cast<std::size_t>(ni) + static_cast<std::size_t>(np))
-    bad(fmt::format("inconsistent sizes (N = {}, internal {}, physical {}, total {})", n_osc, ni, np, in.size()));
-  for (int i = 6; i <= 8; ++i)
-    if (i > 6 && (in[i] < 0 || in[i] != std::floor(in[i]))) bad("negative or fractional counter");
+  const double entries = static_cast<double>(in.size());
+  if (!whole_in(n_osc, 1.0, kMaxHarmonicsBlock) || np != 2 * n_osc + 1 || !whole_in(ni, 0.0, entries) ||
+      entries != static_cast<double>(kHeader) + ni + np)
+    bad(fmt::format("inconsistent sizes (N = {}, internal {}, physical {}, total {}; N must be 1 … {})", n_osc, ni,
+                    np, in.size(), kMaxHarmonicsBlock));
+  constexpr double kTwo32 = 4294967296.0, kTwo64 = 18446744073709551616.0;
+  if (!whole_in(in[4], 0.0, kTwo32 - 1) || !whole_in(in[5], 0.0, kTwo32 - 1))
+    bad("configuration fingerprint: each half must be a whole number in 0 … 2^32 - 1");
+  for (int i = 7; i <= 8; ++i)
+    if (!(whole_in(in[i], 0.0, kTwo64) && in[i] < kTwo64))
+      bad(fmt::format("counter [{}] = {:g}: must be a whole number in 0 … 2^64 - 1", i, in[i]));
+  if (in[7] > in[8]) bad(fmt::format("{:g} skipped samples of {:g} processed", in[7], in[8]));
+  // The held output and the coordinates: a state reached from samples within the input limit stays below
+  // kMaxStateMagnitude (the overflow argument in realtime_filter.hpp); a larger one was not saved by a filter.
+  for (std::size_t i = 6; i < in.size(); i = i == 6 ? kHeader : i + 1)
+    if (std::abs(in[i]) > kMaxStateMagnitude)
+      bad(fmt::format("entry [{}] = {:g}: the held output and the coordinates must be within ±{:g}", i, in[i],
+                      kMaxStateMagnitude));
   const std::uint64_t fp = (static_cast<std::uint64_t>(in[4]) << 32) | static_cast<std::uint64_t>(in[5]);
   std::vector<double> qv;
   if (fp == disc_.fingerprint && ni == disc_.n) {
@@ -596,6 +612,10 @@ void RealtimeFilter::restore_state(std::span<const double> in) {
     for (Eigen::Index i = 0; i < z.size(); ++i) z(i) = in[off + i];
     const Eigen::VectorXd q = to_internal(bank_, disc_, map_state(z, bank_.harmonics()));
     qv = pack(disc_, q.data());
+    for (double x : qv)
+      if (!(std::abs(x) <= kMaxStateMagnitude))
+        bad(fmt::format("its physical state maps to internal coordinates beyond ±{:g} in this configuration",
+                        kMaxStateMagnitude));
   }
   q_.swap(qv);
   held_ = in[6];

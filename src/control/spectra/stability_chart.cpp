@@ -117,6 +117,7 @@ void label_regions(const ChartSpec& spec, const RootTracker& tracker, StabilityC
         r.certified = true;
         return;
       }
+      spec.cancellation.check();
       const UnstableCount u = unstable_roots(spec.family.at(r.x, r.y));
       r.unstable_roots = u.count;
       r.certified = !u.marginal;
@@ -138,6 +139,7 @@ void label_regions(const ChartSpec& spec, const RootTracker& tracker, StabilityC
   // merged with the point's abscissa; if its count still disagrees, the certified spectrum (bounded effort)
   if (static_cast<long>(redo.size()) <= spec.max_recomputed_points) {
     parallel_for(static_cast<long>(redo.size()), spec.threads, [&](long i) {
+      spec.cancellation.check();
       const long p = redo[i];
       const LoopSpec loop = spec.family.at(c.x[p % nx], c.y[p / nx]);
       const TrackedSpectrum fresh = tracker.initial(loop);
@@ -167,6 +169,7 @@ StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(l
   std::vector<TrackedSpectrum> row_start(ny);
   TrackedSpectrum cur = tracker.initial(spec.family.at(c.x[0], c.y[0]));
   for (int j = 0; j < ny; ++j) {
+    spec.cancellation.check();
     const LoopSpec loop = spec.family.at(c.x[0], c.y[j]);
     cur = tracker.update(loop, cur, true);
     if (j % 16 == 15) cur = tracker.merge(cur, tracker.initial(loop));
@@ -176,6 +179,7 @@ StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(l
   parallel_for(ny, spec.threads, [&](long j) {
     TrackedSpectrum s = row_start[j];
     for (int i = 0; i < nx; ++i) {
+      spec.cancellation.check();
       if (i > 0) s = tracker.update(spec.family.at(c.x[i], c.y[j]), s, i % spec.seed_interval == 0);
       const std::size_t p = static_cast<std::size_t>(j) * nx + i;
       c.abscissa[p] = s.abscissa();
@@ -190,7 +194,8 @@ StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(l
 }
 
 MarginMap delay_margin_map(const LoopFamily& family, double x_min, double x_max, int x_points, double y_min,
-                           double y_max, int y_points, int threads, const std::function<void(long, long)>& progress) {
+                           double y_max, int y_points, int threads, const std::function<void(long, long)>& progress,
+                           const Cancellation& cancellation) {
   spectra_detail::validate_window(x_min, x_max, y_min, y_max);
   validate::in_range("x_points", static_cast<long>(x_points), 2L, 100000L);
   validate::in_range("y_points", static_cast<long>(y_points), 2L, 100000L);
@@ -201,6 +206,7 @@ MarginMap delay_margin_map(const LoopFamily& family, double x_min, double x_max,
   m.critical_delay.assign(n, 0.0);
   m.crossing_frequency.assign(n, 0.0);
   parallel_for(static_cast<long>(n), threads, [&](long p) {
+    cancellation.check();
     const int i = static_cast<int>(p % x_points), j = static_cast<int>(p / x_points);
     const DelayMargin dm = delay_margin(family.at(m.x[i], m.y[j]));
     m.critical_delay[p] = dm.stable_at_reference ? dm.upper : std::numeric_limits<double>::quiet_NaN();

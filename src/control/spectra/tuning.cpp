@@ -156,6 +156,7 @@ RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<voi
     errors.run([&] {
       WarmStart warm;
       for (int i = 0; i < n; ++i) {
+        spec.cancellation.check();
         out.coarse_worst_decay[static_cast<std::size_t>(j) * n + i] =
             objective(out.coarse_x[i], out.coarse_y[j], warm, nullptr, nullptr);
       }
@@ -177,6 +178,7 @@ RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<voi
   };
   int used = 0;
   const auto f = [&](const std::array<double, 2>& p) {
+    spec.cancellation.check();
     ++used;
     if (progress) progress(1, total);
     return -objective(p[0], p[1], warm, nullptr, nullptr);
@@ -240,6 +242,7 @@ RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<voi
 #pragma omp parallel for schedule(dynamic, 1) num_threads(nt)
   for (std::size_t i = 0; i < n_cert; ++i) {
     errors.run([&] {
+      spec.cancellation.check();
       const LoopSpec loop = spec.family.at(bx, by, objective.taus()[i % nt_tau], objective.rhos()[i / nt_tau]);
       cert[i] = -rightmost_roots(loop).spectral_abscissa;
     });

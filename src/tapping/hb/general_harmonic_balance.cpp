@@ -1037,9 +1037,10 @@ std::vector<HbPoint> GeneralHarmonicBalance::points_at_q(double q) const {
 }
 
 void GeneralHarmonicBalance::sample(const std::vector<double>& qs, bool include_minus, std::vector<HbPoint>& upper,
-                                    std::vector<HbPoint>& lower) const {
+                                    std::vector<HbPoint>& lower, const Cancellation& cancellation) const {
   // (sample index, point) pairs from every segment whose q range contains samples
   std::vector<std::pair<std::size_t, HbPoint>> found;
+  std::size_t evaluated = 0;  // a cancellation check every 4096 evaluations
   for (std::size_t ci = 0; ci < components_.size(); ++ci) {
     const auto& c = components_[ci];
     for (std::size_t k = 0; k + 1 < c.size(); ++k) {
@@ -1048,6 +1049,7 @@ void GeneralHarmonicBalance::sample(const std::vector<double>& qs, bool include_
       const double lo = std::min(qa, qb), hi = std::max(qa, qb);
       auto it = std::lower_bound(qs.begin(), qs.end(), lo);
       for (; it != qs.end() && *it <= hi; ++it) {
+        if ((++evaluated & 4095) == 0) cancellation.check();
         const double q = *it;
         const auto p = segment_point(q, c[k], c[k + 1]);
         if (p && (include_minus || p->branch != HbBranch::Minus))
@@ -1057,6 +1059,7 @@ void GeneralHarmonicBalance::sample(const std::vector<double>& qs, bool include_
     if (free_end_[ci] && c.size() >= 2) {
       const double q0 = c[0].e.g / c[0].e.b, q1 = c[1].e.g / c[1].e.b;
       for (std::size_t s = 0; s < qs.size(); ++s) {
+        if ((++evaluated & 4095) == 0) cancellation.check();
         if (!((qs[s] - q0) * (q0 - q1) > 0.0)) continue;
         Eval e;
         double slope;

@@ -58,7 +58,7 @@ class GeneralHarmonicBalance {
   /// The curve at the given q samples (increasing): Free/Plus points into `upper`, Minus points into `lower`
   /// (appended, by increasing q, then amplitude).
   void sample(const std::vector<double>& q_samples, bool include_minus, std::vector<HbPoint>& upper,
-              std::vector<HbPoint>& lower) const;
+              std::vector<HbPoint>& lower, const Cancellation& cancellation = {}) const;
   const std::vector<HbFold>& folds() const { return folds_; }
   double free_amplitude() const { return b_ref_; }
   /// Diagnostics: traced components, nodes, describing-function evaluations of the construction.

@@ -66,7 +66,7 @@ void general_curve(const TappingModel& model, const HbCurveOptions& options, std
   const detail::GeneralHarmonicBalance hb(model);
   std::vector<HbPoint> lower;
   out.clear();
-  hb.sample(qs, options.include_minus, out, lower);
+  hb.sample(qs, options.include_minus, out, lower, options.cancellation);
   out.insert(out.end(), lower.begin(), lower.end());
 }
 
@@ -87,7 +87,9 @@ void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& opt
   std::size_t n_minus = 0;
   const double b_free = c.free_amplitude();
   const double phase_free = c.free_phase();
+  std::size_t visited = 0;
   for_each_sample(options, [&](double q, double gap) {
+    if ((++visited & 4095) == 0) options.cancellation.check();
     if (gap <= 0.0) {
       out[n_plus++] = {q, q * b_free, b_free, 0.0, phase_free, HbBranch::Free};
       return;

@@ -104,6 +104,7 @@ struct Tracer {
     double ds = options.initial_step;
     out.points.push_back(make_point(z, r, omega, s, 0));
     for (;;) {
+      options.cancellation.check();
       if (static_cast<int>(out.points.size()) >= options.max_points) return Stop::max_points;
       if (std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count() >
           options.time_budget_seconds)
@@ -216,7 +217,8 @@ ContinuationResult continue_orbits(const TappingModel& base, const PeriodicOrbit
     case Stop::none: break;
   }
   if (options.analyse_points)
-    detail::finish_points(base, out.points, options.shooting.simulation, options.harmonic_balance, options.parallel);
+    detail::finish_points(base, out.points, options.shooting.simulation, options.harmonic_balance, options.parallel,
+                          options.cancellation);
   return out;
 }
 
@@ -225,6 +227,7 @@ ContinuationResult sweep_continuation(const TappingModel& base, double l_min, do
   validate::finite("separation_min", l_min);
   OrbitSearchOptions search;
   search.shooting = options.shooting;
+  search.cancellation = options.cancellation;
   const OrbitSearchResult found = find_orbits(base.with_separation(l_min), search);
   const FoundOrbit* best = nullptr;
   for (const FoundOrbit& f : found.orbits)

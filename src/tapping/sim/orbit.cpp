@@ -288,6 +288,7 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     errors.run([&] {
+    options.cancellation.check();
     try {
       switch (tasks[i].kind) {
         case SeedKind::transient:
@@ -353,6 +354,7 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
     copt.min_step = 1e-6 * std::max(1.0, free_amplitude);
     copt.initial_step = std::clamp(0.1 * w, copt.min_step, copt.max_step);
     copt.time_budget_seconds = options.shooting.time_budget_seconds;
+    copt.cancellation = options.cancellation;
     std::vector<std::pair<PeriodicOrbit, bool>> runs;
     for (const FoundOrbit& f : out.orbits)
       if (f.orbit.period_multiple == 1)
@@ -388,6 +390,7 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
     for (std::size_t i = 0; i < more.size(); ++i) {
       errors.run([&] {
+        options.cancellation.check();
         try {
           shot[i] = try_shoot(model, more[i].start, 1, options.shooting);
         } catch (const NumericalFailure&) {
@@ -405,7 +408,7 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
 
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
   for (std::size_t i = 0; i < out.orbits.size(); ++i)
-    errors.run([&] { out.orbits[i].metrics = analyse_orbit(model, out.orbits[i].orbit, options.shooting.simulation); });
+    errors.run([&] { options.cancellation.check(); out.orbits[i].metrics = analyse_orbit(model, out.orbits[i].orbit, options.shooting.simulation); });
   errors.rethrow();
   // by increasing amplitude; renumber the seeds' orbit indices
   std::vector<int> order(out.orbits.size());

@@ -235,6 +235,7 @@ std::vector<SweepPoint> run_direction(const TappingModel& base, const std::vecto
   out.push_back(first);
   if (options.progress) options.progress(1);
   for (std::size_t k = 1; k < ls.size(); ++k) {
+    options.cancellation.check();
     out.push_back(continue_point(base.with_separation(ls[k]), out[k - 1], direction, options));
     if (out.back().jumped) jumps.push_back(ls[k]);
     if (options.progress) options.progress(1);
@@ -247,13 +248,14 @@ std::vector<SweepPoint> run_direction(const TappingModel& base, const std::vecto
 namespace detail {
 
 void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
-                   bool harmonic_balance, bool parallel) {
+                   bool harmonic_balance, bool parallel, const Cancellation& cancellation) {
   std::optional<HarmonicBalance> hb;  // branch scan once, cheap queries
   if (harmonic_balance) hb.emplace(base);  // any law (closed form for piecewise-linear ones)
   ExceptionCollector errors;
 #pragma omp parallel for schedule(dynamic) if (parallel)
   for (std::size_t i = 0; i < points.size(); ++i) {
     errors.run([&] {
+      cancellation.check();
       SweepPoint& p = points[i];
       p.metrics = analyse_orbit(base.with_separation(p.separation), p.orbit, simulation);
       if (hb) attach_from(hb->solutions(p.separation), p);
@@ -305,8 +307,10 @@ SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separ
   SweepPoint turn = result.approach.back();
   turn.jumped = false;
   result.retract = run_direction(base, up, turn, SweepDirection::retract, options, result.retract_jumps);
-  detail::finish_points(base, result.approach, options.shooting.simulation, options.harmonic_balance, options.parallel);
-  detail::finish_points(base, result.retract, options.shooting.simulation, options.harmonic_balance, options.parallel);
+  detail::finish_points(base, result.approach, options.shooting.simulation, options.harmonic_balance, options.parallel,
+                        options.cancellation);
+  detail::finish_points(base, result.retract, options.shooting.simulation, options.harmonic_balance, options.parallel,
+                        options.cancellation);
   return result;
 }
 
@@ -321,6 +325,7 @@ std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::v
 #pragma omp parallel for schedule(dynamic) if (options.parallel)
   for (std::size_t i = 0; i < separations.size(); ++i) {
     errors.run([&] {
+      options.cancellation.check();
       out[i] = find_orbits(base.with_separation(separations[i]), inner);
       if (progress) {
 #pragma omp critical(afmkit_grid_progress)

@@ -7,6 +7,6 @@
 namespace afmkit::tapping::detail {
 
 void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
-                   bool harmonic_balance, bool parallel);
+                   bool harmonic_balance, bool parallel, const Cancellation& cancellation = {});
 
 }  // namespace afmkit::tapping::detail
