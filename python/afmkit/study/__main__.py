@@ -2,6 +2,7 @@
 [--chunk-seconds 1] [--chunk-points N] [--netcdf F] [--quiet]: runs the study described in the TOML file FILE
 (docs/study.md)."""
 import argparse
+import importlib.util
 import math
 import os
 import signal
@@ -57,6 +58,13 @@ def main(argv=None) -> int:
     def where(e) -> str:  # every message names the study file
         return "" if args.file in str(e) else f"{args.file}: "
 
+    missing = [pkg for module, pkg in (("xarray", "python3-xarray"), ("zarr", "python3-zarr"),
+                                       ("distributed", "python3-distributed"), ("netCDF4", "python3-netcdf4"))
+               if importlib.util.find_spec(module) is None]
+    if missing:  # the machine's set-up, not the study file: exit 1
+        print(f"afmkit study: needs the Debian packages {' '.join(missing)} (scripts/bootstrap.sh --all installs "
+              "them; docs/study.md)", file=sys.stderr)
+        return 1
     try:
         study = Study.from_toml(args.file)
         settings = _run_settings(args.file)
