@@ -2,6 +2,7 @@
 // force law, issue 7.2) sampled over the penetration parameter q, as CSV (q, separation, amplitude, offset, phase,
 // branch) with a JSON sidecar holding the folds (jump points), the free amplitude and the solutions at `separation`;
 // --json prints them (with the curve when --output "" writes no file).
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -33,6 +34,16 @@ nlohmann::json point_json(const tapping::HbPoint& p, const TappingScales& s) {
           {"branch", tapping::branch_name(p.branch)}};
 }
 
+/// The units: by dimension, and per results key (the units of study outputs, docs/study.md#outputs).
+nlohmann::json hb_units(const TappingScales& s) {
+  const std::string L = s.length_unit;
+  const nlohmann::json point = {{"q", "dimensionless"}, {"separation", L}, {"amplitude", L}, {"offset", L},
+                                {"phase", "rad"}, {"branch", "label"}, {"kind", "label"}};
+  return {{"length", L},       {"phase", "rad"},   {"q", "dimensionless"},
+          {"folds", point},    {"free_amplitude", L}, {"solutions_at_separation", point},
+          {"rows", "count"},   {"minimum_separation_limit", L}};
+}
+
 void run_hb(const io::ParamSet& p, Captured* capture) {
   const double q_min = p.real("q_min");
   const double q_max = p.real("q_max");
@@ -57,8 +68,13 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   write_hb_rows(out, curve, scales);
 
   const tapping::HarmonicBalance hb(model);
+  // folds as records sorted by separation (as `tapping sweep` reports its folds and jumps)
+  std::vector<tapping::HbFold> sorted = hb.folds();
+  std::stable_sort(sorted.begin(), sorted.end(), [](const tapping::HbFold& a, const tapping::HbFold& b) {
+    return a.point.separation < b.point.separation;
+  });
   nlohmann::json folds = nlohmann::json::array();
-  for (const tapping::HbFold& f : hb.folds()) {
+  for (const tapping::HbFold& f : sorted) {
     nlohmann::json j = point_json(f.point, scales);
     j["kind"] = f.separation_maximum ? "maximum" : "minimum";
     folds.push_back(j);
@@ -69,7 +85,7 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
                             {"free_amplitude", hb.free_amplitude() * scales.length},
                             {"solutions_at_separation", solutions},
                             {"rows", out.rows()},
-                            {"units", {{"length", scales.length_unit}, {"phase", "rad"}, {"q", "dimensionless"}}}};
+                            {"units", hb_units(scales)}};
   if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
     if (const auto limit = tapping::minimum_separation_limit(model))
       results["minimum_separation_limit"] = *limit * scales.length;  // −∞ is written "-inf"

@@ -109,7 +109,8 @@ TEST(Sweep, ContinuationPassesTheFoldWithUnstableMiddleBranch) {
   const auto model = loop_model();
   const ContinuationResult c = sweep_continuation(model, 8.8, 10.4);
   ASSERT_EQ(c.folds.size(), 1u);
-  EXPECT_NEAR(c.folds[0], 10.1138, 5e-4);
+  EXPECT_NEAR(c.folds[0].separation, 10.1138, 5e-4);
+  EXPECT_TRUE(c.folds[0].separation_maximum);  // the contact branch turns back at its largest l
   ASSERT_EQ(c.grazing.size(), 1u);
   EXPECT_NEAR(c.grazing[0], model.free_amplitude(), 1e-9);
   // stable contact branch up to the fold, unstable branch back down to grazing, stable free branch after
@@ -118,7 +119,7 @@ TEST(Sweep, ContinuationPassesTheFoldWithUnstableMiddleBranch) {
     EXPECT_EQ(p.direction, SweepDirection::continuation);
     if (phase == 0 && !p.orbit.stable) phase = 1;
     if (phase == 1 && p.orbit.stable) phase = 2;
-    if (phase == 0) EXPECT_LT(p.separation, c.folds[0] + 1e-9);
+    if (phase == 0) EXPECT_LT(p.separation, c.folds[0].separation + 1e-9);
     if (phase == 1) {
       ++unstable;
       EXPECT_GT(p.separation, model.free_amplitude());
