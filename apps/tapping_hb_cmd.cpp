@@ -2,7 +2,6 @@
 // force law, issue 7.2) sampled over the penetration parameter q, as CSV (q, separation, amplitude, offset, phase,
 // branch) with a JSON sidecar holding the folds (jump points), the free amplitude and the solutions at `separation`;
 // --json prints them (with the curve when --output "" writes no file).
-#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -69,16 +68,7 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
 
   const tapping::HarmonicBalance hb(model);
   // folds as records sorted by separation (as `tapping sweep` reports its folds and jumps)
-  std::vector<tapping::HbFold> sorted = hb.folds();
-  std::stable_sort(sorted.begin(), sorted.end(), [](const tapping::HbFold& a, const tapping::HbFold& b) {
-    return a.point.separation < b.point.separation;
-  });
-  nlohmann::json folds = nlohmann::json::array();
-  for (const tapping::HbFold& f : sorted) {
-    nlohmann::json j = point_json(f.point, scales);
-    j["kind"] = f.separation_maximum ? "maximum" : "minimum";
-    folds.push_back(j);
-  }
+  const nlohmann::json folds = hb_fold_records(hb, scales);
   nlohmann::json solutions = nlohmann::json::array();
   for (const tapping::HbPoint& s : hb.solutions(model.separation)) solutions.push_back(point_json(s, scales));
   nlohmann::json results = {{"folds", folds},
