@@ -158,18 +158,36 @@ Walk walk(const json& root, const std::vector<Step>& path) {
   return w;
 }
 
-/// The unit the command's "units" document gives the path (its keys; list indices and filters skipped; a unit
+/// The unit a "units" document gives the path from `from` on (its keys; list indices and filters skipped; a unit
 /// given for a key covers what lies below it), or "".
-std::string unit_of(const json& results, const std::vector<Step>& path) {
-  if (!results.contains("units") || !results.at("units").is_object()) return "";
-  const json* u = &results.at("units");
-  for (const Step& step : path) {
+std::string unit_in(const json& units, const std::vector<Step>& path, std::size_t from) {
+  const json* u = &units;
+  for (std::size_t k = from; k < path.size(); ++k) {
+    const Step& step = path[k];
     if (step.is_index) continue;
     if (u->is_string()) return u->get<std::string>();  // one unit for everything below (e.g. counts per kind)
     if (!u->is_object() || !u->contains(step.key)) return "";
     u = &u->at(step.key);
   }
   return u->is_string() ? u->get<std::string>() : "";
+}
+
+/// The unit of a results path: from the command's top-level "units", else from a "units" document of a record
+/// on the way (e.g. tau0/units/beta_critical), or "".
+std::string unit_of(const json& results, const std::vector<Step>& path) {
+  const json* node = &results;
+  for (std::size_t k = 0; k < path.size() && node; ++k) {
+    if (node->is_object() && node->contains("units") && node->at("units").is_object()) {
+      const std::string u = unit_in(node->at("units"), path, k);
+      if (!u.empty()) return u;
+    }
+    const Step& step = path[k];
+    while (node && node->is_array()) node = node->empty() ? nullptr : &node->front();  // a record stands for all
+    if (!node) break;
+    if (step.is_index) continue;
+    node = node->is_object() && node->contains(step.key) ? &node->at(step.key) : nullptr;
+  }
+  return "";
 }
 
 std::string joined_columns(const cli::Captured& c) {

@@ -142,6 +142,9 @@ def test_every_output_has_its_unit():
                                           "orbits/0/floquet_multipliers/0/re"]) == {
         "free_amplitude": "L", "orbits/0/peak_force": "L/t^2", "search/seeds_by_kind/grid": "count",
         "orbits/0/floquet_multipliers/0/re": "dimensionless"}
+    # a record's own "units" (control margin: tau0/units) names its numbers
+    assert units("control margin", {}, ["tau0/beta_critical", "critical_delay"]) == {
+        "tau0/beta_critical": "Omega", "critical_delay": "T"}
 
 
 def _numeric_leaves(doc, path=()):
