@@ -5,7 +5,7 @@
 // down to l_min (approach) and back up (retract); each orbit is continued from the previous one along its branch
 // (follow_branch: Newton from the tangent prediction, in sub-steps of l). The Floquet multipliers are checked at
 // every sub-step: a sub-step is shortened where the stability margins det(I − M), det(I + M) shrink by more than
-// half or the orbit moves by more than state_resolution·A_free, so stability is resolved between grid points
+// half or the orbit moves by more than state_resolution·max(A_free, |z|), so stability is resolved between grid points
 // whatever the grid. Where the followed branch ceases to be stable (a fold, a multiplier through −1, or a corner
 // into another branch) the sub-step is bisected down to jump_tolerance·A_free: the jump is located there, the
 // physical transient is simulated from the last stable state just beyond it until it settles on another orbit,
@@ -38,8 +38,8 @@ struct SweepOptions {
   bool harmonic_balance = true;  // put the nearest HB solution beside each point (any law)
   /// Sub-step budget of follow_branch per separation step (halving / doubling the step in l).
   int max_substeps = 200;
-  /// Resolution of the followed branch: a sub-step moves the scaled orbit state (x, ẋ/ω) by at most this times
-  /// the free amplitude (features of the branch smaller than that may be stepped over).
+  /// Resolution of the followed branch: a sub-step moves the scaled orbit state z = (x, ẋ/ω) by at most this times
+  /// max(A_free, |z|) (features of the branch smaller than that may be stepped over).
   double state_resolution = 0.05;
   /// Jumps are located to within this times the free amplitude (the bisection of the sub-step where the followed
   /// branch ceases to be stable stops there; the reported separation is the middle of the last bracket).
@@ -98,7 +98,7 @@ struct SweepResult {
 /// in l, each a Newton solve from the tangent prediction z + Δl·dz/dl (dz/dl = −(M − I)⁻¹ ∂P/∂l), accepted when
 /// the converged orbit is stable and lies within |Δl|·max|dz/dl| of the prediction (continuity: O(Δl²) on a
 /// smooth branch, O(Δl) at a corner such as grazing), the stability margins det(I − M) and det(I + M) have not
-/// shrunk by more than half and the scaled state has moved by at most state_resolution·A_free; a rejected
+/// shrunk by more than half and the scaled state has moved by at most state_resolution·max(A_free, |z|); a rejected
 /// sub-step is halved, an accepted one doubled. Returns the orbit at l_to, or nullopt when the branch ends before
 /// l_to — a fold (no orbit or only another branch beyond it), a loss of stability, or the sub-step falling below
 /// jump_tolerance·A_free — or the budget of max_substeps Newton solves is spent. `from` must be a converged orbit

@@ -180,7 +180,9 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
   const double amplitude = base_amplitude(base);
   // below this sub-step the branch is taken to end (fold, loss of stability, or a corner into another branch)
   const double h_min = options.jump_tolerance * amplitude;
-  const double max_move = options.state_resolution * amplitude;  // largest move of the scaled state per sub-step
+  // largest move of the scaled state per sub-step (relative to the larger of A_free and the state, e.g. a deep
+  // static deflection in contact)
+  const double max_move = options.state_resolution * amplitude;
   // from the tangent prediction Newton converges in a few iterations; a slow start means the step is too long
   ShootingOptions quick = shooting;
   quick.max_iterations = std::min(quick.max_iterations, 8);
@@ -222,7 +224,7 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
       // resolved (a step over a fold pair or an interval of instability is shortened until it is seen)
       if (accepted && std::abs(dl) > 2.0 * h_min &&
           (!margins_resolved(current, *next) || multiplier_move(current, *next) > kMaxMultiplierMove ||
-           (scaled(next->initial, omega) - z).norm() > max_move)) {
+           (scaled(next->initial, omega) - z).norm() > max_move * std::max(1.0, z.norm() / amplitude))) {
         accepted = false;
         resolved = false;
       }
