@@ -75,10 +75,7 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
   hb_options.points = 4000;
   const auto curve = tapping::harmonic_balance_curve(model, hb_options);
   const tapping::HarmonicBalance balance(model);
-  nlohmann::json folds = nlohmann::json::array();
-  for (const auto& f : balance.folds())
-    folds.push_back({{"separation", f.point.separation * scales.length}, {"amplitude", f.point.amplitude * scales.length},
-                     {"q", f.point.q}});
+  const nlohmann::json folds = hb_fold_records(balance, scales);  // sorted by separation, as `tapping hb`
 
   // 2. Approach–retract sweep, each orbit continued from the previous one (shooting).
   io::Progress progress("demo sweep", 2L * points, true, 1.0);

@@ -32,6 +32,16 @@ nlohmann::json point_json(const tapping::HbPoint& p, const TappingScales& s) {
           {"branch", tapping::branch_name(p.branch)}};
 }
 
+/// The units: by dimension, and per results key (the units of study outputs, docs/study.md#outputs).
+nlohmann::json hb_units(const TappingScales& s) {
+  const std::string L = s.length_unit;
+  const nlohmann::json point = {{"q", "dimensionless"}, {"separation", L}, {"amplitude", L}, {"offset", L},
+                                {"phase", "rad"}, {"branch", "label"}, {"kind", "label"}};
+  return {{"length", L},       {"phase", "rad"},   {"q", "dimensionless"},
+          {"folds", point},    {"free_amplitude", L}, {"solutions_at_separation", point},
+          {"rows", "count"},   {"minimum_separation_limit", L}};
+}
+
 void run_hb(const io::ParamSet& p, Captured* capture) {
   const double q_min = p.real("q_min");
   const double q_max = p.real("q_max");
@@ -57,19 +67,15 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   write_hb_rows(out, curve, scales);
 
   const tapping::HarmonicBalance hb(model);
-  nlohmann::json folds = nlohmann::json::array();
-  for (const tapping::HbFold& f : hb.folds()) {
-    nlohmann::json j = point_json(f.point, scales);
-    j["kind"] = f.separation_maximum ? "maximum" : "minimum";
-    folds.push_back(j);
-  }
+  // folds as records sorted by separation (as `tapping sweep` reports its folds and jumps)
+  const nlohmann::json folds = hb_fold_records(hb, scales);
   nlohmann::json solutions = nlohmann::json::array();
   for (const tapping::HbPoint& s : hb.solutions(model.separation)) solutions.push_back(point_json(s, scales));
   nlohmann::json results = {{"folds", folds},
                             {"free_amplitude", hb.free_amplitude() * scales.length},
                             {"solutions_at_separation", solutions},
                             {"rows", out.rows()},
-                            {"units", {{"length", scales.length_unit}, {"phase", "rad"}, {"q", "dimensionless"}}}};
+                            {"units", hb_units(scales)}};
   if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
     if (const auto limit = tapping::minimum_separation_limit(model))
       results["minimum_separation_limit"] = *limit * scales.length;  // −∞ is written "-inf"

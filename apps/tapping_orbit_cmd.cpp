@@ -101,6 +101,22 @@ nlohmann::json orbit_json(const tapping::FoundOrbit& f, const tapping::OrbitSear
           {"shooting_residual", o.residual}};
 }
 
+/// The unit of every number of orbit_json.
+nlohmann::json orbit_units(const TappingScales& s) {
+  const std::string L = s.length_unit;
+  return {{"found_by", "count"},           {"seeds", "count"},
+          {"period_multiple", "count"},    {"stable", "boolean (0/1)"},
+          {"floquet_max", "dimensionless"}, {"floquet_multipliers", "dimensionless"},
+          {"amplitude", L},                {"offset", L},
+          {"phase", "rad"},                {"harmonics", L},
+          {"contact_fraction", "dimensionless"}, {"peak_force", s.force_unit},
+          {"min_gap", L},                  {"drive_work", s.energy_unit},
+          {"viscous_dissipation", s.energy_unit}, {"contact_dissipation", s.energy_unit},
+          {"energy_dissipated", s.energy_unit},   {"sticking_time", s.time_unit},
+          {"initial_position", L},         {"initial_velocity", L + "/" + s.time_unit},
+          {"shooting_residual", "dimensionless"}};
+}
+
 void run_orbit(const io::ParamSet& p, Captured* capture) {
   const tapping::TappingModel model = tapping_model_from(p);
   const TappingScales scales = tapping_scales_from(p);
@@ -148,8 +164,18 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
       {"orbits", orbits},
       {"transients", transients},
       {"search", search_json(r.report, scales)},
-      {"units", {{"length", length}, {"velocity", velocity}, {"force", scales.force_unit},
-                 {"energy", scales.energy_unit}, {"time", scales.time_unit}, {"phase", "rad"}, {"seconds", "s"}}}};
+      {"units",
+       {{"length", length}, {"velocity", velocity}, {"force", scales.force_unit}, {"energy", scales.energy_unit},
+        {"time", scales.time_unit}, {"phase", "rad"}, {"seconds", "s"},
+        // per results key (the units of study outputs, docs/study.md#outputs)
+        {"separation", length}, {"free_amplitude", length},
+        {"harmonic_balance", {{"q", "dimensionless"}, {"amplitude", length}, {"offset", length}, {"phase", "rad"}}},
+        {"orbits", orbit_units(scales)},
+        {"transients", {{"periods_simulated", "count"}, {"period_multiple", "count"}}},
+        {"search", {{"seeds_by_kind", "count"}, {"converged_by_kind", "count"}, {"seeds_total", "count"},
+                    {"continuation_runs", "count"}, {"continuation_bracket", length}, {"seconds", "s"},
+                    {"seeds", {{"initial_position", length}, {"initial_velocity", velocity}, {"orbits", "count"},
+                               {"grid_phase", "rad"}, {"grid_amplitude", length}}}}}}}};
   CommandOutput out(p, capture, "tapping orbit");
   out.open({{"source", "label", "how the orbit was found first (harmonic_balance, transient, grid, contact, continuation)"},
             {"period_multiple", "count", "n of a period-n orbit (1: the drive period)"},

@@ -34,6 +34,67 @@ nlohmann::json scaled(const std::vector<double>& v, double f) {
   return j;
 }
 
+/// "contact" when the orbit spends part of its period below the law's contact gap, else "free".
+const char* branch_of(const tapping::OrbitMetrics& m) { return m.contact_fraction > 0.0 ? "contact" : "free"; }
+
+/// Records sorted by separation (ties: in the order given).
+nlohmann::json sorted_by_separation(nlohmann::json records) {
+  std::stable_sort(records.begin(), records.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
+    return a["separation"].get<double>() < b["separation"].get<double>();
+  });
+  return records;
+}
+
+/// The instrument sweep's jumps as records, sorted by separation.
+nlohmann::json jump_records(const std::vector<tapping::SweepJump>& jumps, const TappingScales& s) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const tapping::SweepJump& j : jumps)
+    out.push_back({{"separation", j.separation * s.length},
+                   {"tolerance", j.tolerance * s.length},
+                   {"direction", tapping::direction_name(j.direction)},
+                   {"located", j.located},
+                   {"branch", branch_of(j.from_metrics)},
+                   {"amplitude_before", j.from_metrics.amplitude * s.length},
+                   {"amplitude_after", j.to_metrics.amplitude * s.length},
+                   {"landed_periodic", j.landed_periodic}});
+  return sorted_by_separation(std::move(out));
+}
+
+/// The continuation's folds as records (as `tapping hb` reports its folds), sorted by separation.
+nlohmann::json fold_records(const tapping::ContinuationResult& c, const TappingScales& s) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const tapping::ContinuationFold& f : c.folds) {
+    const tapping::OrbitMetrics& m = c.points.at(f.point).metrics;
+    out.push_back({{"separation", f.separation * s.length},
+                   {"amplitude", m.amplitude * s.length},
+                   {"offset", m.offset * s.length},
+                   {"phase", m.phase},
+                   {"branch", branch_of(m)},
+                   {"kind", f.separation_maximum ? "maximum" : "minimum"}});
+  }
+  return sorted_by_separation(std::move(out));
+}
+
+/// The units: by dimension, and per results key (the units of study outputs, docs/study.md#outputs).
+nlohmann::json sweep_units(const TappingScales& s) {
+  const std::string L = s.length_unit;
+  return {{"length", L},
+          {"energy", s.energy_unit},
+          {"force", s.force_unit},
+          {"approach_jumps", L},
+          {"retract_jumps", L},
+          {"jump_tolerance", L},
+          {"jumps", {{"separation", L}, {"tolerance", L}, {"direction", "label"}, {"located", "boolean (0/1)"},
+                     {"branch", "label"}, {"amplitude_before", L}, {"amplitude_after", L},
+                     {"landed_periodic", "boolean (0/1)"}}},
+          {"folds", {{"separation", L}, {"amplitude", L}, {"offset", L}, {"phase", "rad"}, {"branch", "label"},
+                     {"kind", "label"}}},
+          {"grazing", L},
+          {"continuation_points", "count"},
+          {"free_amplitude", L},
+          {"rows", "count"}};
+}
+
 /// The separations of the instrument sweep (model units): the explicit list (`separations` or `separations_file`)
 /// when one is given, else `points` equally spaced in [separation_min, separation_max].
 std::vector<double> sweep_separations(const io::ParamSet& p, double length_scale) {
@@ -97,8 +158,12 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     write_rows(r.retract);
     results["approach_jumps"] = scaled(r.approach_jumps, scales.length);
     results["retract_jumps"] = scaled(r.retract_jumps, scales.length);
-    summary += fmt::format("instrument sweep: jumps on approach at {}, on retract at {} ({})",
-                           results["approach_jumps"].dump(), results["retract_jumps"].dump(), scales.length_unit);
+    results["jumps"] = jump_records(r.jumps, scales);
+    const double tolerance = options.jump_tolerance * base.free_amplitude() * scales.length;
+    results["jump_tolerance"] = tolerance;
+    summary += fmt::format("instrument sweep: jumps on approach at {}, on retract at {} ({}, located to ±{:.2g})",
+                           results["approach_jumps"].dump(), results["retract_jumps"].dump(), scales.length_unit,
+                           tolerance);
   }
   if (continuation) {
     tapping::ContinuationOptions options;
@@ -109,17 +174,19 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     options.cancellation = cancellation_of(capture);
     const tapping::ContinuationResult c = tapping::sweep_continuation(base, l_min, l_max, options);
     write_rows(c.points);
-    results["folds"] = scaled(c.folds, scales.length);
+    results["folds"] = fold_records(c, scales);
     results["grazing"] = scaled(c.grazing, scales.length);
     results["continuation_stop"] = c.stop_reason;
     results["continuation_points"] = c.points.size();
+    std::vector<double> folds;
+    for (const auto& f : results["folds"]) folds.push_back(f["separation"].get<double>());
     summary += fmt::format("{}continuation: {} points, folds at {}, grazing at {} ({}; {})", summary.empty() ? "" : "\n",
-                           c.points.size(), results["folds"].dump(), results["grazing"].dump(), scales.length_unit,
+                           c.points.size(), scaled(folds, 1.0).dump(), results["grazing"].dump(), scales.length_unit,
                            c.stop_reason);
   }
   results["free_amplitude"] = base.free_amplitude() * scales.length;
   results["rows"] = out.rows();
-  results["units"] = {{"length", scales.length_unit}, {"energy", scales.energy_unit}, {"force", scales.force_unit}};
+  results["units"] = sweep_units(scales);
   out.finish(results, summary);
 }
 

@@ -1,5 +1,7 @@
 #include "tapping_tables.hpp"
 
+#include <algorithm>
+
 namespace afmkit::cli {
 
 std::vector<io::Column> hb_columns(const tapping::UnitScales& s) {
@@ -11,6 +13,23 @@ std::vector<io::Column> hb_columns(const tapping::UnitScales& s) {
           {"phase", "rad", "phase lag φ of the first harmonic behind the drive (docs/conventions.md), in (-π, π]"},
           {"branch", "label", "root of the harmonic-balance quadratic: plus, minus or free "
                               "(docs/theory-tapping.md#two-branch-solution)"}};
+}
+
+nlohmann::json hb_fold_records(const tapping::HarmonicBalance& hb, const tapping::UnitScales& s) {
+  std::vector<tapping::HbFold> sorted = hb.folds();
+  std::stable_sort(sorted.begin(), sorted.end(), [](const tapping::HbFold& a, const tapping::HbFold& b) {
+    return a.point.separation < b.point.separation;
+  });
+  nlohmann::json out = nlohmann::json::array();
+  for (const tapping::HbFold& f : sorted)
+    out.push_back({{"q", f.point.q},
+                   {"separation", f.point.separation * s.length},
+                   {"amplitude", f.point.amplitude * s.length},
+                   {"offset", f.point.offset * s.length},
+                   {"phase", f.point.phase},
+                   {"branch", tapping::branch_name(f.point.branch)},
+                   {"kind", f.separation_maximum ? "maximum" : "minimum"}});
+  return out;
 }
 
 std::vector<io::Column> sweep_columns(const tapping::UnitScales& s) {

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "afmkit/io/output.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/sweep.hpp"
@@ -21,6 +23,10 @@ void write_hb_rows(Table& out, const std::vector<tapping::HbPoint>& curve, const
     out.row(pt.q, pt.separation * s.length, pt.amplitude * s.length, pt.offset * s.length, pt.phase,
             tapping::branch_name(pt.branch));
 }
+
+/// The folds of harmonic balance as records (q, separation, amplitude, offset, phase, branch, kind = maximum or
+/// minimum of l(q)) sorted by separation — as `tapping hb` and `demo` report them.
+nlohmann::json hb_fold_records(const tapping::HarmonicBalance& hb, const tapping::UnitScales& s);
 
 /// Columns: separation, direction, amplitude, offset, phase, stable, contact_fraction, energy_dissipated,
 /// then peak_force, min_gap, floquet_max, period_multiple, periodic, jumped, arclength, harmonic_2, harmonic_3,

@@ -30,9 +30,16 @@ struct ContinuationOptions {
   void validate() const;
 };
 
+/// A fold of the continued branch: l(s) has a local extremum there (dl/ds changed sign).
+struct ContinuationFold {
+  double separation = 0.0;         // located by cubic Hermite interpolation of l(s) between the two points
+  bool separation_maximum = false; // true: l has a local maximum (two orbits disappear for larger l)
+  std::size_t point = 0;           // index into points of the point nearer the fold (its orbit describes it)
+};
+
 struct ContinuationResult {
   std::vector<SweepPoint> points;  // direction = continuation, in arclength order
-  std::vector<double> folds;       // separations where l turned (dl/ds changed sign)
+  std::vector<ContinuationFold> folds;  // in arclength order
   /// Separations where a contact branch ran into grazing and the continuation hopped onto the free branch.
   std::vector<double> grazing;
   std::string stop_reason;         // "left range", "max points", "step below min_step (…)" …

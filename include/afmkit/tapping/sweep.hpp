@@ -3,9 +3,13 @@
 //
 // sweep_instrument: what an AFM does in an approach–retract curve. The separation l is stepped from l_max
 // down to l_min (approach) and back up (retract); each orbit is continued from the previous one along its branch
-// (follow_branch: Newton from the tangent prediction, in sub-steps of l where needed). Where the followed branch
-// ends before the next separation (a fold, a loss of stability, or a corner into another branch) the physical
-// transient is simulated from the previous state at the new l until it settles, then shot.
+// (follow_branch: Newton from the tangent prediction, in sub-steps of l). The Floquet multipliers are checked at
+// every sub-step: a sub-step is shortened where the stability margins det(I − M), det(I + M) shrink by more than
+// half or the orbit moves by more than state_resolution·max(A_free, |z|), so stability is resolved between grid points
+// whatever the grid. Where the followed branch ceases to be stable (a fold, a multiplier through −1, or a corner
+// into another branch) the sub-step is bisected down to jump_tolerance·A_free: the jump is located there, the
+// physical transient is simulated from the last stable state just beyond it until it settles on another orbit,
+// and that orbit is followed on to the next grid point (several jumps may happen between two grid points).
 //
 // A jump is a discontinuity of the continued orbit — a change of branch — not a large step: a point is marked
 // jumped only when neither the previous orbit's branch reaches the new orbit (forward follow) nor the new orbit's
@@ -34,6 +38,15 @@ struct SweepOptions {
   bool harmonic_balance = true;  // put the nearest HB solution beside each point (any law)
   /// Sub-step budget of follow_branch per separation step (halving / doubling the step in l).
   int max_substeps = 200;
+  /// Resolution of the followed branch: a sub-step moves the scaled orbit state z = (x, ẋ/ω) by at most this times
+  /// max(A_free, |z|) (features of the branch smaller than that may be stepped over).
+  double state_resolution = 0.05;
+  /// Jumps are located to within this times the free amplitude (the bisection of the sub-step where the followed
+  /// branch ceases to be stable stops there; the reported separation is the middle of the last bracket).
+  double jump_tolerance = 1e-5;
+  /// A response that does not settle (non-periodic) is stepped by transients in sub-steps of this times the free
+  /// amplitude until it settles on a periodic orbit (the exit from it is known to that sub-step).
+  double transient_step = 0.005;
   bool parallel = true;  // OpenMP where points are independent (HB evaluation, grid sweeps, both directions)
   /// Called with the number of newly finished points (thread-safe callers only: may be called concurrently).
   std::function<void(long)> progress;
@@ -60,23 +73,52 @@ struct SweepPoint {
   int hb_solutions = 0;  // number of HB solutions at this l
 };
 
+/// A jump of the instrument sweep: where the followed branch ceased to be stable and the tip landed on another.
+struct SweepJump {
+  double separation = 0.0;  // located: the middle of the last bracket [last stable orbit, first failed sub-step]
+  double tolerance = 0.0;   // half the bracket: |separation − where the branch ceases to be stable| <= tolerance
+  SweepDirection direction = SweepDirection::approach;
+  bool located = true;      // false: after a non-periodic point (reported at the grid point, grid resolution)
+  PeriodicOrbit from;       // the last stable orbit of the branch left
+  PeriodicOrbit to;         // the orbit landed on (at to.separation, just beyond the jump; non-periodic: one period)
+  bool landed_periodic = true;
+  OrbitMetrics from_metrics, to_metrics;  // filled with the points' metrics
+};
+
 struct SweepResult {
   std::vector<SweepPoint> approach;  // l decreasing from l_max to l_min
   std::vector<SweepPoint> retract;   // l increasing from l_min to l_max
-  /// Separations where the response jumped (first point on the new branch), per direction.
+  /// Separations where the response jumped (located, see SweepJump), per direction, in sweep order.
   std::vector<double> approach_jumps;
   std::vector<double> retract_jumps;
+  /// Every jump, approach then retract, in sweep order.
+  std::vector<SweepJump> jumps;
 };
 
 /// Natural-parameter continuation of the period-n orbit `from` (at from.separation) to separation l_to: sub-steps
 /// in l, each a Newton solve from the tangent prediction z + Δl·dz/dl (dz/dl = −(M − I)⁻¹ ∂P/∂l), accepted when
 /// the converged orbit is stable and lies within |Δl|·max|dz/dl| of the prediction (continuity: O(Δl²) on a
-/// smooth branch, O(Δl) at a corner such as grazing); a rejected sub-step is halved, an accepted one doubled.
-/// Returns the orbit at l_to, or nullopt when the branch ends before l_to — a fold (no orbit or only another
-/// branch beyond it), a loss of stability, or the sub-step falling below 1e-5·max(1, |l_to − l|) — or the
-/// budget of max_substeps Newton solves is spent. `from` must be a converged orbit of base at from.separation.
+/// smooth branch, O(Δl) at a corner such as grazing), the stability margins det(I − M) and det(I + M) have not
+/// shrunk by more than half and the scaled state has moved by at most state_resolution·max(A_free, |z|); a rejected
+/// sub-step is halved, an accepted one doubled. Returns the orbit at l_to, or nullopt when the branch ends before
+/// l_to — a fold (no orbit or only another branch beyond it), a loss of stability, or the sub-step falling below
+/// jump_tolerance·A_free — or the budget of max_substeps Newton solves is spent. `from` must be a converged orbit
+/// of base at from.separation.
 std::optional<PeriodicOrbit> follow_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
                                            const ShootingOptions& shooting = {}, int max_substeps = 200);
+
+/// What follow_stable_branch found: the orbit at l_to, or where the branch ceased to be stable.
+struct BranchFollow {
+  std::optional<PeriodicOrbit> reached;  // the orbit at l_to
+  PeriodicOrbit last;                    // the last stable orbit of the branch (= *reached when reached)
+  /// Not reached: the separation of the first sub-step that failed (no stable continuation); the branch ceases
+  /// to be stable in (last.separation, failed_at]. NaN when the sub-step budget ran out first.
+  double failed_at = 0.0;
+  int substeps = 0;  // Newton solves spent
+};
+/// follow_branch with the options of a sweep (resolution, tolerance, budget), telling where the branch ended.
+BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
+                                  const SweepOptions& options);
 
 /// Approach (l_max -> l_min) then retract (l_min -> l_max), `points` equally spaced separations each way.
 /// Starts from the free response at l_max (settled by a transient if it is in contact there).

@@ -357,7 +357,7 @@ def fig_hb_vs_orbits(out_dir: pathlib.Path) -> Figure:
         for f in hb_folds:
             ax.plot(f["separation"], f["amplitude"], "D", mfc="none", mec="k", ms=7,
                     label="HB fold" if f is hb_folds[0] else None)
-        for k, lf in enumerate(cont.results["folds"]):
+        for k, lf in enumerate(f["separation"] for f in cont.results["folds"]):
             ax.axvline(lf, color="#d62728", lw=0.8, ls=":", label="exact fold (continuation)" if k == 0 else None)
         for lg in cont.results["grazing"]:
             numbers.append((f"({tag}) grazing of the free oscillation (exact)", f"l = {lg:.5f} {unit}",
@@ -375,7 +375,7 @@ def fig_hb_vs_orbits(out_dir: pathlib.Path) -> Figure:
         # HB vs exact
         hb_max = max((f["separation"] for f in hb.results["folds"] if f["kind"] == "maximum"), default=np.inf)
         diff = _hb_vs_exact(cont, hb_max)
-        big_exact = max(cont.results["folds"]) if cont.results["folds"] else None
+        big_exact = max((f["separation"] for f in cont.results["folds"]), default=None)
         big_hb = max((f for f in hb_folds if f["kind"] == "maximum"), key=lambda f: f["separation"], default=None)
         if big_exact is not None and big_hb is not None:
             numbers.append((f"({tag}) fold (largest l): exact orbit vs HB",

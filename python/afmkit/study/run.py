@@ -181,7 +181,7 @@ def _pilot(study: Study, measure: bool = True):
 
     params = parameters_of(study.command)
     first = {a.name: int(a.values[0]) if params[a.name]["kind"] == "integer" else a.values[0] for a in study.axes}
-    raw = _afmkit.run(study.command, {**study.parameters, **first})
+    _afmkit.run(study.command, {**study.parameters, **first})  # the parameters checked, errors naming them
     # the first ≤ 64 points of the grid, for up to 0.3 s (only the first when the cost is not wanted): checks
     # the output selectors and measures the cost of a point
     points = _points(study, zstore.chunk_slices(study.shape, zstore.chunk_shape(study.shape, 64 if measure else 1), 0))
@@ -194,17 +194,10 @@ def _pilot(study: Study, measure: bool = True):
         if time.perf_counter() - start > 0.3:
             break
     cost = (time.perf_counter() - start) / n
-    units = raw["results"].get("units", {}) if isinstance(raw["results"].get("units"), dict) else {}
-    columns = {c[0]: c[1] for c in raw["columns"]}
-    out_units = []
-    for o in study.outputs:
-        if "(" in o:
-            agg = o.split("(")[0].strip()
-            col = o.split("(")[1].split("|")[0].strip(" )")
-            out_units.append("count" if agg == "count" else columns.get(col, ""))
-        else:
-            key = o.strip().strip("/").split("/")
-            out_units.append(units.get(key[0]) or units.get(key[-1]) or "")
+    # the unit of each output as the selector resolves it (docs/study.md#outputs): count, a column's unit, or the
+    # command's "units" entry for a results path
+    out_units = list(_afmkit.output_units(study.command, dict(study.parameters), [a.name for a in study.axes],
+                                          points[:n], list(study.outputs)))
     return cost, out_units
 
 

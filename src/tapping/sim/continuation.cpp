@@ -144,12 +144,23 @@ struct Tracer {
         continue;
       }
       const double s_new = s + (zc - z).norm();
-      if ((t_new.z() > 0) != (t.z() > 0))
-        out.folds.push_back(fold_separation(s, z.z(), t.z(), s_new, zc.z(), t_new.z()));
+      const bool fold = (t_new.z() > 0) != (t.z() > 0);
+      ContinuationFold f;
+      if (fold) {
+        f.separation = fold_separation(s, z.z(), t.z(), s_new, zc.z(), t_new.z());
+        f.separation_maximum = t.z() > 0;
+        // the point nearer the fold: the one before (index size − 1) or the one about to be added (index size)
+        f.point = out.points.size() - (std::abs(zc.z() - f.separation) <= std::abs(z.z() - f.separation) ? 0 : 1);
+      }
       z = zc;
       t = t_new;
       s = s_new;
-      if (z.z() < l_min || z.z() > l_max) return Stop::left_range;
+      const bool left = z.z() < l_min || z.z() > l_max;
+      if (fold) {
+        if (left) f.point = out.points.size() - 1;  // the point beyond is not kept
+        out.folds.push_back(f);
+      }
+      if (left) return Stop::left_range;
       out.points.push_back(make_point(z, rc, omega, s, it));
       ds = it <= 3 ? std::min(options.max_step, 1.5 * ds) : (it >= 6 ? 0.7 * ds : ds);
     }

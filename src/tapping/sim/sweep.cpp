@@ -30,6 +30,10 @@ void SweepOptions::validate() const {
   shooting.validate();
   transient.validate();
   validate::require(max_substeps >= 1, "max_substeps", max_substeps, ">= 1");
+  validate::require(state_resolution > 0 && state_resolution <= 1, "state_resolution", state_resolution, "in (0, 1]");
+  validate::require(transient_step > 0 && transient_step <= 1, "transient_step", transient_step, "in (0, 1]");
+  validate::require(jump_tolerance >= 1e-12 && jump_tolerance <= 1e-2, "jump_tolerance", jump_tolerance,
+                    "in [1e-12, 1e-2]");
 }
 
 namespace {
@@ -58,6 +62,8 @@ double distance(TipState a, TipState b, double omega) {
   return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
 }
 double magnitude(TipState a, double omega) { return std::hypot(a.position, a.velocity / omega); }
+/// The length scale of the sweep's tolerances: the free amplitude.
+double base_amplitude(const TappingModel& model) { return std::max(model.free_amplitude(), 1e-300); }
 
 void check_range(double l_min, double l_max, int points) {
   validate::finite("separation_min", l_min);
@@ -121,40 +127,89 @@ bool newton_heads_for(const TappingModel& model, const Eigen::Vector2d& from, co
 
 }  // namespace
 
-std::optional<PeriodicOrbit> follow_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
-                                           const ShootingOptions& shooting, int max_substeps) {
+namespace {
+
+/// Stability margins of a period-n orbit of the 2-D stroboscopic map (Jury): det(I − M) = (1 − λ₁)(1 − λ₂) and
+/// det(I + M) = (1 + λ₁)(1 + λ₂). With |det M| < 1 the orbit is stable iff both are positive; a real multiplier
+/// crosses +1 where the first vanishes (fold, branch point) and −1 where the second does (period doubling).
+Eigen::Vector2d stability_margins(const Eigen::Matrix2d& m) {
+  const double tr = m.trace(), det = m.determinant();
+  return {1.0 - tr + det, 1.0 + tr + det};
+}
+
+/// Whether the margins of `next` show the stability resolved over the sub-step from `current`: neither margin
+/// shrank by more than half (above the rounding level of the monodromy). A branch losing stability is approached
+/// in sub-steps that shorten as the margin vanishes, so the bisection beyond it starts next to the change.
+bool margins_resolved(const PeriodicOrbit& current, const PeriodicOrbit& next) {
+  const Eigen::Vector2d a = stability_margins(current.monodromy), b = stability_margins(next.monodromy);
+  constexpr double noise = 1e-9;
+  return b.x() >= 0.5 * a.x() - noise && b.y() >= 0.5 * a.y() - noise;
+}
+
+/// How far the Floquet multipliers moved between two orbits (the larger move of the closer pairing). A pair that
+/// turns around the unit circle (the effective stiffness of the orbit changing fast, e.g. in an attractive well)
+/// passes −1 and +1 on the way; a sub-step that moves a multiplier by more than kMaxMultiplierMove could have
+/// crossed the unit circle and back unseen.
+double multiplier_move(const PeriodicOrbit& a, const PeriodicOrbit& b) {
+  const auto& x = a.floquet_multipliers;
+  const auto& y = b.floquet_multipliers;
+  return std::min(std::max(std::abs(x[0] - y[0]), std::abs(x[1] - y[1])),
+                  std::max(std::abs(x[0] - y[1]), std::abs(x[1] - y[0])));
+}
+constexpr double kMaxMultiplierMove = 0.25;
+
+}  // namespace
+
+BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
+                                  const SweepOptions& options) {
   validate::finite("separation", l_to);
-  validate::require(max_substeps >= 1, "max_substeps", max_substeps, ">= 1");
+  options.validate();
+  const ShootingOptions& shooting = options.shooting;
   const double omega = base.drive.frequency;
   const int n = from.period_multiple;
+  BranchFollow out;
+  out.last = from;
+  out.failed_at = from.separation;
   const double span = l_to - from.separation;
-  if (span == 0.0) return from.stable ? std::optional<PeriodicOrbit>(from) : std::nullopt;
+  if (!from.stable) return out;  // nothing stable to follow
+  if (span == 0.0) {
+    out.reached = from;
+    return out;
+  }
   const double scale = std::max(1.0, scaled(from.initial, omega).norm());
-  // below this sub-step the branch is taken to end (fold, or a corner into another branch)
-  const double h_min = 1e-5 * std::max(1.0, std::abs(span));
+  const double amplitude = base_amplitude(base);
+  // below this sub-step the branch is taken to end (fold, loss of stability, or a corner into another branch)
+  const double h_min = options.jump_tolerance * amplitude;
+  // largest move of the scaled state per sub-step (relative to the larger of A_free and the state, e.g. a deep
+  // static deflection in contact)
+  const double max_move = options.state_resolution * amplitude;
   // from the tangent prediction Newton converges in a few iterations; a slow start means the step is too long
   ShootingOptions quick = shooting;
   quick.max_iterations = std::min(quick.max_iterations, 8);
   const double closeness = 1e-8 * scale;  // Newton-level agreement
   PeriodicOrbit current = from;
-  if (!current.stable) return std::nullopt;
   double h = span;  // try the whole step first
-  for (int k = 0; k < max_substeps; ++k) {
+  for (int k = 0; k < options.max_substeps; ++k) {
     const double remaining = l_to - current.separation;
-    if (remaining == 0.0) return current;
+    if (remaining == 0.0) break;
     if (std::abs(h) > std::abs(remaining)) h = remaining;
     const auto slope = branch_slope(current, omega);
-    if (!slope) return std::nullopt;
+    if (!slope) {
+      out.failed_at = current.separation + h;
+      return out;  // M − I singular: a fold (reached exactly)
+    }
     const double l_next = std::abs(remaining - h) <= 1e-14 * std::max(1.0, std::abs(l_to)) ? l_to : current.separation + h;
     const Eigen::Vector2d z = scaled(current.initial, omega);
     const Eigen::Vector2d predicted = z + (l_next - current.separation) * *slope;
     std::optional<PeriodicOrbit> next;
+    ++out.substeps;
     try {
       next = try_shoot(base.with_separation(l_next), {predicted.x(), predicted.y() * omega}, n, quick);
     } catch (const NumericalFailure&) {
       next.reset();
     }
     bool accepted = false;
+    bool resolved = true;  // false: the sub-step was too long to see the stability (not a failure of the branch)
     if (next && next->stable && next->period_multiple == n) {
       // continuity, both ways: (1) the corrector moves the prediction by at most |Δl| times the larger of the two
       // branch slopes (O(Δl²) on a smooth branch, O(Δl) at a corner where the slope changes, e.g. grazing; another
@@ -165,6 +220,14 @@ std::optional<PeriodicOrbit> follow_branch(const TappingModel& base, const Perio
       const auto slope_next = branch_slope(*next, omega);
       const double bound = std::abs(dl) * std::max(slope->norm(), slope_next ? slope_next->norm() : 0.0) + closeness;
       accepted = slope_next && (scaled(next->initial, omega) - predicted).norm() <= bound;
+      // (3) the Floquet multipliers along the step: the margins to instability and the move of the orbit are
+      // resolved (a step over a fold pair or an interval of instability is shortened until it is seen)
+      if (accepted && std::abs(dl) > 2.0 * h_min &&
+          (!margins_resolved(current, *next) || multiplier_move(current, *next) > kMaxMultiplierMove ||
+           (scaled(next->initial, omega) - z).norm() > max_move * std::max(1.0, z.norm() / amplitude))) {
+        accepted = false;
+        resolved = false;
+      }
       if (accepted) {
         const Eigen::Vector2d back_guess = scaled(next->initial, omega) - dl * *slope_next;
         const TappingModel at_current = base.with_separation(current.separation);
@@ -185,50 +248,139 @@ std::optional<PeriodicOrbit> follow_branch(const TappingModel& base, const Perio
     if (accepted) {
       current = *next;
       current.separation = l_next;
+      out.last = current;
       h *= 2.0;  // grow again after a successful sub-step
       continue;
     }
+    if (resolved) out.failed_at = l_next;  // no stable continuation at l_next: the bracket's far end
     h *= 0.5;
-    if (std::abs(h) < h_min) return std::nullopt;
+    if (std::abs(h) < h_min) return out;
   }
-  return std::nullopt;
+  if (current.separation == l_to) {
+    out.reached = current;
+  } else {
+    out.failed_at = std::numeric_limits<double>::quiet_NaN();  // budget spent before l_to
+  }
+  return out;
+}
+
+std::optional<PeriodicOrbit> follow_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
+                                           const ShootingOptions& shooting, int max_substeps) {
+  SweepOptions options;
+  options.shooting = shooting;
+  options.max_substeps = max_substeps;
+  return follow_stable_branch(base, from, l_to, options).reached;
 }
 
 namespace {
 
-/// One instrument step: continue `previous` (at the previous separation) to the model's separation.
-SweepPoint continue_point(const TappingModel& model, const SweepPoint& previous, SweepDirection direction,
-                          const SweepOptions& options) {
+/// At most this many jumps, or transient sub-steps through a non-periodic response, between two grid points
+/// (then the tip is left to settle at the grid point).
+constexpr int kMaxPassesPerStep = 64;
+
+/// Whether the orbit reached from `p` (followed back to `previous` at its separation) is the same branch.
+bool connects_back(const TappingModel& model, const PeriodicOrbit& p, const PeriodicOrbit& previous,
+                   const SweepOptions& options) {
   const double omega = model.drive.frequency;
-  if (previous.periodic) {
-    // follow the branch of the previous orbit to the new separation (sub-stepping when needed)
-    if (auto orbit = follow_branch(model, previous.orbit, model.separation, options.shooting, options.max_substeps)) {
+  const auto back = follow_stable_branch(model, p, previous.separation, options).reached;
+  const double scale = std::max(1.0, magnitude(previous.initial, omega));
+  return back && back->period_multiple == previous.period_multiple &&
+         distance(back->initial, previous.initial, omega) <= 1e-6 * scale;
+}
+
+SweepJump make_jump(double separation, double tolerance, SweepDirection direction, bool located,
+                    const PeriodicOrbit& from, const SweepPoint& landed) {
+  SweepJump j;
+  j.separation = separation;
+  j.tolerance = tolerance;
+  j.direction = direction;
+  j.located = located;
+  j.from = from;
+  j.to = landed.orbit;
+  j.landed_periodic = landed.periodic;
+  return j;
+}
+
+/// One instrument step: continue `previous` (at the previous separation) to the model's separation, through every
+/// jump on the way (appended to `jumps`). A stable orbit is followed along its branch; where the branch ceases to
+/// be stable the tip lands (transient) just beyond; a response that does not settle is stepped by transients in
+/// sub-steps of transient_step·A_free until it settles on a periodic orbit.
+SweepPoint continue_point(const TappingModel& model, const SweepPoint& previous, SweepDirection direction,
+                          const SweepOptions& options, std::vector<SweepJump>& jumps) {
+  const double l_to = model.separation;
+  if (previous.periodic && !previous.orbit.stable) {
+    // a neutrally stable periodic response (e.g. a tip resting on the sample) has no stable branch to follow: it
+    // settles (or not) at the new separation; a jump is known to the grid's resolution only
+    SweepPoint p = from_transient(model, previous.orbit.initial, direction, options);
+    if (p.periodic && connects_back(model, p.orbit, previous.orbit, options)) p.jumped = false;
+    if (p.jumped)
+      jumps.push_back(make_jump(l_to, std::abs(l_to - previous.separation), direction, false, previous.orbit, p));
+    return p;
+  }
+  const double step_np = options.transient_step * base_amplitude(model);
+  bool following = previous.periodic;  // else: a non-periodic response, stepped by transients
+  PeriodicOrbit orbit = previous.orbit;  // the followed orbit, or (non-periodic) the last state in orbit.initial
+  double l_at = previous.separation;
+  bool jumped = false;
+  for (int pass = 0; pass < kMaxPassesPerStep; ++pass) {
+    const bool last_pass = pass + 1 == kMaxPassesPerStep;
+    if (!following) {
+      const double l_next = std::abs(l_to - l_at) <= step_np || last_pass ? l_to : l_at + std::copysign(step_np, l_to - l_at);
+      SweepPoint p = from_transient(model.with_separation(l_next), orbit.initial, direction, options);
+      if (p.periodic) {  // it settled: the tip leaves the non-periodic response (known to the sub-step)
+        jumps.push_back(make_jump(0.5 * (l_at + l_next), 0.5 * std::abs(l_next - l_at), direction, false, orbit, p));
+        jumped = true;
+      }
+      if (l_next == l_to || (p.periodic && !p.orbit.stable)) {
+        if (l_next != l_to) p = from_transient(model, p.orbit.initial, direction, options);
+        p.jumped = jumped;
+        return p;
+      }
+      following = p.periodic;
+      orbit = p.orbit;
+      orbit.separation = l_next;
+      l_at = l_next;
+      continue;
+    }
+    const BranchFollow f = follow_stable_branch(model, orbit, l_to, options);
+    if (f.reached) {
       SweepPoint p;
-      p.separation = model.separation;
+      p.separation = l_to;
       p.direction = direction;
-      p.orbit = *orbit;
+      p.orbit = *f.reached;
+      p.jumped = jumped;
       return p;
     }
+    // The followed branch ceases to be stable in (last, failed_at] (budget spent: somewhere before l_to). Do what
+    // the instrument does: the tip keeps moving from where it was and settles on whatever attracts it, just beyond.
+    const double l_last = f.last.separation;
+    const bool located = std::isfinite(f.failed_at) && !last_pass;
+    const double l_land = located ? f.failed_at : l_to;
+    SweepPoint landed = from_transient(model.with_separation(l_land), f.last.initial, direction, options);
+    // Not a jump if the branch of the new orbit, followed back to the last stable orbit through stable orbits
+    // without a fold, arrives at it (the forward follow can fail where the backward one does not, e.g. through a
+    // grazing corner entered from the other side).
+    if (!(landed.periodic && connects_back(model, landed.orbit, f.last, options))) {
+      jumps.push_back(make_jump(located ? 0.5 * (l_last + l_land) : l_land,
+                                std::abs(l_land - l_last) * (located ? 0.5 : 1.0), direction, located, f.last, landed));
+      jumped = true;
+    }
+    if (l_land == l_to || (landed.periodic && !landed.orbit.stable)) {
+      if (l_land != l_to) landed = from_transient(model, landed.orbit.initial, direction, options);
+      landed.jumped = jumped;
+      return landed;
+    }
+    following = landed.periodic;
+    orbit = landed.orbit;
+    orbit.separation = l_land;
+    l_at = l_land;
   }
-  // The branch ends (fold, stability loss, or a corner into another branch) before the new separation: do what
-  // the instrument does — the tip keeps moving from where it was and settles on whatever attracts it.
-  SweepPoint p = from_transient(model, previous.orbit.initial, direction, options);
-  if (p.periodic && previous.periodic) {
-    // Not a jump if the branch of the new orbit, followed back to the previous separation through stable orbits
-    // without a fold, arrives at the previous orbit (the forward follow can fail where the backward one does
-    // not, e.g. through a grazing corner entered from the other side).
-    const auto back = follow_branch(model, p.orbit, previous.separation, options.shooting, options.max_substeps);
-    const double scale = std::max(1.0, magnitude(previous.orbit.initial, omega));
-    if (back && back->period_multiple == previous.orbit.period_multiple &&
-        distance(back->initial, previous.orbit.initial, omega) <= 1e-6 * scale)
-      p.jumped = false;
-  }
-  return p;
+  return {};  // not reached: the last pass ends at l_to
 }
 
 std::vector<SweepPoint> run_direction(const TappingModel& base, const std::vector<double>& ls, SweepPoint first,
                                       SweepDirection direction, const SweepOptions& options,
-                                      std::vector<double>& jumps) {
+                                      std::vector<SweepJump>& jumps) {
   std::vector<SweepPoint> out;
   out.reserve(ls.size());
   first.direction = direction;
@@ -236,8 +388,7 @@ std::vector<SweepPoint> run_direction(const TappingModel& base, const std::vecto
   if (options.progress) options.progress(1);
   for (std::size_t k = 1; k < ls.size(); ++k) {
     options.cancellation.check();
-    out.push_back(continue_point(base.with_separation(ls[k]), out[k - 1], direction, options));
-    if (out.back().jumped) jumps.push_back(ls[k]);
+    out.push_back(continue_point(base.with_separation(ls[k]), out[k - 1], direction, options, jumps));
     if (options.progress) options.progress(1);
   }
   return out;
@@ -259,6 +410,20 @@ void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, co
       SweepPoint& p = points[i];
       p.metrics = analyse_orbit(base.with_separation(p.separation), p.orbit, simulation);
       if (hb) attach_from(hb->solutions(p.separation), p);
+    });
+  }
+  errors.rethrow();
+}
+
+void finish_jumps(const TappingModel& base, std::vector<SweepJump>& jumps, const SimulationOptions& simulation,
+                  bool parallel) {
+  ExceptionCollector errors;
+#pragma omp parallel for schedule(dynamic) if (parallel)
+  for (std::size_t i = 0; i < jumps.size(); ++i) {
+    errors.run([&] {
+      SweepJump& j = jumps[i];
+      j.from_metrics = analyse_orbit(base.with_separation(j.from.separation), j.from, simulation);
+      j.to_metrics = analyse_orbit(base.with_separation(j.to.separation), j.to, simulation);
     });
   }
   errors.rethrow();
@@ -303,14 +468,17 @@ SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separ
   start.jumped = false;
 
   SweepResult result;
-  result.approach = run_direction(base, down, start, SweepDirection::approach, options, result.approach_jumps);
+  result.approach = run_direction(base, down, start, SweepDirection::approach, options, result.jumps);
   SweepPoint turn = result.approach.back();
   turn.jumped = false;
-  result.retract = run_direction(base, up, turn, SweepDirection::retract, options, result.retract_jumps);
+  result.retract = run_direction(base, up, turn, SweepDirection::retract, options, result.jumps);
+  for (const SweepJump& j : result.jumps)
+    (j.direction == SweepDirection::approach ? result.approach_jumps : result.retract_jumps).push_back(j.separation);
   detail::finish_points(base, result.approach, options.shooting.simulation, options.harmonic_balance, options.parallel,
                         options.cancellation);
   detail::finish_points(base, result.retract, options.shooting.simulation, options.harmonic_balance, options.parallel,
                         options.cancellation);
+  detail::finish_jumps(base, result.jumps, options.shooting.simulation, options.parallel);
   return result;
 }
 
