@@ -62,6 +62,7 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
     capture_->results = results;
     capture_->columns = columns_;
     capture_->rows = std::move(rows_);
+    capture_->parameters = params_.to_json();
     return;
   }
   try {

@@ -34,6 +34,8 @@ struct Captured {
   nlohmann::json results = nlohmann::json::object();
   std::vector<io::Column> columns;
   nlohmann::json rows = nlohmann::json::array();
+  /// The parameters as run (what the sidecar records: computed defaults filled in); null until the command finishes.
+  nlohmann::json parameters;
 };
 
 using Declare = std::function<void(io::ParamSet&)>;

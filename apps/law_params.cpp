@@ -27,7 +27,8 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
     const std::string laws = fmt::format("[{}] ", fmt::join(registry.laws_using(k.key), ", "));
     io::Range range{k.lower, std::min(k.upper, 1e308), k.lower_open, false};
     p.real(k.key, k.default_value, laws + k.help, range).unit(k.unit.empty() ? "dimensionless" : k.unit);
-    if (!k.follows.empty()) p.default_text("= " + k.follows);
+    if (!k.follows.empty()) p.follows(k.follows);  // recorded with the value it takes (params.hpp)
+    if (k.only_if_given) p.only_if_given(k.replaces);
   }
 }
 

@@ -114,7 +114,8 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   }
   out["columns"] = columns;
   out["table"] = table;
-  out["params"] = json_to_python(p.to_json());
+  // the parameters as the run used them (computed defaults filled in), as its sidecar records them
+  out["params"] = json_to_python(captured.parameters.is_null() ? p.to_json() : captured.parameters);
   return out;
 }
 
