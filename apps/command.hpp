@@ -11,6 +11,7 @@
 // describing every column; empty path: no file) and prints a one-line summary, or with --json the summary as JSON
 // (plus, when no file is written, the table itself: {"columns": [...], "rows": [[...], ...]}).
 #include <functional>
+#include <stdexcept>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,6 +39,15 @@ struct Captured {
   nlohmann::json parameters;
 };
 
+/// A run that computed no answer of the kind asked for: its results carry `status` other than "ok" and a `note`
+/// (docs/commands.md#exit-status). The outputs are written with the status in them; on the command line finish()
+/// then throws this and the program exits 1 with the note (the Python module returns the result: status in
+/// r.results).
+class NoAnswer : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 using Declare = std::function<void(io::ParamSet&)>;
 /// Runs a command on resolved parameters; `capture` is nullptr on the command line.
 using Run = std::function<void(const io::ParamSet&, Captured* capture)>;
@@ -61,6 +71,10 @@ CLI::App& add_command(CLI::App& parent, const std::string& name, const std::stri
 
 /// Adds a group of subcommands (`afmkit tapping …`, `afmkit control …`): one of them must be given.
 CLI::App& add_command_group(CLI::App& parent, const std::string& name, const std::string& help);
+
+/// Throws NoAnswer when `results` holds a "status" other than "ok" (its "note" in the message); commands that
+/// write their outputs without a CommandOutput call it after writing them.
+void require_answer(const nlohmann::json& results);
 
 /// The "Output" group every table command has: `output` (CSV path, default `default_path`; empty: no file) and
 /// the `json` flag.
@@ -91,7 +105,8 @@ class CommandOutput {
   bool keeps_rows() const { return writes_file() || keep_rows_; }
 
   /// Commits the file with the sidecar (parameters, `results`, columns). Then prints `results` as JSON (--json;
-  /// with the rows when no file was written), or `summary` (if not empty) and where the table went.
+  /// with the rows when no file was written), or `summary` (if not empty) and where the table went. When
+  /// `results` has a "status" other than "ok", throws NoAnswer with its "note" afterwards (command line only).
   void finish(const nlohmann::json& results, const std::string& summary);
 
  private:

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
@@ -56,19 +57,27 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   const std::vector<tapping::HbPoint> curve = tapping::harmonic_balance_curve(model, options);
   write_hb_rows(out, curve, scales);
 
-  const tapping::HarmonicBalance hb(model);
+  // the model and options are checked: what is refused from here on was computed (core/computed.hpp)
+  const tapping::HarmonicBalance hb = computed("harmonic balance", [&] { return tapping::HarmonicBalance(model); });
   nlohmann::json folds = nlohmann::json::array();
-  for (const tapping::HbFold& f : hb.folds()) {
+  for (const tapping::HbFold& f : computed("harmonic balance: its folds", [&] { return hb.folds(); })) {
     nlohmann::json j = point_json(f.point, scales);
     j["kind"] = f.separation_maximum ? "maximum" : "minimum";
     folds.push_back(j);
   }
   nlohmann::json solutions = nlohmann::json::array();
-  for (const tapping::HbPoint& s : hb.solutions(model.separation)) solutions.push_back(point_json(s, scales));
+  for (const tapping::HbPoint& s :
+       computed("harmonic balance: the solutions at separation", [&] { return hb.solutions(model.separation); }))
+    solutions.push_back(point_json(s, scales));
   nlohmann::json results = {{"folds", folds},
                             {"free_amplitude", hb.free_amplitude() * scales.length},
                             {"solutions_at_separation", solutions},
                             {"rows", out.rows()},
+                            {"status", curve.empty() ? "no_solution" : "ok"},
+                            {"note", curve.empty() ? fmt::format("no harmonic-balance solution for q in [{}, {}]: the "
+                                                                 "curve is empty (docs/conventions.md#statuses)",
+                                                                 q_min, q_max)
+                                                   : std::string()},
                             {"units", {{"length", scales.length_unit}, {"phase", "rad"}, {"q", "dimensionless"}}}};
   if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
     if (const auto limit = tapping::minimum_separation_limit(model))

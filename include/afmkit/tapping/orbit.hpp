@@ -33,6 +33,12 @@ struct OrbitMetrics {
   double sticking_duration = 0.0;        // time spent sticking during one orbit
 };
 
+/// Whether the tip is trapped on this orbit: it stays below the law's contact gap over the whole orbit
+/// (contact_fraction >= 1 - 1e-6), so it never taps — held by the sample, e.g. by an adhesion far above the drive
+/// force k A0 / Q (docs/conventions.md#statuses). Its amplitude is the tiny motion in contact, not a tapping
+/// amplitude.
+bool tip_trapped(const OrbitMetrics& metrics);
+
 /// Evaluate the observables of `orbit` by simulating it once (period_multiple drive periods).
 OrbitMetrics analyse_orbit(const TappingModel& model, const PeriodicOrbit& orbit,
                            const SimulationOptions& options = {});

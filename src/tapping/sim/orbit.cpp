@@ -10,6 +10,7 @@
 
 #include <Eigen/LU>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/parallel.hpp"
 #include "afmkit/core/validate.hpp"
@@ -72,6 +73,8 @@ double quadrature_panel(const TappingModel& model) {
 }
 
 }  // namespace
+
+bool tip_trapped(const OrbitMetrics& metrics) { return metrics.contact_fraction >= 1.0 - 1e-6; }
 
 OrbitMetrics analyse_orbit(const TappingModel& model, const PeriodicOrbit& orbit, const SimulationOptions& options) {
   const int n = orbit.period_multiple;
@@ -233,8 +236,8 @@ double elapsed_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOptions& options) {
-  options.validate();
+namespace {
+OrbitSearchResult search_orbits(const TappingModel& model, const OrbitSearchOptions& options) {
   const auto t_start = std::chrono::steady_clock::now();
   OrbitSearchResult out;
   std::vector<Task> tasks;
@@ -429,6 +432,13 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
   }
   report.seconds = elapsed_since(t_start);
   return out;
+}
+}  // namespace
+
+OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOptions& options) {
+  options.validate();
+  // the model and the options are checked: what is refused from here on was computed (core/computed.hpp)
+  return computed("orbit search", [&] { return search_orbits(model, options); });
 }
 
 }  // namespace afmkit::tapping
