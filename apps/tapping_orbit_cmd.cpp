@@ -105,9 +105,9 @@ OrbitStatus orbit_status(const tapping::OrbitSearchResult& r, double separation,
   for (const tapping::FoundOrbit& f : r.orbits)
     if (!tapping::tip_trapped(f.metrics)) return {"ok", ""};
   return {"tip_trapped",
-          fmt::format("tip trapped: on every orbit found ({}) the tip stays in contact over the whole period at "
-                      "separation {} {} (held by the sample: an attraction larger than the drive can pull off); no "
-                      "tapping orbit",
+          fmt::format("tip trapped: on every orbit found ({}) the tip sticks to the sample or stays in contact over "
+                      "the whole period at separation {} {} (held by the sample: an attraction larger than the drive "
+                      "can pull off); no tapping orbit",
                       r.orbits.size(), separation, unit)};
 }
 
@@ -169,7 +169,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
             {"sticking_time", scales.time_unit, "time spent sticking to the sample per orbit"},
             {"initial_position", length, "tip position x at drive phase 0 on the orbit"},
             {"initial_velocity", velocity, "tip velocity at drive phase 0 on the orbit"},
-            {"trapped", "boolean (0/1)", "1: the tip stays in contact over the whole period (held by the sample, no "
+            {"trapped", "boolean (0/1)", "1: the tip sticks to the sample or stays in contact over the whole period (no "
                                          "tapping; docs/conventions.md#statuses)"}});
   for (const tapping::FoundOrbit& f : r.orbits) {
     const auto& m = f.metrics;

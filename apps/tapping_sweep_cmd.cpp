@@ -82,7 +82,7 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
 
   CommandOutput out(p, capture, "tapping sweep");
   out.open(sweep_columns(scales));
-  long trapped = 0;  // rows on which the tip stays in contact (column trapped)
+  long trapped = 0;  // rows on which the tip does not tap (column trapped)
   const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) {
     write_sweep_rows(out, points, scales);
     for (const tapping::SweepPoint& pt : points) trapped += tapping::tip_trapped(pt.metrics) ? 1 : 0;
@@ -129,14 +129,15 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
   results["free_amplitude"] = base.free_amplitude() * scales.length;
   results["rows"] = out.rows();
   results["trapped_rows"] = trapped;
-  // every row with the tip held in contact: no tapping anywhere in the range (docs/conventions.md#statuses)
+  // every row with the tip trapped: no tapping anywhere in the range (docs/conventions.md#statuses)
   const bool all_trapped = out.rows() > 0 && trapped == static_cast<long>(out.rows());
   results["status"] = all_trapped ? "tip_trapped" : "ok";
-  results["note"] = all_trapped ? fmt::format("tip trapped: the tip stays in contact over the whole period at every "
-                                              "separation of the sweep ({} rows; column trapped): no tapping",
+  results["note"] = all_trapped ? fmt::format("tip trapped: the tip sticks to the sample or stays in contact over "
+                                              "the whole period at every separation of the sweep ({} rows; column "
+                                              "trapped): no tapping",
                                               out.rows())
-                                : trapped > 0 ? fmt::format("{} of {} rows with the tip trapped (in contact over the "
-                                                            "whole period; column trapped)",
+                                : trapped > 0 ? fmt::format("{} of {} rows with the tip trapped (stuck to the sample or "
+                                                            "in contact over the whole period; column trapped)",
                                                             trapped, out.rows())
                                               : std::string();
   if (trapped > 0) summary += "\n" + results["note"].get<std::string>();

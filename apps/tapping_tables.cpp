@@ -36,7 +36,7 @@ std::vector<io::Column> sweep_columns(const tapping::UnitScales& s) {
           {"hb_offset", L, "its mean deflection (nan: none)"},
           {"hb_phase", "rad", "its phase (nan: none)"},
           {"hb_solutions", "count", "number of harmonic-balance solutions at this separation"},
-          {"trapped", "boolean (0/1)", "1: the tip stays in contact over the whole period (held by the sample, no "
+          {"trapped", "boolean (0/1)", "1: the tip sticks to the sample or stays in contact over the whole period (no "
                                        "tapping; docs/conventions.md#statuses): amplitude is its motion in contact"}};
 }
 

@@ -218,7 +218,7 @@ TEST(HonestyRecords, FollowedLawKeysRecordTheValueUsedInEveryLawCommand) {
     TempDir dir;
     const auto r = run_cli(cmd + " --hamaker 1e-19 --effective-modulus 3 --output run.csv", dir);
     ASSERT_EQ(r.status, 0) << r.err;
-    const auto params = nlohmann::json::parse(slurp(dir.path / "run.csv.json")).at("parameters");
+    auto params = nlohmann::json::parse(slurp(dir.path / "run.csv.json")).at("parameters");
     EXPECT_EQ(params.at("departure_hamaker").get<double>(), 1e-19);  // not the declared 6.4e-20
     EXPECT_EQ(params.at("departure_modulus").get<double>(), 3.0);
     EXPECT_FALSE(params.contains("restitution"));  // an alternative not given: not used, not recorded

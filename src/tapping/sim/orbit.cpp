@@ -74,7 +74,11 @@ double quadrature_panel(const TappingModel& model) {
 
 }  // namespace
 
-bool tip_trapped(const OrbitMetrics& metrics) { return metrics.contact_fraction >= 1.0 - 1e-6; }
+bool tip_trapped(const OrbitMetrics& metrics) {
+  const double tolerance = 1e-6;
+  const bool stuck = metrics.duration > 0.0 && metrics.sticking_duration >= (1.0 - tolerance) * metrics.duration;
+  return stuck || metrics.contact_fraction >= 1.0 - tolerance;
+}
 
 OrbitMetrics analyse_orbit(const TappingModel& model, const PeriodicOrbit& orbit, const SimulationOptions& options) {
   const int n = orbit.period_multiple;
@@ -98,6 +102,7 @@ OrbitMetrics analyse_orbit(const TappingModel& model, const PeriodicOrbit& orbit
   m.contact_dissipation = integrals.contact_dissipation / n;
   m.impacts_per_period_multiple = r.stats.impacts;
   m.sticking_duration = r.stats.sticking_duration;
+  m.duration = duration;
   return m;
 }
 
