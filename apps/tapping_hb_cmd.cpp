@@ -34,6 +34,19 @@ nlohmann::json point_json(const tapping::HbPoint& p, const TappingScales& s) {
           {"branch", tapping::branch_name(p.branch)}};
 }
 
+/// What the run found (docs/conventions.md#statuses): "ok" (a curve), "empty_curve" (no point of the curve in
+/// the q range, but solutions at `separation`), "no_solution" (neither).
+const char* hb_status(bool empty_curve, bool no_solution_at_separation) {
+  if (!empty_curve) return "ok";
+  return no_solution_at_separation ? "no_solution" : "empty_curve";
+}
+std::string hb_note(bool empty_curve, bool no_solution_at_separation, double q_min, double q_max,
+                    const std::string& separation) {
+  if (!empty_curve) return "";
+  return fmt::format("no harmonic-balance solution for q in [{}, {}]: the curve is empty; {} at separation {}", q_min,
+                     q_max, no_solution_at_separation ? "no solution either" : "solutions (results)", separation);
+}
+
 void run_hb(const io::ParamSet& p, Captured* capture) {
   const double q_min = p.real("q_min");
   const double q_max = p.real("q_max");
@@ -73,11 +86,9 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
                             {"free_amplitude", hb.free_amplitude() * scales.length},
                             {"solutions_at_separation", solutions},
                             {"rows", out.rows()},
-                            {"status", curve.empty() ? "no_solution" : "ok"},
-                            {"note", curve.empty() ? fmt::format("no harmonic-balance solution for q in [{}, {}]: the "
-                                                                 "curve is empty (docs/conventions.md#statuses)",
-                                                                 q_min, q_max)
-                                                   : std::string()},
+                            {"status", hb_status(curve.empty(), solutions.empty())},
+                            {"note", hb_note(curve.empty(), solutions.empty(), q_min, q_max,
+                                             fmt::format("{} {}", p.real("separation"), scales.length_unit))},
                             {"units", {{"length", scales.length_unit}, {"phase", "rad"}, {"q", "dimensionless"}}}};
   if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
     if (const auto limit = tapping::minimum_separation_limit(model))
