@@ -78,7 +78,7 @@ void expect_not_blamed_on_input(const afmkit_test::RunResult& r, const std::stri
 TEST(HonestyInternalFailure, OrbitOnAStickyMeasuredLawIsNeverReportedAsABadSeparation) {
   TempDir dir;
   write_sticky_curve(dir, "F.csv");
-  const auto r = run_cli("tapping orbit " + kSticky + " --separation 20 --output o.csv", dir);
+  const auto r = run_cli("tapping orbit " + kSticky + " --separation 5 --output o.csv", dir);
   expect_not_blamed_on_input(r, "tapping orbit");
   ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;
   if (r.status == 1)  // either no answer (status in the written results) or a numerical failure naming the step
@@ -92,7 +92,7 @@ TEST(HonestyInternalFailure, EveryTappingCommandOnTheStickyLawBlamesNoInput) {
   for (const std::string& cmd :
        {std::string("tapping hb --separation 20 --points 200"),
         std::string("tapping sweep --separation-min 0 --separation-max 24 --points 9 --quiet --mode instrument"),
-        std::string("tapping sweep --separation-min 10 --separation-max 24 --quiet --mode continuation")}) {
+        std::string("tapping sweep --separation-min 3 --separation-max 24 --quiet --mode continuation")}) {
     const auto r = run_cli(cmd + " " + kSticky + " --output out.csv", dir);
     expect_not_blamed_on_input(r, cmd);
   }
