@@ -115,7 +115,9 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   out["columns"] = columns;
   out["table"] = table;
   // the parameters as the run used them (computed defaults filled in), as its sidecar records them
-  out["params"] = json_to_python(captured.parameters.is_null() ? p.to_json() : captured.parameters);
+  nlohmann::json params = captured.parameters.is_null() ? p.to_json() : captured.parameters;
+  params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)
+  out["params"] = json_to_python(params);
   return out;
 }
 
