@@ -9,7 +9,6 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
-#include "afmkit/core/computed.hpp"
 #include "afmkit/core/validate.hpp"
 #include "impact_detail.hpp"
 
@@ -208,10 +207,9 @@ ImpactResult simulate_impact(const ImpactProblem& problem, const ImpactOptions& 
                            "constant external forces; use integrator or automatic");
   const bool closed = options.method == ImpactMethod::closed_form ||
                       (options.method == ImpactMethod::automatic && closed_form_possible);
-  // the input is checked above: what the solvers refuse from here on is theirs (core/computed.hpp)
-  ImpactResult r = computed("impact: the collision", [&] {
-    return closed ? detail::closed_form_impact(problem, options) : detail::integrated_impact(problem, options);
-  });
+  // (no computed() boundary here: the solvers check combinations of the input's scales — stiffness / reduced
+  // mass, gap / speed — and refuse them as InvalidParameter naming the parameter, as input errors)
+  ImpactResult r = closed ? detail::closed_form_impact(problem, options) : detail::integrated_impact(problem, options);
   require_finite_result(r);
   return r;
 }

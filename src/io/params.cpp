@@ -135,11 +135,11 @@ ParamSet& ParamSet::follows(const std::string& key) {
   if (e.default_text.empty()) e.default_text = "= " + key;
   return *this;
 }
-ParamSet& ParamSet::only_if_given(const std::string& instead_of) {
+ParamSet& ParamSet::only_if_given(std::vector<std::string> instead_of) {
   if (last_.empty()) throw std::logic_error("ParamSet::only_if_given before any parameter");
   Entry& e = entries_[last_];
   e.only_if_given = true;
-  e.instead_of = instead_of;
+  e.instead_of = std::move(instead_of);
   return *this;
 }
 void ParamSet::record_used(const std::string& key, Value value) {
@@ -462,7 +462,8 @@ bool ParamSet::recorded(const std::string& key) const {
   const Entry& e = entry(key);
   if (e.only_if_given && !e.set) return false;
   for (const auto& [other, o] : entries_)
-    if (o.only_if_given && o.set && o.instead_of == key) return false;
+    if (o.only_if_given && o.set && std::find(o.instead_of.begin(), o.instead_of.end(), key) != o.instead_of.end())
+      return false;
   return true;
 }
 double ParamSet::real(const std::string& key) const { return std::get<double>(current(key).value); }

@@ -296,3 +296,24 @@ TEST(HonestyRecords, ComputedDefaultsAreRecordedAsComputed) {
   side = nlohmann::json::parse(slurp(dir.path / "m.csv.json"));
   EXPECT_EQ(side["parameters"]["reference_delay"].get<double>(), 0.05);
 }
+
+TEST(HonestyRecords, RestitutionInPhysicalTappingUnitsIsUsedAndRecordedInsteadOfTheStiffness) {
+  // was refused: "give either restitution or departure_stiffness, not both" although only restitution was given
+  TempDir dir;
+  const std::string base = "tapping orbit --units physical --law hysteresis --separation 18 --quality-factor 50";
+  const auto r = run_cli(base + " --restitution 0.5 --output e.csv", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto side = nlohmann::json::parse(slurp(dir.path / "e.csv.json"));
+  const auto& params = side.at("parameters");
+  EXPECT_EQ(params.at("restitution").get<double>(), 0.5);
+  EXPECT_FALSE(params.contains("sample_stiffness_departure"));  // the run used e² K_a, not the declared 320 N/m
+  EXPECT_FALSE(params.contains("departure_stiffness"));
+  // independently: K_b = e² K_a = 0.25 · 400 N/m given directly is the same orbit
+  const auto k = run_cli(base + " --sample-stiffness-departure 100 --output k.csv", dir);
+  ASSERT_EQ(k.status, 0) << k.err;
+  const auto& a = side.at("results").at("orbits").at(0);
+  const auto& b = nlohmann::json::parse(slurp(dir.path / "k.csv.json")).at("results").at("orbits").at(0);
+  EXPECT_NEAR(a.at("amplitude").get<double>(), b.at("amplitude").get<double>(), 1e-9);
+  EXPECT_NEAR(a.at("contact_dissipation").get<double>(), b.at("contact_dissipation").get<double>(),
+              1e-9 * std::abs(b.at("drive_work").get<double>()));
+}

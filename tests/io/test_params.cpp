@@ -139,7 +139,7 @@ ParamSet law_like() {
       .unit("N/m")
       .real("restitution", 1.0, "e, instead of stiffness", Range::positive())
       .unit("dimensionless")
-      .only_if_given("stiffness");
+      .only_if_given({"stiffness"});
   return p;
 }
 }  // namespace

@@ -61,9 +61,9 @@ class ParamSet {
   /// used. --help shows "= key" unless default_text() says otherwise.
   ParamSet& follows(const std::string& key);
   /// The last declared parameter counts only when given (an alternative, e.g. restitution instead of
-  /// departure_stiffness): not given, it is left out of the records; given, it stands for `instead_of` (if not
-  /// empty), which is then left out of the records (a replay gives the alternative, as the run did).
-  ParamSet& only_if_given(const std::string& instead_of = "");
+  /// departure_stiffness): not given, it is left out of the records; given, it stands for the keys `instead_of`,
+  /// which are then left out of the records (a replay gives the alternative, as the run did).
+  ParamSet& only_if_given(std::vector<std::string> instead_of = {});
   /// Records the value a run used for a parameter whose value the command computes or chooses itself
   /// ("automatic", "proven bound", a default that depends on other values): value() and the records give it from
   /// now on; it does not count as given (was_set). Validated as a given value is (InvalidParameter naming the key).
@@ -144,7 +144,7 @@ class ParamSet {
     bool positional = false;              // also accepted as a positional argument
     std::string follows;                  // not given: the value of this parameter
     bool only_if_given = false;           // not given: not recorded
-    std::string instead_of;               // given: this parameter is not recorded
+    std::vector<std::string> instead_of;  // given: these parameters are not recorded
     bool used = false;                    // value recorded by record_used
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
