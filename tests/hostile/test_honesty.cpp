@@ -311,8 +311,8 @@ TEST(HonestyRecords, RestitutionInPhysicalTappingUnitsIsUsedAndRecordedInsteadOf
   // independently: K_b = e² K_a = 0.25 · 400 N/m given directly is the same orbit
   const auto k = run_cli(base + " --sample-stiffness-departure 100 --output k.csv", dir);
   ASSERT_EQ(k.status, 0) << k.err;
-  const auto& a = side.at("results").at("orbits").at(0);
-  const auto& b = nlohmann::json::parse(slurp(dir.path / "k.csv.json")).at("results").at("orbits").at(0);
+  const nlohmann::json a = side.at("results").at("orbits").at(0);
+  const nlohmann::json b = nlohmann::json::parse(slurp(dir.path / "k.csv.json")).at("results").at("orbits").at(0);
   EXPECT_NEAR(a.at("amplitude").get<double>(), b.at("amplitude").get<double>(), 1e-9);
   EXPECT_NEAR(a.at("contact_dissipation").get<double>(), b.at("contact_dissipation").get<double>(),
               1e-9 * std::abs(b.at("drive_work").get<double>()));
