@@ -64,6 +64,7 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
     capture_->results = results;
     capture_->columns = columns_;
     capture_->rows = std::move(rows_);
+    capture_->parameters = params_.to_json();
     return;
   }
   try {
@@ -72,14 +73,23 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
       if (keep_rows_) document["table"] = {{"columns", io::columns_json(columns_)}, {"rows", rows_}};
       else if (!path_.empty()) document["output"] = path_;
       fmt::print("{}\n", io::json_text(document));
-      return;
+    } else {
+      if (!summary.empty()) fmt::print("{}\n", summary);
+      if (!path_.empty())
+        fmt::print("wrote {} rows to {} (columns, units and results in {}.json)\n", count_, path_, path_);
     }
-    if (!summary.empty()) fmt::print("{}\n", summary);
-    if (!path_.empty())
-      fmt::print("wrote {} rows to {} (columns, units and results in {}.json)\n", count_, path_, path_);
   } catch (const std::system_error& e) {  // a full disk, a closed pipe (exit 1, as main's final check)
     throw std::runtime_error(fmt::format("cannot write the results to standard output: {}", e.code().message()));
   }
+  require_answer(results);
+}
+
+void require_answer(const nlohmann::json& results) {
+  const auto status = results.find("status");
+  if (status == results.end() || !status->is_string() || *status == "ok") return;
+  const auto note = results.find("note");
+  throw NoAnswer(fmt::format("status {}: {}", status->get<std::string>(),
+                             note != results.end() && note->is_string() ? note->get<std::string>() : "no answer"));
 }
 
 }  // namespace afmkit::cli

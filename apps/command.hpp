@@ -11,6 +11,7 @@
 // describing every column; empty path: no file) and prints a one-line summary, or with --json the summary as JSON
 // (plus, when no file is written, the table itself: {"columns": [...], "rows": [[...], ...]}).
 #include <functional>
+#include <stdexcept>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,6 +39,17 @@ struct Captured {
   /// Stop request of the caller (Python: Ctrl-C); the long computations check it once per point. The command line
   /// has no capture and keeps its signal handling.
   Cancellation cancellation;
+  /// The parameters as run (what the sidecar records: computed defaults filled in); null until the command finishes.
+  nlohmann::json parameters;
+};
+
+/// A run that computed no answer of the kind asked for: its results carry `status` other than "ok" and a `note`
+/// (docs/commands.md#exit-status). The outputs are written with the status in them; on the command line finish()
+/// then throws this and the program exits 1 with the note (the Python module returns the result: status in
+/// r.results).
+class NoAnswer : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 /// The caller's stop request (empty on the command line).
@@ -66,6 +78,10 @@ CLI::App& add_command(CLI::App& parent, const std::string& name, const std::stri
 
 /// Adds a group of subcommands (`afmkit tapping …`, `afmkit control …`): one of them must be given.
 CLI::App& add_command_group(CLI::App& parent, const std::string& name, const std::string& help);
+
+/// Throws NoAnswer when `results` holds a "status" other than "ok" (its "note" in the message); commands that
+/// write their outputs without a CommandOutput call it after writing them.
+void require_answer(const nlohmann::json& results);
 
 /// The "Output" group every table command has: `output` (CSV path, default `default_path`; empty: no file) and
 /// the `json` flag.
@@ -101,7 +117,8 @@ class CommandOutput {
 
   /// Commits the file with the sidecar (parameters, `results`, columns) and the files of outputs(), as one set.
   /// Then prints `results` as JSON (--json; with the rows when no file was written), or `summary` (if not empty) and
-  /// where the table went.
+  /// where the table went. When `results` has a "status" other than "ok", throws NoAnswer with its "note"
+  /// afterwards (command line only).
   void finish(const nlohmann::json& results, const std::string& summary);
 
  private:

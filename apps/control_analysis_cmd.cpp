@@ -106,9 +106,12 @@ void run_roots(const io::ParamSet& p, Captured* capture) {
   if (p.was_set("max_imag")) o.max_imag = u.rate(p.real("max_imag"));
   o.count = static_cast<int>(p.integer("count"));
   o.collocation_nodes = static_cast<int>(p.integer("nodes"));
-  const io::ParamSet as_run = params_as_run(p, c);
-  CommandOutput out(as_run, capture, "control roots");
   const control::Spectrum sp = control::rightmost_roots(loop, o);
+  // the record holds the box searched: the automatic edge and the proven half-height when not given
+  io::ParamSet as_run = params_as_run(p, c);
+  if (!p.was_set("min_real")) as_run.record_used("min_real", u.in_omega(sp.box.real_min));
+  if (!p.was_set("max_imag")) as_run.record_used("max_imag", u.in_omega(sp.box.imag_max));
+  CommandOutput out(as_run, capture, "control roots");
 
   nlohmann::json res;
   res["loop"] = control::describe_in_rotation_units(loop);
@@ -239,9 +242,10 @@ void run_margin(const io::ParamSet& p, Captured* capture) {
   control::MarginOptions o;
   if (p.was_set("reference_delay")) o.reference_delay = u.delay(p.real("reference_delay"));
   o.grid_points_per_omega = static_cast<int>(p.integer("points_per_omega"));
-  const io::ParamSet as_run = params_as_run(p, c);
-  CommandOutput out(as_run, capture, "control margin");
   const control::DelayMargin m = control::delay_margin(loop, o);
+  io::ParamSet as_run = params_as_run(p, c);
+  as_run.record_used("reference_delay", u.in_periods(m.reference_delay));  // 0, or model_delay (Smith predictor)
+  CommandOutput out(as_run, capture, "control margin");
   nlohmann::json res = margin_json(m, u);
   res["loop"] = control::describe_in_rotation_units(loop);
   res["settings"] = settings_json(c);

@@ -84,6 +84,10 @@ void run_export(const io::ParamSet& p, Captured* capture) {
                 {"smallest_decay_per_sample", "dimensionless"}, {"test_vectors", "count"}};
   if (capture != nullptr) {
     capture->results = j;
+    // the parameters as run: gain / model_rate / model_delay as used, the precision's input limit when 0 was given
+    io::ParamSet as_run = params_as_run(p, c);
+    if (p.real("input_limit") == 0.0) as_run.record_used("input_limit", spec.resolved_input_limit());
+    capture->parameters = as_run.to_json();
     return;
   }
   if (p.flag("json")) {

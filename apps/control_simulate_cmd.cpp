@@ -55,6 +55,14 @@ control::Disturbance disturbance_from(const io::ParamSet& p) {
   return control::Disturbance(p.real("disturbance_offset"), std::move(h));
 }
 
+/// The phases the run drew (one per entry of disturbance_amplitudes; 0 where F_k = 0), for the record.
+std::vector<double> phases_used(const io::ParamSet& p, const control::Disturbance& f) {
+  std::vector<double> phases(p.reals("disturbance_amplitudes").size(), 0.0);
+  for (const auto& h : f.harmonics)
+    if (h.order >= 1 && static_cast<std::size_t>(h.order) <= phases.size()) phases[h.order - 1] = h.phase;
+  return phases;
+}
+
 int highest_order(const control::Disturbance& f) {
   int k = 0;
   for (const auto& h : f.harmonics) k = std::max(k, h.order);
@@ -133,7 +141,8 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
     throw InvalidParameter("max_order", fmt::format("max_order = {} is out of range: must be an integer in [1, {}] "
                                                     "(below half of steps_per_period = {})",
                                                     o.report_max_order, nyquist_order, o.steps_per_period));
-  const io::ParamSet as_run = params_as_run(p, c, {{"max_order", o.report_max_order}});
+  io::ParamSet as_run = params_as_run(p, c, {{"max_order", o.report_max_order}});
+  if (!p.was_set("disturbance_phases")) as_run.record_used("disturbance_phases", phases_used(p, disturbance));
   CommandOutput out(as_run, capture, "control simulate");
   const bool keep_rows = p.flag("json") && !out.writes_file();
   o.record_every = out.writes_file() || keep_rows ? static_cast<int>(p.integer("record_every")) : 0;

@@ -58,8 +58,10 @@ void add_impact_params(io::ParamSet& p) {
       .unit("nm/s")
       .real("v1", 0.0, "initial velocity of body 1 (instead of velocity; needs v2 - v1 < 0)", Range::any())
       .unit("nm/s")
+      .only_if_given({"velocity"})  // the record holds velocity, or v1 and v2, as the run used them
       .real("v2", 0.0, "initial velocity of body 2 (instead of velocity)", Range::any())
       .unit("nm/s")
+      .only_if_given({"velocity"})
       .real("gap", 1.0, "initial gap d(t_s) = x2 - x1; contact below the law's contact gap (0, or a0)", Range::any())
       .unit("nm")
       .real("force1", 0.0, "constant external force F1 on body 1 (seed-1 eq. 1)", Range::any())

@@ -10,7 +10,7 @@
 namespace afmkit::cli {
 
 void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& default_law,
-                    const std::vector<std::string>& skip) {
+                    const std::vector<std::string>& skip, const LawKeyAliases& aliases) {
   std::vector<std::string> summaries;
   for (const auto& name : registry.names()) summaries.push_back(fmt::format("{}: {}", name, registry.find(name).summary));
   p.group("Contact law");
@@ -27,7 +27,13 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
     const std::string laws = fmt::format("[{}] ", fmt::join(registry.laws_using(k.key), ", "));
     io::Range range{k.lower, std::min(k.upper, 1e308), k.lower_open, false};
     p.real(k.key, k.default_value, laws + k.help, range).unit(k.unit.empty() ? "dimensionless" : k.unit);
-    if (!k.follows.empty()) p.default_text("= " + k.follows);
+    if (!k.follows.empty()) p.follows(k.follows);  // recorded with the value it takes (params.hpp)
+    if (k.only_if_given) {  // an alternative: recorded only when given, then instead of the key it replaces
+      std::vector<std::string> replaced{k.replaces};
+      for (const auto& [command_key, registry_key] : aliases)
+        if (registry_key == k.replaces) replaced.push_back(command_key);
+      p.only_if_given(std::move(replaced));
+    }
   }
 }
 
@@ -39,21 +45,24 @@ impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistr
   args.allow_energy_gain = p.flag("allow_energy_gain");
   args.force_curve = p.text("force_curve");
   auto reads = [&](const std::string& key) { return std::find(spec.keys.begin(), spec.keys.end(), key) != spec.keys.end(); };
+  std::vector<std::string> replaced;  // keys a given alternative stands for (restitution -> departure_stiffness)
+  for (const auto& k : registry.keys())
+    if (!k.replaces.empty() && p.was_set(k.key)) replaced.push_back(k.replaces);
+  const auto is_replaced = [&](const std::string& key) {
+    return std::find(replaced.begin(), replaced.end(), key) != replaced.end();
+  };
   for (const auto& [command_key, registry_key] : aliases) {
-    // always pass an alias the law reads (its default is the command's); a given alias of another law is
-    // passed too, so that the registry names it as foreign
-    if (reads(registry_key) || p.was_set(command_key)) args.values[registry_key] = p.real(command_key);
+    // always pass an alias the law reads (its default is the command's) unless a given alternative stands for it;
+    // a given alias of another law is passed too, so that the registry names it as foreign
+    if ((reads(registry_key) && !is_replaced(registry_key)) || p.was_set(command_key))
+      args.values[registry_key] = p.real(command_key);
   }
   // every key the law reads, with the command's value (given, or its default — a command may change defaults);
   // keys that follow another key or count only when given are passed only when given; given keys of other laws
   // are passed so that the registry names them
-  std::vector<std::string> replaced;  // keys a given alternative stands for (restitution -> departure_stiffness)
-  for (const auto& k : registry.keys())
-    if (!k.replaces.empty() && p.was_set(k.key)) replaced.push_back(k.replaces);
   for (const auto& k : registry.keys()) {
     if (args.values.count(k.key)) continue;
-    const bool is_replaced = std::find(replaced.begin(), replaced.end(), k.key) != replaced.end();
-    const bool pass = p.was_set(k.key) || (reads(k.key) && k.follows.empty() && !k.only_if_given && !is_replaced);
+    const bool pass = p.was_set(k.key) || (reads(k.key) && k.follows.empty() && !k.only_if_given && !is_replaced(k.key));
     if (pass) args.values[k.key] = p.real(k.key);
   }
   try {

@@ -16,8 +16,10 @@ using LawKeyAliases = std::map<std::string, std::string>;
 
 /// Declares `law` (default `default_law`), `force_curve`, `allow_energy_gain` and every registry key not in
 /// `skip` (keys the command declares itself).
+/// `aliases`: the command keys that stand for registry keys (law_from_params), so that an alternative given
+/// (restitution) leaves the command key it replaces out of the records too.
 void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& default_law,
-                    const std::vector<std::string>& skip = {});
+                    const std::vector<std::string>& skip = {}, const LawKeyAliases& aliases = {});
 /// The law the parameters describe (InvalidParameter naming the key for a key of another law, a value out of
 /// range or an unknown law). `aliases`: command keys whose values stand for registry keys.
 impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistry& registry,

@@ -1,5 +1,6 @@
 // afmkit — command-line front end. Exit status: 0 success, 2 bad input (parameter, file, config),
-// 1 numerical failure (no convergence, budget exhausted) or any other error.
+// 1 numerical failure (no convergence, budget exhausted), no answer (a status other than "ok" in the written
+// results: docs/commands.md#exit-status) or any other error.
 #include <cstdio>
 #include <iostream>
 #include <new>
@@ -10,6 +11,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/output.hpp"
+#include "command.hpp"
 #include "program.hpp"
 
 int main(int argc, char** argv) {
@@ -43,6 +45,9 @@ int main(int argc, char** argv) {
   } catch (const afmkit::InputError& e) {
     fmt::print(stderr, "afmkit: input error: {}\n", e.what());
     return 2;
+  } catch (const afmkit::cli::NoAnswer& e) {  // outputs written, with the status in them (docs/commands.md)
+    fmt::print(stderr, "afmkit: no answer: {}\n", e.what());
+    return 1;
   } catch (const afmkit::NumericalFailure& e) {
     fmt::print(stderr, "afmkit: numerical failure: {}\n", e.what());
     return 1;

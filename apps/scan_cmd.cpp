@@ -75,7 +75,11 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
     fmt::print(stderr, "afmkit scan: warning: the loop is unstable at the nominal delay (spectral abscissa {:.4g} "
                        "rad/s >= 0; see `afmkit control chart`)\n", abscissa);
 
-  CommandOutput out(p, capture, "scan");
+  // the record says what the run used: a generated sample's side when sample_size was left at 0 (2.04 x end_radius)
+  io::ParamSet as_run = p;
+  if (p.text("sample") != "file" && !p.was_set("sample_size"))
+    as_run.record_used("sample_size", generated_sample_size(p));
+  CommandOutput out(as_run, capture, "scan");
   out.open(turn_columns());
   std::optional<SeriesWriter> series;
   if (!series_path.empty()) series.emplace(series_path, series_every, false);
@@ -137,7 +141,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
                  {"topography_rms_error", "m"}, {"deflection_rms", "m"}, {"valid_pixels", "count"},
                  {"loop_spectral_abscissa", "1/s"}, {"samples", "count"}, {"turns", "count"},
                  {"filter_skipped_samples", "count"}, {"point_cloud_points", "count"}}}};
-  if (series) series->stage(io::make_sidecar("scan (time series)", p, results), out.outputs());
+  if (series) series->stage(io::make_sidecar("scan (time series)", as_run, results), out.outputs());
   const std::string gain =
       std::isnan(result.scan_area_gain)
           ? std::string("nan (the uncontrolled scan does not saturate)")

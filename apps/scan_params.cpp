@@ -213,7 +213,7 @@ void add_scan_params(io::ParamSet& p) {
       .unit("Omega")
       .real("gain", 0.0, "controller gain K (0: the design rule K = bandwidth)", non_negative)
       .unit("rad/s")
-      .default_text("= bandwidth");
+      .follows("bandwidth");  // recorded as the gain used
 }
 
 namespace {
@@ -310,6 +310,10 @@ scan::InstrumentSpec instrument_from(const io::ParamSet& p) {
   return s;
 }
 
+double generated_sample_size(const io::ParamSet& p) {
+  return p.was_set("sample_size") ? p.real("sample_size") : 2.04 * p.real("end_radius");
+}
+
 scan::Surface surface_from(const io::ParamSet& p) {
   const double tilt_angle = p.real("tilt_angle");
   if (!(tilt_angle < 90.0))
@@ -322,8 +326,7 @@ scan::Surface surface_from(const io::ParamSet& p) {
     throw InvalidParameter("sample_file", fmt::format("sample_file is given but sample = {}: set sample = file to "
                                                       "scan the file, or leave sample_file out", kind));
 
-  const double end_radius = p.real("end_radius");
-  const double size = p.was_set("sample_size") ? p.real("sample_size") : 2.04 * end_radius;
+  const double size = generated_sample_size(p);
   if (!(size > 0.0))
     throw InvalidParameter("sample_size", fmt::format("sample_size = {} m is out of range: must be > 0", size));
   const long n = p.integer("sample_resolution");

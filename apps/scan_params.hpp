@@ -14,6 +14,8 @@ namespace afmkit::cli {
 void add_scan_params(io::ParamSet& p);
 /// The instrument given (validated: InvalidParameter naming the parameter).
 scan::InstrumentSpec instrument_from(const io::ParamSet& p);
+/// The side [m] of a generated sample: sample_size when given, else 2.04 x end_radius.
+double generated_sample_size(const io::ParamSet& p);
 /// The sample: a built-in generator or a file (GSF, ASCII matrix, 16-bit PNG) centred on the spindle axis, tilted.
 scan::Surface surface_from(const io::ParamSet& p);
 /// Refuses (InvalidParameter, before anything is read or allocated) a scan whose sample map and images need more

@@ -134,6 +134,17 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
                          "<i4", {{"units", "count"},
                                  {"description", "points of the chunk whose computation failed numerically"}});
   store.commit();
+  // separations where every orbit found has the tip trapped (docs/conventions.md#statuses): counted there as
+  // orbits, never stable; said here so that a count is not mistaken for tapping orbits
+  const auto trapped = std::count_if(results.begin(), results.end(), [](const tapping::OrbitSearchResult& r) {
+    return !r.orbits.empty() && std::all_of(r.orbits.begin(), r.orbits.end(), [](const tapping::FoundOrbit& f) {
+      return tapping::tip_trapped(f.metrics);
+    });
+  });
+  if (trapped > 0)
+    fmt::print("tapping grid: at {} of {} separations the tip is trapped on every orbit found (sticks to the sample "
+               "or stays in contact over the whole period: no tapping; their count_amplitude counts those orbits)\n",
+               trapped, points);
   const auto bands = std::count_if(stable.values.begin(), stable.values.end(), [](double n) { return n > 1; });
   fmt::print("tapping grid: {} separations in [{}, {}] {}, {} with more than one stable orbit; written to {} "
              "(Zarr; xarray: xr.open_zarr)\n",

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
@@ -42,6 +43,19 @@ nlohmann::json hb_units(const TappingScales& s) {
           {"rows", "count"},   {"minimum_separation_limit", L}};
 }
 
+/// What the run found (docs/conventions.md#statuses): "ok" (a curve), "empty_curve" (no point of the curve in
+/// the q range, but solutions at `separation`), "no_solution" (neither).
+const char* hb_status(bool empty_curve, bool no_solution_at_separation) {
+  if (!empty_curve) return "ok";
+  return no_solution_at_separation ? "no_solution" : "empty_curve";
+}
+std::string hb_note(bool empty_curve, bool no_solution_at_separation, double q_min, double q_max,
+                    const std::string& separation) {
+  if (!empty_curve) return "";
+  return fmt::format("no harmonic-balance solution for q in [{}, {}]: the curve is empty; {} at separation {}", q_min,
+                     q_max, no_solution_at_separation ? "no solution either" : "solutions (results)", separation);
+}
+
 void run_hb(const io::ParamSet& p, Captured* capture) {
   const double q_min = p.real("q_min");
   const double q_max = p.real("q_max");
@@ -66,15 +80,21 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   const std::vector<tapping::HbPoint> curve = tapping::harmonic_balance_curve(model, options);
   write_hb_rows(out, curve, scales);
 
-  const tapping::HarmonicBalance hb(model);
+  // the model and options are checked: what is refused from here on was computed (core/computed.hpp)
+  const tapping::HarmonicBalance hb = computed("harmonic balance", [&] { return tapping::HarmonicBalance(model); });
   // folds as records sorted by separation (as `tapping sweep` reports its folds and jumps)
-  const nlohmann::json folds = hb_fold_records(hb, scales);
+  const nlohmann::json folds = computed("harmonic balance: its folds", [&] { return hb_fold_records(hb, scales); });
   nlohmann::json solutions = nlohmann::json::array();
-  for (const tapping::HbPoint& s : hb.solutions(model.separation)) solutions.push_back(point_json(s, scales));
+  for (const tapping::HbPoint& s :
+       computed("harmonic balance: the solutions at separation", [&] { return hb.solutions(model.separation); }))
+    solutions.push_back(point_json(s, scales));
   nlohmann::json results = {{"folds", folds},
                             {"free_amplitude", hb.free_amplitude() * scales.length},
                             {"solutions_at_separation", solutions},
                             {"rows", out.rows()},
+                            {"status", hb_status(curve.empty(), solutions.empty())},
+                            {"note", hb_note(curve.empty(), solutions.empty(), q_min, q_max,
+                                             fmt::format("{} {}", p.real("separation"), scales.length_unit))},
                             {"units", hb_units(scales)}};
   if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
     if (const auto limit = tapping::minimum_separation_limit(model))

@@ -98,7 +98,26 @@ nlohmann::json orbit_json(const tapping::FoundOrbit& f, const tapping::OrbitSear
           {"sticking_time", m.sticking_duration * s.time},
           {"initial_position", o.initial.position * s.length},
           {"initial_velocity", o.initial.velocity * s.length / s.time},
-          {"shooting_residual", o.residual}};
+          {"shooting_residual", o.residual},
+          {"trapped", tapping::tip_trapped(m)}};
+}
+
+/// What the search found, in words (docs/conventions.md#statuses): "ok" (an orbit on which the tip taps),
+/// "tip_trapped" (every orbit found keeps the tip in contact) or "no_orbit" (none found).
+struct OrbitStatus {
+  std::string status, note;
+};
+OrbitStatus orbit_status(const tapping::OrbitSearchResult& r, double separation, const std::string& unit) {
+  if (r.orbits.empty())
+    return {"no_orbit", fmt::format("no periodic orbit found at separation {} {} (see the search report)", separation,
+                                    unit)};
+  for (const tapping::FoundOrbit& f : r.orbits)
+    if (!tapping::tip_trapped(f.metrics)) return {"ok", ""};
+  return {"tip_trapped",
+          fmt::format("tip trapped: on every orbit found ({}) the tip sticks to the sample or stays in contact over "
+                      "the whole period at separation {} {} (held by the sample: an attraction larger than the drive "
+                      "can pull off); no tapping orbit",
+                      r.orbits.size(), separation, unit)};
 }
 
 /// The unit of every number of orbit_json.
@@ -139,6 +158,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   options.cancellation = cancellation_of(capture);
   const tapping::OrbitSearchResult r = tapping::find_orbits(model, options);
   progress.finish();
+  const OrbitStatus status = orbit_status(r, p.real("separation"), scales.length_unit);
 
   nlohmann::json orbits = nlohmann::json::array();
   for (const tapping::FoundOrbit& f : r.orbits) orbits.push_back(orbit_json(f, r.report, scales));
@@ -164,6 +184,8 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
       {"orbits", orbits},
       {"transients", transients},
       {"search", search_json(r.report, scales)},
+      {"status", status.status},
+      {"note", status.note},
       {"units",
        {{"length", length}, {"velocity", velocity}, {"force", scales.force_unit}, {"energy", scales.energy_unit},
         {"time", scales.time_unit}, {"phase", "rad"}, {"seconds", "s"},
@@ -196,7 +218,9 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
             {"floquet_max", "dimensionless", "largest Floquet multiplier modulus"},
             {"sticking_time", scales.time_unit, "time spent sticking to the sample per orbit"},
             {"initial_position", length, "tip position x at drive phase 0 on the orbit"},
-            {"initial_velocity", velocity, "tip velocity at drive phase 0 on the orbit"}});
+            {"initial_velocity", velocity, "tip velocity at drive phase 0 on the orbit"},
+            {"trapped", "boolean (0/1)", "1: the tip sticks to the sample or stays in contact over the whole period (no "
+                                         "tapping; docs/conventions.md#statuses)"}});
   for (const tapping::FoundOrbit& f : r.orbits) {
     const auto& m = f.metrics;
     const double l = scales.length;
@@ -204,7 +228,8 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
             m.offset * l, m.phase, m.harmonics[0] * l, m.harmonics[1] * l, m.harmonics[2] * l, m.harmonics[3] * l,
             m.contact_fraction, m.peak_force * scales.force, m.min_gap * l, m.energy_dissipated() * scales.energy,
             m.viscous_dissipation * scales.energy, m.contact_dissipation * scales.energy, f.orbit.floquet_max,
-            m.sticking_duration * scales.time, f.orbit.initial.position * l, f.orbit.initial.velocity * l / scales.time);
+            m.sticking_duration * scales.time, f.orbit.initial.position * l, f.orbit.initial.velocity * l / scales.time,
+            tapping::tip_trapped(m));
   }
   if (p.flag("json")) {
     out.finish(summary, "");
@@ -223,6 +248,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
                f.metrics.amplitude * scales.length, f.metrics.offset * scales.length, f.metrics.phase,
                f.orbit.stable ? "stable" : "unstable", f.orbit.floquet_max, f.metrics.contact_fraction,
                f.seeds.size());
+  if (status.status != "ok") fmt::print("  {}\n", status.note);
   for (const tapping::TransientOutcome& t : r.transients)
     if (t.kind != tapping::ResponseKind::periodic) fmt::print("  transient: {}\n", t.message);
   {

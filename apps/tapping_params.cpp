@@ -122,7 +122,8 @@ void add_tapping_model_params(io::ParamSet& p) {
       .unit("nN")
       ;
   add_law_params(p, impact::LawRegistry::builtin(), "hysteresis",
-                 {"approach_stiffness", "departure_stiffness", "approach_adhesion", "departure_adhesion"});
+                 {"approach_stiffness", "departure_stiffness", "approach_adhesion", "departure_adhesion"},
+                 physical_aliases);
 }
 
 tapping::TappingModel tapping_model_from(const io::ParamSet& p) {

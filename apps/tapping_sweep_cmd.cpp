@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
@@ -92,6 +93,7 @@ nlohmann::json sweep_units(const TappingScales& s) {
           {"grazing", L},
           {"continuation_points", "count"},
           {"free_amplitude", L},
+          {"trapped_rows", "count"},
           {"rows", "count"}};
 }
 
@@ -141,7 +143,11 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
 
   CommandOutput out(p, capture, "tapping sweep");
   out.open(sweep_columns(scales));
-  const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) { write_sweep_rows(out, points, scales); };
+  long trapped = 0;  // rows on which the tip does not tap (column trapped)
+  const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) {
+    write_sweep_rows(out, points, scales);
+    for (const tapping::SweepPoint& pt : points) trapped += tapping::tip_trapped(pt.metrics) ? 1 : 0;
+  };
   nlohmann::json results = nlohmann::json::object();
   std::string summary;
   if (instrument) {
@@ -151,8 +157,11 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     options.transient = transient_options_from(p);
     options.progress = [&progress](long n) { progress.advance(n); };
     options.cancellation = cancellation_of(capture);
-    const tapping::SweepResult r = list.empty() ? tapping::sweep_instrument(base, l_min, l_max, points, options)
-                                                : tapping::sweep_instrument(base, list, options);
+    options.validate();  // the input; what is refused inside the sweep was computed (core/computed.hpp)
+    const tapping::SweepResult r = computed("instrument sweep", [&] {
+      return list.empty() ? tapping::sweep_instrument(base, l_min, l_max, points, options)
+                          : tapping::sweep_instrument(base, list, options);
+    });
     progress.finish();
     write_rows(r.approach);
     write_rows(r.retract);
@@ -172,7 +181,9 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     options.initial_step = std::min(options.initial_step, options.max_step);
     options.max_points = static_cast<int>(p.integer("max_continuation_points"));
     options.cancellation = cancellation_of(capture);
-    const tapping::ContinuationResult c = tapping::sweep_continuation(base, l_min, l_max, options);
+    options.validate();
+    const tapping::ContinuationResult c =
+        computed("branch continuation", [&] { return tapping::sweep_continuation(base, l_min, l_max, options); });
     write_rows(c.points);
     results["folds"] = fold_records(c, scales);
     results["grazing"] = scaled(c.grazing, scales.length);
@@ -186,6 +197,19 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
   }
   results["free_amplitude"] = base.free_amplitude() * scales.length;
   results["rows"] = out.rows();
+  results["trapped_rows"] = trapped;
+  // every row with the tip trapped: no tapping anywhere in the range (docs/conventions.md#statuses)
+  const bool all_trapped = out.rows() > 0 && trapped == static_cast<long>(out.rows());
+  results["status"] = all_trapped ? "tip_trapped" : "ok";
+  results["note"] = all_trapped ? fmt::format("tip trapped: the tip sticks to the sample or stays in contact over "
+                                              "the whole period at every separation of the sweep ({} rows; column "
+                                              "trapped): no tapping",
+                                              out.rows())
+                                : trapped > 0 ? fmt::format("{} of {} rows with the tip trapped (stuck to the sample or "
+                                                            "in contact over the whole period; column trapped)",
+                                                            trapped, out.rows())
+                                              : std::string();
+  if (trapped > 0) summary += "\n" + results["note"].get<std::string>();
   results["units"] = sweep_units(scales);
   out.finish(results, summary);
 }

@@ -54,7 +54,9 @@ std::vector<io::Column> sweep_columns(const tapping::UnitScales& s) {
           {"hb_amplitude", L, "nearest harmonic-balance amplitude at the same separation (nan: none)"},
           {"hb_offset", L, "its mean deflection (nan: none)"},
           {"hb_phase", "rad", "its phase (nan: none)"},
-          {"hb_solutions", "count", "number of harmonic-balance solutions at this separation"}};
+          {"hb_solutions", "count", "number of harmonic-balance solutions at this separation"},
+          {"trapped", "boolean (0/1)", "1: the tip sticks to the sample or stays in contact over the whole period (no "
+                                       "tapping; docs/conventions.md#statuses): amplitude is its motion in contact"}};
 }
 
 }  // namespace afmkit::cli

@@ -30,7 +30,7 @@ nlohmann::json hb_fold_records(const tapping::HarmonicBalance& hb, const tapping
 
 /// Columns: separation, direction, amplitude, offset, phase, stable, contact_fraction, energy_dissipated,
 /// then peak_force, min_gap, floquet_max, period_multiple, periodic, jumped, arclength, harmonic_2, harmonic_3,
-/// hb_amplitude, hb_offset, hb_phase, hb_solutions.
+/// hb_amplitude, hb_offset, hb_phase, hb_solutions, trapped.
 std::vector<io::Column> sweep_columns(const tapping::UnitScales& scales);
 /// Rows of the points into `out` (a CommandOutput or an io::TableWriter opened with sweep_columns).
 template <class Table>
@@ -41,7 +41,8 @@ void write_sweep_rows(Table& out, const std::vector<tapping::SweepPoint>& points
             m.offset * s.length, m.phase, pt.orbit.stable, m.contact_fraction, m.energy_dissipated() * s.energy,
             m.peak_force * s.force, m.min_gap * s.length, pt.orbit.floquet_max, pt.orbit.period_multiple,
             pt.periodic, pt.jumped, pt.arclength, m.harmonics[0] * s.length, m.harmonics[1] * s.length,
-            pt.hb_amplitude * s.length, pt.hb_offset * s.length, pt.hb_phase, pt.hb_solutions);
+            pt.hb_amplitude * s.length, pt.hb_offset * s.length, pt.hb_phase, pt.hb_solutions,
+            tapping::tip_trapped(m));
   }
 }
 

@@ -115,7 +115,10 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   }
   out["columns"] = columns;
   out["table"] = table;
-  out["params"] = json_to_python(p.to_json());
+  // the parameters as the run used them (computed defaults filled in), as its sidecar records them
+  nlohmann::json params = captured.parameters.is_null() ? p.to_json() : captured.parameters;
+  params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)
+  out["params"] = json_to_python(params);
   return out;
 }
 

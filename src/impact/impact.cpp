@@ -207,6 +207,8 @@ ImpactResult simulate_impact(const ImpactProblem& problem, const ImpactOptions& 
                            "constant external forces; use integrator or automatic");
   const bool closed = options.method == ImpactMethod::closed_form ||
                       (options.method == ImpactMethod::automatic && closed_form_possible);
+  // (no computed() boundary here: the solvers check combinations of the input's scales — stiffness / reduced
+  // mass, gap / speed — and refuse them as InvalidParameter naming the parameter, as input errors)
   ImpactResult r = closed ? detail::closed_form_impact(problem, options) : detail::integrated_impact(problem, options);
   require_finite_result(r);
   return r;

@@ -188,6 +188,37 @@ ParamSet& ParamSet::default_text(const std::string& text) {
   entries_[last_].default_text = text;
   return *this;
 }
+ParamSet& ParamSet::follows(const std::string& key) {
+  if (last_.empty()) throw std::logic_error("ParamSet::follows before any parameter");
+  const auto it = entries_.find(key);
+  if (it == entries_.end() || key == last_)
+    throw std::logic_error(fmt::format("ParamSet::follows: '{}' follows '{}', which is not declared before it", last_, key));
+  Entry& e = entries_[last_];
+  if (it->second.value.index() != e.value.index())
+    throw std::logic_error(fmt::format("ParamSet::follows: '{}' and '{}' are not of the same kind", last_, key));
+  e.follows = key;
+  if (e.default_text.empty()) e.default_text = "= " + key;
+  return *this;
+}
+ParamSet& ParamSet::only_if_given(std::vector<std::string> instead_of) {
+  if (last_.empty()) throw std::logic_error("ParamSet::only_if_given before any parameter");
+  Entry& e = entries_[last_];
+  e.only_if_given = true;
+  e.instead_of = std::move(instead_of);
+  return *this;
+}
+void ParamSet::record_used(const std::string& key, Value value) {
+  auto it = entries_.find(key);
+  if (it == entries_.end()) throw std::logic_error("ParamSet::record_used: no parameter named '" + key + "'");
+  Entry& e = it->second;
+  if (std::holds_alternative<double>(e.value) && std::holds_alternative<long>(value))
+    value = static_cast<double>(std::get<long>(value));
+  if (value.index() != e.value.index())
+    throw std::logic_error(fmt::format("ParamSet::record_used: '{}' recorded with a value of another kind", key));
+  e.value = std::move(value);
+  e.used = true;
+  check(key, e, "");
+}
 ParamSet& ParamSet::positional() {
   if (last_.empty() || !std::holds_alternative<std::string>(entries_[last_].value))
     throw std::logic_error("ParamSet::positional: the last declared parameter is not a text or file");
@@ -487,26 +518,42 @@ const ParamSet::Entry& ParamSet::entry(const std::string& key) const {
   if (it == entries_.end()) throw std::logic_error("ParamSet: no parameter named '" + key + "'");
   return it->second;
 }
-double ParamSet::real(const std::string& key) const { return std::get<double>(entry(key).value); }
-long ParamSet::integer(const std::string& key) const { return std::get<long>(entry(key).value); }
-const std::string& ParamSet::text(const std::string& key) const& { return std::get<std::string>(entry(key).value); }
-bool ParamSet::flag(const std::string& key) const { return std::get<bool>(entry(key).value); }
+const ParamSet::Entry& ParamSet::current(const std::string& key) const {
+  const Entry* e = &entry(key);
+  // a chain of follows ends: each followed key is declared before its follower
+  while (!e->set && !e->used && !e->follows.empty()) e = &entry(e->follows);
+  return *e;
+}
+bool ParamSet::recorded(const std::string& key) const {
+  const Entry& e = entry(key);
+  if (e.only_if_given && !e.set) return false;
+  for (const auto& [other, o] : entries_)
+    if (o.only_if_given && o.set && std::find(o.instead_of.begin(), o.instead_of.end(), key) != o.instead_of.end())
+      return false;
+  return true;
+}
+double ParamSet::real(const std::string& key) const { return std::get<double>(current(key).value); }
+long ParamSet::integer(const std::string& key) const { return std::get<long>(current(key).value); }
+const std::string& ParamSet::text(const std::string& key) const& { return std::get<std::string>(current(key).value); }
+bool ParamSet::flag(const std::string& key) const { return std::get<bool>(current(key).value); }
 const std::vector<double>& ParamSet::reals(const std::string& key) const& {
-  return std::get<std::vector<double>>(entry(key).value);
+  return std::get<std::vector<double>>(current(key).value);
 }
 bool ParamSet::was_set(const std::string& key) const { return entry(key).set; }
 
 nlohmann::json ParamSet::units_json() const {
   nlohmann::json j = nlohmann::json::object();
   for (const auto& key : order_)
-    if (!entries_.at(key).unit.empty()) j[key] = entries_.at(key).unit;
+    if (!entries_.at(key).unit.empty() && recorded(key)) j[key] = entries_.at(key).unit;
   return j;
 }
 
 nlohmann::json ParamSet::to_json() const {
   nlohmann::json j = nlohmann::json::object();
+  // the values the run used: a key that follows another records the followed value, a value recorded by
+  // record_used replaces the default, an alternative not given is left out (params.hpp)
   for (const auto& key : order_) {
-    std::visit([&](const auto& v) { j[key] = v; }, entries_.at(key).value);
+    if (recorded(key)) std::visit([&](const auto& v) { j[key] = v; }, current(key).value);
   }
   return j;
 }

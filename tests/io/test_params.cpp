@@ -125,3 +125,82 @@ TEST(ParamSet, ANumberWithoutAUnitIsAProgrammingError) {
   q.text("law", "hysteresis", "force law");
   EXPECT_THROW(q.unit("nm"), std::logic_error);  // a name has no unit
 }
+
+// ---------------------------------------------------------------- the records hold what a run used (issue 24 §2)
+namespace {
+ParamSet law_like() {
+  ParamSet p;
+  p.real("hamaker", 6.4e-20, "A_H", Range::non_negative())
+      .unit("J")
+      .real("departure_hamaker", 6.4e-20, "A_H departing", Range::non_negative())
+      .unit("J")
+      .follows("hamaker")
+      .real("stiffness", 8.0, "K_b", Range::non_negative())
+      .unit("N/m")
+      .real("restitution", 1.0, "e, instead of stiffness", Range::positive())
+      .unit("dimensionless")
+      .only_if_given({"stiffness"});
+  return p;
+}
+}  // namespace
+
+TEST(ParamSetRecords, AFollowerNotGivenTakesAndRecordsTheFollowedValue) {
+  ParamSet p = law_like();
+  p.set_from_string("hamaker", "1e-19");
+  EXPECT_EQ(p.real("departure_hamaker"), 1e-19);
+  EXPECT_FALSE(p.was_set("departure_hamaker"));
+  EXPECT_EQ(p.to_json()["departure_hamaker"].get<double>(), 1e-19);  // not the declared 6.4e-20
+  EXPECT_EQ(std::get<double>(p.value("departure_hamaker")), 1e-19);
+  // given, it keeps its own value
+  p.set_from_string("departure_hamaker", "2e-19");
+  EXPECT_EQ(p.to_json()["departure_hamaker"].get<double>(), 2e-19);
+  EXPECT_EQ(p.to_json()["hamaker"].get<double>(), 1e-19);
+}
+
+TEST(ParamSetRecords, FollowsShowsTheKeyInHelpAndRefusesAnUndeclaredOrOtherKind) {
+  ParamSet p = law_like();
+  for (const auto& d : p.describe())
+    if (d.key == "departure_hamaker") EXPECT_EQ(d.default_text, "= hamaker");
+  ParamSet q;
+  q.real("a", 1.0, "a").unit("m");
+  EXPECT_THROW(q.follows("nothing"), std::logic_error);
+  q.text("t", "x", "t");
+  EXPECT_THROW(q.follows("a"), std::logic_error);  // a text cannot follow a number
+}
+
+TEST(ParamSetRecords, AnAlternativeIsRecordedOnlyWhenGivenAndThenReplacesItsKey) {
+  ParamSet p = law_like();
+  p.resolve();
+  nlohmann::json j = p.to_json();
+  EXPECT_FALSE(j.contains("restitution"));  // not used: a replay must not give it
+  EXPECT_TRUE(j.contains("stiffness"));
+  p.set_from_string("restitution", "0.5");
+  j = p.to_json();
+  EXPECT_EQ(j["restitution"].get<double>(), 0.5);
+  EXPECT_FALSE(j.contains("stiffness"));  // the run used e, not the declared K_b
+  EXPECT_FALSE(p.units_json().contains("stiffness"));
+}
+
+TEST(ParamSetRecords, RecordUsedReplacesTheDefaultInTheRecordWithoutCountingAsGiven) {
+  ParamSet p = law_like();
+  p.record_used("stiffness", 3.25);
+  EXPECT_EQ(p.real("stiffness"), 3.25);
+  EXPECT_FALSE(p.was_set("stiffness"));
+  EXPECT_EQ(p.to_json()["stiffness"].get<double>(), 3.25);
+  // a recorded value of a follower is its own
+  p.record_used("departure_hamaker", 5e-20);
+  p.set_from_string("hamaker", "1e-19");
+  EXPECT_EQ(p.to_json()["departure_hamaker"].get<double>(), 5e-20);
+  EXPECT_THROW(p.record_used("stiffness", -1.0), InvalidParameter);  // validated as a given value
+  EXPECT_THROW(p.record_used("stiffness", std::string("x")), std::logic_error);
+}
+
+TEST(ParamSetRecords, AFollowedChainResolvesToTheFirstGivenValue) {
+  ParamSet p;
+  p.real("a", 1.0, "a").unit("m").real("b", 2.0, "b").unit("m").follows("a").real("c", 3.0, "c").unit("m").follows("b");
+  p.set_from_string("a", "7");
+  EXPECT_EQ(p.real("c"), 7.0);
+  p.set_from_string("b", "5");
+  EXPECT_EQ(p.real("c"), 5.0);
+  EXPECT_EQ(p.to_json()["c"].get<double>(), 5.0);
+}

@@ -67,6 +67,18 @@ class ParamSet {
   /// What --help shows as the default of the last declared parameter when it is not a fixed value ("automatic",
   /// "= plant_rate", …); the declared default stays the value used when nothing else applies.
   ParamSet& default_text(const std::string& text);
+  /// The last declared parameter, when not given, takes the value of parameter `key` (declared before it, of the
+  /// same kind): value(), real(), … and the records (to_json: sidecars, Python r.params) give the value the run
+  /// used. --help shows "= key" unless default_text() says otherwise.
+  ParamSet& follows(const std::string& key);
+  /// The last declared parameter counts only when given (an alternative, e.g. restitution instead of
+  /// departure_stiffness): not given, it is left out of the records; given, it stands for the keys `instead_of`,
+  /// which are then left out of the records (a replay gives the alternative, as the run did).
+  ParamSet& only_if_given(std::vector<std::string> instead_of = {});
+  /// Records the value a run used for a parameter whose value the command computes or chooses itself
+  /// ("automatic", "proven bound", a default that depends on other values): value() and the records give it from
+  /// now on; it does not count as given (was_set). Validated as a given value is (InvalidParameter naming the key).
+  void record_used(const std::string& key, Value value);
   /// The unit of the last declared number (docs/units.md: "nm", "rad", "dimensionless", "units of Omega", …),
   /// shown in --help and written to sidecars. Every real parameter needs one (add_options throws
   /// std::logic_error otherwise); integers default to "count".
@@ -117,7 +129,7 @@ class ParamSet {
   /// Every parameter in declaration order.
   std::vector<Description> describe() const;
   /// The value of any parameter.
-  const Value& value(const std::string& key) const& { return entry(key).value; }
+  const Value& value(const std::string& key) const& { return current(key).value; }
 
   double real(const std::string& key) const;
   long integer(const std::string& key) const;
@@ -152,9 +164,17 @@ class ParamSet {
     bool positional = false;              // also accepted as a positional argument
     bool written = false;                 // a file parameter that is an output (writes())
     WrittenPaths written_paths;           // what its value writes (empty: the file itself)
+    std::string follows;                  // not given: the value of this parameter
+    bool only_if_given = false;           // not given: not recorded
+    std::vector<std::string> instead_of;  // given: these parameters are not recorded
+    bool used = false;                    // value recorded by record_used
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;
+  /// The entry whose value `key` has now: its own, or (not given, following another key) the followed one's.
+  const Entry& current(const std::string& key) const;
+  /// Whether `key` goes into the records (to_json, units_json).
+  bool recorded(const std::string& key) const;
   std::map<std::string, Entry> entries_;
   std::vector<std::string> order_;
   std::string config_path_;

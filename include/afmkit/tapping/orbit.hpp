@@ -32,7 +32,15 @@ struct OrbitMetrics {
   double energy_dissipated() const { return viscous_dissipation + contact_dissipation; }
   long impacts_per_period_multiple = 0;  // contacts during one orbit (n drive periods)
   double sticking_duration = 0.0;        // time spent sticking during one orbit
+  double duration = 0.0;                 // of the orbit: period_multiple drive periods (0: not analysed)
 };
+
+/// Whether the tip is trapped on this orbit: it never taps — it sticks to the sample for the whole orbit (at rest
+/// where the force lies between the approach and retract branches, e.g. held by an adhesion far above the drive
+/// force k A0 / Q) or stays below the law's contact gap over the whole orbit (each up to a fraction 1e-6 of the
+/// orbit's duration; docs/conventions.md#statuses). Its amplitude is the motion in contact (often ~1e-16 nm), not
+/// a tapping amplitude.
+bool tip_trapped(const OrbitMetrics& metrics);
 
 /// Evaluate the observables of `orbit` by simulating it once (period_multiple drive periods).
 OrbitMetrics analyse_orbit(const TappingModel& model, const PeriodicOrbit& orbit,

@@ -9,6 +9,7 @@
 
 #include "afmkit/control/dde_collocation.hpp"
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/validate.hpp"
 #include "spectra_detail.hpp"
 
@@ -82,8 +83,9 @@ CharacteristicRoot refine_root(const LoopSpec& loop, std::complex<double> guess,
   return {r.root, 1, r.correction, false};
 }
 
-Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
-  check_options(o);
+namespace {
+// rightmost_roots on checked arguments (the public function checks them first)
+Spectrum rightmost_roots_checked(const LoopSpec& loop, const SpectrumOptions& o) {
   const auto v = spectra_detail::view(loop);
   const double omega = v.omega;
   Spectrum out;
@@ -261,6 +263,13 @@ Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
     out.notes.push_back(fmt::format("incomplete: the argument principle counts {} roots in the box, {} were found",
                                     n_box, have));
   return out;
+}
+}  // namespace
+
+Spectrum rightmost_roots(const LoopSpec& loop, const SpectrumOptions& o) {
+  check_options(o);
+  // the arguments are checked: what is refused from here on was computed (core/computed.hpp)
+  return computed("rightmost roots", [&] { return rightmost_roots_checked(loop, o); });
 }
 
 double spectral_abscissa(const LoopSpec& loop) { return rightmost_roots(loop).spectral_abscissa; }

@@ -11,6 +11,7 @@
 #include "afmkit/control/delay_margin.hpp"
 #include "afmkit/control/spectrum.hpp"
 #include "afmkit/core/parallel.hpp"
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/validate.hpp"
 #include "spectra_detail.hpp"
 #include "tracking.hpp"
@@ -153,8 +154,9 @@ void label_regions(const ChartSpec& spec, const RootTracker& tracker, StabilityC
 }
 }  // namespace
 
-StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(long, long)>& progress) {
-  check_spec(spec);
+namespace {
+// stability_chart on checked arguments (the public function checks them first)
+StabilityChart stability_chart_checked(const ChartSpec& spec, const std::function<void(long, long)>& progress) {
   const int nx = spec.x_points, ny = spec.y_points;
   StabilityChart c;
   c.x = linspace(spec.x_min, spec.x_max, nx);
@@ -192,13 +194,19 @@ StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(l
   if (spec.boundaries) c.boundaries = stability_boundaries(spec.family, spec.x_min, spec.x_max, spec.y_min, spec.y_max);
   return c;
 }
+}  // namespace
 
-MarginMap delay_margin_map(const LoopFamily& family, double x_min, double x_max, int x_points, double y_min,
-                           double y_max, int y_points, int threads, const std::function<void(long, long)>& progress,
-                           const Cancellation& cancellation) {
-  spectra_detail::validate_window(x_min, x_max, y_min, y_max);
-  validate::in_range("x_points", static_cast<long>(x_points), 2L, 100000L);
-  validate::in_range("y_points", static_cast<long>(y_points), 2L, 100000L);
+StabilityChart stability_chart(const ChartSpec& spec, const std::function<void(long, long)>& progress) {
+  check_spec(spec);
+  // the arguments are checked: what is refused from here on was computed (core/computed.hpp)
+  return computed("stability chart", [&] { return stability_chart_checked(spec, progress); });
+}
+
+namespace {
+// delay_margin_map on checked arguments (the public function checks them first)
+MarginMap delay_margin_map_checked(const LoopFamily& family, double x_min, double x_max, int x_points, double y_min,
+                                   double y_max, int y_points, int threads,
+                                   const std::function<void(long, long)>& progress, const Cancellation& cancellation) {
   MarginMap m;
   m.x = linspace(x_min, x_max, x_points);
   m.y = linspace(y_min, y_max, y_points);
@@ -214,6 +222,20 @@ MarginMap delay_margin_map(const LoopFamily& family, double x_min, double x_max,
     if (progress) progress(1, static_cast<long>(n));
   });
   return m;
+}
+}  // namespace
+
+MarginMap delay_margin_map(const LoopFamily& family, double x_min, double x_max, int x_points, double y_min,
+                           double y_max, int y_points, int threads, const std::function<void(long, long)>& progress,
+                           const Cancellation& cancellation) {
+  spectra_detail::validate_window(x_min, x_max, y_min, y_max);
+  validate::in_range("x_points", static_cast<long>(x_points), 2L, 100000L);
+  validate::in_range("y_points", static_cast<long>(y_points), 2L, 100000L);
+  // the arguments are checked: what is refused from here on was computed (core/computed.hpp)
+  return computed("delay-margin map", [&] {
+    return delay_margin_map_checked(family, x_min, x_max, x_points, y_min, y_max, y_points, threads, progress,
+                                    cancellation);
+  });
 }
 
 }  // namespace afmkit::control

@@ -12,6 +12,7 @@
 #include "afmkit/control/delay_margin.hpp"
 #include "afmkit/control/spectrum.hpp"
 #include "afmkit/core/parallel.hpp"
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/validate.hpp"
 #include "spectra_detail.hpp"
 #include "tracking.hpp"
@@ -138,8 +139,9 @@ double worst_case_decay(const RobustTuningSpec& spec, double x, double y, double
   return Objective(spec)(x, y, warm, worst_delay, worst_gain_ratio);
 }
 
-RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<void(long, long)>& progress) {
-  check(spec);
+namespace {
+// robust_tuning on checked arguments (the public function checks them first)
+RobustTuning robust_tuning_checked(const RobustTuningSpec& spec, const std::function<void(long, long)>& progress) {
   const Objective objective(spec);
   RobustTuning out;
   const int n = spec.coarse_points;
@@ -258,6 +260,13 @@ RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<voi
                            dm.upper_frequency});
   }
   return out;
+}
+}  // namespace
+
+RobustTuning robust_tuning(const RobustTuningSpec& spec, const std::function<void(long, long)>& progress) {
+  check(spec);
+  // the arguments are checked: what is refused from here on was computed (core/computed.hpp)
+  return computed("robust tuning", [&] { return robust_tuning_checked(spec, progress); });
 }
 
 }  // namespace afmkit::control

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/validate.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "general_harmonic_balance.hpp"
@@ -70,10 +71,7 @@ void general_curve(const TappingModel& model, const HbCurveOptions& options, std
   out.insert(out.end(), lower.begin(), lower.end());
 }
 
-}  // namespace
-
-void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out) {
-  validate_options(options);
+void curve_of_checked(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out) {
   if (model.law.piecewise_linear() == nullptr) {
     general_curve(model, options, out);
     return;
@@ -101,6 +99,14 @@ void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& opt
   std::copy(out.begin() + static_cast<std::ptrdiff_t>(n), out.begin() + static_cast<std::ptrdiff_t>(n + n_minus),
             out.begin() + static_cast<std::ptrdiff_t>(n_plus));
   out.resize(n_plus + n_minus);
+}
+
+}  // namespace
+
+void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out) {
+  validate_options(options);
+  // the options are checked: what is refused from here on was computed (core/computed.hpp)
+  computed("harmonic-balance curve", [&] { curve_of_checked(model, options, out); });
 }
 
 std::vector<HbPoint> harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options) {

@@ -35,6 +35,12 @@ struct Residual {
 
 Residual residual(const TappingModel& base, const Eigen::Vector3d& z, const SimulationOptions& sim) {
   const double omega = base.drive.frequency;
+  // a predictor along a tangent of a singular Jacobian (a tip held in contact: no motion to follow) gives NaN
+  // unknowns; that is the continuation's failure, not a separation the user gave (issue 24 §2)
+  if (!z.allFinite())
+    throw NumericalFailure(fmt::format("branch continuation: the unknowns (x, v/omega, l) = ({}, {}, {}) are not "
+                                       "finite (the shooting Jacobian is singular: no branch to follow)",
+                                       z.x(), z.y(), z.z()));
   const TappingModel model = base.with_separation(z.z());
   Residual r;
   r.map = stroboscopic_map(model, {z.x(), z.y() * omega}, 1, sim);

@@ -10,6 +10,7 @@
 
 #include <Eigen/LU>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/parallel.hpp"
 #include "afmkit/core/validate.hpp"
@@ -73,6 +74,12 @@ double quadrature_panel(const TappingModel& model) {
 
 }  // namespace
 
+bool tip_trapped(const OrbitMetrics& metrics) {
+  const double tolerance = 1e-6;
+  const bool stuck = metrics.duration > 0.0 && metrics.sticking_duration >= (1.0 - tolerance) * metrics.duration;
+  return stuck || metrics.contact_fraction >= 1.0 - tolerance;
+}
+
 OrbitMetrics analyse_orbit(const TappingModel& model, const PeriodicOrbit& orbit, const SimulationOptions& options) {
   const int n = orbit.period_multiple;
   const double duration = n * model.period();
@@ -95,6 +102,7 @@ OrbitMetrics analyse_orbit(const TappingModel& model, const PeriodicOrbit& orbit
   m.contact_dissipation = integrals.contact_dissipation / n;
   m.impacts_per_period_multiple = r.stats.impacts;
   m.sticking_duration = r.stats.sticking_duration;
+  m.duration = duration;
   return m;
 }
 
@@ -233,8 +241,8 @@ double elapsed_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOptions& options) {
-  options.validate();
+namespace {
+OrbitSearchResult search_orbits(const TappingModel& model, const OrbitSearchOptions& options) {
   const auto t_start = std::chrono::steady_clock::now();
   OrbitSearchResult out;
   std::vector<Task> tasks;
@@ -432,6 +440,13 @@ OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOption
   }
   report.seconds = elapsed_since(t_start);
   return out;
+}
+}  // namespace
+
+OrbitSearchResult find_orbits(const TappingModel& model, const OrbitSearchOptions& options) {
+  options.validate();
+  // the model and the options are checked: what is refused from here on was computed (core/computed.hpp)
+  return computed("orbit search", [&] { return search_orbits(model, options); });
 }
 
 }  // namespace afmkit::tapping

@@ -1,0 +1,138 @@
+"""r.params records what a run used, and replays (issue 24 §2): a key whose default is another key records that
+key's value, a default the command computes records the computed value, an alternative not given is left out."""
+import math
+
+import numpy as np
+import pytest
+
+import afmkit
+from afmkit import _afmkit
+
+# fast settings per command (each run takes well under a second)
+FAST = {
+    "impact": dict(mass1=1e-11, mass2=1.0, velocity=1e6, gap=2.0),
+    "tapping hb": dict(points=50),
+    "tapping orbit": dict(free_amplitude=10.0, separation=8.0),
+    "tapping sweep": dict(free_amplitude=10.0, separation_min=7.0, separation_max=9.0, points=3, mode="instrument",
+                          quiet=True),
+    "control tf": dict(harmonics=3, points=20),
+    "control roots": dict(harmonics=3),
+    "control margin": dict(harmonics=3),
+    "control chart": dict(harmonics=2, x_points=6, y_points=6),
+    "control tune": dict(harmonics=2, coarse_points=6),
+    "control simulate": dict(harmonics=2, periods=3, steps_per_period=64),
+    "scan": dict(end_radius=2e-4, sample_resolution=64, image_resolution=32, sample_rate=5e3, spindle_frequency=50.0,
+                 radial_speed=5e-4, harmonics=2),
+    "demo": dict(points=5),
+    "control export": dict(harmonics=3, sample_rate=1000.0),
+}
+# commands that write files whatever the output keys say: into the test's folder
+FILES = {"demo": lambda d: dict(output_dir=str(d / "demo")), "control export": lambda d: dict(output=str(d / "f.h"))}
+FUNCTIONS = {
+    "impact": afmkit.impact, "tapping hb": afmkit.tapping.hb, "tapping orbit": afmkit.tapping.orbit,
+    "tapping sweep": afmkit.tapping.sweep, "control tf": afmkit.control.tf, "control roots": afmkit.control.roots,
+    "control margin": afmkit.control.margin, "control chart": afmkit.control.chart,
+    "control tune": afmkit.control.tune, "control simulate": afmkit.control.simulate, "scan": afmkit.scan,
+    "demo": afmkit.demo, "control export": afmkit.control.export,
+}
+# a value for the followed key, inside its range, other than its default
+NEW_VALUE = {"hamaker": 1e-19, "effective_modulus": 3.0, "plant_rate": 7.0, "delay": 0.05, "bandwidth": 5000.0}
+
+
+def replayable(command, params):
+    """The record without the keys at their declared defaults (the run used those anyway) and without the keys of
+    another law or unit system than the run's (their --help text starts with "[law, ...]" or "[normalised]" /
+    "[physical]"): keys of other laws are recorded too but refused when given — a separate issue."""
+    spec = next(s for s in _afmkit.commands() if s["path"] == command)
+    law, units = params.get("law"), params.get("units")
+    out = {}
+    for p in spec["params"]:
+        k = p["key"]
+        if k not in params or params[k] == p["default"]:
+            continue
+        tag = p["help"][1:p["help"].index("]")].split(", ") if p["help"].startswith("[") else None
+        if tag and tag != [units] and law not in tag:
+            continue
+        out[k] = params[k]
+    return out
+
+
+def followers():
+    """(command, key, followed key) for every parameter whose --help default reads "= <other key>"."""
+    out = []
+    for spec in _afmkit.commands():
+        keys = {p["key"] for p in spec["params"]}
+        for p in spec["params"]:
+            text = p["default_text"]
+            if text.startswith("= ") and text[2:] in keys:
+                out.append((spec["path"], p["key"], text[2:]))
+    return out
+
+
+def test_the_followers_are_known_and_every_command_with_one_is_tested():
+    found = followers()
+    assert {(c, k) for c, k, _ in found if k == "departure_hamaker"} >= {("impact", "departure_hamaker"),
+                                                                          ("tapping orbit", "departure_hamaker")}
+    for command, key, source in found:
+        assert command in FAST, f"{command}: {key} follows {source}; add fast settings to FAST"
+        assert source in NEW_VALUE, f"{command}: {key} follows {source}; add a value to NEW_VALUE"
+
+
+@pytest.mark.parametrize("command,key,source", followers())
+def test_a_followed_default_is_recorded_as_the_value_used(command, key, source, tmp_path):
+    kwargs = dict(FAST[command])
+    kwargs.update(FILES.get(command, lambda d: {})(tmp_path))
+    if (command.startswith("tapping") or command == "demo") and source in ("hamaker", "effective_modulus"):
+        kwargs.update(units="physical", law="dmt")
+    if command == "impact" and source in ("hamaker", "effective_modulus"):
+        kwargs.update(law="dmt")
+    if command == "control margin" and key == "model_delay":
+        kwargs.update(controller="smith")
+    kwargs[source] = NEW_VALUE[source]
+    r = FUNCTIONS[command](**kwargs)
+    used = NEW_VALUE[source]
+    expected = [used] if isinstance(r.params[key], list) else used  # delays = [delay]
+    assert r.params[key] == expected, f"{command}: {key} recorded {r.params[key]}"
+    # the record replays and records the same (the keys of other laws are recorded too, and refused when given:
+    # a separate issue; the replay leaves them out)
+    again = FUNCTIONS[command](**replayable(command, r.params))
+    assert again.params == r.params
+
+
+def test_dmt_record_gives_the_same_law_and_replays():
+    r = afmkit.impact(law="dmt", hamaker=1e-19, mass1=1e-11, mass2=1.0, velocity=1e6, gap=2.0)
+    assert r.params["departure_hamaker"] == 1e-19
+    assert "restitution" not in r.params
+    again = afmkit.impact(**replayable("impact", r.params))  # was: "departure_hamaker = 6.4e-20 must be >= hamaker"
+    assert again.results["restitution"] == r.results["restitution"]
+    # independently of the record: the run with both A_H given explicitly is the same impact
+    explicit = afmkit.impact(law="dmt", hamaker=1e-19, departure_hamaker=1e-19, mass1=1e-11, mass2=1.0,
+                             velocity=1e6, gap=2.0)
+    assert explicit.results["restitution"] == r.results["restitution"]
+    assert explicit.results["peak_force"] == r.results["peak_force"]
+
+
+def test_an_alternative_is_recorded_only_when_used():
+    r = afmkit.impact(restitution=0.5)
+    assert r.params["restitution"] == 0.5 and "departure_stiffness" not in r.params
+    assert afmkit.impact(**replayable("impact", r.params)).results["restitution"] == pytest.approx(
+        r.results["restitution"], rel=1e-12)
+    r = afmkit.impact(v1=1.0, v2=-2.0)
+    assert "velocity" not in r.params and r.params["v1"] == 1.0
+    assert afmkit.impact(**replayable("impact", r.params)).results["restitution"] == r.results["restitution"]
+
+
+def test_computed_defaults_are_recorded_as_computed():
+    r = afmkit.control.roots(harmonics=3)
+    assert r.params["min_real"] == r.results["box"]["real_min"]
+    assert r.params["max_imag"] == r.results["box"]["imag_max"]
+    r = afmkit.control.tf(harmonics=3, plant_rate=7.0, points=20)
+    assert r.params["gain"] == 7.0 and r.params["model_rate"] == 7.0
+    r = afmkit.control.simulate(harmonics=2, periods=3, steps_per_period=64)
+    phases = r.params["disturbance_phases"]
+    assert len(phases) == len(r.params["disturbance_amplitudes"]) and phases[0] == 0.0
+    assert all(0.0 <= p < 2 * math.pi for p in phases)
+    again = afmkit.control.simulate(**r.params)  # the phases drawn, given explicitly: the same run
+    assert again.params == r.params
+    assert again.results["first_harmonic"]["abs"] == pytest.approx(r.results["first_harmonic"]["abs"], rel=1e-12)
+    assert np.allclose(again["y"], r["y"], rtol=1e-12, atol=1e-15)
