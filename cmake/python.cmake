@@ -22,7 +22,9 @@ set(AFMKIT_PYTHON_INSTALL_DIR "lib/python3.${Python_VERSION_MINOR}/dist-packages
     "where `cmake --install` puts the Python package afmkit (relative to the prefix)")
 
 file(GLOB _pysrc CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/python/src/*.cpp)
-pybind11_add_module(afmkit_python MODULE THIN_LTO ${_pysrc})
+# NO_EXTRAS: no link-time optimisation (the bindings call the library, whose code is optimised already; LTO made
+# the module's link the longest step of the main-job build) and no strip.
+pybind11_add_module(afmkit_python MODULE NO_EXTRAS ${_pysrc})
 set_target_properties(afmkit_python PROPERTIES OUTPUT_NAME _afmkit
   LIBRARY_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/python/afmkit)
 target_link_libraries(afmkit_python PRIVATE afmkit_commands)
