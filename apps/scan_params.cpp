@@ -124,13 +124,6 @@ scan::HeightMap sample_from_file(const io::ParamSet& p) {
     z = std::move(m.values);
     for (double& v : z) v *= scale;
   }
-  for (std::size_t k = 0; k < z.size(); ++k)  // name the file and the pixel, not the map's internal array
-    if (!std::isfinite(z[k]))
-      throw InvalidParameter("sample_z_scale",
-                             fmt::format("{}: the height at pixel (column {}, row {}) times sample_z_scale = {} m is "
-                                         "{}: beyond the range of numbers (use a smaller sample_z_scale)",
-                                         path, k % static_cast<std::size_t>(columns),
-                                         k / static_cast<std::size_t>(columns), scale, z[k]));
   const double dx = size / static_cast<double>(columns);
   return centred(scan::Grid{columns, rows, size, dx * static_cast<double>(rows), 0.0, 0.0}, std::move(z));
 }
