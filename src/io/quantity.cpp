@@ -44,7 +44,8 @@ std::string quantity(double value, std::string_view unit, int digits) {
   if (std::isinf(value)) return fmt::format("{} {}", value > 0 ? "inf" : "-inf", unit);
   const auto parts = split_unit(unit);
   if (!parts || value == 0.0) return fmt::format("{:.{}g} {}", value, digits, unit);
-  const auto [base, from] = *parts;
+  const auto base = parts->first;  // (a structured binding cannot be captured by clang 14's lambdas)
+  const int from = parts->second;
   // the exponent of 1000 that puts |value| · 1000^from in [1, 1000), after rounding to `digits`
   const double magnitude = std::abs(value);
   int k = static_cast<int>(std::floor(std::log10(magnitude) / 3.0)) + from;
