@@ -369,3 +369,27 @@ def test_a_store_removed_while_the_study_runs_is_named_without_zarrs_template(tm
     with pytest.raises(StudyError, match="no longer a study store") as e:
         runner.compute_chunk(str(tmp_path / "gone.zarr"), study.definition(), 0)
     assert e.value.field == "store" and "%r" not in str(e.value)
+
+
+def test_every_python_writer_has_its_own_temporary(tmp_path):
+    """Two writers of one target (two threads of one process too) never share a temporary (issue 24 §3): each gets
+    a new file in the target's folder with the permissions a new file gets."""
+    import threading
+    from afmkit._files import unique_temporary
+    target = tmp_path / "index.html"
+    names = []
+
+    def take():
+        names.append(unique_temporary(target))
+
+    threads = [threading.Thread(target=take) for _ in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(set(names)) == 8
+    mask = os.umask(0o022)
+    os.umask(mask)
+    for n in names:
+        assert n.parent == tmp_path and n.name.startswith(".index.html.tmp-") and n.stat().st_size == 0
+        assert (n.stat().st_mode & 0o777) == (0o666 & ~mask)

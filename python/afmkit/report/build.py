@@ -12,6 +12,8 @@ import time
 import traceback
 from pathlib import Path
 
+from .._files import unique_temporary
+
 #: Figure modules (python/afmkit/figures/<name>.py), in report order; each lists its figures in FIGURES.
 FIGURE_MODULES = ["seed000", "seed003", "scan"]
 
@@ -226,8 +228,9 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all") -> Path:
         # Move the figures in, then the page last (atomic rename): an interrupted run never leaves a page that
         # points at missing or half-written images.
         total = time.perf_counter() - started
-        tmp = out / f".index.html.tmp-{os.getpid()}"
+        tmp = None
         try:
+            tmp = unique_temporary(out / "index.html")
             (out / "figures").mkdir(exist_ok=True)
             for fig in ordered:
                 os.replace(staging / fig.filename, out / "figures" / fig.filename)
@@ -236,7 +239,8 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all") -> Path:
             tmp.write_text(text, encoding="utf-8")
             os.replace(tmp, out / "index.html")
         except OSError as e:  # a full disk, a folder made read-only or removed meanwhile: say which file and why
-            tmp.unlink(missing_ok=True)
+            if tmp is not None:
+                tmp.unlink(missing_ok=True)
             raise ReportError(f"cannot write '{e.filename or out / 'index.html'}': {e.strerror or e}") from None
         print(f"afmkit report: {len(ordered)} figures in {total:.1f} s", file=sys.stderr, flush=True)
         return out / "index.html"

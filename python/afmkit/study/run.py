@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import unique_temporary
 from . import store as zstore
 from .definition import Study, StudyError, parameters_of, require_memory
 
@@ -280,15 +281,17 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
     ds.attrs["failed_points"] = failed
     if netcdf is not None:
         out = Path(netcdf)
-        tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}")
+        tmp = None
         try:
             out.parent.mkdir(parents=True, exist_ok=True)
+            tmp = unique_temporary(out)
             ds.load().to_netcdf(tmp)
             os.replace(tmp, out)
         except OSError as e:
             raise write_error("netcdf", out, e) from None
         finally:
-            tmp.unlink(missing_ok=True)
+            if tmp is not None:
+                tmp.unlink(missing_ok=True)
     return ds
 
 
