@@ -8,8 +8,10 @@
 #include "afmkit/control/stability_chart.hpp"
 #include "afmkit/control/tuning.hpp"
 #include "afmkit/core/cancellation.hpp"
+#include "../counting_stop.hpp"
 
 using namespace afmkit;
+using afmkit_test::CountingStop;
 using namespace afmkit::control;
 
 namespace {
@@ -17,16 +19,6 @@ namespace {
 LoopFamily family() {
   return LoopFamily::from_loop(LoopSpec(OscillatorBank::single(1.0, 0.5, 0.0, 20.0), PlantKind::Static, 20.0, 0.3));
 }
-
-/// A hook that asks to stop at its `after`-th call, counting every call.
-struct CountingStop {
-  std::atomic<long> calls{0};
-  long after;
-  explicit CountingStop(long a) : after(a) {}
-  Cancellation cancellation() {
-    return Cancellation([this] { return ++calls >= after; });
-  }
-};
 
 }  // namespace
 

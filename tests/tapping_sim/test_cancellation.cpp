@@ -6,26 +6,15 @@
 #include <atomic>
 
 #include "afmkit/core/cancellation.hpp"
+#include "../counting_stop.hpp"
 #include "afmkit/tapping/continuation.hpp"
 #include "afmkit/tapping/sweep.hpp"
 #include "fixtures.hpp"
 
 using namespace afmkit;
+using afmkit_test::CountingStop;
 using namespace afmkit::tapping;
 using namespace afmkit::tapping::testing;
-
-namespace {
-
-struct CountingStop {
-  std::atomic<long> calls{0};
-  long after;
-  explicit CountingStop(long a) : after(a) {}
-  Cancellation cancellation() {
-    return Cancellation([this] { return ++calls >= after; });
-  }
-};
-
-}  // namespace
 
 TEST(Cancellation, AnInstrumentSweepStopsAtThePointOfTheRequest) {
   SweepOptions o;
