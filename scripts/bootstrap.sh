@@ -22,7 +22,7 @@ done
 
 # The main job. GoogleTest and Google Benchmark are small and let CMake configure the same tree in both modes.
 packages=(build-essential cmake ninja-build ccache pkg-config
-          libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev nlohmann-json3-dev libboost-dev libpng-dev
+          libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev nlohmann-json3-dev libboost-dev libpng-dev libzip-dev
           libgtest-dev libbenchmark-dev
           python3-dev pybind11-dev python3-numpy python3-matplotlib)   # the Python module and the report
 if [ "$all" = 1 ]; then

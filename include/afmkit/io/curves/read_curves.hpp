@@ -1,0 +1,43 @@
+#pragma once
+// Reading measured force curves from instrument files (docs/curve-files.md lists the formats and presets).
+// Every reader produces RawCurve values (raw_curve.hpp: SI units, one sign convention); bad input throws
+// afmkit::InputError naming the file (and line, column or record where it applies).
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "afmkit/io/curves/raw_curve.hpp"
+
+namespace afmkit::io::curves {
+
+/// A column of a text export, chosen by name (case-insensitive match of the header cell, without its unit) or by
+/// 1-based position; with the unit of its values when the header does not give one.
+struct ColumnChoice {
+  std::string name;    ///< header name; empty: not chosen by name
+  int position = 0;    ///< 1-based column; 0: not chosen by position
+  std::string unit;    ///< e.g. "nm", "um", "m", "V", "nN", "pN", "N", "s", "ms"; empty: from the header
+  bool given() const { return !name.empty() || position > 0; }
+};
+
+/// How to read a file. Defaults read any supported file: the format from its content and extension, the columns
+/// of a text export from its preset or header.
+struct ReadOptions {
+  /// "auto", or one of: "jpk-force", "ibw", "text", and the text presets "jpk-txt", "asylum-txt",
+  /// "nanoscope-txt", "ntmdt-txt", "afmworkshop-csv".
+  std::string format = "auto";
+  ColumnChoice height, deflection, force, time, segment;  ///< text exports: the columns (presets fill them)
+  /// Calibration that overrides (or supplies) what the file says; NaN: take the file's.
+  double spring_constant = std::numeric_limits<double>::quiet_NaN();  ///< k [N/m]
+  double invols = std::numeric_limits<double>::quiet_NaN();           ///< [m/V]
+};
+
+/// Reads every curve of the file at `path` (a file may hold several repeated curves).
+std::vector<RawCurve> read_curves(const std::string& path, const ReadOptions& options = {});
+
+/// The same for the bytes of a file already in memory (`origin` names it in messages); `extension` (".jpk-force",
+/// ".ibw", ".txt", …) helps the "auto" format.
+std::vector<RawCurve> parse_curves(std::string_view bytes, const std::string& origin, const std::string& extension,
+                                   const ReadOptions& options = {});
+
+}  // namespace afmkit::io::curves
