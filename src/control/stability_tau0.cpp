@@ -3,9 +3,9 @@
 #include <cmath>
 #include <numbers>
 
-#include <Eigen/Eigenvalues>
 #include <boost/math/tools/toms748_solve.hpp>
 
+#include "afmkit/control/eigenvalues.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
 
@@ -114,7 +114,7 @@ std::vector<std::complex<double>> undelayed_poles(const LoopSpec& loop) {
     if (!b || b->harmonics() > 50) throw;
   }
   const Eigen::MatrixXd a = closed_loop_dde(loop).undelayed_matrix();
-  const Eigen::VectorXcd ev = Eigen::EigenSolver<Eigen::MatrixXd>(a, false).eigenvalues();
+  const Eigen::VectorXcd ev = eigenvalues(a, "the undelayed closed loop's poles");
   return {ev.data(), ev.data() + ev.size()};
 }
 

@@ -1,9 +1,9 @@
 #include "afmkit/control/state_space.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <fmt/format.h>
 
+#include "afmkit/control/eigenvalues.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
 
@@ -50,7 +50,7 @@ std::complex<double> StateSpace::operator()(std::complex<double> s) const {
 
 Eigen::VectorXcd StateSpace::poles() const {
   if (states() == 0) return Eigen::VectorXcd(0);
-  return Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues();
+  return eigenvalues(A, "state-space poles");
 }
 
 StateSpace ss(Eigen::MatrixXd a, Eigen::MatrixXd b, Eigen::MatrixXd c, Eigen::MatrixXd d) {

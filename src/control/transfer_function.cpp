@@ -4,8 +4,8 @@
 #include <limits>
 
 #include <fmt/format.h>
-#include <Eigen/Eigenvalues>
 
+#include "afmkit/control/eigenvalues.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
 
@@ -130,7 +130,7 @@ std::vector<std::complex<double>> Polynomial::roots() const {
       for (int i = 1; i < n; ++i) m(i, i - 1) = 1.0;
       for (int i = 0; i < n; ++i) m(i, n - 1) = -c(i) / c(n);
       balance(m);
-      const Eigen::VectorXcd ev = Eigen::EigenSolver<Eigen::MatrixXd>(m, false).eigenvalues();
+      const Eigen::VectorXcd ev = eigenvalues(m, "polynomial roots (companion matrix)");
       for (int j = 0; j < n; ++j) out.push_back(ev(j));
     }
   }

@@ -6,9 +6,9 @@
 #include <map>
 #include <numbers>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
+#include "afmkit/control/eigenvalues.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
 
@@ -90,9 +90,8 @@ std::vector<std::complex<double>> collocation_eigenvalues(const DelayDifferentia
     }
     off += p.r * p.n;
   }
-  Eigen::EigenSolver<Eigen::MatrixXd> es(m, false);
-  if (es.info() != Eigen::Success) throw NumericalFailure("collocation: the eigenvalue solver did not converge");
-  std::vector<std::complex<double>> out(es.eigenvalues().data(), es.eigenvalues().data() + size);
+  const Eigen::VectorXcd ev = eigenvalues(m, "collocation");
+  std::vector<std::complex<double>> out(ev.data(), ev.data() + size);
   return out;
 }
 
