@@ -1,0 +1,178 @@
+// FM-AFM forward model (include/afmkit/tapping/fm.hpp) against independent computations: the exact linear
+// oscillator, the small-amplitude limit Δf/f0 = −k_ts/(2k), Giessibl's first-order formula (independent
+// Gauss–Chebyshev quadrature), the hysteresis area, the far field, and an independent RK4 simulation.
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/impact/law_registry.hpp"
+#include "afmkit/tapping/fm.hpp"
+#include "afmkit/tapping/units.hpp"
+
+namespace afmkit::tapping {
+namespace {
+
+using std::numbers::pi;
+
+impact::ForceLaw conservative(std::function<double(double)> h, std::vector<double> gaps = {}) {
+  return impact::ForceLaw(impact::CustomLaw{h, h, std::move(gaps), "test"});
+}
+
+// (a) a linear force law H(d) = H0 + g (d − d0) everywhere: the FM orbit is the linear oscillator of stiffness
+// ω_n² − g, exactly at its resonance: ω = √(1 − g), Γ/Γ_free = ω, no dissipation.
+TEST(FmOrbit, LinearForceGradientIsExact) {
+  for (double g : {-0.05, 0.03}) {
+    const FmSetting s(Cantilever(1.0, 100.0), conservative([g](double d) { return 0.2 + g * (d - 3.0); }), 1.0);
+    const auto o = try_solve_fm(s, 4.0, free_fm_state(s));
+    ASSERT_TRUE(o) << "g = " << g;
+    const double w = std::sqrt(1.0 - g);
+    EXPECT_NEAR(o->state.frequency, w, 1e-9) << "g = " << g;
+    EXPECT_NEAR(o->frequency_shift(), w - 1.0, 1e-9);
+    EXPECT_NEAR(o->drive_ratio(), w, 1e-8);
+    EXPECT_NEAR(o->metrics.amplitude, 1.0, 1e-9);
+    EXPECT_NEAR(o->metrics.phase, pi / 2, 1e-9);
+    EXPECT_NEAR(o->metrics.offset, 0.2 / (1.0 - g) + g * (4.0 - 3.0) / (1.0 - g), 1e-8);  // static deflection
+    EXPECT_NEAR(o->tip_dissipation(), 0.0, 1e-9 * o->metrics.viscous_dissipation);
+    EXPECT_NEAR(o->metrics.drive_work, pi * o->state.drive * 1.0, 1e-9);  // W = π Γ A
+  }
+}
+
+// (a) small amplitude on a smooth law: Δω/ω_n → −g(d̄)/2 with g = dH/dd at the mean gap (plus O(g²), O(A²)).
+TEST(FmOrbit, SmallAmplitudeLimitIsTheForceGradient) {
+  const double f0 = 0.02, lambda = 1.0;
+  const auto h = [=](double d) { return -f0 * std::exp(-d / lambda); };
+  double previous = 1.0;
+  for (double a : {0.1, 0.03, 0.01}) {
+    const FmSetting s(Cantilever(1.0, 300.0), conservative(h), a);
+    const auto o = try_solve_fm(s, 0.5, free_fm_state(s));
+    ASSERT_TRUE(o) << "A = " << a;
+    const double mean_gap = 0.5 + o->metrics.offset;
+    const double g = (f0 / lambda) * std::exp(-mean_gap / lambda);
+    const double limit = std::sqrt(1.0 - g) - 1.0;  // the linearised oscillator at the mean gap
+    const double error = std::abs(o->frequency_shift() / limit - 1.0);
+    EXPECT_LT(error, 2.0 * a * a / (lambda * lambda)) << "A = " << a;  // curvature of the gradient: O(A²/λ²)
+    EXPECT_LT(error, previous) << "A = " << a;
+    previous = error;
+    EXPECT_NEAR(o->frequency_shift(), -g / 2, 0.05 * g) << "−k_ts/(2k) to first order";
+  }
+}
+
+/// Giessibl (2001) first order: Δω/ω_n = −(1/(π A)) ∫_{−1}^{1} H(z + A(1 + u)) u / √(1 − u²) du, with H = F/k (model
+/// units), z = closest gap. Gauss–Chebyshev quadrature of the first kind (independent of the engine).
+double giessibl(const impact::ForceLaw& law, double z, double a) {
+  const int n = 40000;
+  double sum = 0.0;
+  for (int j = 1; j <= n; ++j) {
+    const double u = std::cos((2.0 * j - 1.0) * pi / (2.0 * n));
+    sum += law.approach(z + a * (1.0 + u)) * u;
+  }
+  return -(1.0 / (pi * a)) * (pi / n) * sum;
+}
+
+// (b) large amplitude: the first-order formula on a Lennard-Jones law; its error shrinks with the perturbation
+// parameter (Δf/f0 ∝ 1/k at fixed force): a stiffer cantilever makes it 10× smaller.
+TEST(FmOrbit, LargeAmplitudeMatchesGiessibl) {
+  const impact::ForceLaw physical = impact::LawRegistry::builtin().build("lennard_jones", {});
+  double error_soft = 0.0;
+  for (double k : {4.0, 40.0}) {
+    const PhysicalCantilever pc(k, 300.0, 1000.0, 5.0, 1.0);
+    const FmSetting s(pc.cantilever(), pc.normalised_law(physical), 5.0);
+    FmSweepOptions options;
+    const auto r = sweep_fm(s, {9.0, 7.0, 6.0, 5.6}, options);  // approach to a closest gap of ~0.6 nm
+    ASSERT_EQ(r.converged(), 4) << "k = " << k;
+    const FmOrbit& o = *r.points.back().orbit;
+    const double predicted = giessibl(s.law, o.metrics.min_gap, 5.0);
+    const double error = std::abs(o.frequency_shift() / predicted - 1.0);
+    EXPECT_LT(std::abs(predicted), 0.05) << "weak perturbation";
+    EXPECT_NEAR(o.tip_dissipation(), 0.0, 1e-7 * o.metrics.viscous_dissipation) << "conservative law";
+    if (k == 4.0) {
+      error_soft = error;
+      EXPECT_LT(error, 0.1);
+    } else {
+      EXPECT_LT(error, error_soft / 4.0) << "first-order error should shrink ~ like 1/k";
+    }
+  }
+}
+
+// (c) hysteresis law (seed eq. 11): the tip–sample force takes the area between the branches over the visited
+// range, ∫_{d_min}^{0} (H_a − H_b) dd = (K_a − K_b) d_min² / 2.
+TEST(FmOrbit, HysteresisDissipatesTheAreaBetweenBranches) {
+  const double ka = 10.0, kb = 8.0;
+  const FmSetting s(Cantilever(1.0, 100.0), impact::ForceLaw(impact::PiecewiseLinearLaw(ka, kb, 0.0, 0.0)), 1.0);
+  FmSweepOptions options;
+  const auto r = sweep_fm(s, {1.5, 0.97, 0.93, 0.9}, options);
+  ASSERT_EQ(r.converged(), 4);
+  const FmOrbit& far = *r.points.front().orbit;
+  EXPECT_NEAR(far.frequency_shift(), 0.0, 1e-12) << "d) no contact: the free FM orbit";
+  EXPECT_NEAR(far.drive_ratio(), 1.0, 1e-10);
+  for (std::size_t i = 1; i < r.points.size(); ++i) {
+    const FmOrbit& o = *r.points[i].orbit;
+    const double dmin = o.metrics.min_gap;
+    ASSERT_LT(dmin, 0.0);
+    const double area = 0.5 * (ka - kb) * dmin * dmin;
+    EXPECT_NEAR(o.tip_dissipation(), area, 1e-7 * area + 1e-12) << "l = " << o.separation;
+    EXPECT_NEAR(o.metrics.contact_dissipation, area, 1e-7 * area + 1e-12);
+    EXPECT_GT(o.frequency_shift(), 0.0) << "repulsive contact stiffens";
+    EXPECT_GT(o.drive_ratio(), 1.0);
+  }
+}
+
+// (d) far from a long-range law Δf → 0 and the drive → the free drive (vdW tail ~ 1/d²: Δf ~ 1/l^{3/2}).
+TEST(FmOrbit, FarFieldIsFree) {
+  const impact::ForceLaw physical = impact::LawRegistry::builtin().build("dmt", {});
+  const PhysicalCantilever pc(40.0, 300.0, 1000.0, 2.0, 1.0);
+  const FmSetting s(pc.cantilever(), pc.normalised_law(physical), 2.0);
+  const auto r = sweep_fm(s, {400.0, 100.0, 20.0, 5.0});
+  ASSERT_EQ(r.converged(), 4);
+  double previous = 0.0;
+  for (const FmPoint& p : r.points) {
+    const double shift = std::abs(p.orbit->frequency_shift());
+    EXPECT_GT(shift, previous) << "l = " << p.separation;
+    previous = shift;
+  }
+  EXPECT_LT(std::abs(r.points.front().orbit->frequency_shift()), 1e-7);
+  EXPECT_NEAR(r.points.front().orbit->drive_ratio(), 1.0, 1e-6);
+}
+
+// (e) the orbit checked by an independent simulation: classical RK4 of ẍ = Γcos ωt − ẋ/Q − x + H(x + l) with
+// the found (x(0), ẋ(0), ω, Γ) returns to its start after 2π/ω, and its first harmonic is A sin ωt.
+TEST(FmOrbit, IndependentSimulationOfTheOrbit) {
+  const double q = 50.0, l = 1.2, a = 1.0;
+  const auto h = [](double d) { return 0.3 * std::exp(-2.0 * d) - 0.1 * std::exp(-d); };  // repulsive + attractive
+  const FmSetting s(Cantilever(1.0, q), conservative(h), a);
+  const auto o = try_solve_fm(s, l, free_fm_state(s));
+  ASSERT_TRUE(o);
+  const double w = o->state.frequency, gamma = o->state.drive, period = 2 * pi / w;
+  auto f = [&](double t, double x, double v) { return gamma * std::cos(w * t) - v / q - x + h(x + l); };
+  const int n = 20000;
+  const double dt = period / n;
+  double x = o->state.initial.position, v = o->state.initial.velocity, t = 0.0, c = 0.0, si = 0.0;
+  for (int i = 0; i < n; ++i) {
+    c += x * std::cos(w * t) * dt;  // rectangle rule on a periodic integrand: spectrally accurate
+    si += x * std::sin(w * t) * dt;
+    const double k1x = v, k1v = f(t, x, v);
+    const double k2x = v + 0.5 * dt * k1v, k2v = f(t + 0.5 * dt, x + 0.5 * dt * k1x, v + 0.5 * dt * k1v);
+    const double k3x = v + 0.5 * dt * k2v, k3v = f(t + 0.5 * dt, x + 0.5 * dt * k2x, v + 0.5 * dt * k2v);
+    const double k4x = v + dt * k3v, k4v = f(t + dt, x + dt * k3x, v + dt * k3v);
+    x += dt / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
+    v += dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    t += dt;
+  }
+  EXPECT_NEAR(x, o->state.initial.position, 1e-8);
+  EXPECT_NEAR(v, o->state.initial.velocity, 1e-8);
+  EXPECT_NEAR(2.0 / period * c, 0.0, 1e-8) << "drive 90° ahead of the deflection";
+  EXPECT_NEAR(2.0 / period * si, a, 1e-8) << "first-harmonic amplitude A";
+  EXPECT_GT(std::abs(o->frequency_shift()), 1e-3) << "a real interaction";
+}
+
+TEST(FmOrbit, RejectsBadSettings) {
+  EXPECT_THROW(FmSetting(Cantilever(1.0, 100.0), impact::PiecewiseLinearLaw(10, 8, 0, 0), 0.0), InvalidParameter);
+  FmOptions o;
+  o.difference_step = -1.0;
+  EXPECT_THROW(o.validate(), InvalidParameter);
+}
+
+}  // namespace
+}  // namespace afmkit::tapping
