@@ -46,7 +46,7 @@ std::vector<io::Column> fm_columns(const FmUnits& u) {
           {"relative_frequency_shift", "dimensionless", "Δf/f0"},
           {"frequency", u.frequency(), "oscillation frequency f held by the phase-locked loop"},
           {"drive_ratio", "dimensionless", "drive amplitude over the free cantilever's drive at the same amplitude"},
-          {"dissipation", u.energy(), "energy taken by the tip-sample force per cycle: drive work − viscous loss"},
+          {"dissipation", u.energy(), "energy taken by the tip-sample force per cycle (−∫ F dz; = drive work − viscous loss)"},
           {"dissipation_ev", "eV", "the same in eV (nan in normalised units)"},
           {"peak_force", u.s.force_unit, "largest tip-sample force over the cycle (positive: repulsive)"},
           {"offset", L, "mean deflection of the tip over the cycle"},

@@ -12,7 +12,7 @@
 // is the exact monodromy matrix of the event-driven integrator, the other columns and rows are forward differences
 // of the same map. Observables: frequency shift Δω = ω − ω_n, drive ratio Γ/Γ_free (Γ_free = 2ξω_n² A, the drive
 // of the free cantilever at amplitude A), and the energy the tip–sample force takes per cycle
-//   E_ts = W − ∫₀ᵀ 2ξω_n ẋ² dt,   W = ∫₀ᵀ Γ cos(ωt) ẋ dt = π Γ A   (exact on an FM orbit, by parts).
+//   E_ts = −∫₀ᵀ H ẋ dt = W − ∫₀ᵀ 2ξω_n ẋ² dt,   W = ∫₀ᵀ Γ cos(ωt) ẋ dt = π Γ A   (on an FM orbit, by parts).
 #include <complex>
 #include <functional>
 #include <optional>
@@ -75,7 +75,7 @@ struct FmOrbit {
   OrbitMetrics metrics;     // of the orbit (harmonics, offset, gap, forces, energies; phase ≈ π/2)
   double frequency_shift() const;   // Δω = ω − ω_n (model units, rad per time unit)
   double drive_ratio() const;       // Γ/Γ_free
-  double tip_dissipation() const;   // E_ts = W − viscous, per cycle (model energy units)
+  double tip_dissipation() const;   // E_ts = −∫ H ẋ dt per cycle (= W − viscous; model energy units)
 };
 
 /// Newton on the FM conditions at separation l from `guess`; nullopt when it does not converge within the
