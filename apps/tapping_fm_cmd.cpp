@@ -1,5 +1,6 @@
 // afmkit tapping fm: the FM-AFM forward model — the self-excited cantilever at constant amplitude with an ideal
 // phase-locked loop, frequency shift and drive (dissipation) along an approach (docs/theory-tapping.md#fm-afm).
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -55,6 +56,8 @@ std::vector<io::Column> fm_columns(const FmUnits& u) {
           {"contact_fraction", "dimensionless", "fraction of the cycle with the gap below the law's contact gap"},
           {"floquet_max", "dimensionless", "largest Floquet multiplier modulus with the drive frozen (loops held)"},
           {"stable", "boolean (0/1)", "1: floquet_max < 1"},
+          {"jumped", "boolean (0/1)", "1: reached past a fold of the branch in the separation (another branch, as an "
+                                      "instrument's loops would jump)"},
           {"newton_iterations", "count", "Newton iterations of the FM orbit"},
           {"residual", "dimensionless", "largest scaled residual of the four FM conditions"},
           {"status", "label", "ok, or no_orbit: Newton found no FM orbit here (values nan)"}};
@@ -70,6 +73,9 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
   tapping::FmSweepOptions options;
   options.fm.shooting = shooting_options_from(p);
   options.max_bisections = static_cast<int>(p.integer("max_bisections"));
+  const bool at_gap = p.text("axis") == "min_gap";
+  options.axis = at_gap ? tapping::FmAxis::min_gap : tapping::FmAxis::separation;
+  options.jumps = p.flag("jumps");
   options.cancellation = cancellation_of(capture);
   const bool quiet = p.flag("json") || p.flag("quiet");
   io::Progress progress("tapping fm", static_cast<long>(separations.size()), !quiet);
@@ -85,17 +91,18 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
   const double wn = base.cantilever.natural_frequency;
   for (const tapping::FmPoint& pt : r.points) {
     if (!pt.orbit) {
-      out.row(pt.separation * u.s.length, kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan,
-              kNan, false, 0L, kNan, tapping::fm_status_name(pt.status));
+      const double target = pt.separation * u.s.length;
+      out.row(at_gap ? kNan : target, at_gap ? target : kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan,
+              kNan, kNan, kNan, false, false, 0L, kNan, tapping::fm_status_name(pt.status));
       continue;
     }
     const tapping::FmOrbit& o = *pt.orbit;
     const auto& m = o.metrics;
     const double e = o.tip_dissipation() * ef;
-    out.row(pt.separation * u.s.length, m.min_gap * u.s.length, o.frequency_shift() * ff, o.frequency_shift() / wn,
+    out.row(o.separation * u.s.length, m.min_gap * u.s.length, o.frequency_shift() * ff, o.frequency_shift() / wn,
             o.state.frequency * ff, o.drive_ratio(), e, u.physical ? e / kElectronvolt : kNan, m.peak_force * u.s.force,
             m.offset * u.s.length, m.amplitude * u.s.length, m.harmonics[0] * u.s.length, m.contact_fraction,
-            o.floquet_max, o.stable, static_cast<long>(o.iterations), o.residual, tapping::fm_status_name(pt.status));
+            o.floquet_max, o.stable, pt.jumped, static_cast<long>(o.iterations), o.residual, tapping::fm_status_name(pt.status));
   }
   const long n = static_cast<long>(r.points.size()), converged = r.converged();
   nlohmann::json results;
@@ -103,6 +110,7 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
   results["resonance_frequency"] = wn * ff;
   results["rows"] = n;
   results["converged_rows"] = converged;
+  results["jumped_rows"] = std::count_if(r.points.begin(), r.points.end(), [](const auto& q) { return q.jumped; });
   results["no_orbit_rows"] = n - converged;
   results["evaluations"] = r.evaluations;
   results["failed_attempts"] = r.failed_attempts;
@@ -110,15 +118,15 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
   results["seconds_per_separation"] = n > 0 ? r.seconds / static_cast<double>(n) : kNan;
   results["status"] = converged > 0 ? "ok" : "no_orbit";
   results["note"] = converged == 0
-                        ? fmt::format("no FM orbit: Newton converged at none of the {} separations (from the free "
+                        ? fmt::format("no FM orbit: Newton converged at none of the {} {} (from the free "
                                       "oscillation at the largest, with up to {} bisections of each step)",
-                                      n, options.max_bisections)
+                                      n, at_gap ? "turning-point gaps" : "separations", options.max_bisections)
                     : converged < n ? fmt::format("no FM orbit at {} of {} separations (rows with status no_orbit)",
                                                   n - converged, n)
                                     : std::string();
   const std::string L = u.s.length_unit;
   results["units"] = {{"amplitude", L}, {"resonance_frequency", u.frequency()}, {"rows", "count"},
-                      {"converged_rows", "count"}, {"no_orbit_rows", "count"}, {"evaluations", "count"},
+                      {"converged_rows", "count"}, {"jumped_rows", "count"}, {"no_orbit_rows", "count"}, {"evaluations", "count"},
                       {"failed_attempts", "count"}, {"seconds", "s"}, {"seconds_per_separation", "s"}};
   // summary: the closest point reached
   std::string summary;
@@ -132,7 +140,7 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
         "FM approach at amplitude {}: {} of {} separations converged ({} one-period simulations, {} per separation)\n"
         "closest: separation {}, turning point {}: Δf = {} (Δf/f0 = {:.4g}), drive ratio {:.6g}, dissipation {}",
         length(setting.amplitude), converged, n, r.evaluations, io::quantity(results["seconds_per_separation"], "s"),
-        length(last->separation), length(o.metrics.min_gap),
+        length(o.separation), length(o.metrics.min_gap),
         u.physical ? io::quantity(o.frequency_shift() * ff, "Hz") : fmt::format("{:.6g} 1/t", o.frequency_shift() * ff),
         o.frequency_shift() / wn, o.drive_ratio(),
         u.physical ? fmt::format("{} ({:.4g} eV)", io::quantity(o.tip_dissipation() * ef, "J"),

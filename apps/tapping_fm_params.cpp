@@ -31,6 +31,12 @@ void add_tapping_fm_params(io::ParamSet& p) {
       .default_text("none: points on [separation_min, separation_max]")
       .file("separations_file", "",
             "file with the separations instead (numbers separated by commas, spaces or lines; # comments)")
+      .text("axis", "separation",
+            "what separation_min, separation_max and separations set: separation (the rest position l, stepped as an "
+            "instrument's piezo) or min_gap (the tip-sample distance at the lower turning point; l is solved for)",
+            {"separation", "min_gap"})
+      .flag("jumps", true, "where the branch ends in a fold in the separation, follow it through the fold to the branch "
+                           "that reaches the next separation (row jumped = 1); --no-jumps: row no_orbit")
       .integer("max_bisections", 6, "where Newton fails from the previous separation, halve the step up to this "
                                     "many times",
                0, 20);

@@ -236,6 +236,54 @@ TEST(FmOrbit, AdhesionHysteresisDissipatesTheAreaBetweenBranches) {
   EXPECT_GT(r.points.back().orbit->tip_dissipation(), 1e-3 * r.points.back().orbit->metrics.viscous_dissipation);
 }
 
+// The turning-point axis: solving for the separation at a given gap of closest approach inverts the solve at a
+// given separation (same orbit both ways).
+TEST(FmOrbit, MinGapAxisInvertsTheSeparationAxis) {
+  const impact::ForceLaw physical = impact::LawRegistry::builtin().build("dmt", {});
+  const PhysicalCantilever pc(40.0, 300.0, 1000.0, 5.0, 1.0);
+  const FmSetting s(pc.cantilever(), pc.normalised_law(physical), 5.0);
+  const auto at_l = sweep_fm(s, {9.0, 7.0, 5.2});
+  ASSERT_EQ(at_l.converged(), 3);
+  const FmOrbit& o = *at_l.points.back().orbit;
+  FmSweepOptions options;
+  options.axis = FmAxis::min_gap;
+  const auto at_z = sweep_fm(s, {4.0, 2.0, o.metrics.min_gap}, options);
+  ASSERT_EQ(at_z.converged(), 3);
+  const FmOrbit& p = *at_z.points.back().orbit;
+  EXPECT_NEAR(p.metrics.min_gap, o.metrics.min_gap, 1e-8);
+  EXPECT_NEAR(p.separation, 5.2, 1e-7);
+  EXPECT_NEAR(p.frequency_shift(), o.frequency_shift(), 1e-6 * std::abs(o.frequency_shift()));
+  EXPECT_NEAR(p.drive_ratio(), o.drive_ratio(), 1e-8);
+}
+
+// A steep stretch of the Lennard-Jones wall (Δf/f0 from −6e-4 to +0.2 within 0.25 nm of separation): Newton from
+// the previous separation fails, the branch is followed in the turning-point gap instead, and lands on the orbit a
+// fine approach reaches (not a jump: no fold in l there).
+TEST(FmOrbit, SteepStretchIsFollowedInTheTurningPointGap) {
+  const impact::ForceLaw physical = impact::LawRegistry::builtin().build("lennard_jones", {});
+  const PhysicalCantilever pc(40.0, 300.0, 1000.0, 5.0, 1.0);
+  const FmSetting s(pc.cantilever(), pc.normalised_law(physical), 5.0);
+  FmSweepOptions no_bisection;
+  no_bisection.max_bisections = 0;
+  const auto coarse = sweep_fm(s, {5.25, 5.0}, no_bisection);
+  ASSERT_EQ(coarse.converged(), 2);
+  EXPECT_FALSE(coarse.points.back().jumped);
+  std::vector<double> fine;
+  for (double l = 5.25; l > 4.999; l -= 0.01) fine.push_back(l);
+  const auto reference = sweep_fm(s, fine);
+  ASSERT_EQ(reference.converged(), static_cast<long>(fine.size()));
+  const FmOrbit& a = *coarse.points.back().orbit;
+  const FmOrbit& b = *reference.points.back().orbit;
+  EXPECT_NEAR(b.separation, 5.0, 1e-12);
+  EXPECT_NEAR(a.frequency_shift(), b.frequency_shift(), 1e-6 * std::abs(b.frequency_shift()));
+  EXPECT_GT(a.frequency_shift(), 0.1) << "on the repulsive wall";
+  FmSweepOptions stuck = no_bisection;
+  stuck.jumps = false;
+  stuck.fm.shooting.max_iterations = 10;
+  EXPECT_EQ(sweep_fm(s, {5.25, 5.0}, stuck).points.back().status, FmStatus::no_orbit)
+      << "without the turning-point walk this step is out of Newton's reach (the test exercises the walk)";
+}
+
 TEST(FmOrbit, RejectsBadSettings) {
   EXPECT_THROW(FmSetting(Cantilever(1.0, 100.0), impact::PiecewiseLinearLaw(10, 8, 0, 0), 0.0), InvalidParameter);
   FmOptions o;

@@ -83,37 +83,53 @@ struct FmOrbit {
 std::optional<FmOrbit> try_solve_fm(const FmSetting& setting, double separation, const FmState& guess,
                                     const FmOptions& options = {});
 
+/// As try_solve_fm with the separation an unknown too, fixed by the condition that the smallest gap over the cycle
+/// (the tip–sample distance at the lower turning point) is `min_gap`; Newton starts from `separation_guess`.
+std::optional<FmOrbit> try_solve_fm_at_gap(const FmSetting& setting, double min_gap, double separation_guess,
+                                           const FmState& guess, const FmOptions& options = {});
+
 enum class FmStatus { converged, no_orbit };
 const char* fm_status_name(FmStatus status);
 
 struct FmPoint {
-  double separation = 0.0;
+  double separation = 0.0;  // the target: separation l (FmAxis::separation) or min gap (FmAxis::min_gap)
   FmStatus status = FmStatus::no_orbit;
+  bool jumped = false;           // reached past a fold of the branch in l: the orbit lies on another branch
   std::optional<FmOrbit> orbit;  // when converged
 };
 
+/// What the targets of sweep_fm are: separations l (as an instrument steps its piezo), or gaps at the lower
+/// turning point (the tip–sample distance of closest approach; l is solved for).
+enum class FmAxis { separation, min_gap };
+
 struct FmSweepOptions {
   FmOptions fm;
+  FmAxis axis = FmAxis::separation;
   /// Where Newton fails from the previous point, the step is halved up to this many times (2^depth sub-steps).
   int max_bisections = 6;
-  std::function<void(long)> progress;  // called with 1 after each separation
+  /// Separation axis: where the branch ends in a fold before the next separation, follow it in the turning-point
+  /// gap (through the fold) to the branch that reaches that separation, as the loops of an instrument would jump.
+  bool jumps = true;
+  std::function<void(long)> progress;  // called with 1 after each target
   Cancellation cancellation;
   void validate() const;
 };
 
 struct FmSweepResult {
-  std::vector<FmPoint> points;  // in the order of the separations given
+  std::vector<FmPoint> points;  // in the order of the targets given
   long evaluations = 0;         // one-period simulations of the converged Newton solves
   long failed_attempts = 0;     // Newton solves that did not converge (then retried in smaller steps)
   double seconds = 0.0;
   long converged() const;
 };
 
-/// FM orbits along the separations in the order given (an approach: decreasing separations), each warm started
-/// from the previous converged orbit (secant predictor), the step bisected where Newton fails; the first from
-/// the free FM orbit (marched in from l + 3A above the law's switching gaps when needed). A separation where no
-/// orbit is found is a point with status no_orbit; the sweep continues from the last converged orbit.
-FmSweepResult sweep_fm(const FmSetting& setting, const std::vector<double>& separations,
+/// FM orbits at the targets in the order given (an approach: decreasing), each warm started from the previous
+/// converged orbits (secant predictor), the step bisected where Newton fails; the first from the free FM orbit
+/// (marched in from 3A above the law's switching gaps when needed). On the separation axis, a branch that ends in
+/// a fold is followed through it in the turning-point gap to the branch that reaches the next separation (point
+/// marked jumped). A target where no orbit is found is a point with status no_orbit; the sweep continues from the
+/// last converged orbit.
+FmSweepResult sweep_fm(const FmSetting& setting, const std::vector<double>& targets,
                        const FmSweepOptions& options = {});
 
 }  // namespace afmkit::tapping

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #include <Eigen/LU>
 #include <fmt/format.h>
@@ -58,21 +59,25 @@ double quadrature_panel(const TappingModel& model) {
   return shortest / 12.0 / (model.law.piecewise_linear() ? 1.0 : 4.0);
 }
 
-/// One period of the driven orbit from z = (x(0), ẋ(0), ω, Γ): the four scaled residuals, the monodromy and the
+/// One period of the driven orbit from z = (x(0), ẋ(0), ω, Γ[, l]): the scaled residuals, the monodromy and the
 /// orbit integrals.
 struct Evaluation {
-  Eigen::Vector4d residual = Eigen::Vector4d::Zero();
-  Eigen::Matrix2d monodromy = Eigen::Matrix2d::Identity();
+  Eigen::VectorXd residual;
+  Eigen::Matrix3d sensitivity = Eigen::Matrix3d::Identity();  // ∂(x, ẋ, l)(T)/∂(x, ẋ, l)(0)
   OrbitMetrics metrics;
   double norm = 0.0;
 };
 
+/// The FM conditions at a fixed separation (4 unknowns) or at a fixed gap of the lower turning point (5 unknowns:
+/// the separation too, with the condition min gap = target).
 class FmProblem {
  public:
-  FmProblem(const FmSetting& setting, double separation, const FmOptions& options)
-      : setting_(setting), separation_(separation), options_(options) {
+  FmProblem(const FmSetting& setting, double separation, std::optional<double> gap, const FmOptions& options)
+      : setting_(setting), separation_(separation), gap_(gap), options_(options) {
     const double wn = setting.cantilever.natural_frequency, a = setting.amplitude;
-    scale_ << a, a * wn, wn, setting.free_drive();
+    scale_.resize(size());
+    scale_.head<4>() << a, a * wn, wn, setting.free_drive();
+    if (gap_) scale_(4) = a;
     if (options.difference_step > 0) step_ = options.difference_step;
     else if (resolve_integrator(setting.model(separation, wn, scale_(3)), options.shooting.simulation.integrator) ==
              Integrator::adaptive)
@@ -80,12 +85,14 @@ class FmProblem {
     else step_ = 1e-7;
   }
 
-  const Eigen::Vector4d& scale() const { return scale_; }
+  int size() const { return gap_ ? 5 : 4; }
+  const Eigen::VectorXd& scale() const { return scale_; }
   long evaluations() const { return evaluations_; }
+  double separation(const Eigen::VectorXd& z) const { return gap_ ? z(4) : separation_; }
 
-  Evaluation evaluate(const Eigen::Vector4d& z, bool sensitivity, bool metrics) {
+  Evaluation evaluate(const Eigen::VectorXd& z, bool sensitivity) {
     ++evaluations_;
-    const TappingModel model = setting_.model(separation_, z(2), z(3));
+    const TappingModel model = setting_.model(separation(z), z(2), z(3));
     const double period = model.period();
     SimulationOptions o = options_.shooting.simulation;
     o.sensitivity = sensitivity;
@@ -94,88 +101,92 @@ class FmProblem {
     Evaluation e;
     const double a = setting_.amplitude;
     const std::complex<double> c1 = 2.0 * integrals.fourier[1] / period;  // x ≈ x̄ + Re(c1 e^{iωt}); want −iA
-    e.residual << (r.state.position - z(0)) / scale_(0), (r.state.velocity - z(1)) / (a * z(2)), c1.real() / a,
-        (-c1.imag() - a) / a;
+    e.residual.resize(size());
+    e.residual.head<4>() << (r.state.position - z(0)) / scale_(0), (r.state.velocity - z(1)) / (a * z(2)),
+        c1.real() / a, (-c1.imag() - a) / a;
+    if (gap_) e.residual(4) = (integrals.min_gap - *gap_) / a;
     e.norm = e.residual.cwiseAbs().maxCoeff();
-    e.monodromy = r.sensitivity.topLeftCorner<2, 2>();
-    if (metrics) {
-      OrbitMetrics& m = e.metrics;
-      m.offset = integrals.fourier[0].real() / period;
-      m.amplitude = std::abs(c1);
-      m.phase = -std::arg(c1);
-      for (int k = 2; k <= 5; ++k) m.harmonics[k - 2] = 2.0 * std::abs(integrals.fourier[k]) / period;
-      m.contact_fraction = integrals.contact_time / period;
-      m.peak_force = integrals.peak_force;
-      m.min_gap = integrals.min_gap;
-      m.drive_work = integrals.drive_work;
-      m.viscous_dissipation = integrals.viscous_dissipation;
-      m.contact_dissipation = integrals.contact_dissipation;
-      m.impacts_per_period_multiple = r.stats.impacts;
-      m.sticking_duration = r.stats.sticking_duration;
-      m.duration = period;
-    }
+    e.sensitivity = r.sensitivity;
+    OrbitMetrics& m = e.metrics;
+    m.offset = integrals.fourier[0].real() / period;
+    m.amplitude = std::abs(c1);
+    m.phase = -std::arg(c1);
+    for (int k = 2; k <= 5; ++k) m.harmonics[k - 2] = 2.0 * std::abs(integrals.fourier[k]) / period;
+    m.contact_fraction = integrals.contact_time / period;
+    m.peak_force = integrals.peak_force;
+    m.min_gap = integrals.min_gap;
+    m.drive_work = integrals.drive_work;
+    m.viscous_dissipation = integrals.viscous_dissipation;
+    m.contact_dissipation = integrals.contact_dissipation;
+    m.impacts_per_period_multiple = r.stats.impacts;
+    m.sticking_duration = r.stats.sticking_duration;
+    m.duration = period;
     return e;
   }
 
   /// Jacobian of the scaled residuals with respect to the scaled unknowns u = z / scale.
-  Eigen::Matrix4d jacobian(const Eigen::Vector4d& z, const Evaluation& at) {
-    Eigen::Matrix4d j;
-    for (int c = 0; c < 4; ++c) {
-      Eigen::Vector4d zc = z;
-      const double h = step_ * scale_(c);
-      zc(c) += h;
-      j.col(c) = (evaluate(zc, false, false).residual - at.residual) / step_;
+  Eigen::MatrixXd jacobian(const Eigen::VectorXd& z, const Evaluation& at) {
+    const int n = size();
+    Eigen::MatrixXd j(n, n);
+    for (int c = 0; c < n; ++c) {
+      Eigen::VectorXd zc = z;
+      zc(c) += step_ * scale_(c);
+      j.col(c) = (evaluate(zc, false).residual - at.residual) / step_;
     }
-    // periodicity block from the exact monodromy (variational equations + saltation matrices)
+    // periodicity rows from the exact sensitivity (variational equations + saltation matrices)
     const double a = setting_.amplitude;
-    const Eigen::Matrix2d mi = at.monodromy - Eigen::Matrix2d::Identity();
-    j(0, 0) = mi(0, 0);
-    j(0, 1) = mi(0, 1) * scale_(1) / scale_(0);
-    j(1, 0) = mi(1, 0) * scale_(0) / (a * z(2));
-    j(1, 1) = mi(1, 1) * scale_(1) / (a * z(2));
+    const Eigen::Matrix3d& s = at.sensitivity;
+    const double row_scale[2] = {scale_(0), a * z(2)};
+    for (int r = 0; r < 2; ++r) {
+      j(r, 0) = (s(r, 0) - (r == 0 ? 1.0 : 0.0)) * scale_(0) / row_scale[r];
+      j(r, 1) = (s(r, 1) - (r == 1 ? 1.0 : 0.0)) * scale_(1) / row_scale[r];
+      if (gap_) j(r, 4) = s(r, 2) * scale_(4) / row_scale[r];
+    }
     return j;
   }
 
  private:
   const FmSetting& setting_;
   double separation_;
+  std::optional<double> gap_;
   const FmOptions& options_;
-  Eigen::Vector4d scale_;
+  Eigen::VectorXd scale_;
   double step_ = 1e-7;
   long evaluations_ = 0;
 };
 
-}  // namespace
-
-std::optional<FmOrbit> try_solve_fm(const FmSetting& setting, double separation, const FmState& guess,
-                                    const FmOptions& options) {
+std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::optional<double> gap,
+                             const FmState& guess, const FmOptions& options) {
   options.validate();
   validate::finite("separation", separation);
+  if (gap) validate::finite("min_gap", *gap);
   validate::finite("position", guess.initial.position);
   validate::finite("velocity", guess.initial.velocity);
   validate::positive("frequency", guess.frequency);
   validate::positive("drive", guess.drive);
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  FmProblem problem(setting, separation, options);
+  FmProblem problem(setting, separation, gap, options);
   const TappingModel probe = setting.model(separation, guess.frequency, guess.drive);
   // the adaptive integrator's map is only as smooth as its tolerance: do not ask Newton for more (as shooting)
   const double tolerance =
       resolve_integrator(probe, options.shooting.simulation.integrator) == Integrator::adaptive
           ? std::max(options.shooting.tolerance, 10.0 * options.shooting.simulation.relative_tolerance)
           : options.shooting.tolerance;
-  Eigen::Vector4d z(guess.initial.position, guess.initial.velocity, guess.frequency, guess.drive);
-  Evaluation e = problem.evaluate(z, true, true);
+  Eigen::VectorXd z(problem.size());
+  z.head<4>() << guess.initial.position, guess.initial.velocity, guess.frequency, guess.drive;
+  if (gap) z(4) = separation;
+  Evaluation e = problem.evaluate(z, true);
   for (int it = 0;; ++it) {
     if (e.norm <= tolerance) {
       FmOrbit orbit;
-      orbit.separation = separation;
+      orbit.separation = problem.separation(z);
       orbit.state = {{z(0), z(1)}, z(2), z(3)};
       orbit.natural_frequency = setting.cantilever.natural_frequency;
       orbit.free_drive = setting.free_drive();
-      orbit.monodromy = e.monodromy;
+      orbit.monodromy = e.sensitivity.topLeftCorner<2, 2>();
       PeriodicOrbit p;  // Floquet multipliers of the monodromy (frozen drive)
-      p.monodromy = e.monodromy;
+      p.monodromy = orbit.monodromy;
       set_floquet(p);
       orbit.floquet_multipliers = p.floquet_multipliers;
       orbit.floquet_max = p.floquet_max;
@@ -190,20 +201,21 @@ std::optional<FmOrbit> try_solve_fm(const FmSetting& setting, double separation,
     if (elapsed() > options.shooting.time_budget_seconds)
       throw NumericalFailure(fmt::format("FM orbit: time budget of {} s exhausted after {} Newton iterations "
                                          "(residual {:.3g}) at separation {}",
-                                         options.shooting.time_budget_seconds, it, e.norm, separation));
-    const Eigen::Matrix4d j = problem.jacobian(z, e);
-    const Eigen::FullPivLU<Eigen::Matrix4d> lu(j);
+                                         options.shooting.time_budget_seconds, it, e.norm, problem.separation(z)));
+    const Eigen::MatrixXd j = problem.jacobian(z, e);
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(j);
     if (!lu.isInvertible()) return std::nullopt;
-    Eigen::Vector4d step = -lu.solve(e.residual).cwiseProduct(problem.scale());
+    Eigen::VectorXd step = -lu.solve(e.residual).cwiseProduct(problem.scale());
     if (!step.allFinite()) return std::nullopt;
-    // keep ω and Γ positive and the frequency step moderate
+    // keep ω and Γ positive, the frequency step moderate and (gap condition) the separation step below A
     double lambda = 1.0;
     if (std::abs(step(2)) > 0.2 * z(2)) lambda = 0.2 * z(2) / std::abs(step(2));
     if (z(3) + lambda * step(3) < 0.2 * z(3)) lambda = 0.8 * z(3) / std::abs(step(3));
+    if (gap && std::abs(lambda * step(4)) > setting.amplitude) lambda = setting.amplitude / std::abs(step(4));
     bool accepted = false;
     for (int k = 0; k < 10; ++k, lambda *= 0.5) {
-      const Eigen::Vector4d trial = z + lambda * step;
-      Evaluation t = problem.evaluate(trial, true, true);
+      const Eigen::VectorXd trial = z + lambda * step;
+      Evaluation t = problem.evaluate(trial, true);
       if (t.norm < e.norm || k == 9) {
         accepted = t.norm < e.norm;
         z = trial;
@@ -213,6 +225,18 @@ std::optional<FmOrbit> try_solve_fm(const FmSetting& setting, double separation,
     }
     if (!accepted && e.norm > 1e3 * tolerance) return std::nullopt;
   }
+}
+
+}  // namespace
+
+std::optional<FmOrbit> try_solve_fm(const FmSetting& setting, double separation, const FmState& guess,
+                                    const FmOptions& options) {
+  return solve(setting, separation, std::nullopt, guess, options);
+}
+
+std::optional<FmOrbit> try_solve_fm_at_gap(const FmSetting& setting, double min_gap, double separation_guess,
+                                           const FmState& guess, const FmOptions& options) {
+  return solve(setting, separation_guess, min_gap, guess, options);
 }
 
 const char* fm_status_name(FmStatus status) {

@@ -1,5 +1,5 @@
-// FM orbits along the separation: warm start from the previous orbit (secant predictor), bisection of the step
-// where Newton fails (include/afmkit/tapping/fm.hpp).
+// FM orbits along an approach: warm start from the previous orbits (secant predictor), bisection of the step where
+// Newton fails, and the jump past a fold of the branch in l (include/afmkit/tapping/fm.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,112 +20,182 @@ long FmSweepResult::converged() const {
 
 namespace {
 
-/// Linear extrapolation in l of the unknowns from two converged orbits (a, b: b the latest) to l.
-FmState predict(const FmOrbit& a, const FmOrbit& b, double l) {
-  const double dl = b.separation - a.separation;
-  if (dl == 0.0) return b.state;
-  const double s = (l - b.separation) / dl;
-  FmState p;
-  p.initial.position = b.state.initial.position + s * (b.state.initial.position - a.state.initial.position);
-  p.initial.velocity = b.state.initial.velocity + s * (b.state.initial.velocity - a.state.initial.velocity);
-  p.frequency = b.state.frequency + s * (b.state.frequency - a.state.frequency);
-  p.drive = b.state.drive + s * (b.state.drive - a.state.drive);
-  if (!(p.frequency > 0.0) || !(p.drive > 0.0)) return b.state;
-  return p;
-}
+/// A starting point of Newton: the FM unknowns and the separation.
+struct Guess {
+  FmState state;
+  double separation;
+};
 
-struct Tracker {
-  const FmSetting& setting;
-  const FmSweepOptions& options;
+Guess guess_of(const FmOrbit& o) { return {o.state, o.separation}; }
+
+class Tracker {
+ public:
+  Tracker(const FmSetting& setting, const FmSweepOptions& options, FmAxis axis)
+      : setting_(setting), options_(options), axis_(axis) {}
+
   long evaluations = 0;
   long failed_attempts = 0;
+  bool folded = false;  // the last jump() passed a fold (l turned back): the orbit is on another branch
   std::optional<FmOrbit> last, before_last;
 
-  std::optional<FmOrbit> attempt(double l, const FmState& guess) {
-    auto o = try_solve_fm(setting, l, guess, options.fm);
+  double parameter(const FmOrbit& o, FmAxis axis) const {
+    return axis == FmAxis::min_gap ? o.metrics.min_gap : o.separation;
+  }
+
+  std::optional<FmOrbit> attempt(double target, const Guess& g, FmAxis axis) {
+    auto o = axis == FmAxis::min_gap ? try_solve_fm_at_gap(setting_, target, g.separation, g.state, options_.fm)
+                                     : try_solve_fm(setting_, target, g.state, options_.fm);
     if (o) evaluations += o->evaluations;
     else ++failed_attempts;
     return o;
   }
 
-  void accept(const FmOrbit& o) {
-    before_last = last;
-    last = o;
+  /// Linear extrapolation of the unknowns and the separation from two orbits (b the latest) to `target`.
+  Guess predict(const FmOrbit& a, const FmOrbit& b, double target, FmAxis axis) const {
+    const double pa = parameter(a, axis), pb = parameter(b, axis);
+    if (pa == pb) return guess_of(b);
+    const double s = (target - pb) / (pb - pa);
+    auto lin = [s](double va, double vb) { return vb + s * (vb - va); };
+    Guess g{{{lin(a.state.initial.position, b.state.initial.position),
+              lin(a.state.initial.velocity, b.state.initial.velocity)},
+             lin(a.state.frequency, b.state.frequency),
+             lin(a.state.drive, b.state.drive)},
+            lin(a.separation, b.separation)};
+    if (!(g.state.frequency > 0.0) || !(g.state.drive > 0.0)) return guess_of(b);
+    return g;
   }
 
-  /// From the last converged orbit to l: direct (predicted, then plain warm start), else in 2^k sub-steps.
-  std::optional<FmOrbit> reach(double l) {
+  /// From `b` (and `a` before it, for the secant) to target: predicted, then plain warm start.
+  std::optional<FmOrbit> step(const std::optional<FmOrbit>& a, const FmOrbit& b, double target, FmAxis axis) {
     std::optional<FmOrbit> o;
-    if (before_last) o = attempt(l, predict(*before_last, *last, l));
-    if (!o) o = attempt(l, last->state);
-    if (o) {
-      before_last = last;
-      return o;
-    }
-    const double from = last->separation;
-    for (int depth = 1; depth <= options.max_bisections; ++depth) {
+    if (a) o = attempt(target, predict(*a, b, target, axis), axis);
+    if (!o) o = attempt(target, guess_of(b), axis);
+    return o;
+  }
+
+  /// From the last converged orbit to target: directly, else in 2^k sub-steps. Updates last / before_last.
+  std::optional<FmOrbit> reach(double target) {
+    if (auto o = step(before_last, *last, target, axis_)) return advance(*o);
+    return bisect(target);
+  }
+
+  std::optional<FmOrbit> bisect(double target) {
+    const double from = parameter(*last, axis_);
+    for (int depth = 1; depth <= options_.max_bisections; ++depth) {
+      options_.cancellation.check();
       const int n = 1 << depth;
       std::optional<FmOrbit> a = before_last, b = last;
       bool ok = true;
-      for (int k = 1; k <= n; ++k) {
-        const double lk = from + (l - from) * k / n;
-        std::optional<FmOrbit> o = a ? attempt(lk, predict(*a, *b, lk)) : std::nullopt;
-        if (!o) o = attempt(lk, b->state);
-        if (!o) {
-          ok = false;
-          break;
-        }
-        a = b;
-        b = o;
+      for (int k = 1; k <= n && ok; ++k) {
+        auto o = step(a, *b, from + (target - from) * k / n, axis_);
+        if (!o) ok = false;
+        else a = b, b = o;
       }
       if (ok) {
-        before_last = a;  // the sub-step before l: a closer secant for the next separation
+        before_last = a;
+        last = b;
         return b;
       }
-      options.cancellation.check();
     }
     return std::nullopt;
+  }
+
+  /// Separation axis, past a fold: follow the branch from the last orbit in the turning-point gap (through the
+  /// fold, where l turns back) until l passes `target`, then solve at target from that bracket. Updates last.
+  std::optional<FmOrbit> jump(double target) {
+    const double a = setting_.amplitude, l0 = last->separation;
+    const double sense = target < l0 ? -1.0 : 1.0;  // approach: l must come below target
+    double dz = 0.01 * a;
+    folded = false;
+    std::optional<FmOrbit> pp, prev = last;
+    for (int k = 0; k < 400 && dz > 1e-6 * a; ++k) {
+      options_.cancellation.check();
+      auto o = step(pp, *prev, prev->metrics.min_gap + sense * dz, FmAxis::min_gap);
+      if (!o) {
+        dz *= 0.5;
+        continue;
+      }
+      if (sense * (o->separation - prev->separation) < 0.0) folded = true;  // l turns back: past a fold
+      if (sense * (o->separation - target) >= 0.0) {
+        // bracket [prev, o] in l: interpolate the unknowns to target, Newton at the separation
+        auto r = step(std::nullopt, *o, target, FmAxis::separation);
+        if (!r) r = attempt(target, predict(*prev, *o, target, FmAxis::separation), FmAxis::separation);
+        if (!r) return std::nullopt;
+        before_last.reset();  // no secant across branches
+        last = r;
+        return r;
+      }
+      pp = prev;
+      prev = o;
+      dz = std::min(1.5 * dz, 0.05 * a);
+    }
+    return std::nullopt;
+  }
+
+  /// The first orbit: from the free FM orbit; else marched in from 3A above the law's switching gaps.
+  std::optional<FmOrbit> first(double target) {
+    const double a = setting_.amplitude;
+    const auto& gaps = setting_.law.switching_gaps();
+    const double top_gap = (gaps.empty() ? 0.0 : gaps.back()) + 2.0 * a;  // turning point far above the law's gaps
+    FmState free = free_fm_state(setting_);
+    const double l_free = axis_ == FmAxis::min_gap ? target + a : target;
+    if (auto o = attempt(target, {free, l_free}, axis_)) return advance(*o);
+    const double far = axis_ == FmAxis::min_gap ? top_gap : top_gap + a;
+    if (!(far > target)) return std::nullopt;
+    auto o = attempt(far, {free, axis_ == FmAxis::min_gap ? far + a : far}, axis_);
+    if (!o) return std::nullopt;
+    last = o;
+    before_last.reset();
+    auto r = reach(target);
+    if (!r) last.reset(), before_last.reset();
+    return r;
+  }
+
+ private:
+  const FmSetting& setting_;
+  const FmSweepOptions& options_;
+  FmAxis axis_;
+
+  std::optional<FmOrbit> advance(const FmOrbit& o) {
+    before_last = last;
+    last = o;
+    return o;
   }
 };
 
 }  // namespace
 
-FmSweepResult sweep_fm(const FmSetting& setting, const std::vector<double>& separations,
-                       const FmSweepOptions& options) {
+FmSweepResult sweep_fm(const FmSetting& setting, const std::vector<double>& targets, const FmSweepOptions& options) {
   options.validate();
-  for (double l : separations) validate::finite("separation", l);
+  for (double t : targets) validate::finite(options.axis == FmAxis::min_gap ? "min_gap" : "separation", t);
   const auto start = std::chrono::steady_clock::now();
   FmSweepResult result;
-  Tracker tracker{setting, options};
-  for (double l : separations) {
+  Tracker tracker(setting, options, options.axis);
+  for (double target : targets) {
     options.cancellation.check();
-    std::optional<FmOrbit> orbit;
-    if (tracker.last) {
-      orbit = tracker.reach(l);
-      if (orbit) tracker.last = orbit;  // (reach set before_last)
-    } else {
-      orbit = tracker.attempt(l, free_fm_state(setting));
-      if (!orbit) {
-        // march in from above the law's switching gaps, where the free orbit is a good guess
-        const auto& gaps = setting.law.switching_gaps();
-        const double top = std::max(l, (gaps.empty() ? 0.0 : gaps.back()) + 3.0 * setting.amplitude);
-        if (top > l) {
-          if (auto far = tracker.attempt(top, free_fm_state(setting))) {
-            tracker.accept(*far);
-            orbit = tracker.reach(l);
-            if (orbit) tracker.last = orbit;
-            else tracker.last.reset(), tracker.before_last.reset();
-          }
-        }
-      } else {
-        tracker.accept(*orbit);
-      }
-    }
     FmPoint p;
-    p.separation = l;
+    p.separation = target;
+    std::optional<FmOrbit> orbit;
+    if (!tracker.last) {
+      orbit = tracker.first(target);
+    } else if (options.axis == FmAxis::separation && options.jumps) {
+      // directly; else along the branch in the turning-point gap (through a fold, or a steep stretch where the
+      // gap barely moves), else in bisected steps of l
+      if (auto o = tracker.step(tracker.before_last, *tracker.last, target, FmAxis::separation)) {
+        tracker.before_last = tracker.last;
+        tracker.last = o;
+        orbit = o;
+      } else if ((orbit = tracker.jump(target))) {
+        p.jumped = tracker.folded;
+      } else {
+        orbit = tracker.bisect(target);
+      }
+    } else {
+      orbit = tracker.reach(target);
+    }
     if (orbit) {
       p.status = FmStatus::converged;
-      p.orbit = orbit;
+      p.orbit = std::move(orbit);
     }
     result.points.push_back(std::move(p));
     if (options.progress) options.progress(1);
