@@ -147,7 +147,10 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
                                  o.tip_dissipation() * ef / kElectronvolt)
                    : fmt::format("{:.6g} {}", o.tip_dissipation(), u.energy()));
   }
-  if (!results["note"].get<std::string>().empty()) summary += (summary.empty() ? "" : "\n") + results["note"].get<std::string>();
+  if (const std::string note = results["note"].get<std::string>(); !note.empty()) {
+    if (!summary.empty()) summary += '\n';
+    summary += note;
+  }
   out.finish(results, summary);
 }
 

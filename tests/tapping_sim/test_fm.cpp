@@ -11,6 +11,7 @@
 #include "afmkit/impact/law_registry.hpp"
 #include "afmkit/tapping/fm.hpp"
 #include "afmkit/tapping/units.hpp"
+#include "../counting_stop.hpp"
 
 namespace afmkit::tapping {
 namespace {
@@ -282,6 +283,46 @@ TEST(FmOrbit, SteepStretchIsFollowedInTheTurningPointGap) {
   stuck.fm.shooting.max_iterations = 10;
   EXPECT_EQ(sweep_fm(s, {5.25, 5.0}, stuck).points.back().status, FmStatus::no_orbit)
       << "without the turning-point walk this step is out of Newton's reach (the test exercises the walk)";
+}
+
+// The sweep stops on request (once per target and per sub-step), and reports progress once per target.
+TEST(FmOrbit, SweepIsCancellableAndReportsProgress) {
+  const FmSetting s(Cantilever(1.0, 100.0), impact::ForceLaw(impact::PiecewiseLinearLaw(10, 8, 0, 0)), 1.0);
+  long progress = 0;
+  FmSweepOptions options;
+  options.progress = [&](long n) { progress += n; };
+  EXPECT_EQ(sweep_fm(s, {2.0, 1.5, 1.0, 0.9}, options).converged(), 4);
+  EXPECT_EQ(progress, 4);
+  afmkit_test::CountingStop stop(3);
+  options.cancellation = stop.cancellation();
+  EXPECT_THROW(sweep_fm(s, {2.0, 1.5, 1.0, 0.9, 0.8}, options), Cancelled);
+  EXPECT_EQ(stop.calls.load(), 3);
+}
+
+// On the Lennard-Jones wall (Δf/f0 ≈ 0.6 at l = 3.1 nm, Q = 100) DOP853's one-period map at its default tolerance
+// is noisier than the convergence target: Newton stagnates there, and converges once the integrator is tightened.
+TEST(FmOrbit, StagnationOnAStiffWallTightensTheIntegrator) {
+  const impact::ForceLaw physical = impact::LawRegistry::builtin().build("lennard_jones", {});
+  const PhysicalCantilever pc(40.0, 300.0, 100.0, 5.0, 1.0);
+  const FmSetting s(pc.cantilever(), pc.normalised_law(physical), 5.0);
+  std::vector<double> approach;
+  for (double l = 10.0; l > 3.15; l -= 0.1) approach.push_back(l);
+  const auto r = sweep_fm(s, approach);
+  ASSERT_EQ(r.converged(), static_cast<long>(approach.size()));
+  const FmOrbit& from = *r.points.back().orbit;  // l = 3.2
+  FmOptions plain;
+  plain.tightenings = 0;
+  EXPECT_FALSE(try_solve_fm(s, 3.1, from.state, plain)) << "stagnates above the target at rtol = 1e-10";
+  const auto o = try_solve_fm(s, 3.1, from.state);
+  ASSERT_TRUE(o);
+  EXPECT_LE(o->residual, 1e-9);
+  EXPECT_GT(o->frequency_shift(), 0.5);
+  FmOptions tight;  // the same orbit found directly with the tighter integrator
+  tight.shooting.simulation.relative_tolerance = 1e-12;
+  tight.shooting.simulation.absolute_tolerance = 1e-14;
+  const auto p = try_solve_fm(s, 3.1, from.state, tight);
+  ASSERT_TRUE(p);
+  EXPECT_NEAR(o->frequency_shift(), p->frequency_shift(), 1e-8);
 }
 
 TEST(FmOrbit, RejectsBadSettings) {

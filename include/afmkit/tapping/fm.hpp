@@ -56,6 +56,10 @@ struct FmOptions {
   /// Forward-difference step of the columns not given by the monodromy, relative to the scale of each unknown
   /// (A, Aω, ω, Γ); 0: chosen from the integrator (1e-7 closed form, √(relative_tolerance) adaptive, ≥ 1e-7).
   double difference_step = 0.0;
+  /// Where Newton stagnates within 1e3 × the tolerance with the adaptive integrator (its one-period map noisier
+  /// than its tolerance, e.g. on a stiff repulsive wall), it goes on with relative and absolute tolerances ten times
+  /// smaller, up to this many times (to the same convergence target).
+  int tightenings = 3;
   void validate() const;
 };
 

@@ -40,6 +40,7 @@ void FmOptions::validate() const {
   shooting.validate();
   validate::require(std::isfinite(difference_step) && difference_step >= 0.0 && difference_step <= 1e-2,
                     "difference_step", difference_step, "in [0, 1e-2]");
+  validate::require(tightenings >= 0 && tightenings <= 5, "tightenings", tightenings, "in [0, 5]");
 }
 
 double FmOrbit::frequency_shift() const { return state.frequency - natural_frequency; }
@@ -223,7 +224,31 @@ std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::o
         break;
       }
     }
-    if (!accepted && e.norm > 1e3 * tolerance) return std::nullopt;
+    if (!accepted) {
+      // stagnation just above the tolerance: the adaptive integrator's map is noisier than its tolerance says
+      // (a stiff wall); retry from here with a tenfold tighter integrator
+      const SimulationOptions& sim = options.shooting.simulation;
+      const bool adaptive = resolve_integrator(probe, sim.integrator) == Integrator::adaptive;
+      if (adaptive && options.tightenings > 0 && e.norm <= 1e3 * tolerance && sim.relative_tolerance > 1e-13) {
+        FmOptions tighter = options;
+        --tighter.tightenings;
+        tighter.shooting.simulation.relative_tolerance = sim.relative_tolerance / 10.0;
+        tighter.shooting.simulation.absolute_tolerance = sim.absolute_tolerance / 10.0;
+        tighter.shooting.tolerance = tolerance;  // the same target: only the map's noise is reduced
+        const double left = options.shooting.time_budget_seconds - elapsed();
+        if (left <= 0.0) return std::nullopt;
+        tighter.shooting.time_budget_seconds = left;
+        tighter.shooting.max_iterations = std::max(1, options.shooting.max_iterations - it - 1);
+        const FmState from{{z(0), z(1)}, z(2), z(3)};
+        auto o = solve(setting, problem.separation(z), gap, from, tighter);
+        if (o) {
+          o->evaluations += problem.evaluations();
+          o->iterations += it + 1;
+        }
+        return o;
+      }
+      if (e.norm > 1e3 * tolerance) return std::nullopt;
+    }
   }
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <vector>
 
 #include "afmkit/core/validate.hpp"
 #include "afmkit/tapping/fm.hpp"
@@ -66,7 +67,7 @@ class Tracker {
   }
 
   /// From `b` (and `a` before it, for the secant) to target: predicted, then plain warm start.
-  std::optional<FmOrbit> step(const std::optional<FmOrbit>& a, const FmOrbit& b, double target, FmAxis axis) {
+  std::optional<FmOrbit> step(const FmOrbit* a, const FmOrbit& b, double target, FmAxis axis) {
     std::optional<FmOrbit> o;
     if (a) o = attempt(target, predict(*a, b, target, axis), axis);
     if (!o) o = attempt(target, guess_of(b), axis);
@@ -75,7 +76,7 @@ class Tracker {
 
   /// From the last converged orbit to target: directly, else in 2^k sub-steps. Updates last / before_last.
   std::optional<FmOrbit> reach(double target) {
-    if (auto o = step(before_last, *last, target, axis_)) return advance(*o);
+    if (auto o = step(before_last ? &*before_last : nullptr, *last, target, axis_)) return advance(*o);
     return bisect(target);
   }
 
@@ -84,17 +85,20 @@ class Tracker {
     for (int depth = 1; depth <= options_.max_bisections; ++depth) {
       options_.cancellation.check();
       const int n = 1 << depth;
-      std::optional<FmOrbit> a = before_last, b = last;
+      std::vector<FmOrbit> chain;  // the orbits of the sub-steps, after the last two converged
+      if (before_last) chain.push_back(*before_last);
+      chain.push_back(*last);
       bool ok = true;
       for (int k = 1; k <= n && ok; ++k) {
-        auto o = step(a, *b, from + (target - from) * k / n, axis_);
-        if (!o) ok = false;
-        else a = b, b = o;
+        const FmOrbit* a = chain.size() >= 2 ? &chain[chain.size() - 2] : nullptr;
+        auto o = step(a, chain.back(), from + (target - from) * k / n, axis_);
+        if (o) chain.push_back(std::move(*o));
+        else ok = false;
       }
       if (ok) {
-        before_last = a;
-        last = b;
-        return b;
+        before_last = chain[chain.size() - 2];
+        last = chain.back();
+        return last;
       }
     }
     return std::nullopt;
@@ -107,26 +111,27 @@ class Tracker {
     const double sense = target < l0 ? -1.0 : 1.0;  // approach: l must come below target
     double dz = 0.01 * a;
     folded = false;
-    std::optional<FmOrbit> pp, prev = last;
+    std::vector<FmOrbit> chain{*last};  // the orbits of the walk in the turning-point gap
     for (int k = 0; k < 400 && dz > 1e-6 * a; ++k) {
       options_.cancellation.check();
-      auto o = step(pp, *prev, prev->metrics.min_gap + sense * dz, FmAxis::min_gap);
+      const FmOrbit& prev = chain.back();
+      const FmOrbit* pp = chain.size() >= 2 ? &chain[chain.size() - 2] : nullptr;
+      auto o = step(pp, prev, prev.metrics.min_gap + sense * dz, FmAxis::min_gap);
       if (!o) {
         dz *= 0.5;
         continue;
       }
-      if (sense * (o->separation - prev->separation) < 0.0) folded = true;  // l turns back: past a fold
+      if (sense * (o->separation - prev.separation) < 0.0) folded = true;  // l turns back: past a fold
       if (sense * (o->separation - target) >= 0.0) {
-        // bracket [prev, o] in l: interpolate the unknowns to target, Newton at the separation
-        auto r = step(std::nullopt, *o, target, FmAxis::separation);
-        if (!r) r = attempt(target, predict(*prev, *o, target, FmAxis::separation), FmAxis::separation);
+        // bracket [prev, o] in l: Newton at the separation from o, else from the interpolation
+        auto r = step(nullptr, *o, target, FmAxis::separation);
+        if (!r) r = attempt(target, predict(prev, *o, target, FmAxis::separation), FmAxis::separation);
         if (!r) return std::nullopt;
         before_last.reset();  // no secant across branches
         last = r;
         return r;
       }
-      pp = prev;
-      prev = o;
+      chain.push_back(std::move(*o));
       dz = std::min(1.5 * dz, 0.05 * a);
     }
     return std::nullopt;
@@ -181,7 +186,8 @@ FmSweepResult sweep_fm(const FmSetting& setting, const std::vector<double>& targ
     } else if (options.axis == FmAxis::separation && options.jumps) {
       // directly; else along the branch in the turning-point gap (through a fold, or a steep stretch where the
       // gap barely moves), else in bisected steps of l
-      if (auto o = tracker.step(tracker.before_last, *tracker.last, target, FmAxis::separation)) {
+      const FmOrbit* before = tracker.before_last ? &*tracker.before_last : nullptr;
+      if (auto o = tracker.step(before, *tracker.last, target, FmAxis::separation)) {
         tracker.before_last = tracker.last;
         tracker.last = o;
         orbit = o;
