@@ -34,3 +34,16 @@ def test_fm_bad_input_names_the_parameter():
         afmkit.tapping.fm(amplitude=-1.0)
     with pytest.raises(ValueError, match="drive_amplitude does not apply"):
         afmkit.tapping.fm(drive_amplitude=0.3)
+
+
+def test_fm_is_a_study_computation(tmp_path):
+    from afmkit.study import Study, run
+
+    params = dict(units="physical", law="dmt", separations=[8.0, 6.0, 5.0], quiet=True)
+    study = Study.make(computation="tapping.fm", axes={"amplitude": [2.0, 5.0]},
+                       outputs=["min(frequency_shift)", "converged_rows"], parameters=params)
+    ds = run(study, tmp_path / "fm.zarr", scheduler="serial", progress=False).load()
+    for i, a in enumerate([2.0, 5.0]):
+        r = afmkit.tapping.fm(amplitude=a, **params)
+        assert ds["min_frequency_shift"].values[i] == np.min(r["frequency_shift"])
+        assert ds["converged_rows"].values[i] == 3
