@@ -56,10 +56,6 @@ struct FmOptions {
   /// Forward-difference step of the columns not given by the monodromy, relative to the scale of each unknown
   /// (A, Aω, ω, Γ); 0: chosen from the integrator (1e-7 closed form, √(relative_tolerance) adaptive, ≥ 1e-7).
   double difference_step = 0.0;
-  /// Where Newton stagnates within 1e3 × the tolerance with the adaptive integrator (its one-period map noisier
-  /// than its tolerance, e.g. on a stiff repulsive wall), it goes on with relative and absolute tolerances ten times
-  /// smaller, up to this many times (to the same convergence target).
-  int tightenings = 3;
   void validate() const;
 };
 
@@ -82,15 +78,24 @@ struct FmOrbit {
   double tip_dissipation() const;   // E_ts = −∫ H ẋ dt per cycle (= W − viscous; model energy units)
 };
 
+/// The Jacobian of the FM conditions (in the unknowns scaled by A, Aω_n, ω_n, Γ_free[, A]) kept from one solve for
+/// the next: along an approach it changes little, so Newton starts from it and updates it by Broyden's rule,
+/// recomputing it by differences only where it stops reducing the residual (sweep_fm keeps one).
+struct FmJacobian {
+  Eigen::MatrixXd matrix;  // empty: none yet
+};
+
 /// Newton on the FM conditions at separation l from `guess`; nullopt when it does not converge within the
-/// iteration budget (throws NumericalFailure when the time budget is exhausted).
+/// iteration budget (throws NumericalFailure when the time budget is exhausted). `reuse`: a Jacobian to start from
+/// and to update (nullptr: differences at the guess).
 std::optional<FmOrbit> try_solve_fm(const FmSetting& setting, double separation, const FmState& guess,
-                                    const FmOptions& options = {});
+                                    const FmOptions& options = {}, FmJacobian* reuse = nullptr);
 
 /// As try_solve_fm with the separation an unknown too, fixed by the condition that the smallest gap over the cycle
 /// (the tip–sample distance at the lower turning point) is `min_gap`; Newton starts from `separation_guess`.
 std::optional<FmOrbit> try_solve_fm_at_gap(const FmSetting& setting, double min_gap, double separation_guess,
-                                           const FmState& guess, const FmOptions& options = {});
+                                           const FmState& guess, const FmOptions& options = {},
+                                           FmJacobian* reuse = nullptr);
 
 enum class FmStatus { converged, no_orbit };
 const char* fm_status_name(FmStatus status);

@@ -40,7 +40,6 @@ void FmOptions::validate() const {
   shooting.validate();
   validate::require(std::isfinite(difference_step) && difference_step >= 0.0 && difference_step <= 1e-2,
                     "difference_step", difference_step, "in [0, 1e-2]");
-  validate::require(tightenings >= 0 && tightenings <= 5, "tightenings", tightenings, "in [0, 5]");
 }
 
 double FmOrbit::frequency_shift() const { return state.frequency - natural_frequency; }
@@ -125,7 +124,8 @@ class FmProblem {
     return e;
   }
 
-  /// Jacobian of the scaled residuals with respect to the scaled unknowns u = z / scale.
+  /// Jacobian of the scaled residuals with respect to the scaled unknowns u = z / scale: forward differences,
+  /// with the periodicity rows exact.
   Eigen::MatrixXd jacobian(const Eigen::VectorXd& z, const Evaluation& at) {
     const int n = size();
     Eigen::MatrixXd j(n, n);
@@ -134,7 +134,13 @@ class FmProblem {
       zc(c) += step_ * scale_(c);
       j.col(c) = (evaluate(zc, false).residual - at.residual) / step_;
     }
-    // periodicity rows from the exact sensitivity (variational equations + saltation matrices)
+    set_exact_rows(j, z, at);
+    return j;
+  }
+
+  /// The periodicity rows' columns x(0), ẋ(0) (and l) from the exact sensitivity (variational equations +
+  /// saltation matrices) of the evaluation at z.
+  void set_exact_rows(Eigen::MatrixXd& j, const Eigen::VectorXd& z, const Evaluation& at) const {
     const double a = setting_.amplitude;
     const Eigen::Matrix3d& s = at.sensitivity;
     const double row_scale[2] = {scale_(0), a * z(2)};
@@ -143,7 +149,6 @@ class FmProblem {
       j(r, 1) = (s(r, 1) - (r == 1 ? 1.0 : 0.0)) * scale_(1) / row_scale[r];
       if (gap_) j(r, 4) = s(r, 2) * scale_(4) / row_scale[r];
     }
-    return j;
   }
 
  private:
@@ -157,7 +162,7 @@ class FmProblem {
 };
 
 std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::optional<double> gap,
-                             const FmState& guess, const FmOptions& options) {
+                             const FmState& guess, const FmOptions& options, FmJacobian* reuse) {
   options.validate();
   validate::finite("separation", separation);
   if (gap) validate::finite("min_gap", *gap);
@@ -178,8 +183,13 @@ std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::o
   z.head<4>() << guess.initial.position, guess.initial.velocity, guess.frequency, guess.drive;
   if (gap) z(4) = separation;
   Evaluation e = problem.evaluate(z, true);
+  // the Jacobian: a previous solve's (Broyden-updated along the iterations) or forward differences here
+  Eigen::MatrixXd j;
+  bool fresh = !(reuse && reuse->matrix.rows() == problem.size());
+  bool refresh = fresh;
   for (int it = 0;; ++it) {
     if (e.norm <= tolerance) {
+      if (reuse && j.size() > 0) reuse->matrix = j;
       FmOrbit orbit;
       orbit.separation = problem.separation(z);
       orbit.state = {{z(0), z(1)}, z(2), z(3)};
@@ -203,50 +213,52 @@ std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::o
       throw NumericalFailure(fmt::format("FM orbit: time budget of {} s exhausted after {} Newton iterations "
                                          "(residual {:.3g}) at separation {}",
                                          options.shooting.time_budget_seconds, it, e.norm, problem.separation(z)));
-    const Eigen::MatrixXd j = problem.jacobian(z, e);
+    if (refresh) {
+      j = problem.jacobian(z, e);
+      fresh = true;
+      refresh = false;
+    } else {
+      if (j.size() == 0) j = reuse->matrix;
+      problem.set_exact_rows(j, z, e);
+    }
     const Eigen::FullPivLU<Eigen::MatrixXd> lu(j);
-    if (!lu.isInvertible()) return std::nullopt;
-    Eigen::VectorXd step = -lu.solve(e.residual).cwiseProduct(problem.scale());
-    if (!step.allFinite()) return std::nullopt;
+    Eigen::VectorXd step;
+    if (lu.isInvertible()) step = -lu.solve(e.residual).cwiseProduct(problem.scale());
+    if (step.size() == 0 || !step.allFinite()) {
+      if (fresh) return std::nullopt;
+      refresh = true;  // the reused Jacobian is singular here: differences
+      continue;
+    }
     // keep ω and Γ positive, the frequency step moderate and (gap condition) the separation step below A
     double lambda = 1.0;
     if (std::abs(step(2)) > 0.2 * z(2)) lambda = 0.2 * z(2) / std::abs(step(2));
     if (z(3) + lambda * step(3) < 0.2 * z(3)) lambda = 0.8 * z(3) / std::abs(step(3));
     if (gap && std::abs(lambda * step(4)) > setting.amplitude) lambda = setting.amplitude / std::abs(step(4));
     bool accepted = false;
-    for (int k = 0; k < 10; ++k, lambda *= 0.5) {
+    const int trials = fresh ? 10 : 2;  // a reused Jacobian that does not reduce the residual is recomputed
+    for (int k = 0; k < trials; ++k, lambda *= 0.5) {
       const Eigen::VectorXd trial = z + lambda * step;
       Evaluation t = problem.evaluate(trial, true);
-      if (t.norm < e.norm || k == 9) {
+      if (t.norm < e.norm || (fresh && k == trials - 1)) {
         accepted = t.norm < e.norm;
+        if (accepted) {
+          // Broyden's update of the difference columns (the periodicity rows are set exactly next iteration)
+          const Eigen::VectorXd du = (lambda * step).cwiseQuotient(problem.scale());
+          const Eigen::VectorXd dr = t.residual - e.residual;
+          if (du.squaredNorm() > 0) j += (dr - j * du) * du.transpose() / du.squaredNorm();
+          if (!fresh && t.norm > 0.5 * e.norm) refresh = true;  // slow progress: differences next
+          fresh = false;
+        }
         z = trial;
         e = std::move(t);
         break;
       }
     }
+    if (!accepted && !fresh) {
+      refresh = true;
+      continue;
+    }
     if (!accepted) {
-      // stagnation just above the tolerance: the adaptive integrator's map is noisier than its tolerance says
-      // (a stiff wall); retry from here with a tenfold tighter integrator
-      const SimulationOptions& sim = options.shooting.simulation;
-      const bool adaptive = resolve_integrator(probe, sim.integrator) == Integrator::adaptive;
-      if (adaptive && options.tightenings > 0 && e.norm <= 1e3 * tolerance && sim.relative_tolerance > 1e-13) {
-        FmOptions tighter = options;
-        --tighter.tightenings;
-        tighter.shooting.simulation.relative_tolerance = sim.relative_tolerance / 10.0;
-        tighter.shooting.simulation.absolute_tolerance = sim.absolute_tolerance / 10.0;
-        tighter.shooting.tolerance = tolerance;  // the same target: only the map's noise is reduced
-        const double left = options.shooting.time_budget_seconds - elapsed();
-        if (left <= 0.0) return std::nullopt;
-        tighter.shooting.time_budget_seconds = left;
-        tighter.shooting.max_iterations = std::max(1, options.shooting.max_iterations - it - 1);
-        const FmState from{{z(0), z(1)}, z(2), z(3)};
-        auto o = solve(setting, problem.separation(z), gap, from, tighter);
-        if (o) {
-          o->evaluations += problem.evaluations();
-          o->iterations += it + 1;
-        }
-        return o;
-      }
       if (e.norm > 1e3 * tolerance) return std::nullopt;
     }
   }
@@ -255,13 +267,13 @@ std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::o
 }  // namespace
 
 std::optional<FmOrbit> try_solve_fm(const FmSetting& setting, double separation, const FmState& guess,
-                                    const FmOptions& options) {
-  return solve(setting, separation, std::nullopt, guess, options);
+                                    const FmOptions& options, FmJacobian* reuse) {
+  return solve(setting, separation, std::nullopt, guess, options, reuse);
 }
 
 std::optional<FmOrbit> try_solve_fm_at_gap(const FmSetting& setting, double min_gap, double separation_guess,
-                                           const FmState& guess, const FmOptions& options) {
-  return solve(setting, separation_guess, min_gap, guess, options);
+                                           const FmState& guess, const FmOptions& options, FmJacobian* reuse) {
+  return solve(setting, separation_guess, min_gap, guess, options, reuse);
 }
 
 const char* fm_status_name(FmStatus status) {

@@ -44,10 +44,15 @@ class Tracker {
   }
 
   std::optional<FmOrbit> attempt(double target, const Guess& g, FmAxis axis) {
-    auto o = axis == FmAxis::min_gap ? try_solve_fm_at_gap(setting_, target, g.separation, g.state, options_.fm)
-                                     : try_solve_fm(setting_, target, g.state, options_.fm);
+    FmJacobian& jac = axis == FmAxis::min_gap ? gap_jacobian_ : separation_jacobian_;
+    auto o = axis == FmAxis::min_gap
+                 ? try_solve_fm_at_gap(setting_, target, g.separation, g.state, options_.fm, &jac)
+                 : try_solve_fm(setting_, target, g.state, options_.fm, &jac);
     if (o) evaluations += o->evaluations;
-    else ++failed_attempts;
+    else {
+      ++failed_attempts;
+      jac.matrix.resize(0, 0);  // a failed solve's Jacobian is not trusted for the next
+    }
     return o;
   }
 
@@ -160,6 +165,7 @@ class Tracker {
   const FmSetting& setting_;
   const FmSweepOptions& options_;
   FmAxis axis_;
+  FmJacobian separation_jacobian_, gap_jacobian_;  // kept from solve to solve (Broyden-updated)
 
   std::optional<FmOrbit> advance(const FmOrbit& o) {
     before_last = last;
