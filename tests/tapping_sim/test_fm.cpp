@@ -299,6 +299,33 @@ TEST(FmOrbit, SweepIsCancellableAndReportsProgress) {
   EXPECT_EQ(stop.calls.load(), 3);
 }
 
+// The Jacobian kept along the approach (Broyden-updated) gives the orbits Newton finds with a fresh difference
+// Jacobian at every separation, for about a third of the one-period simulations.
+TEST(FmOrbit, KeptJacobianGivesTheSameOrbitsForFewerSimulations) {
+  const impact::ForceLaw physical = impact::LawRegistry::builtin().build("dmt", {});
+  const PhysicalCantilever pc(40.0, 300.0, 1000.0, 5.0, 1.0);
+  const FmSetting s(pc.cantilever(), pc.normalised_law(physical), 5.0);
+  std::vector<double> approach;
+  for (double l = 8.0; l > 3.9; l -= 0.1) approach.push_back(l);
+  const auto kept = sweep_fm(s, approach);
+  ASSERT_EQ(kept.converged(), static_cast<long>(approach.size()));
+  long fresh_evaluations = 0;
+  FmState previous = free_fm_state(s);
+  for (std::size_t i = 0; i < approach.size(); ++i) {
+    const auto o = try_solve_fm(s, approach[i], previous);  // no Jacobian kept: differences at every solve
+    ASSERT_TRUE(o) << "l = " << approach[i];
+    fresh_evaluations += o->evaluations;
+    previous = o->state;
+    const FmOrbit& k = *kept.points[i].orbit;
+    // both converged to residuals ≤ 1e-9 (DOP853's floor): Δω to a few relative_tolerance (1e-10, the integrator's
+    // phase accuracy); the drive, set by the energy balance, to about Q × the periodicity residual
+    EXPECT_NEAR(k.frequency_shift(), o->frequency_shift(), 5e-10);
+    EXPECT_NEAR(k.drive_ratio(), o->drive_ratio(), 1000.0 * 1e-9);
+  }
+  EXPECT_LT(3 * kept.evaluations, 2 * fresh_evaluations) << kept.evaluations << " vs " << fresh_evaluations;
+  EXPECT_LT(kept.evaluations, 4 * static_cast<long>(approach.size()));
+}
+
 TEST(FmOrbit, RejectsBadSettings) {
   EXPECT_THROW(FmSetting(Cantilever(1.0, 100.0), impact::PiecewiseLinearLaw(10, 8, 0, 0), 0.0), InvalidParameter);
   FmOptions o;
