@@ -326,6 +326,53 @@ TEST(FmOrbit, KeptJacobianGivesTheSameOrbitsForFewerSimulations) {
   EXPECT_LT(kept.evaluations, 4 * static_cast<long>(approach.size()));
 }
 
+// A fold of the FM branch in l: a short-range attraction (λ = 0.1 against A = 3) pulls the mean deflection down
+// faster than the turning point moves (dx̄/dz > 1), so l(z) is S-shaped — its minimum l ≈ 3.041 near z = 0.05, its
+// maximum l ≈ 3.073 near z = 0 (mapped on the turning-point axis). Approaching below the fold, the orbit jumps to
+// the branch beyond it, as the loops of an instrument would: the row is marked jumped, and it is the orbit the
+// turning-point axis finds at its gap.
+TEST(FmOrbit, ApproachJumpsPastAFoldOfTheBranch) {
+  const auto h = [](double d) { return -5.0 * std::exp(-d / 0.1) + 20.0 * std::exp(-d / 0.02); };
+  const FmSetting s(Cantilever(1.0, 300.0), conservative(h), 3.0);
+  FmSweepOptions on_gap;
+  on_gap.axis = FmAxis::min_gap;
+  std::vector<double> gaps;
+  for (double z = 0.2; z > -0.035; z -= 0.01) gaps.push_back(z);
+  const auto curve = sweep_fm(s, gaps, on_gap);
+  ASSERT_EQ(curve.converged(), static_cast<long>(gaps.size()));
+  double l_min = 1e9, l_max_after = -1e9;
+  bool turned = false;
+  for (std::size_t i = 1; i < curve.points.size(); ++i) {
+    const double l = curve.points[i].orbit->separation, before = curve.points[i - 1].orbit->separation;
+    if (l > before) turned = true;
+    if (!turned) l_min = std::min(l_min, l);
+    else l_max_after = std::max(l_max_after, l);
+  }
+  ASSERT_TRUE(turned) << "l(z) has a fold";
+  ASSERT_LT(l_min, 3.045);
+  ASSERT_GT(l_max_after, 3.06);
+
+  const auto approach = sweep_fm(s, {3.2, 3.1, 3.06, 3.05, 3.045, 3.03});
+  ASSERT_EQ(approach.converged(), 6);
+  for (std::size_t i = 0; i + 1 < approach.points.size(); ++i) EXPECT_FALSE(approach.points[i].jumped);
+  const FmPoint& jump = approach.points.back();
+  EXPECT_TRUE(jump.jumped);
+  EXPECT_NEAR(jump.orbit->separation, 3.03, 1e-12);
+  EXPECT_LT(jump.orbit->metrics.min_gap, 0.0) << "beyond the fold's gaps";
+  EXPECT_GT(approach.points[4].orbit->metrics.min_gap, 0.04) << "before it: still on the first branch";
+  // the turning-point axis at the jumped orbit's gap finds the same orbit
+  const auto check = try_solve_fm_at_gap(s, jump.orbit->metrics.min_gap, 3.03, jump.orbit->state);
+  ASSERT_TRUE(check);
+  EXPECT_NEAR(check->separation, 3.03, 1e-8);
+  EXPECT_NEAR(check->frequency_shift(), jump.orbit->frequency_shift(), 1e-8);
+  FmSweepOptions no_jumps;
+  no_jumps.jumps = false;
+  no_jumps.max_bisections = 1;
+  no_jumps.fm.shooting.max_iterations = 10;
+  EXPECT_EQ(sweep_fm(s, {3.2, 3.1, 3.06, 3.05, 3.045, 3.03}, no_jumps).points.back().status, FmStatus::no_orbit)
+      << "the branch followed in l ends at the fold";
+}
+
 TEST(FmOrbit, RejectsBadSettings) {
   EXPECT_THROW(FmSetting(Cantilever(1.0, 100.0), impact::PiecewiseLinearLaw(10, 8, 0, 0), 0.0), InvalidParameter);
   FmOptions o;
