@@ -254,12 +254,14 @@ std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::o
         break;
       }
     }
-    if (!accepted && !fresh) {
-      refresh = true;
-      continue;
-    }
     if (!accepted) {
+      if (!fresh) {  // the kept Jacobian misled the step (z unchanged): differences here
+        refresh = true;
+        continue;
+      }
+      // a fresh Jacobian and no decrease: z moved by the smallest trial step (as shooting); differences there
       if (e.norm > 1e3 * tolerance) return std::nullopt;
+      refresh = true;
     }
   }
 }
