@@ -10,6 +10,7 @@ void register_tapping(CLI::App& app) {
   register_tapping_hb(tapping);
   register_tapping_sweep(tapping);
   register_tapping_grid(tapping);
+  register_tapping_fm(tapping);
 }
 
 }  // namespace afmkit::cli

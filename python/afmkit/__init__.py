@@ -6,7 +6,7 @@ Every command of the ``afmkit`` program is a function whose keyword arguments ar
     r = afmkit.tapping.hb(units="physical", quality_factor=100, separation_min=-5, separation_max=30)
     r["amplitude"], r.units["amplitude"], r.results["folds"]
 
-    afmkit.impact(...), afmkit.tapping.orbit | hb | sweep(...), afmkit.control.tf | roots | margin | chart |
+    afmkit.impact(...), afmkit.tapping.orbit | hb | sweep | fm(...), afmkit.control.tf | roots | margin | chart |
     tune | simulate | export(...), afmkit.scan(...), afmkit.demo(...)
 
 ``afmkit.control.RealtimeFilter`` runs the real-time filter on NumPy buffers. Bad input raises

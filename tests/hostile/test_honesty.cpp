@@ -96,6 +96,12 @@ TEST(HonestyInternalFailure, EveryTappingCommandOnTheStickyLawBlamesNoInput) {
     const auto r = run_cli(cmd + " " + kSticky + " --output out.csv", dir);
     expect_not_blamed_on_input(r, cmd);
   }
+  // tapping fm: the loops set the drive, so the sticky model without its free amplitude
+  const std::string fm_model = kSticky.substr(0, kSticky.find(" --free-amplitude"));
+  const auto r = run_cli("tapping fm --amplitude 20 --separation-min 0 --separation-max 24 --points 9 --quiet " +
+                             fm_model + " --output out.csv",
+                         dir);
+  expect_not_blamed_on_input(r, "tapping fm");
 }
 
 // ------------------------------------------------------------------ 2. no silent empty answers
@@ -221,7 +227,8 @@ TEST(HonestyRecords, FollowedLawKeysRecordTheValueUsedInEveryLawCommand) {
       "tapping hb --units physical --law dmt --points 50",
       "tapping orbit --units physical --law dmt --free-amplitude 10 --separation 8",
       "tapping sweep --units physical --law dmt --free-amplitude 10 --separation-min 7 --separation-max 9 --points 3 "
-      "--mode instrument --quiet"};
+      "--mode instrument --quiet",
+      "tapping fm --units physical --law dmt --separation-min 7 --separation-max 9 --points 3 --quiet"};
   for (const std::string& cmd : commands) {
     SCOPED_TRACE(cmd);
     TempDir dir;

@@ -32,7 +32,8 @@ def test_every_command_of_the_program_is_a_function_with_its_toml_keys():
     paths = {s["path"] for s in _afmkit.commands()}
     functions = {"impact": afmkit.impact, "scan": afmkit.scan, "demo": afmkit.demo,
                  "tapping orbit": afmkit.tapping.orbit, "tapping hb": afmkit.tapping.hb,
-                 "tapping sweep": afmkit.tapping.sweep, "control tf": afmkit.control.tf,
+                 "tapping sweep": afmkit.tapping.sweep, "tapping fm": afmkit.tapping.fm,
+                 "control tf": afmkit.control.tf,
                  "control roots": afmkit.control.roots, "control margin": afmkit.control.margin,
                  "control chart": afmkit.control.chart, "control tune": afmkit.control.tune,
                  "control simulate": afmkit.control.simulate, "control export": afmkit.control.export}
@@ -50,6 +51,7 @@ def test_every_command_of_the_program_is_a_function_with_its_toml_keys():
     ("tapping hb", {"quality_factor": 150.0, "points": 300}),
     ("control tf", {"harmonics": 4, "points": 200}),
     ("tapping sweep", {"points": 15}),
+    ("tapping fm", {"points": 9}),
     ("impact", {"restitution": 0.7, "points": 300}),
 ])
 def test_result_equals_the_command_lines_table_bit_for_bit(command, args):

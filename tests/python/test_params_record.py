@@ -15,6 +15,7 @@ FAST = {
     "tapping orbit": dict(free_amplitude=10.0, separation=8.0),
     "tapping sweep": dict(free_amplitude=10.0, separation_min=7.0, separation_max=9.0, points=3, mode="instrument",
                           quiet=True),
+    "tapping fm": dict(separation_min=7.0, separation_max=9.0, points=3, quiet=True),
     "control tf": dict(harmonics=3, points=20),
     "control roots": dict(harmonics=3),
     "control margin": dict(harmonics=3),
@@ -30,7 +31,7 @@ FAST = {
 FILES = {"demo": lambda d: dict(output_dir=str(d / "demo")), "control export": lambda d: dict(output=str(d / "f.h"))}
 FUNCTIONS = {
     "impact": afmkit.impact, "tapping hb": afmkit.tapping.hb, "tapping orbit": afmkit.tapping.orbit,
-    "tapping sweep": afmkit.tapping.sweep, "control tf": afmkit.control.tf, "control roots": afmkit.control.roots,
+    "tapping sweep": afmkit.tapping.sweep, "tapping fm": afmkit.tapping.fm, "control tf": afmkit.control.tf, "control roots": afmkit.control.roots,
     "control margin": afmkit.control.margin, "control chart": afmkit.control.chart,
     "control tune": afmkit.control.tune, "control simulate": afmkit.control.simulate, "scan": afmkit.scan,
     "demo": afmkit.demo, "control export": afmkit.control.export,

@@ -22,6 +22,7 @@ COMPUTATIONS = {
     "tapping.orbit": "tapping orbit",
     "tapping.sweep": "tapping sweep",
     "tapping.hb": "tapping hb",
+    "tapping.fm": "tapping fm",
     "control.roots": "control roots",
     "control.margin": "control margin",
     "control.simulate": "control simulate",
