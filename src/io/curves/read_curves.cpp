@@ -33,6 +33,10 @@ std::string detect_format(std::string_view bytes, const std::string& extension) 
   const std::string ext = lower(extension);
   if (bytes.size() >= 4 && bytes.substr(0, 4) == std::string_view("PK\x03\x04", 4)) return "jpk-force";
   if (ext == ".jpk-force" || ext == ".jpk-force-map" || ext == ".jpk-qi-data") return "jpk-force";
+  // An Igor binary wave: version 5 (either byte order) in its first two bytes and room for its headers.
+  if (bytes.size() >= 384 && (bytes.substr(0, 2) == std::string_view("\x05\x00", 2) ||
+                              bytes.substr(0, 2) == std::string_view("\x00\x05", 2)))
+    return "ibw";
   if (ext == ".ibw" || ext == ".bwav") return "ibw";
   return "text";
 }

@@ -397,7 +397,7 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
     retract.height = pick(rh, options.retract_height);
     retract.deflection = pick(rd, options.retract_deflection);
     retract.force = pick(rf, options.retract_force);
-    retract.time = Column{};
+    retract.time = pick(preset.retract_time, ColumnChoice{});
     if (retract.height.index < 0) retract.height = approach.height;  // one height axis for both (NT-MDT)
     if (retract.deflection.index < 0 && retract.force.index < 0)
       throw InputError(fmt::format("{}: no retract deflection or force column{}", origin,

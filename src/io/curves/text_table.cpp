@@ -129,6 +129,10 @@ TextTable parse_text_table(std::string_view text, const std::string& origin, Tex
   TextTable table;
   // Skip a UTF-8 byte-order mark.
   if (text.size() >= 3 && text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  if (const auto nul = text.substr(0, 65536).find('\0'); nul != std::string_view::npos)
+    throw InputError(fmt::format("{}: byte {}: a NUL byte: not a text export (a binary file? its format may be "
+                                 "jpk-force or ibw)",
+                                 origin, nul));
   std::vector<std::string_view> lines;
   {
     std::size_t start = 0;
@@ -158,9 +162,7 @@ TextTable parse_text_table(std::string_view text, const std::string& origin, Tex
       while (k < lines.size() && (trim(lines[k]).empty() || is_comment(trim(lines[k])))) ++k;
       bool confirmed = k >= lines.size();
       if (!confirmed) {
-        const auto a = split_cells(t, sep);
-        const auto b = split_cells(trim(lines[k]), sep);
-        confirmed = a.size() == b.size() && all_numeric(b, dc);
+        confirmed = all_numeric(split_cells(trim(lines[k]), sep), dc);  // its count is checked as data
       }
       if (confirmed) {
         first = i;
