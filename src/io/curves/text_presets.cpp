@@ -219,11 +219,15 @@ std::optional<CommentHeader> comment_header(const TextTable& table, const std::s
         throw InputError(fmt::format("{}: line {}: the segment's columns differ from those of line {}", origin,
                                      l.line, out->line));
       if (!out) out = std::move(h);
-    } else if (low.rfind("units:", 0) == 0 && out && out->units.empty()) {
-      out->units = words(std::string_view(l.text).substr(6));
-      if (out->units.size() != out->names.size())
+    } else if (low.rfind("units:", 0) == 0 && out) {
+      auto units = words(std::string_view(l.text).substr(6));
+      if (units.size() != out->names.size())
         throw InputError(fmt::format("{}: line {}: '# units:' gives {} units for {} columns", origin, l.line,
-                                     out->units.size(), out->names.size()));
+                                     units.size(), out->names.size()));
+      if (!out->units.empty() && units != out->units)
+        throw InputError(fmt::format("{}: line {}: the segment's units differ from those of the first segment",
+                                     origin, l.line));
+      out->units = std::move(units);
     }
   };
   for (const TextLine& l : table.preamble) scan(l);
@@ -261,8 +265,8 @@ void check_signature(const Preset& preset, const TextTable& table, const std::st
     line = table.preamble.empty() ? line : table.preamble.front().line;
   }
   if (!ok)
-    throw InputError(fmt::format("{}: line {}: not a {} file: the {} preset expects {}", origin, line,
-                                 preset.instrument, preset.format, preset.signature));
+    throw InputError(fmt::format("{}: line {}: not the layout of the {} preset ({}), which expects {}", origin, line,
+                                 preset.format, preset.instrument, preset.signature));
 }
 
 }  // namespace afmkit::io::curves::detail

@@ -345,7 +345,14 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
   if (preset_ptr == nullptr)
     throw InputError(fmt::format("{}: '{}' is not a text format ({})", origin, format, text_format_names()));
   const Preset& preset = *preset_ptr;
-  TextTable table = parse_text_table(bytes, origin, syntax_of(options, preset, origin));
+  const TextSyntax syntax = syntax_of(options, preset, origin);
+  TextTable table;
+  try {
+    table = parse_text_table(bytes, origin, syntax);
+  } catch (const InputError& e) {
+    if (preset.signature.empty()) throw;
+    throw InputError(fmt::format("{} (the {} preset expects {})", e.what(), format, preset.signature));
+  }
   check_signature(preset, table, origin);
 
   // The header: the header row, or (JPK) the "# columns:" / "# units:" comments.
@@ -458,8 +465,14 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
           if (v < approach.height_sign * h[imin]) imin = r;
           if (v > approach.height_sign * h[imax]) imax = r;
         }
-        const std::size_t turn = (imin > 0 && imin + 1 < n) ? imin : (imax > 0 && imax + 1 < n) ? imax : 0;
-        if (turn > 0) starts.emplace_back(turn + 1, SegmentKind::unknown);
+        // Down to the lowest point then up: approach then retract (or the reverse around the highest point).
+        if (imin > 0 && imin + 1 < n) {
+          starts.front().second = SegmentKind::approach;
+          starts.emplace_back(imin + 1, SegmentKind::retract);
+        } else if (imax > 0 && imax + 1 < n) {
+          starts.front().second = SegmentKind::retract;
+          starts.emplace_back(imax + 1, SegmentKind::approach);
+        }
       }
     }
     for (std::size_t i = 0; i < starts.size(); ++i) {
