@@ -156,3 +156,11 @@ TEST(CurvesIbw, NoLabelsOrNoZSnsrIsRefused) {
   const std::string wrong = curves_test::make_ibw({"A", "B"}, {v, v}, "");
   EXPECT_NE(error_of(wrong).find("no height column 'ZSnsr' (columns: A, B)"), std::string::npos) << error_of(wrong);
 }
+
+TEST(CurvesIbw, NonPositiveCalibrationInTheNoteIsRefused) {
+  EXPECT_NE(error_of(triangle("SpringConstant: 0\r")).find("note: 'SpringConstant: 0': must be positive"),
+            std::string::npos)
+      << error_of(triangle("SpringConstant: 0\r"));
+  const auto c = ac::parse_curves(triangle("ThermalQ: 0\r"), "w.ibw", ".ibw")[0];  // no thermal tune: ignored
+  EXPECT_TRUE(std::isnan(c.metadata.quality_factor));
+}

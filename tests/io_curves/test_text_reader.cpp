@@ -222,3 +222,12 @@ TEST(CurvesText, NonRegularFilesAreRefusedWithoutBlocking) {
   ::unlink(fifo.c_str());
   EXPECT_THROW(ac::read_curves(dir + "/does_not_exist.txt"), afmkit::InputError);
 }
+
+TEST(CurvesText, NonPositiveCalibrationInTheFileIsRefusedWithItsLine) {
+  const std::string msg = error_of("# springConstant: -0.1\nHeight (nm)\tDefl (V)\n30\t0\n10\t1\n20\t0\n");
+  EXPECT_NE(msg.find("curve.txt: line 1: 'springConstant: -0.1': the spring constant must be positive"),
+            std::string::npos)
+      << msg;
+  const std::string zero = error_of("# InvOLS: 0\nHeight (nm)\tDefl (V)\n30\t0\n10\t1\n20\t0\n");
+  EXPECT_NE(zero.find("line 1: 'InvOLS: 0': the InvOLS must be positive"), std::string::npos) << zero;
+}

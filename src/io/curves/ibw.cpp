@@ -297,13 +297,19 @@ std::vector<RawCurve> read_ibw(std::string_view bytes, const std::string& origin
   if (fc >= 0) force = read_column(fc);
   const bool defl_volts = data_units == "V";
   // Calibration from the note.
-  auto meta = [&](const char* key, double& target) {
-    if (const auto v = note_number(note, key); v && *v > 0) target = *v;
+  auto meta = [&](const char* key, double& target, bool required_positive) {
+    const auto v = note_number(note, key);
+    if (!v) return;
+    if (*v > 0) target = *v;
+    else if (required_positive)
+      throw InputError(fmt::format("{}: note: '{}: {}': must be positive", origin, key, *v));
+    else
+      curve.notes.push_back(fmt::format("note: '{}: {}' is not positive: ignored (no thermal tune)", key, *v));
   };
-  meta("SpringConstant", curve.metadata.spring_constant);
-  meta("InvOLS", curve.metadata.invols);
-  meta("ThermalFrequency", curve.metadata.resonance_frequency);
-  meta("ThermalQ", curve.metadata.quality_factor);
+  meta("SpringConstant", curve.metadata.spring_constant, true);
+  meta("InvOLS", curve.metadata.invols, true);
+  meta("ThermalFrequency", curve.metadata.resonance_frequency, false);
+  meta("ThermalQ", curve.metadata.quality_factor, false);
   // Trailing NaN padding (every chosen column NaN at the end) is dropped; a NaN elsewhere is an error.
   std::size_t n = static_cast<std::size_t>(rows);
   auto empty_row = [&](std::size_t i) {

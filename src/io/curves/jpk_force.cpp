@@ -340,11 +340,22 @@ RawCurve read_one(const ZipArchive& zip, const std::vector<std::string>& names, 
       seg.deflection_volts = volts;
       if (const auto d = conversion(c, "vDeflection", "distance"); d && d->unit == "m") {
         seg.deflection = apply_conversion(*d, volts);
-        if (d->steps.size() == 1 && d->steps[0].second == 0.0) curve.metadata.invols = d->steps[0].first;
+        if (d->steps.size() == 1 && d->steps[0].second == 0.0) {
+          if (!(d->steps[0].first > 0))
+            throw InputError(fmt::format("{}: {}: vDeflection distance multiplier (InvOLS) {} m/V: must be positive",
+                                         origin, c.entry, d->steps[0].first));
+          curve.metadata.invols = d->steps[0].first;
+        }
       }
       if (const auto f = conversion(c, "vDeflection", "force"); f && f->unit == "N") {
         seg.force = apply_conversion(*f, volts);
-        if (f->steps.size() == 2 && f->steps[1].second == 0.0) curve.metadata.spring_constant = f->steps[1].first;
+        if (f->steps.size() == 2 && f->steps[1].second == 0.0) {
+          if (!(f->steps[1].first > 0))
+            throw InputError(fmt::format("{}: {}: vDeflection force multiplier (spring constant) {} N/m: must be "
+                                         "positive",
+                                         origin, c.entry, f->steps[1].first));
+          curve.metadata.spring_constant = f->steps[1].first;
+        }
       }
     } else {
       throw InputError(fmt::format("{}: {}: no vDeflection channel (entry '{}{}/channels/vDeflection.dat')", origin,

@@ -47,6 +47,36 @@ void check_calibration(double value, const char* name, const char* unit, const s
     throw InputError(fmt::format("{}: {} = {} {}: must be a positive finite number", origin, name, value, unit));
 }
 
+// Every reader's output obeys raw_curve.hpp: finite values in SI (a huge encoder multiplier or a float32
+// overflow can still make one infinite after conversion), channels of equal length, no empty segment.
+void validate(const RawCurve& curve) {
+  if (curve.segments.empty()) throw InputError(fmt::format("{}: no segment with data", curve.origin));
+  for (std::size_t s = 0; s < curve.segments.size(); ++s) {
+    const Segment& seg = curve.segments[s];
+    const std::size_t n = seg.size();
+    if (n == 0) throw InputError(fmt::format("{}: segment {} has no samples", curve.origin, s + 1));
+    const std::pair<const char*, const std::vector<double>*> channels[] = {
+        {"height", &seg.height}, {"deflection", &seg.deflection}, {"deflection signal", &seg.deflection_volts},
+        {"force", &seg.force}, {"time", &seg.time}};
+    for (const auto& [name, v] : channels) {
+      if (!v->empty() && v->size() != n)
+        throw NumericalFailure(fmt::format("{}: segment {}: the {} has {} samples, the segment {} (reader defect)",
+                                           curve.origin, s + 1, name, v->size(), n));
+      for (std::size_t i = 0; i < v->size(); ++i)
+        if (!std::isfinite((*v)[i]))
+          throw InputError(fmt::format("{}: segment {} ({}), sample {}: the {} is not finite after conversion to SI "
+                                       "units",
+                                       curve.origin, s + 1, to_string(seg.kind), i + 1, name));
+    }
+  }
+  const auto& m = curve.metadata;
+  for (const auto& [name, v] : {std::pair{"spring constant", m.spring_constant}, std::pair{"InvOLS", m.invols},
+                                std::pair{"resonance frequency", m.resonance_frequency},
+                                std::pair{"quality factor", m.quality_factor}})
+    if (!std::isnan(v) && !(std::isfinite(v) && v > 0))
+      throw InputError(fmt::format("{}: the file's {} is {}: must be positive and finite", curve.origin, name, v));
+}
+
 }  // namespace
 
 std::vector<RawCurve> parse_curves(std::string_view bytes, const std::string& origin, const std::string& extension,
@@ -71,6 +101,7 @@ std::vector<RawCurve> parse_curves(std::string_view bytes, const std::string& or
   for (RawCurve& c : curves) {
     if (!std::isnan(options.spring_constant)) c.metadata.spring_constant = options.spring_constant;
     if (!std::isnan(options.invols)) c.metadata.invols = options.invols;
+    validate(c);
   }
   return curves;
 }

@@ -211,7 +211,7 @@ std::optional<double> metadata_value(std::string_view text, std::string_view key
 }
 
 void read_metadata(const Preset& preset, const std::vector<TextLine>& lines, CurveMetadata& meta,
-                   std::vector<std::string>& notes) {
+                   std::vector<std::string>& notes, const std::string& origin) {
   for (const TextLine& line : lines) {
     for (const MetadataKey& key : preset.metadata) {
       const auto v = metadata_value(line.text, key.key);
@@ -222,6 +222,10 @@ void read_metadata(const Preset& preset, const std::vector<TextLine>& lines, Cur
         continue;
       }
       const double si = key.reciprocal ? 1.0 / (*v * key.scale) : *v * key.scale;
+      if (!(std::isfinite(si) && si > 0))
+        throw InputError(fmt::format("{}: line {}: '{}': the {} must be positive and finite", origin, line.line,
+                                     line.text, key.target == MetadataKey::spring_constant ? "spring constant"
+                                                                                           : "InvOLS"));
       (key.target == MetadataKey::spring_constant ? meta.spring_constant : meta.invols) = si;
     }
   }
@@ -376,7 +380,7 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
   curve.origin = origin;
   curve.metadata.format = format;
   curve.metadata.instrument = preset.instrument;
-  read_metadata(preset, table.preamble, curve.metadata, curve.notes);
+  read_metadata(preset, table.preamble, curve.metadata, curve.notes, origin);
   if (!std::isnan(options.spring_constant)) curve.metadata.spring_constant = options.spring_constant;
   if (!std::isnan(options.invols)) curve.metadata.invols = options.invols;
 
