@@ -363,6 +363,8 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
   std::vector<HeaderCell> header;
   int header_line = table.header_line;
   for (const auto& cell : table.header) header.push_back(parse_header_cell(cell));
+  for (std::size_t i = 0; i < table.header_units.size() && i < header.size(); ++i)
+    if (header[i].unit.empty()) header[i].unit = table.header_units[i];
   if (preset.comment_header) {
     if (const auto ch = comment_header(table, origin)) {
       header.clear();
