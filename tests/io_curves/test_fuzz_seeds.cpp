@@ -66,3 +66,17 @@ TEST(CurvesFuzzSeeds, EveryTextAndIbwSeedParses) {
     EXPECT_GE(count, 3) << target;
   }
 }
+
+TEST(CurvesFuzzSeeds, JpkForceMapGivesOneCurvePerIndex) {
+  const std::string bytes = seed("fuzz_io_curves_jpk", "force_map_two_indices");
+  ASSERT_FALSE(bytes.empty());
+  const auto curves = ac::parse_curves(bytes, "map.jpk-force-map", ".jpk-force-map");
+  ASSERT_EQ(curves.size(), 2u);
+  EXPECT_EQ(curves[0].origin, "map.jpk-force-map (index/0)");
+  EXPECT_EQ(curves[1].origin, "map.jpk-force-map (index/1)");
+  // Index i's last extend deflection is raw 200 (i + 1) -> 0.2 (i + 1) V -> x 5e-8 m/V -> x 0.05 N/m.
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_EQ(curves[static_cast<std::size_t>(i)].segments.size(), 2u);
+    EXPECT_DOUBLE_EQ(curves[static_cast<std::size_t>(i)].segments[0].force[3], 0.2 * (i + 1) * 5e-8 * 0.05);
+  }
+}
