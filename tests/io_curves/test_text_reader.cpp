@@ -246,3 +246,12 @@ TEST(CurvesText, TrailingSeparatorsAndAUnitsRowUnderTheNames) {
   const std::string msg = error_of("Height (nm)\tDefl (nm)\n30\t0\t1\n10\t2\t1\n20\t0\t1\n");
   EXPECT_NE(msg.find("has no unit (no header row)"), std::string::npos) << msg;
 }
+
+TEST(CurvesText, SegmentColumnWithPaddingRows) {
+  const auto c = parse("Height (nm),Defl (nm),Segment\n30,0,0\n10,2,0\n10,2,1\n30,0,1\n,,\n")[0];
+  ASSERT_EQ(c.segments.size(), 2u);
+  EXPECT_EQ(c.segments[1].size(), 2u);
+  EXPECT_NE(error_of("Height (nm),Defl (nm),Segment\n30,0,0\n10,2,\n10,2,1\n").find("line 3, column 3: the segment "
+                                                                                     "column has no value"),
+            std::string::npos);
+}

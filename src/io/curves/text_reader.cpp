@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -442,11 +443,16 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
     const Column seg = pick(preset.segment, options.segment);
     if (seg.index >= 0) {
       const auto& s = table.columns[static_cast<std::size_t>(seg.index)];
+      const auto& h = table.columns[static_cast<std::size_t>(approach.height.index)];
+      double previous = std::numeric_limits<double>::quiet_NaN();
       for (std::size_t r = 0; r < s.size(); ++r) {
-        if (std::isnan(s[r]))
+        if (std::isnan(s[r])) {
+          if (std::isnan(h[r])) continue;  // padding: make_segment drops it (or refuses a hole)
           throw InputError(fmt::format("{}: line {}, column {}: the segment column has no value", origin,
                                        table.row_line[r], seg.index + 1));
-        if (r == 0 || s[r] != s[r - 1]) starts.emplace_back(r, SegmentKind::unknown);
+        }
+        if (starts.empty() || s[r] != previous) starts.emplace_back(starts.empty() ? 0 : r, SegmentKind::unknown);
+        previous = s[r];
       }
     } else if (preset.comment_segments) {
       for (const TextLine& l : table.preamble)
