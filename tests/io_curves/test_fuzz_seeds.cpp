@@ -80,3 +80,14 @@ TEST(CurvesFuzzSeeds, JpkForceMapGivesOneCurvePerIndex) {
     EXPECT_DOUBLE_EQ(curves[static_cast<std::size_t>(i)].segments[0].force[3], 0.2 * (i + 1) * 5e-8 * 0.05);
   }
 }
+
+TEST(CurvesFuzzSeeds, BigEndianIbwSeedValues) {
+  const std::string bytes = seed("fuzz_io_curves_ibw", "v5_be_noindexes");
+  ASSERT_FALSE(bytes.empty());
+  const auto c = ac::parse_curves(bytes.substr(1), "be.ibw", ".ibw")[0];
+  // ZSnsr = 0, 1, ..., 4, 3, ..., 0 (x 1e-7 m), Defl = index x 1e-9 m, big-endian float32: split after point 4.
+  ASSERT_EQ(c.segments.size(), 2u);
+  EXPECT_FLOAT_EQ(static_cast<float>(c.segments[0].height[4]), -4e-7f);
+  EXPECT_FLOAT_EQ(static_cast<float>(c.segments[0].deflection[4]), 4e-9f);
+  EXPECT_EQ(c.segments[1].size(), 4u);
+}
