@@ -27,6 +27,16 @@ struct ReadOptions {
   /// "nanoscope-txt", "ntmdt-txt", "afmworkshop-csv".
   std::string format = "auto";
   ColumnChoice height, deflection, force, time, segment;  ///< text exports: the columns (presets fill them)
+  /// Text exports that write the retract beside the approach (one row holds a sample of each): the retract's
+  /// columns; when one is given, height/deflection/force above are the approach's. A retract deflection or force
+  /// without a retract height shares the approach's height column (NT-MDT). (Addition to the lead's API.)
+  ColumnChoice retract_height, retract_deflection, retract_force;
+  /// Text exports: "auto", "tab", "semicolon", "comma", "blank"; and the decimal mark "auto", "point", "comma".
+  std::string separator = "auto";
+  std::string decimal = "auto";
+  /// Which way the height column of a text export grows: "auto" (the preset's; for "text": away from the
+  /// sample), "away" (a height), "towards" (an extension, e.g. Asylum's ZSnsr: the reader negates it).
+  std::string height_direction = "auto";
   /// Calibration that overrides (or supplies) what the file says; NaN: take the file's.
   double spring_constant = std::numeric_limits<double>::quiet_NaN();  ///< k [N/m]
   double invols = std::numeric_limits<double>::quiet_NaN();           ///< [m/V]

@@ -1,0 +1,12 @@
+#include <fmt/format.h>
+
+#include "afmkit/core/error.hpp"
+#include "binary_readers.hpp"
+
+namespace afmkit::io::curves::detail {
+
+std::vector<RawCurve> read_jpk_force(std::string_view, const std::string& origin, const ReadOptions&) {
+  throw InputError(fmt::format("{}: the jpk-force reader is not in this build yet", origin));
+}
+
+}  // namespace afmkit::io::curves::detail

@@ -1,0 +1,79 @@
+#include "afmkit/io/curves/read_curves.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/core/input_file.hpp"
+#include "binary_readers.hpp"
+#include "text_reader.hpp"
+
+namespace afmkit::io::curves {
+
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string extension_of(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  const auto dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return {};
+  return path.substr(dot);
+}
+
+// The format of `bytes` when the options say "auto": the content first (a zip archive is a JPK file, an Igor
+// binary wave starts with its version), then the extension.
+std::string detect_format(std::string_view bytes, const std::string& extension) {
+  const std::string ext = lower(extension);
+  if (bytes.size() >= 4 && bytes.substr(0, 4) == std::string_view("PK\x03\x04", 4)) return "jpk-force";
+  if (ext == ".jpk-force" || ext == ".jpk-force-map" || ext == ".jpk-qi-data") return "jpk-force";
+  if (ext == ".ibw" || ext == ".bwav") return "ibw";
+  return "text";
+}
+
+void check_calibration(double value, const char* name, const char* unit, const std::string& origin) {
+  if (std::isnan(value)) return;
+  if (!std::isfinite(value) || value <= 0)
+    throw InputError(fmt::format("{}: {} = {} {}: must be a positive finite number", origin, name, value, unit));
+}
+
+}  // namespace
+
+std::vector<RawCurve> parse_curves(std::string_view bytes, const std::string& origin, const std::string& extension,
+                                   const ReadOptions& options) {
+  check_calibration(options.spring_constant, "spring constant", "N/m", origin);
+  check_calibration(options.invols, "InvOLS", "m/V", origin);
+  const std::string format = options.format == "auto" ? detect_format(bytes, extension) : options.format;
+  std::vector<RawCurve> curves;
+  if (format == "jpk-force") {
+    curves = detail::read_jpk_force(bytes, origin, options);
+  } else if (format == "ibw") {
+    curves = detail::read_ibw(bytes, origin, options);
+  } else if (detail::is_text_format(format)) {
+    ReadOptions o = options;
+    o.format = format;
+    curves = detail::read_text_curves(bytes, origin, o);
+  } else {
+    throw InputError(fmt::format("{}: format '{}' is not one of auto, jpk-force, ibw, text, jpk-txt, asylum-txt, "
+                                 "nanoscope-txt, ntmdt-txt, afmworkshop-csv",
+                                 origin, format));
+  }
+  for (RawCurve& c : curves) {
+    if (!std::isnan(options.spring_constant)) c.metadata.spring_constant = options.spring_constant;
+    if (!std::isnan(options.invols)) c.metadata.invols = options.invols;
+  }
+  return curves;
+}
+
+std::vector<RawCurve> read_curves(const std::string& path, const ReadOptions& options) {
+  const std::string bytes = files::read_input_file(path, "force curve");
+  return parse_curves(bytes, path, extension_of(path), options);
+}
+
+}  // namespace afmkit::io::curves
