@@ -81,7 +81,8 @@ ContactPoint find_contact_point(const std::vector<double>& x, const std::vector<
   try {
     cp.fit = fit_hertz(fx, ff, xt, fit_options);
   } catch (const NumericalFailure& e) {
-    throw NumericalFailure(fmt::format("{}: contact point: {}", origin, e.what()));
+    throw NumericalFailure(fmt::format("{}: contact point: {} (contact_method threshold needs no fit)", origin,
+                                       e.what()));
   }
   cp.position = cp.fit->contact_point;
   cp.error = cp.fit->contact_point_error;

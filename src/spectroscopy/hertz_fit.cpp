@@ -113,6 +113,12 @@ HertzFit fit_hertz(const std::vector<double>& position, const std::vector<double
     throw NumericalFailure(fmt::format("{}: no contact at the solution ({} samples indented, coefficient {:.3g}): the "
                                        "approach in the fit range does not look like an indentation",
                                        name, indented, p[1] * scale / std::pow(length, 1.5)));
+  // the contact point may lie beyond the samples (DMT: the snap-in jumps past it), but not by more than their span
+  if (p[0] < (*xlo - contact_guess) / length - 1 || p[0] > (*xhi - contact_guess) / length + 1)
+    throw NumericalFailure(fmt::format("{}: the fitted contact point {:.6g} µm lies far outside the fitted samples "
+                                       "({:.6g} to {:.6g} µm): the approach there does not look like a {} indentation",
+                                       name, (contact_guess + length * p[0]) * 1e6, *xlo * 1e6, *xhi * 1e6,
+                                       dmt ? "DMT" : "Hertz"));
   Eigen::VectorXd r(static_cast<Eigen::Index>(n));
   Eigen::MatrixXd j(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(unknowns));
   functor(p, r);
