@@ -302,9 +302,9 @@ std::string summary_text(const sp::PreparedCurve& r, const nlohmann::json& resul
   std::string s = fmt::format("spectroscopy prepare: {} curve(s), status {}\n", r.curves.size(),
                               results.at("status").get<std::string>());
   for (const auto& c : r.curves) {
-    s += fmt::format("  {}: k = {} N/m ({}), InvOLS = {}\n", c.origin, c.spring_constant, c.spring_constant_source,
+    s += fmt::format("  {}: k = {:.6g} N/m ({}), InvOLS = {}\n", c.origin, c.spring_constant, c.spring_constant_source,
                      std::isnan(c.invols) ? std::string("not needed")
-                                          : fmt::format("{} nm/V ({})", c.invols * 1e9, c.invols_source));
+                                          : fmt::format("{:.6g} nm/V ({})", c.invols * 1e9, c.invols_source));
     s += fmt::format("    baseline: offset {} at z = 0, tilt {:.4g} N/m, noise sigma {} ({} samples)\n",
                      q(c.baseline.offset, "N"), c.baseline.slope, q(c.baseline.residual_rms, "N"), c.baseline.points);
     s += fmt::format("    contact point ({}): tip position {} +- {}\n", sp::to_string(c.contact.method),
@@ -364,9 +364,17 @@ void run_prepare_curves(const io::ParamSet& p, const std::vector<io::curves::Raw
     if (!p.flag("allow_energy_gain")) law.require_dissipative();
   } catch (const InvalidParameter& e) {
     status = "law_refused";
-    note = fmt::format("the prepared table is refused by the table law: {} — a larger --bin-width averages the noise "
-                       "down{}, or --allow-energy-gain accepts it (give it to the orbit commands as well)",
-                       e.what(), p.flag("keep_baseline") ? ", leaving out --keep-baseline trims the far baseline" : "");
+    const std::string why = e.what();
+    const std::string advice =
+        why.find("straight line") != std::string::npos
+            ? "the retract is stiffer than the approach at the deepest point (unloading usually is), which the table "
+              "law's straight continuation below the measured depth turns into an energy gain there: "
+              "--allow-energy-gain accepts it (give it to the orbit commands as well, and keep their orbits above "
+              "the measured depth)"
+            : fmt::format("a larger --bin-width averages the noise down{}, or --allow-energy-gain accepts it (give "
+                          "it to the orbit commands as well)",
+                          p.flag("keep_baseline") ? ", leaving out --keep-baseline trims the far baseline" : "");
+    note = fmt::format("the prepared table is refused by the table law: {} — {}", why, advice);
     check = "refused (see the note)";
   }
 

@@ -14,6 +14,7 @@ Keyword options are the command's keys (``afmkit spectroscopy prepare --help``),
 """
 from __future__ import annotations
 
+import inspect
 import json
 import sys
 
@@ -134,12 +135,29 @@ def prepare(height, deflection=None, *, deflection_volts=None, force=None, segme
     return PreparedCurve(results, params, _law_from_columns(columns))
 
 
-def prepare_file(path, **options) -> PreparedCurve:
-    """Prepares every curve of the instrument file ``path`` (JPK .jpk-force, Asylum .ibw, text exports with
-    ``format``, ``height_column``, … as the command's keys). Options as ``prepare``; ``spring_constant`` [N/m] and
-    ``invols`` [m/V] override the file's."""
-    raw = _afmkit.run("spectroscopy prepare", _options(dict(options, input=path)))
+def prepare_file(input, **options) -> PreparedCurve:
+    """Prepares every curve of the instrument file ``input`` (JPK .jpk-force, Asylum .ibw, text exports with
+    ``format``, ``height_column``, … as the command's keys). Options as ``prepare`` (SI units: ``invols`` [m/V],
+    ``tip_radius`` [m], ``bin_width`` [m]); ``spring_constant`` [N/m] and ``invols`` override the file's."""
+    raw = _afmkit.run("spectroscopy prepare", _options(dict(options, input=input)))
     return PreparedCurve(raw["results"], raw["params"], _law_from_columns(raw["table"]))
+
+
+def _file_signature():
+    """prepare_file's keywords: the command's keys (its --help), lengths in SI units here."""
+    spec = next(s for s in _afmkit.commands() if s["path"] == "spectroscopy prepare")
+    params = [inspect.Parameter("input", inspect.Parameter.POSITIONAL_OR_KEYWORD)]
+    for p in spec["params"]:
+        if p["key"] == "input":
+            continue
+        default = None if p["key"] in ("spring_constant", "invols") else p["default"]
+        if p["key"] in _SI_TO_COMMAND and default:
+            default = default / _SI_TO_COMMAND[p["key"]]
+        params.append(inspect.Parameter(p["key"], inspect.Parameter.KEYWORD_ONLY, default=default))
+    return inspect.Signature(params, return_annotation=PreparedCurve)
+
+
+prepare_file.__signature__ = _file_signature()
 
 
 def plot(data: dict, path: str) -> None:
