@@ -53,6 +53,7 @@ Preset base(std::string format, std::string instrument) {
   p.retract_height = role("retract height", {}, kLength);
   p.retract_deflection = role("retract deflection", {}, kDeflection);
   p.retract_force = role("retract force", {}, kForce);
+  p.retract_time = role("retract time", {}, kTime);
   return p;
 }
 
@@ -60,7 +61,7 @@ Preset make_text() {
   Preset p = base("text", "text");
   p.height = role("height",
                   {{"~height", ""}, {"~zsnsr", ""}, {"~z-sense", ""}, {"~zsensor", ""}, {"~z sensor", ""},
-                   {"~ramp", ""}, {"~piezo", ""}, {"~lvdt", ""}, {"z", ""}, {"~extension", ""}},
+                   {"~ramp", ""}, {"~piezo", ""}, {"~lvdt", ""}, {"z", ""}, {"h", ""}, {"~extension", ""}},
                   kLength, true, "", 1);
   p.deflection = role("deflection", {{"~defl", ""}, {"~t-b", ""}}, kDeflection, false, "", 2);
   p.force = role("force", {{"~force", ""}}, kForce);
@@ -116,7 +117,8 @@ Preset make_nanoscope_txt() {
   p.side_by_side = p.require_retract = true;
   p.height = role("height", {{"Calc_Ramp_Ex", ""}, {"Height_Sensor_Ex", ""}, {"ZSensor_Ex", ""}}, kLength, true,
                   "'Calc_Ramp_Ex_nm' (or 'Height_Sensor_Ex_nm', 'ZSensor_Ex_nm')");
-  p.retract_height = role("retract height", {{"Calc_Ramp_Rt", ""}, {"Height_Sensor_Rt", ""}, {"ZSensor_Rt", ""}},
+  p.retract_height = role("retract height",
+                          {{"Calc_Ramp_Rt", ""}, {"Cal_Ramp_Rt", ""}, {"Height_Sensor_Rt", ""}, {"ZSensor_Rt", ""}},
                           kLength, true, "'Calc_Ramp_Rt_nm' (or 'Height_Sensor_Rt_nm', 'ZSensor_Rt_nm')");
   p.deflection = role("deflection", {{"Defl_Ex", ""}, {"Deflection_Ex", ""}}, kDeflection, false,
                       "'Defl_nm_Ex', 'Defl_pN_Ex' or 'Defl_V_Ex'");
@@ -124,6 +126,8 @@ Preset make_nanoscope_txt() {
                               "'Defl_nm_Rt', 'Defl_pN_Rt' or 'Defl_V_Rt'");
   p.force = role("force", {{"Force_Ex", ""}}, kForce);
   p.retract_force = role("retract force", {{"Force_Rt", ""}}, kForce);
+  p.time = role("time", {{"Time_Ex", ""}}, kTime);
+  p.retract_time = role("retract time", {{"Time_Rt", ""}}, kTime);
   p.metadata = {key(MetadataKey::spring_constant, "Spring Constant"), key(MetadataKey::spring_constant, "Spring constant")};
   p.signature = "a header row with '..._Ex' and '..._Rt' ramp columns (NanoScope force curve ASCII export)";
   return p;
@@ -215,11 +219,15 @@ std::optional<CommentHeader> comment_header(const TextTable& table, const std::s
         throw InputError(fmt::format("{}: line {}: the segment's columns differ from those of line {}", origin,
                                      l.line, out->line));
       if (!out) out = std::move(h);
-    } else if (low.rfind("units:", 0) == 0 && out && out->units.empty()) {
-      out->units = words(std::string_view(l.text).substr(6));
-      if (out->units.size() != out->names.size())
+    } else if (low.rfind("units:", 0) == 0 && out) {
+      auto units = words(std::string_view(l.text).substr(6));
+      if (units.size() != out->names.size())
         throw InputError(fmt::format("{}: line {}: '# units:' gives {} units for {} columns", origin, l.line,
-                                     out->units.size(), out->names.size()));
+                                     units.size(), out->names.size()));
+      if (!out->units.empty() && units != out->units)
+        throw InputError(fmt::format("{}: line {}: the segment's units differ from those of the first segment",
+                                     origin, l.line));
+      out->units = std::move(units);
     }
   };
   for (const TextLine& l : table.preamble) scan(l);
@@ -257,8 +265,8 @@ void check_signature(const Preset& preset, const TextTable& table, const std::st
     line = table.preamble.empty() ? line : table.preamble.front().line;
   }
   if (!ok)
-    throw InputError(fmt::format("{}: line {}: not a {} file: the {} preset expects {}", origin, line,
-                                 preset.instrument, preset.format, preset.signature));
+    throw InputError(fmt::format("{}: line {}: not the layout of the {} preset ({}), which expects {}", origin, line,
+                                 preset.format, preset.instrument, preset.signature));
 }
 
 }  // namespace afmkit::io::curves::detail

@@ -47,7 +47,7 @@ struct Preset {
   bool comment_header = false;  ///< column names and units in "# columns:" / "# units:" comments (JPK)
   bool comment_segments = false;  ///< segments labelled by "# segment: extend" comments (JPK)
   TextSyntax syntax;
-  Role height, deflection, force, time, segment, retract_height, retract_deflection, retract_force;
+  Role height, deflection, force, time, segment, retract_height, retract_deflection, retract_force, retract_time;
   std::vector<MetadataKey> metadata;
   std::string signature;        ///< for messages: what the file must look like
 };

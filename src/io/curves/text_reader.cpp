@@ -211,7 +211,7 @@ std::optional<double> metadata_value(std::string_view text, std::string_view key
 }
 
 void read_metadata(const Preset& preset, const std::vector<TextLine>& lines, CurveMetadata& meta,
-                   std::vector<std::string>& notes) {
+                   std::vector<std::string>& notes, const std::string& origin) {
   for (const TextLine& line : lines) {
     for (const MetadataKey& key : preset.metadata) {
       const auto v = metadata_value(line.text, key.key);
@@ -222,6 +222,10 @@ void read_metadata(const Preset& preset, const std::vector<TextLine>& lines, Cur
         continue;
       }
       const double si = key.reciprocal ? 1.0 / (*v * key.scale) : *v * key.scale;
+      if (!(std::isfinite(si) && si > 0))
+        throw InputError(fmt::format("{}: line {}: '{}': the {} must be positive and finite", origin, line.line,
+                                     line.text, key.target == MetadataKey::spring_constant ? "spring constant"
+                                                                                           : "InvOLS"));
       (key.target == MetadataKey::spring_constant ? meta.spring_constant : meta.invols) = si;
     }
   }
@@ -345,7 +349,14 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
   if (preset_ptr == nullptr)
     throw InputError(fmt::format("{}: '{}' is not a text format ({})", origin, format, text_format_names()));
   const Preset& preset = *preset_ptr;
-  TextTable table = parse_text_table(bytes, origin, syntax_of(options, preset, origin));
+  const TextSyntax syntax = syntax_of(options, preset, origin);
+  TextTable table;
+  try {
+    table = parse_text_table(bytes, origin, syntax);
+  } catch (const InputError& e) {
+    if (preset.signature.empty()) throw;
+    throw InputError(fmt::format("{} (the {} preset expects {})", e.what(), format, preset.signature));
+  }
   check_signature(preset, table, origin);
 
   // The header: the header row, or (JPK) the "# columns:" / "# units:" comments.
@@ -369,7 +380,7 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
   curve.origin = origin;
   curve.metadata.format = format;
   curve.metadata.instrument = preset.instrument;
-  read_metadata(preset, table.preamble, curve.metadata, curve.notes);
+  read_metadata(preset, table.preamble, curve.metadata, curve.notes, origin);
   if (!std::isnan(options.spring_constant)) curve.metadata.spring_constant = options.spring_constant;
   if (!std::isnan(options.invols)) curve.metadata.invols = options.invols;
 
@@ -397,7 +408,7 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
     retract.height = pick(rh, options.retract_height);
     retract.deflection = pick(rd, options.retract_deflection);
     retract.force = pick(rf, options.retract_force);
-    retract.time = Column{};
+    retract.time = pick(preset.retract_time, ColumnChoice{});
     if (retract.height.index < 0) retract.height = approach.height;  // one height axis for both (NT-MDT)
     if (retract.deflection.index < 0 && retract.force.index < 0)
       throw InputError(fmt::format("{}: no retract deflection or force column{}", origin,
@@ -458,8 +469,14 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
           if (v < approach.height_sign * h[imin]) imin = r;
           if (v > approach.height_sign * h[imax]) imax = r;
         }
-        const std::size_t turn = (imin > 0 && imin + 1 < n) ? imin : (imax > 0 && imax + 1 < n) ? imax : 0;
-        if (turn > 0) starts.emplace_back(turn + 1, SegmentKind::unknown);
+        // Down to the lowest point then up: approach then retract (or the reverse around the highest point).
+        if (imin > 0 && imin + 1 < n) {
+          starts.front().second = SegmentKind::approach;
+          starts.emplace_back(imin + 1, SegmentKind::retract);
+        } else if (imax > 0 && imax + 1 < n) {
+          starts.front().second = SegmentKind::retract;
+          starts.emplace_back(imax + 1, SegmentKind::approach);
+        }
       }
     }
     for (std::size_t i = 0; i < starts.size(); ++i) {

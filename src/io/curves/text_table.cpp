@@ -66,8 +66,11 @@ std::string_view trim(std::string_view s) {
 
 std::vector<std::string_view> split_cells(std::string_view line, char separator) {
   std::vector<std::string_view> cells;
-  line = trim(line);
   if (separator != ' ') {
+    // Trailing separators are empty cells (a retract shorter than the approach), so only the line's own blanks
+    // other than the separator are trimmed.
+    while (!line.empty() && line.back() != separator && is_blank(line.back())) line.remove_suffix(1);
+    while (!line.empty() && line.front() != separator && is_blank(line.front())) line.remove_prefix(1);
     std::size_t start = 0;
     while (true) {
       const std::size_t at = line.find(separator, start);
@@ -77,6 +80,7 @@ std::vector<std::string_view> split_cells(std::string_view line, char separator)
     }
     return cells;
   }
+  line = trim(line);
   std::size_t i = 0;
   while (i < line.size()) {
     while (i < line.size() && is_blank(line[i])) ++i;
@@ -129,6 +133,10 @@ TextTable parse_text_table(std::string_view text, const std::string& origin, Tex
   TextTable table;
   // Skip a UTF-8 byte-order mark.
   if (text.size() >= 3 && text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  if (const auto nul = text.substr(0, 65536).find('\0'); nul != std::string_view::npos)
+    throw InputError(fmt::format("{}: byte {}: a NUL byte: not a text export (a binary file? its format may be "
+                                 "jpk-force or ibw)",
+                                 origin, nul));
   std::vector<std::string_view> lines;
   {
     std::size_t start = 0;
@@ -143,6 +151,7 @@ TextTable parse_text_table(std::string_view text, const std::string& origin, Tex
   // data), so that a lone number in a metadata block is not taken for data.
   std::size_t first = lines.size();
   std::vector<TextLine> pending;  // non-numeric lines before the data
+  std::vector<std::string_view> pending_raw;  // the last non-comment ones, untrimmed
   for (std::size_t i = 0; i < lines.size() && first == lines.size(); ++i) {
     const std::string_view t = trim(lines[i]);
     if (t.empty()) continue;
@@ -152,15 +161,13 @@ TextTable parse_text_table(std::string_view text, const std::string& origin, Tex
     }
     char sep = 0;
     bool dc = false;
-    if (detect_syntax(t, syntax, sep, dc)) {
+    if (detect_syntax(lines[i], syntax, sep, dc)) {
       // Confirm with the next non-blank, non-comment line.
       std::size_t k = i + 1;
       while (k < lines.size() && (trim(lines[k]).empty() || is_comment(trim(lines[k])))) ++k;
       bool confirmed = k >= lines.size();
       if (!confirmed) {
-        const auto a = split_cells(t, sep);
-        const auto b = split_cells(trim(lines[k]), sep);
-        confirmed = a.size() == b.size() && all_numeric(b, dc);
+        confirmed = all_numeric(split_cells(lines[k], sep), dc);  // its count is checked as data
       }
       if (confirmed) {
         first = i;
@@ -170,15 +177,16 @@ TextTable parse_text_table(std::string_view text, const std::string& origin, Tex
       }
     }
     pending.push_back({static_cast<int>(i + 1), std::string(t), false, 0});
+    pending_raw.push_back(lines[i]);
   }
   if (first == lines.size())
     throw InputError(fmt::format("{}: no rows of numbers found (a text export needs lines of numbers separated by "
                                  "tabs, ';', ',' or blanks)",
                                  origin));
-  const std::size_t ncol = split_cells(trim(lines[first]), table.separator).size();
+  const std::size_t ncol = split_cells(lines[first], table.separator).size();
   // The header row: the last non-comment line before the data, when it has as many cells as the data.
   if (!pending.empty() && !pending.back().comment) {
-    const auto cells = split_cells(pending.back().text, table.separator);
+    const auto cells = split_cells(pending_raw.back(), table.separator);
     if (cells.size() == ncol) {
       for (std::string_view c : cells) table.header.emplace_back(c);
       table.header_line = pending.back().line;
@@ -198,7 +206,7 @@ TextTable parse_text_table(std::string_view text, const std::string& origin, Tex
           {line_no, t.empty() ? std::string() : std::string(strip_comment_marker(t)), !t.empty(), table.rows()});
       continue;
     }
-    cells = split_cells(t, table.separator);
+    cells = split_cells(lines[i], table.separator);
     if (cells.size() > ncol)
       throw InputError(fmt::format("{}: line {}: {} columns, but the data begin (line {}) with {}", origin, line_no,
                                    cells.size(), first + 1, ncol));
