@@ -185,7 +185,7 @@ def plot(data: dict, path: str) -> None:
             d = np.linspace(lo, 0.0, 200)  # distance from the prepared contact point
             delta = np.maximum(0.0, fit["contact_point"] - (c["contact"] + d))
             prep_ax.plot(d * 1e9, (fit["coefficient"] * delta ** 1.5 + fit["offset"]) * 1e9, "k-", lw=1,
-                         label=f"{fit['model'].upper()} fit")
+                         label=f"{ {'hertz': 'Hertz', 'dmt': 'DMT'}.get(fit['model'], fit['model'])} fit")
     for branch, colour in (("approach", "navy"), ("retract", "darkred")):
         prep_ax.plot(np.asarray(data[branch]["distance"]) * 1e9, np.asarray(data[branch]["force"]) * 1e9, "-",
                      color=colour, lw=1.6, label=f"{branch} (binned table)")

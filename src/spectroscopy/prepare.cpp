@@ -109,6 +109,14 @@ PreparedCurve prepare(const std::vector<io::curves::RawCurve>& curves, const Pre
       keep_up_to(out.retract, out.trimmed_at);
     }
   }
+  // both branches end at the same distance: above its table a branch is 0, so a branch ending earlier would be
+  // compared with the other's (noisy, or attractive) values there
+  if (out.approach.size() > 0 && out.retract.size() > 0) {
+    const double end = std::min(out.approach.distance.back(), out.retract.distance.back());
+    keep_up_to(out.approach, end);
+    keep_up_to(out.retract, end);
+    if (end < out.trimmed_at) out.trimmed_at = end;
+  }
   for (auto [branch, what] : {std::pair{&out.approach, "approach"}, std::pair{&out.retract, "retract"}})
     if (branch->size() < 4)
       throw InvalidParameter("bin_width", fmt::format("bin_width = {:.4g} nm leaves the {} branch {} bins, fewer than "

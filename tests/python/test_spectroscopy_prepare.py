@@ -162,6 +162,10 @@ def test_the_vendor_hertz_fit_of_the_jpk_file():
         if "not in this build" in str(e):
             pytest.skip(f"the JPK reader is not in this build: {e}")
         raise
-    # tolerances: the vendor fits its own choice of range and baseline; ours differ (docs/spectroscopy.md)
-    assert r.contact_point == pytest.approx(18.03e-6, abs=0.05e-6)
-    assert r.youngs_modulus == pytest.approx(233.1e3, rel=0.15)
+    # The vendor's contact point is given to 10 nm (18.03 µm: ±5 nm) and its fit range and baseline are not in the
+    # file; ours, for baseline fractions 0.1-0.7 and the Hertz or DMT model, lie within 18.0393-18.0403 µm (standard
+    # error 0.8 nm): 9-10 nm above the vendor's. Tolerance 15 nm. E: ours 233.3 ± 3.0 kPa (233.2-234.6 kPa over the
+    # same choices) against 233.1 kPa: tolerance 2 %.
+    assert r.contact_point == pytest.approx(18.03e-6, abs=15e-9)
+    assert r.youngs_modulus == pytest.approx(233.1e3, rel=0.02)
+    assert r.status == "ok"

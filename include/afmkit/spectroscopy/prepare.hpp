@@ -26,6 +26,7 @@ struct PrepareOptions {
   /// Trim both branches beyond the interaction range: the largest distance where a branch's binned force leaves
   /// the band ±n·σ/√count, plus 2 bins (beyond it the table law is 0 anyway; noise there is no force).
   bool trim_baseline = true;
+  // Whether trimmed or not, both branches are then cut to the smaller of their largest distances (they end together).
 };
 
 /// What was found for one curve of the input.
@@ -49,7 +50,7 @@ struct PreparedCurve {
   double bin_width = 0;   ///< used [m]
   BinnedBranch approach, retract;  ///< averaged and binned (distances [m] from the contact point, forces [N])
   CurveEvent snap_in, pull_off;
-  double trimmed_at = 0;  ///< largest distance kept [m] (inf: not trimmed)
+  double trimmed_at = 0;  ///< largest distance kept [m] (the common end of the branches)
 };
 
 /// Prepares the curves (repeated measurements of the same spot): each is calibrated, levelled and given its own
