@@ -26,6 +26,11 @@ BaselineFit fit_baseline(const ForceSegment& approach, double fraction, std::siz
     n += 1; sz += z; sf += f; szz += z * z; szf += z * f;
   }
   fit.points = static_cast<std::size_t>(n);
+  if (fit.points < std::max<std::size_t>(min_points, 3) && fraction == 1)
+    throw InvalidParameter("baseline_fraction",
+                           fmt::format("baseline_fraction = 1: the whole approach holds {} samples, fewer than the {} a "
+                                       "baseline fit needs (record a longer approach)",
+                                       fit.points, std::max<std::size_t>(min_points, 3)));
   if (fit.points < std::max<std::size_t>(min_points, 3))
     throw InvalidParameter("baseline_fraction",
                            fmt::format("baseline_fraction = {}: the far {:.3g} % of the approach's height range ({:.4g} "

@@ -21,7 +21,7 @@ BinnedBranch bin_branch(const std::vector<double>& distance, const std::vector<d
                                                     "distances (at most 10^7): give a larger bin_width",
                                                     width * 1e9, last - first + 1, (*hi - *lo) * 1e6));
   const std::size_t bins = static_cast<std::size_t>(last - first) + 1;
-  std::vector<double> sum(bins, 0.0), sum2(bins, 0.0);
+  std::vector<double> sum(bins, 0.0), sum2(bins, 0.0), sumd(bins, 0.0);
   std::vector<std::size_t> count(bins, 0);
   // a per-bin shift (the first sample's force) keeps the variance accurate for forces far from 0
   std::vector<double> shift(bins, 0.0);
@@ -30,6 +30,7 @@ BinnedBranch bin_branch(const std::vector<double>& distance, const std::vector<d
     if (count[b] == 0) shift[b] = force[i];
     const double v = force[i] - shift[b];
     sum[b] += v;
+    sumd[b] += distance[i];
     sum2[b] += v * v;
     ++count[b];
   }
@@ -37,7 +38,11 @@ BinnedBranch bin_branch(const std::vector<double>& distance, const std::vector<d
     if (count[b] == 0) continue;
     const double c = static_cast<double>(count[b]), mean = sum[b] / c;
     const double var = count[b] > 1 ? std::max(0.0, (sum2[b] - c * mean * mean) / (c - 1)) : 0.0;
-    out.distance.push_back((first + static_cast<double>(b)) * width);
+    // the samples' mean distance, not the bin centre: a bin the samples cover only in part (at a branch's ends, at
+    // a snap-in gap) keeps its mean force at the distance it belongs to (no bias of the end slopes)
+    out.distance.push_back(std::clamp(sumd[b] / c, (first + static_cast<double>(b) - 0.5) * width,
+                                      (first + static_cast<double>(b) + 0.5) * width));
+    out.centre.push_back((first + static_cast<double>(b)) * width);
     out.force.push_back(shift[b] + mean);
     out.force_error.push_back(std::sqrt(var / c));
     out.count.push_back(count[b]);

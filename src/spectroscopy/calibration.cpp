@@ -108,7 +108,7 @@ CalibratedCurve calibrate(const io::curves::RawCurve& raw, const Calibration& us
       double invols = user_s ? user.invols : raw.metadata.invols;
       if (std::isnan(invols))
         throw InvalidParameter("invols", fmt::format("{}: the file gives the deflection in volts but no InvOLS: give "
-                                                     "it with --invols (m/V)", out.origin));
+                                                     "it with --invols", out.origin));
       if (!(invols > 0) || !std::isfinite(invols))
         throw InvalidParameter("invols", fmt::format("{}: the file's InvOLS {} m/V is out of range (must be > 0): "
                                                      "give the right one with --invols", out.origin, invols));

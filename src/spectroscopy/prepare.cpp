@@ -31,15 +31,17 @@ double interaction_range(const BinnedBranch& b, double band) {
     return b.force[i] > limit ? 1 : b.force[i] < -limit ? -1 : 0;
   };
   for (std::size_t i = b.size(); i-- > 1;)
-    if (side(i) != 0 && side(i) == side(i - 1)) return b.distance[i];
+    if (side(i) != 0 && side(i) == side(i - 1)) return b.centre[i];
   return -std::numeric_limits<double>::infinity();
 }
 
+/// Keeps the bins whose centre is ≤ limit (at least 4 when there are).
 void keep_up_to(BinnedBranch& b, double limit) {
   std::size_t keep = 0;
-  while (keep < b.size() && b.distance[keep] <= limit) ++keep;
+  while (keep < b.size() && b.centre[keep] <= limit) ++keep;
   keep = std::max<std::size_t>(keep, std::min<std::size_t>(4, b.size()));
   b.distance.resize(keep);
+  b.centre.resize(keep);
   b.force.resize(keep);
   b.force_error.resize(keep);
   b.count.resize(keep);
@@ -109,13 +111,15 @@ PreparedCurve prepare(const std::vector<io::curves::RawCurve>& curves, const Pre
       keep_up_to(out.retract, out.trimmed_at);
     }
   }
-  // both branches end at the same distance: above its table a branch is 0, so a branch ending earlier would be
-  // compared with the other's (noisy, or attractive) values there
+  // both branches end in the same bin, at its centre: above its table a branch is 0, so a branch ending earlier
+  // would be compared with the other's (noisy, or attractive) values there
   if (out.approach.size() > 0 && out.retract.size() > 0) {
-    const double end = std::min(out.approach.distance.back(), out.retract.distance.back());
+    const double end = std::min(out.approach.centre.back(), out.retract.centre.back());
     keep_up_to(out.approach, end);
     keep_up_to(out.retract, end);
-    if (end < out.trimmed_at) out.trimmed_at = end;
+    for (BinnedBranch* b : {&out.approach, &out.retract})
+      if (b->centre.back() == end && (b->size() < 2 || (*b).distance[b->size() - 2] < end)) b->distance.back() = end;
+    out.trimmed_at = std::min(out.trimmed_at, end);
   }
   for (auto [branch, what] : {std::pair{&out.approach, "approach"}, std::pair{&out.retract, "retract"}})
     if (branch->size() < 4)

@@ -23,7 +23,7 @@ NOISE_V = 2e-3                         # signal noise [V]
 SIGMA = K * INVOLS * NOISE_V           # force noise of one sample [N]
 
 
-def hertz_curve(seed=5, n=1500, loss=0.8, contact=XC):
+def hertz_curve(seed=5, n=1500, loss=0.8, contact=XC, noise=NOISE_V):
     """Height [m] and signal [V] of an approach (Hertz) and a retract (Hertz x loss) over z in [1, 5] µm.
     Made from the tip position x: F(x) = C (x_c − x)^{3/2}, z = x − F/k (monotone: F decreases with x)."""
     def branch(x, factor):
@@ -34,7 +34,7 @@ def hertz_curve(seed=5, n=1500, loss=0.8, contact=XC):
     zr, dr = branch(x[::-1], loss)
     z, d = np.concatenate([za, zr]), np.concatenate([da, dr])
     rng = np.random.default_rng(seed)
-    volts = (d + OFFSET + TILT * z) / INVOLS + rng.normal(0.0, NOISE_V, z.size)
+    volts = (d + OFFSET + TILT * z) / INVOLS + rng.normal(0.0, noise, z.size)
     segment = np.array(["approach"] * n + ["retract"] * n)
     return z, volts, segment
 
@@ -84,13 +84,16 @@ def test_the_law_file_is_what_the_table_law_reads(tmp_path):
     r = afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=K, invols=INVOLS,
                                     allow_energy_gain=True, output=str(law))
     assert r.status == "ok"
-    # the file: the 4-column layout, the binned branches in nm and nN, exactly
+    # the file: the 4-column layout, the binned branches in nm and nN
     lines = law.read_text().splitlines()
     assert lines[0] == "approach distance (nm),approach force (nN),retract distance (nm),retract force (nN)"
     cells = [ln.split(",") for ln in lines[1:]]
     for i, key in enumerate(["approach_distance", "approach_force", "retract_distance", "retract_force"]):
         col = np.array([float(c[i]) for c in cells if c[i] != ""])
         np.testing.assert_allclose(col, r.law[key] * 1e9, rtol=1e-15, atol=0)  # r.law: the file's numbers x 1e-9
+    # both branches end together, within 2 bins beyond the contact's interaction range (the far baseline trimmed)
+    assert r.law["approach_distance"][-1] == r.law["retract_distance"][-1]
+    assert r.law["approach_distance"][-1] <= 3 * r.bin_width
     side = json.loads((tmp_path / "law.csv.json").read_text())
     assert side["results"]["status"] == "ok" and side["parameters"]["bin_width"] == pytest.approx(r.bin_width * 1e9)
     # and the table law takes it (the impact command reads it with --law table)
@@ -99,12 +102,29 @@ def test_the_law_file_is_what_the_table_law_reads(tmp_path):
     assert hit.results["outcome"] in ("separated", "captured")
 
 
+def test_a_dissipative_curve_gives_a_law_the_table_law_accepts_as_it_is(tmp_path):
+    # without noise the retract lies 20 % below the approach over the whole contact: no energy gain anywhere
+    z, v, seg = hertz_curve(noise=0.0)
+    law = tmp_path / "law.csv"
+    r = afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=K, invols=INVOLS,
+                                    output=str(law))
+    assert r.status == "ok" and r.noise < 1e-15
+    assert abs(r.contact_point - XC) < 1e-12
+    hit = afmkit.impact(law="table", force_curve=str(law), velocity=1e6, gap=50.0, points=10)
+    assert hit.results["kinetic_energy_loss"] >= 0
+
+
 def test_a_law_the_table_law_refuses_is_reported_with_the_option_that_helps():
     z, v, seg = hertz_curve()
-    r = afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=K, invols=INVOLS)
-    # the retract ends stiffer than the approach at the deepest point: refused without allow_energy_gain
+    # the far baseline kept: its noise makes the retract exceed the approach somewhere
+    r = afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=K, invols=INVOLS,
+                                    keep_baseline=True)
     assert r.status == "law_refused"
-    assert "allow-energy-gain" in r.results["note"]
+    assert "a larger --bin-width averages the noise down, leaving out --keep-baseline" in r.results["note"]
+    assert "--allow-energy-gain accepts it" in r.results["note"]
+    ok = afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=K, invols=INVOLS,
+                                     keep_baseline=True, allow_energy_gain=True)
+    assert ok.status == "ok"
 
 
 def text_file(path, z, v, k_header=True):
@@ -168,4 +188,8 @@ def test_the_vendor_hertz_fit_of_the_jpk_file():
     # same choices) against 233.1 kPa: tolerance 2 %.
     assert r.contact_point == pytest.approx(18.03e-6, abs=15e-9)
     assert r.youngs_modulus == pytest.approx(233.1e3, rel=0.02)
-    assert r.status == "ok"
+    assert r.pull_off is not None and r.pull_off[1] < -0.2e-9  # adhesion on the retract
+    # the cell unloads stiffer than it loads: the table law's straight continuation below the measured depth
+    # would create energy there, which the status says, with the option that accepts it
+    assert r.status == "law_refused"
+    assert "stiffer than the approach at the deepest point" in r.results["note"]

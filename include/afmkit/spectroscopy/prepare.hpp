@@ -26,7 +26,7 @@ struct PrepareOptions {
   /// Trim both branches beyond the interaction range: the largest distance where a branch's binned force leaves
   /// the band ±n·σ/√count, plus 2 bins (beyond it the table law is 0 anyway; noise there is no force).
   bool trim_baseline = true;
-  // Whether trimmed or not, both branches are then cut to the smaller of their largest distances (they end together).
+  // Whether trimmed or not, both branches then end in the same bin (the smaller of their last bins), at its centre.
 };
 
 /// What was found for one curve of the input.
