@@ -54,9 +54,13 @@ void add_prepare_params(io::ParamSet& p) {
            fmt::format("text exports: the {} column, by header name or 1-based position (empty: the preset's or the "
                        "header's)",
                        c == "segment" ? "segment label" : std::string(c == "force" ? "force" : c)));
-  p.text("height_unit", "", "unit of the height column when its header gives none (nm, um, m)")
-      .text("deflection_unit", "", "unit of the deflection column when its header gives none (nm, m, V)")
-      .text("force_unit", "", "unit of the force column when its header gives none (pN, nN, N)")
+  p.text("height_unit", "header", "text exports: unit of the height columns (header: the header's)",
+         {"header", "m", "mm", "um", "nm", "pm"})
+      .text("deflection_unit", "header",
+            "text exports: unit of the deflection columns: a length, or the detector's signal (V) or current (A)",
+            {"header", "m", "mm", "um", "nm", "pm", "V", "mV", "uV", "A", "mA", "uA", "nA", "pA"})
+      .text("force_unit", "header", "text exports: unit of the force columns (header: the header's)",
+            {"header", "N", "mN", "uN", "nN", "pN"})
       .text("separator", "auto", "text exports: column separator", {"auto", "tab", "semicolon", "comma", "blank"})
       .text("decimal", "auto", "text exports: decimal mark", {"auto", "point", "comma"})
       .text("height_direction", "auto",
@@ -98,7 +102,7 @@ void add_prepare_params(io::ParamSet& p) {
       .unit("nm")
       .default_text("automatic")
       .flag("keep_baseline", false,
-            "keep the far baseline in the table (default: trimmed 2 bins beyond the last force outside the noise "
+            "keep the far baseline in the table (otherwise it is trimmed 2 bins beyond the last force outside the noise "
             "band, where the table law is 0 anyway)")
       .flag("allow_energy_gain", false,
             "accept a prepared law whose retract force exceeds the approach force somewhere (noise); the orbit "
@@ -126,7 +130,7 @@ io::curves::ColumnChoice column_choice(const io::ParamSet& p, const std::string&
   } else {
     c.name = v;
   }
-  if (!unit_key.empty()) c.unit = p.text(unit_key);
+  if (!unit_key.empty() && p.text(unit_key) != "header") c.unit = p.text(unit_key);
   return c;
 }
 
