@@ -67,6 +67,27 @@ def test_prepare_recovers_the_known_model_within_the_noise():
     np.testing.assert_allclose(a_f[deep], model, rtol=0.03)
 
 
+def test_deflection_in_metres_volts_or_force_give_the_same_preparation():
+    z, v, seg = hertz_curve()
+    volts = afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=K, invols=INVOLS)
+    metres = afmkit.spectroscopy.prepare(z, v * INVOLS, segment=seg, spring_constant=K)
+    newtons = afmkit.spectroscopy.prepare(z, force=v * INVOLS * K, segment=seg, spring_constant=K)
+    for other in (metres, newtons):
+        assert other.contact_point == pytest.approx(volts.contact_point, rel=1e-12)
+        assert other.noise == pytest.approx(volts.noise, rel=1e-9)
+        np.testing.assert_allclose(other.law["approach_force"], volts.law["approach_force"], rtol=1e-9, atol=1e-20)
+    assert metres.curves[0]["invols_source"] == ""  # not needed for a deflection in metres
+
+
+def test_without_segment_labels_the_approach_runs_down_to_the_lowest_height():
+    z, v, seg = hertz_curve()
+    labelled = afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=K, invols=INVOLS)
+    split = afmkit.spectroscopy.prepare(z, deflection_volts=v, spring_constant=K, invols=INVOLS)
+    # the turning point's sample belongs to both segments there: the same contact within its uncertainty
+    assert abs(split.contact_point - labelled.contact_point) < 2 * labelled.contact_point_error
+    assert split.curves[0]["retract_samples"] == labelled.curves[0]["retract_samples"] + 1
+
+
 def test_prepare_of_repeated_curves_pools_them():
     one = hertz_curve(seed=1)
     two = hertz_curve(seed=2, contact=XC + 40e-9)
