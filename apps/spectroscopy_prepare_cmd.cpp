@@ -354,9 +354,15 @@ void run_prepare_curves(const io::ParamSet& p, const std::vector<io::curves::Raw
   const sp::PreparedCurve r = sp::prepare(curves, prepare_options(p));
   io::ParamSet as_run = p;  // the sidecar records the values used (computed defaults filled in)
   as_run.record_used("bin_width", r.bin_width * 1e9);
+  // k and InvOLS taken from the file: recorded when every curve used the same (else each curve's are in the results)
+  const auto same = [&](auto value) {
+    return std::all_of(r.curves.begin(), r.curves.end(), [&](const auto& c) { return value(c) == value(r.curves[0]); });
+  };
   if (!r.curves.empty()) {
-    if (!p.was_set("spring_constant")) as_run.record_used("spring_constant", r.curves[0].spring_constant);
-    if (!p.was_set("invols") && std::isfinite(r.curves[0].invols)) as_run.record_used("invols", r.curves[0].invols * 1e9);
+    if (!p.was_set("spring_constant") && same([](const auto& c) { return c.spring_constant; }))
+      as_run.record_used("spring_constant", r.curves[0].spring_constant);
+    if (!p.was_set("invols") && std::isfinite(r.curves[0].invols) && same([](const auto& c) { return c.invols; }))
+      as_run.record_used("invols", r.curves[0].invols * 1e9);
   }
 
   // the check: the table as written, read back by the table law's reader and law

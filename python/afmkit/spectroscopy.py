@@ -30,15 +30,17 @@ _LAW_KEYS = ("approach_distance", "approach_force", "retract_distance", "retract
 
 class PreparedCurve:
     """What ``prepare`` found. Attributes in SI units (``units`` names them); ``results`` is the command's document
-    (nm, nN, Pa: ``results["units"]``), ``params`` the parameters as run (command units)."""
+    (nm, nN, Pa: ``results["units"]``), ``params`` the parameters as run (SI lengths, as the keywords here)."""
 
+    # params: the parameters as run, in this module's units (SI lengths): prepare_file(**r.params) repeats the run
     units = {"approach_distance": "m", "approach_force": "N", "retract_distance": "m", "retract_force": "N",
              "contact_point": "m", "contact_point_error": "m", "youngs_modulus": "Pa", "youngs_modulus_error": "Pa",
              "noise": "N", "bin_width": "m", "snap_in": "(m, N)", "pull_off": "(m, N)"}
 
     def __init__(self, results: dict, params: dict, law: dict):
         self.results = results
-        self.params = params
+        self.params = {k: (v / _SI_TO_COMMAND[k] if k in _SI_TO_COMMAND and isinstance(v, (int, float)) else v)
+                       for k, v in params.items()}
         self.law = law  # SI arrays: approach_distance [m], approach_force [N], retract_distance [m], retract_force [N]
         self.status: str = results["status"]
         first = results["curves"][0]

@@ -69,6 +69,7 @@ py::dict prepare_arrays(const py::list& curves, const py::dict& kwargs) {
   out["results"] = io::json_text(captured.results);
   nlohmann::json params = captured.parameters;
   params.erase("json");
+  for (const std::string& key : cli::prepare_file_keys()) params.erase(key);  // not keywords of prepare(arrays)
   out["params"] = io::json_text(params);
   out["rows"] = captured.rows.dump();
   return out;

@@ -173,6 +173,10 @@ def test_command_line_and_python_agree_and_the_plot_is_drawn(tmp_path):
                                          tip_radius=R, allow_energy_gain=True)
     assert side["results"]["curves"][0]["contact"]["position"] == pytest.approx(r.contact_point * 1e9, rel=1e-12)
     assert side["parameters"]["invols"] == pytest.approx(50.0)
+    # the parameters as run repeat the run (SI lengths in Python)
+    assert r.params["invols"] == pytest.approx(INVOLS) and r.params["tip_radius"] == pytest.approx(R)
+    again = afmkit.spectroscopy.prepare_file(**r.params)
+    assert again.contact_point == r.contact_point and again.bin_width == r.bin_width
 
 
 def test_bad_input_names_the_parameter_or_the_file(tmp_path):
