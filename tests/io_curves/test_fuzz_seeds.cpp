@@ -66,3 +66,28 @@ TEST(CurvesFuzzSeeds, EveryTextAndIbwSeedParses) {
     EXPECT_GE(count, 3) << target;
   }
 }
+
+TEST(CurvesFuzzSeeds, JpkForceMapGivesOneCurvePerIndex) {
+  const std::string bytes = seed("fuzz_io_curves_jpk", "force_map_two_indices");
+  ASSERT_FALSE(bytes.empty());
+  const auto curves = ac::parse_curves(bytes, "map.jpk-force-map", ".jpk-force-map");
+  ASSERT_EQ(curves.size(), 2u);
+  EXPECT_EQ(curves[0].origin, "map.jpk-force-map (index/0)");
+  EXPECT_EQ(curves[1].origin, "map.jpk-force-map (index/1)");
+  // Index i's last extend deflection is raw 200 (i + 1) -> 0.2 (i + 1) V -> x 5e-8 m/V -> x 0.05 N/m.
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_EQ(curves[static_cast<std::size_t>(i)].segments.size(), 2u);
+    EXPECT_DOUBLE_EQ(curves[static_cast<std::size_t>(i)].segments[0].force[3], 0.2 * (i + 1) * 5e-8 * 0.05);
+  }
+}
+
+TEST(CurvesFuzzSeeds, BigEndianIbwSeedValues) {
+  const std::string bytes = seed("fuzz_io_curves_ibw", "v5_be_noindexes");
+  ASSERT_FALSE(bytes.empty());
+  const auto c = ac::parse_curves(bytes.substr(1), "be.ibw", ".ibw")[0];
+  // ZSnsr = 0, 1, ..., 4, 3, ..., 0 (x 1e-7 m), Defl = index x 1e-9 m, big-endian float32: split after point 4.
+  ASSERT_EQ(c.segments.size(), 2u);
+  EXPECT_FLOAT_EQ(static_cast<float>(c.segments[0].height[4]), -4e-7f);
+  EXPECT_FLOAT_EQ(static_cast<float>(c.segments[0].deflection[4]), 4e-9f);
+  EXPECT_EQ(c.segments[1].size(), 4u);
+}

@@ -2,6 +2,8 @@
 // archives (truncated, wrong magic, lying sizes).
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -89,4 +91,24 @@ TEST(CurvesJpk, WrongMagicAsJpkIsRefused) {
   o.format = "jpk-force";
   const std::string msg = error_of("Height (nm)\tDefl (nm)\n1\t2\n", o);
   EXPECT_NE(msg.find("not a readable JPK"), std::string::npos) << msg;
+}
+
+TEST(CurvesJpk, AnEntryDeclaringMoreThanItCanHoldIsRefusedBeforeAllocation) {
+  std::ifstream in(std::string(AFMKIT_SOURCE_DIR) + "/fuzz/corpus/fuzz_io_curves_jpk/shared_layout_deflated",
+                   std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  std::string bytes = s.str();
+  ASSERT_FALSE(bytes.empty());
+  // Every entry's uncompressed size (local header offset 22, central directory offset 24) := 2^31 - 1 bytes.
+  const std::uint32_t huge = 0x7fffffff;
+  int patched = 0;
+  for (std::size_t at = 0; at + 30 < bytes.size(); ++at) {
+    if (bytes.compare(at, 4, std::string("PK\x03\x04", 4)) == 0) std::memcpy(&bytes[at + 22], &huge, 4), ++patched;
+    if (bytes.compare(at, 4, std::string("PK\x01\x02", 4)) == 0) std::memcpy(&bytes[at + 24], &huge, 4), ++patched;
+  }
+  ASSERT_GE(patched, 4);
+  const std::string msg = error_of(bytes);
+  EXPECT_NE(msg.find("x.jpk-force"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("declares 2147483647 bytes"), std::string::npos) << msg;
 }

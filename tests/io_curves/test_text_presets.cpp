@@ -2,6 +2,7 @@
 // files of another instrument given the wrong preset.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "afmkit/core/error.hpp"
@@ -193,4 +194,23 @@ TEST(CurvesPresets, AutoFormatReadsEachRealFile) {
   CURVES_REAL_FILE(ibw, "asylum_SiN_FD_plot.ibw");
   EXPECT_EQ(ac::read_curves(jpk)[0].metadata.format, "jpk-force");
   EXPECT_EQ(ac::read_curves(ibw)[0].metadata.format, "ibw");
+}
+
+TEST(CurvesPresets, AfmWorkshopWithoutRetractColumnsIsRefused) {
+  const std::string text =
+      "Force-Distance Curve\nFile Format:\t3\n\nExtend Z-Sense(nm),Extend Force(nN)\n100,1\n200,2\n300,3\n";
+  const std::string msg = error_of(text, "afmworkshop-csv");
+  EXPECT_NE(msg.find("export.txt: no retract height column in the header (line 4: 1 'Extend Z-Sense(nm)', 2 "
+                     "'Extend Force(nN)'): the afmworkshop-csv preset expects 'Retract Z-Sense(nm)'"),
+            std::string::npos)
+      << msg;
+  // The placeholders of an uncalibrated instrument (1 nN/nm, 1 mV/nm) are not taken for a calibration.
+  const auto c = parse("Force-Distance Curve\nForce Constant, nN/nm:\t1\nLight Lever Gain, mV/nm:\t20\n\n"
+                       "Extend Z-Sense(nm),Extend T-B(V),Retract Z-Sense(nm),Retract T-B(V)\n100,0.1,300,1.2\n"
+                       "200,0.1,200,0.2\n300,1.3,100,0.1\n",
+                       "afmworkshop-csv");
+  EXPECT_TRUE(std::isnan(c.metadata.spring_constant));
+  EXPECT_DOUBLE_EQ(c.metadata.invols, 1.0 / 20e6);  // 20 mV/nm = 2e7 V/m
+  EXPECT_DOUBLE_EQ(c.segments[0].deflection_volts[2], 1.3);
+  EXPECT_DOUBLE_EQ(c.segments[1].height[0], -300e-9);
 }

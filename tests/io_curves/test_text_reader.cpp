@@ -231,3 +231,27 @@ TEST(CurvesText, NonPositiveCalibrationInTheFileIsRefusedWithItsLine) {
   const std::string zero = error_of("# InvOLS: 0\nHeight (nm)\tDefl (V)\n30\t0\n10\t1\n20\t0\n");
   EXPECT_NE(zero.find("line 1: 'InvOLS: 0': the InvOLS must be positive"), std::string::npos) << zero;
 }
+
+TEST(CurvesText, TrailingSeparatorsAndAUnitsRowUnderTheNames) {
+  // Rows ending with a tab (an empty last column) under a header without it, and the reverse.
+  const auto a = parse("Height (nm)\tDefl (nm)\n30\t0\t\n10\t2\t\n20\t0\t\n")[0];
+  EXPECT_DOUBLE_EQ(a.segments[0].deflection[1], 2e-9);
+  const auto b = parse("Height (nm)\tDefl (nm)\t\n30\t0\n10\t2\n20\t0\n")[0];
+  EXPECT_DOUBLE_EQ(b.segments[0].deflection[1], 2e-9);
+  // Names, then units on their own row.
+  const auto c = parse("Height;Deflection\nnm;(pm)\n30;5\n10;7\n20;1\n")[0];
+  EXPECT_DOUBLE_EQ(c.segments[0].height[0], 30e-9);
+  EXPECT_DOUBLE_EQ(c.segments[0].deflection[0], 5e-12);
+  // A last column with values is data, not a separator: the two-cell line is then no header.
+  const std::string msg = error_of("Height (nm)\tDefl (nm)\n30\t0\t1\n10\t2\t1\n20\t0\t1\n");
+  EXPECT_NE(msg.find("has no unit (no header row)"), std::string::npos) << msg;
+}
+
+TEST(CurvesText, SegmentColumnWithPaddingRows) {
+  const auto c = parse("Height (nm),Defl (nm),Segment\n30,0,0\n10,2,0\n10,2,1\n30,0,1\n,,\n")[0];
+  ASSERT_EQ(c.segments.size(), 2u);
+  EXPECT_EQ(c.segments[1].size(), 2u);
+  EXPECT_NE(error_of("Height (nm),Defl (nm),Segment\n30,0,0\n10,2,\n10,2,1\n").find("line 3, column 3: the segment "
+                                                                                     "column has no value"),
+            std::string::npos);
+}

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -363,6 +364,8 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
   std::vector<HeaderCell> header;
   int header_line = table.header_line;
   for (const auto& cell : table.header) header.push_back(parse_header_cell(cell));
+  for (std::size_t i = 0; i < table.header_units.size() && i < header.size(); ++i)
+    if (header[i].unit.empty()) header[i].unit = table.header_units[i];
   if (preset.comment_header) {
     if (const auto ch = comment_header(table, origin)) {
       header.clear();
@@ -440,11 +443,16 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
     const Column seg = pick(preset.segment, options.segment);
     if (seg.index >= 0) {
       const auto& s = table.columns[static_cast<std::size_t>(seg.index)];
+      const auto& h = table.columns[static_cast<std::size_t>(approach.height.index)];
+      double previous = std::numeric_limits<double>::quiet_NaN();
       for (std::size_t r = 0; r < s.size(); ++r) {
-        if (std::isnan(s[r]))
+        if (std::isnan(s[r])) {
+          if (std::isnan(h[r])) continue;  // padding: make_segment drops it (or refuses a hole)
           throw InputError(fmt::format("{}: line {}, column {}: the segment column has no value", origin,
                                        table.row_line[r], seg.index + 1));
-        if (r == 0 || s[r] != s[r - 1]) starts.emplace_back(r, SegmentKind::unknown);
+        }
+        if (starts.empty() || s[r] != previous) starts.emplace_back(starts.empty() ? 0 : r, SegmentKind::unknown);
+        previous = s[r];
       }
     } else if (preset.comment_segments) {
       for (const TextLine& l : table.preamble)

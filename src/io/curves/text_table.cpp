@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "units.hpp"
 
 namespace afmkit::io::curves::detail {
 
@@ -107,10 +108,11 @@ bool parse_cell(std::string_view cell, bool decimal_comma, double& value) {
     return true;
   }
   if (cell.front() == '+') cell.remove_prefix(1);
-  if (cell.empty() || cell.front() == '+' || cell.size() > 64) return false;
-  char buffer[65];
+  if (cell.empty() || cell.front() == '+') return false;
+  char buffer[256];
   const char* begin = cell.data();
   if (decimal_comma) {
+    if (cell.size() >= sizeof buffer) return false;
     std::size_t n = 0;
     for (char c : cell) {
       if (c == '.') return false;  // a point in a decimal-comma file is not part of a number
@@ -184,16 +186,21 @@ TextTable parse_text_table(std::string_view text, const std::string& origin, Tex
                                  "tabs, ';', ',' or blanks)",
                                  origin));
   const std::size_t ncol = split_cells(lines[first], table.separator).size();
-  // The header row: the last non-comment line before the data, when it has as many cells as the data.
+  // The header row: the last non-comment line before the data, when it has as many cells as the data (trailing
+  // empty cells of the header, or one trailing empty column of the data, do not count: decided after the rows).
+  std::vector<std::string_view> header;
+  int header_line = 0;
   if (!pending.empty() && !pending.back().comment) {
-    const auto cells = split_cells(pending_raw.back(), table.separator);
-    if (cells.size() == ncol) {
-      for (std::string_view c : cells) table.header.emplace_back(c);
-      table.header_line = pending.back().line;
+    header = split_cells(pending_raw.back(), table.separator);
+    while (header.size() > ncol && header.back().empty()) header.pop_back();
+    if (header.size() == ncol || header.size() + 1 == ncol) {
+      header_line = pending.back().line;
       pending.pop_back();
+      pending_raw.pop_back();
+    } else {
+      header.clear();
     }
   }
-  table.preamble = std::move(pending);
   table.columns.assign(ncol, {});
   for (auto& c : table.columns) c.reserve(lines.size() - first);
   table.row_line.reserve(lines.size() - first);
@@ -225,6 +232,45 @@ TextTable parse_text_table(std::string_view text, const std::string& origin, Tex
     }
     table.row_line.push_back(line_no);
   }
+  if (header_line > 0 && header.size() + 1 == ncol) {
+    // "a<TAB>b" over rows "1<TAB>2<TAB>": the data's last column is the rows' trailing separator when it is empty.
+    bool empty = true;
+    for (double v : table.columns.back()) empty = empty && std::isnan(v);
+    if (empty) {
+      table.columns.pop_back();
+    } else {
+      pending.push_back({header_line, std::string(trim(lines[static_cast<std::size_t>(header_line - 1)])), false, 0});
+      header.clear();
+      header_line = 0;
+    }
+  }
+  if (header_line > 0) {
+    // A row of units under the row of names ("Height<TAB>Defl" then "nm<TAB>V"): every cell a unit.
+    bool units = !header.empty();
+    for (std::string_view c : header) {
+      std::string_view u = trim(c);
+      if (u.size() >= 2 && (u.front() == '(' || u.front() == '[')) u = trim(u.substr(1, u.size() - 2));
+      units = units && parse_unit(u).has_value();
+    }
+    if (units && !pending.empty() && !pending.back().comment && pending.back().line == header_line - 1) {
+      auto names = split_cells(pending_raw.back(), table.separator);
+      while (names.size() > header.size() && names.back().empty()) names.pop_back();
+      if (names.size() == header.size()) {
+        for (std::string_view c : header) {
+          std::string_view u = trim(c);
+          if (u.size() >= 2 && (u.front() == '(' || u.front() == '[')) u = trim(u.substr(1, u.size() - 2));
+          table.header_units.emplace_back(u);
+        }
+        header = names;
+        header_line = pending.back().line;
+        pending.pop_back();
+        pending_raw.pop_back();
+      }
+    }
+    for (std::string_view c : header) table.header.emplace_back(c);
+    table.header_line = header_line;
+  }
+  table.preamble = std::move(pending);
   return table;
 }
 

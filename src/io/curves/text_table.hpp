@@ -23,6 +23,7 @@ struct TextTable {
   bool decimal_comma = false;            ///< "1,5" means 1.5
   std::vector<std::string> header;       ///< header cells (empty: no header row)
   int header_line = 0;                   ///< its line (0: none)
+  std::vector<std::string> header_units; ///< a row of units under the header row (empty: none)
   std::vector<TextLine> preamble;        ///< comment and metadata lines before the first numeric row
   std::vector<TextLine> interludes;      ///< comment lines and blank lines (text empty) among the numeric rows
   std::vector<std::vector<double>> columns;  ///< columns[c][r]; NaN where a cell is empty or "NaN"
