@@ -322,6 +322,7 @@ std::string summary_text(const sp::PreparedCurve& r, const nlohmann::json& resul
       if (f.model == sp::ContactModel::dmt) s += fmt::format(", adhesion offset {} +- {}", q(f.offset, "N"), q(f.offset_error, "N"));
       s += "\n";
     }
+    for (const std::string& n : c.notes) s += fmt::format("    note: {}\n", n);
   }
   s += fmt::format("  bins of {}: approach {} points, retract {} points{}\n", q(r.bin_width, "m"), r.approach.size(),
                    r.retract.size(),

@@ -72,6 +72,12 @@ PreparedCurve prepare(const std::vector<io::curves::RawCurve>& curves, const Pre
     for (std::size_t i = 0; i < ax.size(); ++i) ax[i] = cal.approach.height[i] + cal.approach.deflection[i];
     for (std::size_t i = 0; i < rx.size(); ++i) rx[i] = cal.retract.height[i] + cal.retract.deflection[i];
     c.contact = find_contact_point(ax, cal.approach.force, c.baseline.residual_rms, options.contact, c.origin);
+    if (c.contact.fit && c.contact.fit->residual_rms > 10 * c.baseline.residual_rms)
+      c.notes.push_back(fmt::format(
+          "the {} fit leaves residuals of {:.4g} nN RMS, {:.3g} times the noise: the model does not describe this "
+          "contact (its E and contact point are doubtful; contact_method threshold assumes no model)",
+          c.contact.fit->model == ContactModel::dmt ? "DMT" : "Hertz", c.contact.fit->residual_rms * 1e9,
+          c.contact.fit->residual_rms / c.baseline.residual_rms));
     for (double& v : ax) v -= c.contact.position;
     for (double& v : rx) v -= c.contact.position;
     ad.insert(ad.end(), ax.begin(), ax.end());

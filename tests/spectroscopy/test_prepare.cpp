@@ -289,3 +289,14 @@ TEST(PrepareRealFile, JpkVendorHertzFit) {
   EXPECT_TRUE(p.pull_off.detected);
   EXPECT_LT(p.pull_off.force, -0.2e-9);
 }
+
+TEST(Prepare, AFitTheModelDoesNotDescribeIsNoted) {
+  // the Hertz model (no adhesion offset) on the DMT + vdW curve: residuals far above the noise, said in a note
+  sp::PrepareOptions o;
+  o.bin_width = 0.1e-9;
+  const sp::PreparedCurve p = sp::prepare({afmkit_test::synthetic_curve(dmt_model())}, o);
+  ASSERT_EQ(p.curves[0].notes.size(), 1u);
+  EXPECT_NE(p.curves[0].notes[0].find("the model does not describe this contact"), std::string::npos);
+  // the Hertz curve fitted by Hertz: no note
+  EXPECT_TRUE(sp::prepare({afmkit_test::synthetic_curve(hertz_model())}).curves[0].notes.empty());
+}

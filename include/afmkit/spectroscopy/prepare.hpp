@@ -37,7 +37,7 @@ struct CurvePreparation {
   BaselineFit baseline;
   ContactPoint contact;
   std::size_t approach_samples = 0, retract_samples = 0;
-  std::vector<std::string> notes;
+  std::vector<std::string> notes;  ///< the reader's and calibration's notes; a fit whose residual exceeds 10 σ
   /// The samples, for plots: height z [m], force before the baseline was subtracted [N], tip–sample distance [m],
   /// force after [N].
   ForceSegment approach, retract;
