@@ -1,6 +1,7 @@
 // Handing a command over to the Python package afmkit (python_launch.hpp).
 #include "python_launch.hpp"
 
+#include <dlfcn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <system_error>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -30,13 +32,28 @@ namespace fs = std::filesystem;
 
 /// The folder holding the Python package `afmkit` with its subpackage `module`: build/python next to build/bin in
 /// a build tree, or <prefix>/AFMKIT_PYTHON_INSTALL_DIR next to <prefix>/bin when installed.
+/// The folder holding the package afmkit when this code runs inside its compiled module (Python: the commands of
+/// afmkit._afmkit): the module file's folder's parent; empty otherwise.
+fs::path loaded_package_dir() {
+  Dl_info info{};
+  if (::dladdr(reinterpret_cast<void*>(&loaded_package_dir), &info) == 0 || info.dli_fname == nullptr) return {};
+  std::error_code ec;
+  const fs::path so = fs::canonical(info.dli_fname, ec);
+  return ec ? fs::path() : so.parent_path().parent_path();
+}
+
 std::string python_package_dir(const std::string& module, bool file = false) {
   std::error_code ec;
+  std::vector<fs::path> dirs;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  const fs::path prefix = exe.parent_path().parent_path();
-  for (const fs::path& dir : {prefix / "python", prefix / AFMKIT_PYTHON_INSTALL_DIR})
-    if (fs::exists(file ? dir / "afmkit" / (module + ".py") : dir / "afmkit" / module / "__main__.py", ec))
+  if (!ec) {
+    const fs::path prefix = exe.parent_path().parent_path();
+    dirs = {prefix / "python", prefix / AFMKIT_PYTHON_INSTALL_DIR};
+  }
+  if (file) dirs.push_back(loaded_package_dir());  // inside Python, the interpreter is /proc/self/exe
+  for (const fs::path& dir : dirs)
+    if (!dir.empty() &&
+        fs::exists(file ? dir / "afmkit" / (module + ".py") : dir / "afmkit" / module / "__main__.py", ec))
       return dir.string();
   return {};
 }

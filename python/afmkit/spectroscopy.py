@@ -168,15 +168,16 @@ def plot(data: dict, path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (raw_ax, prep_ax) = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
+    fig, (raw_ax, prep_ax, zoom_ax) = plt.subplots(1, 3, figsize=(15, 4.2), constrained_layout=True)
     for i, c in enumerate(data["curves"]):
         label = "" if i else " (raw)"
         for branch, colour in (("approach", "tab:blue"), ("retract", "tab:red")):
             b = c[branch]
             raw_ax.plot(np.asarray(b["height"]) * 1e6, np.asarray(b["raw_force"]) * 1e9, lw=0.6, color=colour,
                         alpha=0.7, label=branch + label if i == 0 else None)
-            prep_ax.plot(np.asarray(b["distance"]) * 1e9, np.asarray(b["force"]) * 1e9, ".", ms=1.5, color=colour,
-                         alpha=0.25, label=f"{branch} samples" if i == 0 else None)
+            for ax in (prep_ax, zoom_ax):
+                ax.plot(np.asarray(b["distance"]) * 1e9, np.asarray(b["force"]) * 1e9, ".", ms=1.5, color=colour,
+                        alpha=0.25, label=f"{branch} samples" if i == 0 else None)
         bl = c["baseline"]
         z = np.linspace(bl["height_from"], bl["height_to"], 2)
         raw_ax.plot(z * 1e6, (bl["offset"] + bl["slope"] * z) * 1e9, "k--", lw=1.2,
@@ -186,18 +187,34 @@ def plot(data: dict, path: str) -> None:
             lo = min(np.min(c["approach"]["distance"]), 0.0)
             d = np.linspace(lo, 0.0, 200)  # distance from the prepared contact point
             delta = np.maximum(0.0, fit["contact_point"] - (c["contact"] + d))
-            prep_ax.plot(d * 1e9, (fit["coefficient"] * delta ** 1.5 + fit["offset"]) * 1e9, "k-", lw=1,
-                         label=f"{ {'hertz': 'Hertz', 'dmt': 'DMT'}.get(fit['model'], fit['model'])} fit")
-    for branch, colour in (("approach", "navy"), ("retract", "darkred")):
-        prep_ax.plot(np.asarray(data[branch]["distance"]) * 1e9, np.asarray(data[branch]["force"]) * 1e9, "-",
-                     color=colour, lw=1.6, label=f"{branch} (binned table)")
-    for name, marker in (("snap_in", "v"), ("pull_off", "^")):
-        e = data[name]
-        if e["detected"]:
-            prep_ax.plot([e["distance"] * 1e9], [e["force"] * 1e9], marker, color="k", ms=8,
-                         label=name.replace("_", "-"))
-    prep_ax.axvline(0.0, color="grey", lw=0.8, ls=":")
-    prep_ax.axhline(0.0, color="grey", lw=0.8, ls=":")
+            for ax in (prep_ax, zoom_ax):
+                ax.plot(d * 1e9, (fit["coefficient"] * delta ** 1.5 + fit["offset"]) * 1e9, "k-", lw=1,
+                        label=f"{ {'hertz': 'Hertz', 'dmt': 'DMT'}.get(fit['model'], fit['model'])} fit")
+    for ax in (prep_ax, zoom_ax):
+        for branch, colour in (("approach", "navy"), ("retract", "darkred")):
+            ax.plot(np.asarray(data[branch]["distance"]) * 1e9, np.asarray(data[branch]["force"]) * 1e9, "-",
+                    color=colour, lw=1.6, label=f"{branch} (binned table)")
+        for name, marker in (("snap_in", "v"), ("pull_off", "^")):
+            e = data[name]
+            if e["detected"]:
+                ax.plot([e["distance"] * 1e9], [e["force"] * 1e9], marker, color="k", ms=8,
+                        label=name.replace("_", "-"))
+        ax.axvline(0.0, color="grey", lw=0.8, ls=":")
+        ax.axhline(0.0, color="grey", lw=0.8, ls=":")
+    # the zoom: the contact and the adhesion, from the deepest bin out to 3 times as far beyond the contact (or to
+    # the pull-off and snap-in, when farther)
+    deepest = min(np.min(data["approach"]["distance"]), np.min(data["retract"]["distance"]))
+    reach = 3 * abs(deepest)
+    for name in ("snap_in", "pull_off"):
+        if data[name]["detected"]:
+            reach = max(reach, 1.5 * data[name]["distance"])
+    zoom_ax.set_xlim(deepest * 1e9 * 1.05, reach * 1e9)
+    inside = np.concatenate([np.asarray(data[b]["force"])[np.asarray(data[b]["distance"]) <= reach]
+                             for b in ("approach", "retract")])
+    if inside.size:
+        pad = 0.05 * (inside.max() - inside.min() + 1e-30)
+        zoom_ax.set_ylim((inside.min() - pad) * 1e9, (inside.max() + pad) * 1e9)
+    zoom_ax.set(xlabel="tip–sample distance (nm)", ylabel="force (nN)", title="prepared, near the contact")
     raw_ax.set(xlabel="piezo height z (µm)", ylabel="force k·d (nN)", title="raw (calibrated)")
     prep_ax.set(xlabel="tip–sample distance (nm)", ylabel="force (nN)",
                 title=f"prepared (noise σ = {data['noise'] * 1e12:.3g} pN, status {data['status']})")

@@ -3,6 +3,7 @@ curves made here from a known model (Hertz contact, known k, InvOLS, baseline of
 a fixed seed) are prepared back within bounds derived from the noise; the law file is read back by the table law."""
 import json
 import os
+import shutil
 import subprocess
 
 import numpy as np
@@ -177,6 +178,29 @@ def test_command_line_and_python_agree_and_the_plot_is_drawn(tmp_path):
     assert r.params["invols"] == pytest.approx(INVOLS) and r.params["tip_radius"] == pytest.approx(R)
     again = afmkit.spectroscopy.prepare_file(**r.params)
     assert again.contact_point == r.contact_point and again.bin_width == r.bin_width
+
+
+def test_python_draws_the_plot_too(tmp_path):
+    z, v, seg = hertz_curve()
+    png = tmp_path / "p.png"
+    r = afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=K, invols=INVOLS,
+                                    plot=str(png))
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and r.params["plot"] == str(png)
+
+
+def test_without_the_python_package_the_plot_is_refused_before_anything_is_written(tmp_path):
+    # the program copied away from the build tree: no Python package next to it
+    (tmp_path / "bin").mkdir()
+    alone = tmp_path / "bin" / "afmkit"
+    shutil.copy(CLI, alone)
+    z, v, seg = hertz_curve()
+    text_file(tmp_path / "curve.csv", z, v)
+    p = subprocess.run([str(alone), "spectroscopy", "prepare", "curve.csv", "--segment-column", "segment",
+                        "--spring-constant", "0.1", "--invols", "50", "--output", "law.csv", "--plot", "p.png"],
+                       capture_output=True, text=True, cwd=tmp_path)
+    assert p.returncode == 2
+    assert "plot: drawing needs the Python package afmkit" in p.stderr
+    assert not (tmp_path / "law.csv").exists() and not (tmp_path / "p.png").exists()
 
 
 def test_bad_input_names_the_parameter_or_the_file(tmp_path):

@@ -300,3 +300,19 @@ TEST(Prepare, AFitTheModelDoesNotDescribeIsNoted) {
   // the Hertz curve fitted by Hertz: no note
   EXPECT_TRUE(sp::prepare({afmkit_test::synthetic_curve(hertz_model())}).curves[0].notes.empty());
 }
+
+TEST(Prepare, PausesAndUnlabelledSegmentsAreTakenByTheirDirection) {
+  const auto labelled = afmkit_test::synthetic_curve(hertz_model());
+  auto raw = labelled;
+  // a dwell at the turning point between the two, and the labels dropped: kinds from the height's direction
+  afmkit::io::curves::Segment pause;
+  pause.kind = afmkit::io::curves::SegmentKind::pause;
+  pause.height.assign(50, raw.segments[0].height.back());
+  pause.deflection_volts.assign(50, raw.segments[0].deflection_volts.back());
+  raw.segments.insert(raw.segments.begin() + 1, pause);
+  raw.segments[0].kind = raw.segments[2].kind = afmkit::io::curves::SegmentKind::unknown;
+  const sp::PreparedCurve a = sp::prepare({labelled}), b = sp::prepare({raw});
+  EXPECT_EQ(a.curves[0].contact.position, b.curves[0].contact.position);
+  EXPECT_EQ(a.approach.force, b.approach.force);
+  EXPECT_EQ(a.retract.force, b.retract.force);
+}
