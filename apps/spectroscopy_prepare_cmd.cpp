@@ -48,7 +48,11 @@ void add_prepare_params(io::ParamSet& p) {
             "force-curve file: JPK .jpk-force, Asylum .ibw or a text export (docs/curve-files.md); every curve it "
             "holds is prepared and the repeated curves averaged")
       .positional()
-      .text("format", "auto", "file format or text preset (auto: from the content and extension)", kFormats);
+      .text("format", "auto", "file format or text preset (auto: from the content and extension)", kFormats)
+      .integer("curve", 0,
+               "which curve of a file holding several (a force map, repeated curves), 1-based; 0: every curve, "
+               "averaged (repeated curves of one spot)",
+               0, 100000000);
   for (const std::string& c : kColumnKeys)
     p.text(c + "_column", "",
            fmt::format("text exports: the {} column, by header name or 1-based position (empty: the preset's or the "
@@ -352,7 +356,14 @@ void run_prepare_curves(const io::ParamSet& p, const std::vector<io::curves::Raw
   if (!plot.empty() && !python_module_found("spectroscopy"))
     throw InvalidParameter("plot", "plot: drawing needs the Python package afmkit (with Matplotlib), which is not "
                                    "next to this program (docs/python.md); leave --plot out");
-  const sp::PreparedCurve r = sp::prepare(curves, prepare_options(p));
+  const long pick = p.integer("curve");
+  if (pick > static_cast<long>(curves.size()))
+    throw InvalidParameter("curve", fmt::format("curve = {} is out of range: the input holds {} curve{} (1 to {}, or 0 "
+                                                "for all)",
+                                                pick, curves.size(), curves.size() == 1 ? "" : "s", curves.size()));
+  const sp::PreparedCurve r =
+      pick > 0 ? sp::prepare({curves[static_cast<std::size_t>(pick - 1)]}, prepare_options(p))
+               : sp::prepare(curves, prepare_options(p));
   io::ParamSet as_run = p;  // the sidecar records the values used (computed defaults filled in)
   as_run.record_used("bin_width", r.bin_width * 1e9);
   // k and InvOLS taken from the file: recorded when every curve used the same (else each curve's are in the results)

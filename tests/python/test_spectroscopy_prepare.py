@@ -95,6 +95,9 @@ def test_prepare_of_repeated_curves_pools_them():
     r = afmkit.spectroscopy.prepare([one[0], two[0]], deflection_volts=[one[1], two[1]], segment=[one[2], two[2]],
                                     spring_constant=K, invols=INVOLS)
     assert len(r.curves) == 2
+    second = afmkit.spectroscopy.prepare([one[0], two[0]], deflection_volts=[one[1], two[1]],
+                                         segment=[one[2], two[2]], spring_constant=K, invols=INVOLS, curve=2)
+    assert len(second.curves) == 1 and second.contact_point == r.curves[1]["contact"]["position"] * 1e-9
     d = (r.curves[1]["contact"]["position"] - r.curves[0]["contact"]["position"]) * 1e-9
     err = np.hypot(r.curves[0]["contact"]["error"], r.curves[1]["contact"]["error"]) * 1e-9
     assert abs(d - 40e-9) < 5 * err
