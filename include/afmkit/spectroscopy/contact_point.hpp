@@ -33,7 +33,8 @@ struct ContactPoint {
 
 /// The contact point of an approach (samples in recording order: tip position x = z + d [m], baseline-corrected
 /// force F [N]) with force noise σ [N]. Throws InputError naming `origin` when the approach never rises above the
-/// noise band (no contact); NumericalFailure when the fit fails.
+/// noise band (no contact: fewer than 3 consecutive samples above n·σ up to the deepest one, so that a noise spike
+/// is no contact); InvalidParameter "noise_multiple" when n is not > 0; NumericalFailure when the fit fails.
 ContactPoint find_contact_point(const std::vector<double>& position, const std::vector<double>& force, double sigma,
                                 const ContactPointOptions& options, const std::string& origin);
 
