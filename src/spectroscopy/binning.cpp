@@ -16,9 +16,9 @@ BinnedBranch bin_branch(const std::vector<double>& distance, const std::vector<d
   if (distance.empty()) return out;
   const auto [lo, hi] = std::minmax_element(distance.begin(), distance.end());
   const double first = std::floor(*lo / width + 0.5), last = std::floor(*hi / width + 0.5);
-  if (last - first + 1 > 1e7)
+  if (last - first + 1 > 1e6)  // 40 bytes of sums per bin: at most 40 MB
     throw InvalidParameter("bin_width", fmt::format("bin_width = {:.4g} nm makes {:.3g} bins over the {:.4g} µm of "
-                                                    "distances (at most 10^7): give a larger bin_width",
+                                                    "distances (at most 10^6): give a larger bin_width",
                                                     width * 1e9, last - first + 1, (*hi - *lo) * 1e6));
   const std::size_t bins = static_cast<std::size_t>(last - first) + 1;
   std::vector<double> sum(bins, 0.0), sum2(bins, 0.0), sumd(bins, 0.0);

@@ -35,11 +35,11 @@ double interaction_range(const BinnedBranch& b, double band) {
   return -std::numeric_limits<double>::infinity();
 }
 
-/// Keeps the bins whose centre is ≤ limit (at least 4 when there are).
-void keep_up_to(BinnedBranch& b, double limit) {
+/// Keeps the bins whose centre is ≤ limit (at least `minimum` when there are).
+void keep_up_to(BinnedBranch& b, double limit, std::size_t minimum = 0) {
   std::size_t keep = 0;
   while (keep < b.size() && b.centre[keep] <= limit) ++keep;
-  keep = std::max<std::size_t>(keep, std::min<std::size_t>(4, b.size()));
+  keep = std::max<std::size_t>(keep, std::min<std::size_t>(minimum, b.size()));
   b.distance.resize(keep);
   b.centre.resize(keep);
   b.force.resize(keep);
@@ -113,8 +113,8 @@ PreparedCurve prepare(const std::vector<io::curves::RawCurve>& curves, const Pre
     const double range = std::max(interaction_range(out.approach, band), interaction_range(out.retract, band));
     if (std::isfinite(range)) {
       out.trimmed_at = range + 2 * out.bin_width;
-      keep_up_to(out.approach, out.trimmed_at);
-      keep_up_to(out.retract, out.trimmed_at);
+      keep_up_to(out.approach, out.trimmed_at, 4);  // the trimming leaves a table law's 4 points
+      keep_up_to(out.retract, out.trimmed_at, 4);
     }
   }
   // both branches end in the same bin, at its centre: above its table a branch is 0, so a branch ending earlier
@@ -130,7 +130,7 @@ PreparedCurve prepare(const std::vector<io::curves::RawCurve>& curves, const Pre
   for (auto [branch, what] : {std::pair{&out.approach, "approach"}, std::pair{&out.retract, "retract"}})
     if (branch->size() < 4)
       throw InvalidParameter("bin_width", fmt::format("bin_width = {:.4g} nm leaves the {} branch {} bins, fewer than "
-                                                      "the 4 points a table law needs: give a smaller bin_width",
+                                                      "the 4 points a table law needs: give a smaller bin_width (or a curve with more samples near the contact)",
                                                       out.bin_width * 1e9, what, branch->size()));
   return out;
 }

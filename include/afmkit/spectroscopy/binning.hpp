@@ -20,7 +20,7 @@ struct BinnedBranch {
 };
 
 /// Bins (distance [m], force [N]) with width `width` [m]. InvalidParameter "bin_width" when width is not > 0 or
-/// makes more than 10⁷ bins over the distance range.
+/// makes more than 10⁶ bins over the distance range.
 BinnedBranch bin_branch(const std::vector<double>& distance, const std::vector<double>& force, double width);
 
 }  // namespace afmkit::spectroscopy
