@@ -2,6 +2,7 @@
 // the file's text here (first and last rows) and converted by hand, independently of the reader.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "afmkit/core/error.hpp"
@@ -58,4 +59,9 @@ TEST(CurvesRealText, NtmdtText) {
   EXPECT_DOUBLE_EQ(r.deflection_volts.front(), 1.4711e-9);
   EXPECT_DOUBLE_EQ(r.deflection_volts.back(), -1.0926e-9);
   EXPECT_TRUE(std::isnan(c.metadata.spring_constant));
+  // Lines 1-179 repeat 1,4726 (column 2) and 1,4711 (column 3): kept, and said.
+  ASSERT_GE(c.notes.size(), 2u);
+  EXPECT_NE(c.notes[0].find("lines 1-179: column 2 repeats one value (1.4726) 179 times"), std::string::npos)
+      << c.notes[0];
+  EXPECT_NE(c.notes[1].find("lines 1-179: column 3"), std::string::npos) << c.notes[1];
 }

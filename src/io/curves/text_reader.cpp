@@ -418,6 +418,20 @@ std::vector<RawCurve> read_text_curves(std::string_view bytes, const std::string
                                    preset.side_by_side ? fmt::format(" (the {} preset expects {})", format,
                                                                      preset.retract_deflection.expected)
                                                        : std::string()));
+    if (preset.format == "ntmdt-txt") {
+      // NT-MDT exports may begin with rows of one repeated deflection value (export padding or a saturated
+      // detector at the contact end): kept as read, but said, since it looks like a flat contact region.
+      for (const Column* c : {&approach.deflection, &retract.deflection}) {
+        if (c->index < 0) continue;
+        const auto& v = table.columns[static_cast<std::size_t>(c->index)];
+        std::size_t k = 1;
+        while (k < v.size() && v[k] == v[0]) ++k;
+        if (k >= 10)
+          curve.notes.push_back(fmt::format("lines {}-{}: column {} repeats one value ({:g}) {} times (export "
+                                            "padding or a saturated detector): kept as read",
+                                            table.row_line[0], table.row_line[k - 1], c->index + 1, v[0], k));
+      }
+    }
     Segment a = make_segment(table, approach, 0, table.rows(), origin, curve.notes);
     Segment r = make_segment(table, retract, 0, table.rows(), origin, curve.notes);
     // Side by side, the rows need not be in recording order (NT-MDT sorts both by height): an approach runs

@@ -26,7 +26,10 @@ struct ReadOptions {
   /// "auto", or one of: "jpk-force", "ibw", "text", and the text presets "jpk-txt", "asylum-txt",
   /// "nanoscope-txt", "ntmdt-txt", "afmworkshop-csv".
   std::string format = "auto";
-  ColumnChoice height, deflection, force, time, segment;  ///< text exports: the columns (presets fill them)
+  /// Text exports: the columns (presets fill them). The binary formats use only the names: `height.name` picks a
+  /// JPK channel ("height" for the piezo's; default the measured height) or an Igor wave column label (default
+  /// "ZSnsr"); `deflection.name` and `force.name` pick Igor column labels ("Defl", "Force").
+  ColumnChoice height, deflection, force, time, segment;
   /// Text exports that write the retract beside the approach (one row holds a sample of each): the retract's
   /// columns; when one is given, height/deflection/force above are the approach's. A retract deflection or force
   /// without a retract height shares the approach's height column (NT-MDT). (Addition to the lead's API.)
