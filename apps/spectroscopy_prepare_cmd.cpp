@@ -207,6 +207,9 @@ nlohmann::json curve_json(const sp::CurvePreparation& c) {
        {{"offset", c.baseline.offset * 1e9},
         {"slope", c.baseline.slope},
         {"noise", c.baseline.residual_rms * 1e9},
+        {"level_error", c.baseline.level_error * 1e9},
+        {"slope_error", c.baseline.slope_error},
+        {"mean_height", c.baseline.mean_height * 1e9},
         {"points", c.baseline.points},
         {"height_from", c.baseline.height_from * 1e9},
         {"height_to", c.baseline.height_to * 1e9}}},
@@ -214,6 +217,7 @@ nlohmann::json curve_json(const sp::CurvePreparation& c) {
        {{"method", sp::to_string(c.contact.method)},
         {"position", c.contact.position * 1e9},
         {"error", c.contact.error * 1e9},
+        {"baseline_error", c.contact.baseline_error * 1e9},
         {"threshold_position", c.contact.threshold_position * 1e9}}},
       {"notes", c.notes}};
   if (c.contact.fit) j["contact"]["fit"] = fit_json(*c.contact.fit);

@@ -50,6 +50,10 @@ BaselineFit fit_baseline(const ForceSegment& approach, double fraction, std::siz
     ss += r * r;
   }
   fit.residual_rms = std::sqrt(ss / (n - 2));
+  fit.mean_height = zc + sz / n;
+  fit.level_error = fit.residual_rms / std::sqrt(n);
+  const double sxx = szz - sz * sz / n;  // Σ(z − z̄)²
+  fit.slope_error = sxx > 0 ? fit.residual_rms / std::sqrt(sxx) : 0.0;
   return fit;
 }
 

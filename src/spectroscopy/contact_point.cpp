@@ -44,10 +44,13 @@ ContactPoint find_contact_point(const std::vector<double>& x, const std::vector<
     const double w = (band - force[j]) / (force[j + 1] - force[j]);
     xt = x[j] + w * (x[j + 1] - x[j]);
   }
-  // local slope dF/dx of the rise: least squares over up to 10 samples past the crossing
-  const std::size_t a = std::min(j + 1, top), b = std::min(top, a + 10);
+  // local slope dF/dx of the rise at the crossing: least squares over the samples from the crossing in to where the
+  // force reaches 3 n·σ (at least 3 samples)
+  const std::size_t a = std::min(j + 1, top);
+  std::size_t b = a;
+  while (b < top && (force[b] < 3 * band || b < a + 2)) ++b;
   double sx = 0, sf = 0, sxx = 0, sxf = 0, m = 0;
-  for (std::size_t i = a; i <= b; ++i) {
+  for (std::size_t i = j; i <= b; ++i) {
     sx += x[i]; sf += force[i]; sxx += x[i] * x[i]; sxf += x[i] * force[i]; m += 1;
   }
   const double det = m * sxx - sx * sx;
@@ -55,7 +58,10 @@ ContactPoint find_contact_point(const std::vector<double>& x, const std::vector<
   if (!(std::abs(slope) > 0) && x[top] != xt) slope = (force[top] - band) / (x[top] - xt);
   cp.threshold_position = xt;
   cp.position = xt;
-  cp.error = std::abs(slope) > 0 ? sigma / std::abs(slope) : std::abs(x[top] - xt);
+  // a sample's noise moves it along the slope k (x = z + d, F = k·d): the crossing moves by σ/|F'| + σ/k
+  const double k = options.spring_constant;
+  cp.error = (std::abs(slope) > 0 ? sigma / std::abs(slope) : std::abs(x[top] - xt)) +
+             (std::isfinite(k) && k > 0 ? sigma / k : 0.0);
   if (options.method == ContactMethod::threshold) return cp;
 
   // fit range (docs/spectroscopy.md#contact-point): Hertz: from the deepest sample out to as far beyond the

@@ -47,6 +47,39 @@ void keep_up_to(BinnedBranch& b, double limit, std::size_t minimum = 0) {
   b.count.resize(keep);
 }
 
+/// The baseline's own uncertainty (its level at the mean height and its slope, independent there) moves the contact
+/// point and the modulus: found by preparing the contact point again with the baseline shifted by one standard error
+/// of each (the whole procedure, threshold and fit range included), added in quadrature to their errors.
+void propagate_baseline_error(ContactPoint& cp, const ForceSegment& approach, const std::vector<double>& x,
+                              const BaselineFit& base, double k, const ContactPointOptions& options,
+                              const std::string& origin) {
+  double dx2 = 0, de2 = 0;
+  for (const auto& [level, slope] : {std::pair{base.level_error, 0.0}, std::pair{0.0, base.slope_error}}) {
+    if (level == 0 && slope == 0) continue;
+    std::vector<double> f(approach.force), xs(x);
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const double shift = level + slope * (approach.height[i] - base.mean_height);
+      f[i] -= shift;
+      xs[i] -= shift / k;  // d = F/k follows the levelled force
+    }
+    try {
+      const ContactPoint moved = find_contact_point(xs, f, base.residual_rms, options, origin);
+      dx2 += (moved.position - cp.position) * (moved.position - cp.position);
+      if (cp.fit && moved.fit)
+        de2 += (moved.fit->youngs_modulus - cp.fit->youngs_modulus) * (moved.fit->youngs_modulus - cp.fit->youngs_modulus);
+    } catch (const NumericalFailure&) {
+      // the shifted fit fails where the fit itself succeeded: leave the fit's own errors
+    }
+  }
+  cp.baseline_error = std::sqrt(dx2);
+  cp.error = std::hypot(cp.error, cp.baseline_error);
+  if (cp.fit) {
+    cp.fit->contact_point_error = cp.error;
+    if (std::isfinite(cp.fit->youngs_modulus_error))
+      cp.fit->youngs_modulus_error = std::hypot(cp.fit->youngs_modulus_error, std::sqrt(de2));
+  }
+}
+
 }  // namespace
 
 PreparedCurve prepare(const std::vector<io::curves::RawCurve>& curves, const PrepareOptions& options) {
@@ -71,7 +104,10 @@ PreparedCurve prepare(const std::vector<io::curves::RawCurve>& curves, const Pre
     std::vector<double> ax(cal.approach.size()), rx(cal.retract.size());
     for (std::size_t i = 0; i < ax.size(); ++i) ax[i] = cal.approach.height[i] + cal.approach.deflection[i];
     for (std::size_t i = 0; i < rx.size(); ++i) rx[i] = cal.retract.height[i] + cal.retract.deflection[i];
-    c.contact = find_contact_point(ax, cal.approach.force, c.baseline.residual_rms, options.contact, c.origin);
+    ContactPointOptions contact = options.contact;
+    contact.spring_constant = cal.spring_constant;
+    c.contact = find_contact_point(ax, cal.approach.force, c.baseline.residual_rms, contact, c.origin);
+    propagate_baseline_error(c.contact, cal.approach, ax, c.baseline, cal.spring_constant, contact, c.origin);
     if (c.contact.fit && c.contact.fit->residual_rms > 10 * c.baseline.residual_rms)
       c.notes.push_back(fmt::format(
           "the {} fit leaves residuals of {:.4g} nN RMS, {:.3g} times the noise: the model does not describe this "

@@ -246,8 +246,8 @@ TEST(PrepareBadInput, NamesTheParameterOrTheCurve) {
 // The real JPK file (shared/data/force-curves, beside the clone): the vendor's paraboloid Hertz fit (R = 40 nm,
 // ν = 0.5) gives E = 233.1 kPa and the contact point 18.03 µm (tip position). Its value is given to 10 nm (±5 nm)
 // and its fit range and baseline are not in the file; ours, for baseline fractions 0.1–0.7 and the Hertz or DMT
-// model, lie within 18.0393–18.0403 µm (standard error 0.8 nm), 9–10 nm above: tolerance 15 nm. E: ours
-// 233.3 ± 3.0 kPa (233.2–234.6 kPa over the same choices): tolerance 2 %.
+// model, lie within 18.0393–18.0403 µm (standard error 1.0 nm), 9–10 nm above: tolerance 15 nm. E: ours
+// 233.3 ± 3.1 kPa (233.2–234.6 kPa over the same choices): tolerance 2 %.
 TEST(PrepareRealFile, JpkVendorHertzFit) {
   const std::string path = std::string(AFMKIT_SOURCE_DIR) + "/../shared/data/force-curves/jpk_spot3-0192.jpk-force";
   if (!std::ifstream(path)) GTEST_SKIP() << "the measured force curves are not beside the clone: " << path;

@@ -15,6 +15,9 @@ struct BaselineFit {
   double residual_rms = 0;  ///< σ [N]: RMS of the residuals (n − 2 degrees of freedom)
   std::size_t points = 0;   ///< approach samples in the fit range
   double height_from = 0, height_to = 0;  ///< the fit range of z [m]
+  double mean_height = 0;   ///< z̄ of the fitted samples [m]: the line's level there and its slope are independent
+  double level_error = 0;   ///< standard error of the line at z̄: σ/√n [N]
+  double slope_error = 0;   ///< standard error of the slope: σ/√Σ(z − z̄)² [N/m]
   double at(double height) const { return offset + slope * height; }
 };
 
