@@ -55,6 +55,15 @@ class PreparedCurve:
         self.snap_in = _event(results["snap_in"])
         self.pull_off = _event(results["pull_off"])
 
+    def law_arguments(self) -> dict:
+        """The keywords that make the tapping and impact functions use the prepared law: ``law="table"``, the law file
+        written with ``output=`` and ``allow_energy_gain`` as prepared, e.g.
+        ``afmkit.tapping.orbit(**r.law_arguments(), units="physical", ...)``."""
+        path = self.params.get("output", "")
+        if not path:
+            raise ValueError("the prepared law was not written: give output='law.csv' to prepare() to write it")
+        return {"law": "table", "force_curve": path, "allow_energy_gain": bool(self.params.get("allow_energy_gain"))}
+
     def __repr__(self) -> str:
         return (f"PreparedCurve(status={self.status!r}, contact_point={self.contact_point:.6g} m, "
                 f"youngs_modulus={self.youngs_modulus:.6g} Pa, noise={self.noise:.3g} N, "

@@ -155,7 +155,8 @@ def test_a_dissipative_curve_gives_a_law_the_table_law_accepts_as_it_is(tmp_path
                                     output=str(law))
     assert r.status == "ok" and r.noise < 1e-15
     assert abs(r.contact_point - XC) < 1e-12
-    hit = afmkit.impact(law="table", force_curve=str(law), velocity=1e6, gap=50.0, points=10)
+    hit = afmkit.impact(**r.law_arguments(), velocity=1e6, gap=50.0, points=10)
+    assert r.law_arguments() == {"law": "table", "force_curve": str(law), "allow_energy_gain": False}
     assert hit.results["kinetic_energy_loss"] >= 0
 
 
