@@ -12,4 +12,12 @@ namespace afmkit::cli {
 /// cannot be started.
 [[noreturn]] void exec_python_module(const std::string& module, const std::vector<std::string>& args);
 
+/// Whether the module file afmkit/<module>.py of the package is next to this program (a check before computing).
+bool python_module_found(const std::string& module);
+
+/// Runs `function(argv)` of the module afmkit.<module> (a plain module file) in a child Python interpreter, the
+/// package's folder first on PYTHONPATH, and waits for it: its exit status (its messages go to this process's
+/// standard error). InputError when the package is not found or the interpreter cannot be started.
+int run_python_function(const std::string& module, const std::string& function, const std::vector<std::string>& args);
+
 }  // namespace afmkit::cli

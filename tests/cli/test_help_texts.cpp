@@ -13,7 +13,11 @@ using namespace afmkit_test;
 namespace {
 // options whose value is free text (paths are FILE, choices NAME): report's comma-separated list of figure ids
 const std::set<std::string> kTextOptions = {"figures",     // a list of figure ids
-                                            "scheduler"};  // serial, local or any Dask scheduler address
+                                            "scheduler",   // serial, local or any Dask scheduler address
+                                            // spectroscopy prepare: a column of a text export, by name or position
+                                            "height-column", "deflection-column", "force-column", "segment-column",
+                                            "retract-height-column", "retract-deflection-column",
+                                            "retract-force-column"};
 }  // namespace
 
 class HelpText : public ::testing::TestWithParam<std::string> {};
