@@ -115,7 +115,8 @@ LawRegistry LawRegistry::builtin() {
          }});
   r.add({"table", "measured force curve: approach and retract tables (--force-curve FILE), monotone interpolation",
          {}, true, false, [=](const V&, const LawArguments& a) {
-           return make_law<TableLaw>(read_force_curve(a.force_curve), gain(a));
+           return make_law<TableLaw>(read_force_curve(a.force_curve), gain(a),
+                                     a.hysteresis == "velocity" ? Hysteresis::velocity : Hysteresis::contact);
          }});
   return r;
 }
@@ -184,8 +185,19 @@ ForceLaw LawRegistry::build(const std::string& name, const LawArguments& args) c
   if (!spec.needs_force_curve && !args.force_curve.empty())
     throw InvalidParameter("force_curve", fmt::format("force_curve applies only to law = table (this run: law = {})",
                                                       name));
+  if (!args.hysteresis.empty() && args.hysteresis != "law" && args.hysteresis != "contact" &&
+      args.hysteresis != "velocity")
+    throw InvalidParameter("hysteresis", fmt::format("hysteresis = '{}' is not one of law, contact, velocity",
+                                                     args.hysteresis));
   const auto value = [&](const std::string& k) { return args.real(key(k), keys_); };
   ForceLaw law = spec.build(value, args);
+  if (!args.hysteresis.empty() && args.hysteresis != "law" && args.hysteresis != hysteresis_name(law.hysteresis()))
+    throw InvalidParameter("hysteresis",
+                           fmt::format("hysteresis = {} applies only to law = table; law = {} switches its branches "
+                                       "by the {} rule (docs/force-laws.md#hysteresis)",
+                                       args.hysteresis, name,
+                                       law.hysteresis() == Hysteresis::velocity ? "velocity-sign (seed-1 eq. 4)"
+                                                                                : "contact"));
   // every command alike: a law that creates energy (K_b > K_a, E*_b > E*_a, …) only with allow_energy_gain
   law.require_dissipative();
   return law;

@@ -134,7 +134,7 @@ TEST(LawFidelity, TableSampledFromDmtAt200PointsReproducesItsSweep) {
   const tapping::PhysicalCantilever pc(40.0, 300.0, 400.0, 10.0, 1.0);
   const auto analytic = tapping::TappingModel(pc.cantilever(), pc.drive(), pc.normalised_law(dmt), 9.0);
   const auto table = tapping::TappingModel(pc.cantilever(), pc.drive(),
-                                           pc.normalised_law(impact::make_law<impact::TableLaw>(curve)), 9.0);
+                                           pc.normalised_law(impact::make_law<impact::TableLaw>(curve, false, impact::Hysteresis::velocity)), 9.0);
   const auto a = tapping::sweep_instrument(analytic, 6.0, 9.5, 8, {});
   const auto t = tapping::sweep_instrument(table, 6.0, 9.5, 8, {});
   ASSERT_EQ(a.approach.size(), t.approach.size());

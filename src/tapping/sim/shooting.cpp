@@ -67,14 +67,24 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   };
   Eigen::Vector2d y(guess.position, guess.velocity);
+  // The memory of a contact-aware law is part of the orbit's state (docs/force-laws.md#hysteresis): a periodic
+  // orbit starts with the memory it ends with. An orbit that touches (or rises above the release gap) fixes its
+  // end memory whatever it started with, so the start memory is taken from the end of the period, re-evaluated
+  // once when it changes; Newton converges only on a state whose memory repeats.
+  bool memory = guess.contact;
   auto evaluate = [&](const Eigen::Vector2d& at) {
-    return stroboscopic_map(model, {at.x(), at.y()}, period_multiple, options.simulation);
+    StroboscopicMap m = stroboscopic_map(model, {at.x(), at.y(), memory}, period_multiple, options.simulation);
+    if (m.end.contact != memory) {
+      memory = m.end.contact;
+      m = stroboscopic_map(model, {at.x(), at.y(), memory}, period_multiple, options.simulation);
+    }
+    return m;
   };
   StroboscopicMap map = evaluate(y);
   Eigen::Vector2d r = Eigen::Vector2d(map.end.position, map.end.velocity) - y;
   double norm = scaled_norm(r, y, omega);
   for (int it = 0; it <= options.max_iterations; ++it) {
-    if (norm <= tolerance) {
+    if (norm <= tolerance && map.end.contact == memory) {
       // the last Newton step, from the map already evaluated, takes the state from a residual of size `norm` to
       // one of size O(norm²): without it the fixed point is off by (M − I)⁻¹ r, large when a multiplier is
       // near 1 (high Q)
@@ -86,7 +96,7 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
       PeriodicOrbit orbit;
       orbit.separation = model.separation;
       orbit.period_multiple = period_multiple;
-      orbit.initial = {y.x(), y.y()};
+      orbit.initial = {y.x(), y.y(), memory};
       orbit.monodromy = map.sensitivity.topLeftCorner<2, 2>();
       orbit.separation_sensitivity = map.sensitivity.topRightCorner<2, 1>();
       orbit.residual = norm;
