@@ -25,7 +25,8 @@ namespace {
 
 // the cantilever of the outside report (k = 1.18 N/m, f0 = 23.3 kHz, Q = 139, A0 = 20 nm) and a stiff one
 const tapping::PhysicalCantilever kSoft(1.1841, 23.251, 139.13, 20.0, 1.0);
-const tapping::PhysicalCantilever kStiff(40.0, 300.0, 400.0, 10.0, 1.0);
+const tapping::PhysicalCantilever kStiff(40.0, 300.0, 400.0, 10.0, 1.0);  // held by the neck once it touched
+const tapping::PhysicalCantilever kTap(40.0, 300.0, 400.0, 20.0, 1.0);    // taps: pulls off every cycle
 
 tapping::TappingModel model(const tapping::PhysicalCantilever& pc, const impact::ForceCurve& curve, Hysteresis h,
                             double separation) {
@@ -166,9 +167,14 @@ double max_gap(const tapping::TappingModel& m, const tapping::PeriodicOrbit& o) 
 // to the neck (never rising above the release gap) over [min gap, max gap]. For a period-1 tapping orbit that is
 // also what the velocity-sign law does.
 TEST(ContactHysteresis, AnOrbitInContactDissipatesTheAreaBetweenTheBranchesVisited) {
-  for (double separation : {9.0, 6.0}) {
+  struct Case {
+    const tapping::PhysicalCantilever* pc;
+    double separation;
+  };
+  for (const Case c : {Case{&kTap, 13.0}, Case{&kStiff, 6.0}}) {
+    const double separation = c.separation;
     SCOPED_TRACE(separation);
-    const auto aware = model(kStiff, afmkit_test::neck_curve(), Hysteresis::contact, separation);
+    const auto aware = model(*c.pc, afmkit_test::neck_curve(), Hysteresis::contact, separation);
     const auto oa = orbit_of(aware);
     const auto ma = metrics(aware, oa);
     const double top = max_gap(aware, oa);
@@ -183,9 +189,9 @@ TEST(ContactHysteresis, AnOrbitInContactDissipatesTheAreaBetweenTheBranchesVisit
     EXPECT_NEAR(ma.contact_dissipation, area, 1e-7 * area);
     EXPECT_NEAR(ma.drive_work, ma.viscous_dissipation + ma.contact_dissipation, 1e-8 * ma.drive_work);
     if (tapping_orbit) {  // a single load/unload per cycle: the same orbit as the velocity-sign law
-      const auto seed = model(kStiff, afmkit_test::neck_curve(), Hysteresis::velocity, separation);
+      const auto seed = model(*c.pc, afmkit_test::neck_curve(), Hysteresis::velocity, separation);
       const auto ms = metrics(seed, tapping::shoot(seed, oa.initial, 1, tight()));
-      EXPECT_NEAR(ma.amplitude, ms.amplitude, 1e-8 * kStiff.free_amplitude);
+      EXPECT_NEAR(ma.amplitude, ms.amplitude, 1e-8 * c.pc->free_amplitude);
       EXPECT_NEAR(ma.phase, ms.phase, 1e-8);
     }
   }
@@ -195,7 +201,7 @@ TEST(ContactHysteresis, AnOrbitInContactDissipatesTheAreaBetweenTheBranchesVisit
 // (rising) per period of a touching orbit; the monodromy (variational equations + saltation) matches finite
 // differences of the stroboscopic map across them.
 TEST(ContactHysteresis, ContactEntryAndReleaseAreEventsAndTheMonodromyStaysExact) {
-  const auto m = model(kStiff, afmkit_test::neck_curve(), Hysteresis::contact, 9.0);
+  const auto m = model(kTap, afmkit_test::neck_curve(), Hysteresis::contact, 13.0);
   const auto o = orbit_of(m);
   tapping::EventRecorder events;
   tapping::simulate(m, 0.0, o.initial, m.period(), tight().simulation, &events);
@@ -226,9 +232,16 @@ TEST(ContactHysteresis, ContactEntryAndReleaseAreEventsAndTheMonodromyStaysExact
     const auto fm = tapping::simulate(m, 0.0, minus, m.period(), so.simulation).state;
     const double dx = (fp.position - fm.position) / (2 * h[j]), dv = (fp.velocity - fm.velocity) / (2 * h[j]);
     const double scale = std::abs(o.monodromy(0, j)) + std::abs(o.monodromy(1, j)) + 1e-3;
-    EXPECT_NEAR(o.monodromy(0, j), dx, 1e-4 * scale) << "column " << j;
-    EXPECT_NEAR(o.monodromy(1, j), dv, 1e-4 * scale) << "column " << j;
+    // (the PCHIP law is only C¹ at its knots: central differences are first-order accurate there)
+    EXPECT_NEAR(o.monodromy(0, j), dx, 2e-3 * scale) << "column " << j;
+    EXPECT_NEAR(o.monodromy(1, j), dv, 2e-3 * scale) << "column " << j;
   }
+  // and to rounding against the velocity-sign law on the same (tapping) orbit, whose saltation matrices the seed
+  // tests check: the contact entry and the release add no jump of the vector field (H_a = H_b at d_r)
+  const auto seed = model(kTap, afmkit_test::neck_curve(), Hysteresis::velocity, 13.0);
+  const auto os = tapping::shoot(seed, o.initial, 1, so);
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) EXPECT_NEAR(o.monodromy(i, j), os.monodromy(i, j), 1e-6 * o.monodromy.norm());
 }
 
 // (e) A long time simulation from a perturbed start settles onto the orbit found by shooting (same state at the
@@ -239,7 +252,7 @@ TEST(ContactHysteresis, TimeSimulationSettlesOntoTheShotOrbit) {
     double separation;
     int periods;
   };
-  for (const Case c : {Case{&kSoft, 25.0, 1500}, Case{&kStiff, 9.0, 3000}, Case{&kStiff, 6.0, 3000}}) {
+  for (const Case c : {Case{&kSoft, 25.0, 1500}, Case{&kTap, 13.0, 3000}, Case{&kStiff, 6.0, 3000}}) {
     SCOPED_TRACE(c.separation);
     const auto m = model(*c.pc, afmkit_test::neck_curve(), Hysteresis::contact, c.separation);
     const auto o = orbit_of(m);
