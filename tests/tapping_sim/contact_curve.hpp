@@ -1,8 +1,9 @@
 #pragma once
 // A realistic measured-like force curve for the contact-aware hysteresis tests (docs/force-laws.md#hysteresis):
 // approach = DMT + van der Waals (E* = 1 GPa, R = 10 nm, A_H = 6.4e-20 J, a0 = 0.165 nm); retract = DMT with
-// E* = 0.8 GPa minus an adhesion neck of 2 nN that thins out quadratically and breaks at the pull-off distance
-// +14 nm: neck(d) = 2 nN (1 − (d − a0)/(14 nm − a0))² for a0 < d < 14 nm, 2 nN below a0, 0 above.
+// E* = 0.8 GPa minus an adhesion neck of 3 nN that thins out and breaks at the pull-off distance +14 nm:
+// neck(d) = 3 nN (1 − (d − a0)/(14 nm − a0))⁴ for a0 < d < 14 nm, 3 nN below a0, 0 above (the 4th power ends it
+// smoothly enough that the PCHIP retract never rises above the approach where the neck ends: a dissipative law).
 // Sampled every 0.1 nm from −2 nm to 40 nm (3-column table, as AFM software exports it).
 #include <algorithm>
 #include <cmath>
@@ -13,7 +14,7 @@ namespace afmkit_test {
 
 inline constexpr double kNeckA0 = 0.165;      // nm
 inline constexpr double kPullOff = 14.0;      // nm
-inline constexpr double kNeckForce = 2.0;     // nN
+inline constexpr double kNeckForce = 3.0;     // nN
 
 inline double dmt_force(double d, double modulus_gpa) {
   const double r = 10.0, hamaker = 6.4e-20;
@@ -28,7 +29,7 @@ inline double neck_force(double d) {
   if (d >= kPullOff) return 0.0;
   if (d <= kNeckA0) return kNeckForce;
   const double u = 1.0 - (d - kNeckA0) / (kPullOff - kNeckA0);
-  return kNeckForce * u * u;
+  return kNeckForce * (u * u) * (u * u);
 }
 
 inline afmkit::impact::ForceCurve neck_curve() {
