@@ -32,22 +32,25 @@ inline double neck_force(double d) {
   return kNeckForce * (u * u) * (u * u);
 }
 
-inline afmkit::impact::ForceCurve neck_curve() {
+/// `drag` [nN]: a constant difference of the branches over the whole table (hydrodynamic drag, or a baseline
+/// offset left between approach and retract), as measured curves have; `top` [nm]: the table's last distance.
+inline afmkit::impact::ForceCurve neck_curve(double drag = 0.0, double top = 40.0) {
   afmkit::impact::ForceCurve c;
   c.origin = "neck curve";
-  for (int i = 0; i <= 420; ++i) {
+  const int n = static_cast<int>(std::lround((top + 2.0) / 0.1));
+  for (int i = 0; i <= n; ++i) {
     const double d = -2.0 + 0.1 * i;
     c.approach_gap.push_back(d);
     c.approach_force.push_back(dmt_force(d, 1.0));
     c.retract_gap.push_back(d);
-    c.retract_force.push_back(dmt_force(d, 0.8) - neck_force(d));
+    c.retract_force.push_back(dmt_force(d, 0.8) - neck_force(d) - drag);
   }
   return c;
 }
 
 /// The same curve with the retract branch replaced by the approach branch (a conservative law).
-inline afmkit::impact::ForceCurve approach_only_curve() {
-  auto c = neck_curve();
+inline afmkit::impact::ForceCurve approach_only_curve(double top = 40.0) {
+  auto c = neck_curve(0.0, top);
   c.retract_force = c.approach_force;
   return c;
 }

@@ -68,22 +68,28 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
   };
   Eigen::Vector2d y(guess.position, guess.velocity);
   // The memory of a contact-aware law is part of the orbit's state (docs/force-laws.md#hysteresis): a periodic
-  // orbit starts with the memory it ends with. An orbit that touches (or rises above the release gap) fixes its
-  // end memory whatever it started with, so the start memory is taken from the end of the period, re-evaluated
-  // once when it changes; Newton converges only on a state whose memory repeats.
+  // orbit starts with the memory it ends with. Newton runs with the guess's memory; when it has converged on a
+  // state whose period ends with the other memory (an orbit that touches, or rises above the release gap, fixes
+  // its end memory whatever it started with), it continues from there with that memory (at most twice). The
+  // memory never changes at an unconverged iterate: a wild Newton step that touches the sample cannot turn a
+  // free orbit between the contact and the release gaps into an attached one.
   bool memory = guess.contact;
+  int memory_switches = 0;
   auto evaluate = [&](const Eigen::Vector2d& at) {
-    StroboscopicMap m = stroboscopic_map(model, {at.x(), at.y(), memory}, period_multiple, options.simulation);
-    if (m.end.contact != memory) {
-      memory = m.end.contact;
-      m = stroboscopic_map(model, {at.x(), at.y(), memory}, period_multiple, options.simulation);
-    }
-    return m;
+    return stroboscopic_map(model, {at.x(), at.y(), memory}, period_multiple, options.simulation);
   };
   StroboscopicMap map = evaluate(y);
   Eigen::Vector2d r = Eigen::Vector2d(map.end.position, map.end.velocity) - y;
   double norm = scaled_norm(r, y, omega);
   for (int it = 0; it <= options.max_iterations; ++it) {
+    if (norm <= tolerance && map.end.contact != memory) {
+      if (memory_switches == 2) return std::nullopt;  // the memory does not repeat: no period-n orbit here
+      ++memory_switches;
+      memory = map.end.contact;
+      map = evaluate(y);
+      r = Eigen::Vector2d(map.end.position, map.end.velocity) - y;
+      norm = scaled_norm(r, y, omega);
+    }
     if (norm <= tolerance && map.end.contact == memory) {
       // the last Newton step, from the map already evaluated, takes the state from a residual of size `norm` to
       // one of size O(norm²): without it the fixed point is off by (M − I)⁻¹ r, large when a multiplier is
