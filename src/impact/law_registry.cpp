@@ -46,6 +46,10 @@ std::vector<LawKey> builtin_keys() {
       positive("intermolecular_distance", "nm", 0.165, "intermolecular distance a0 (contact gap)"),
       non_negative("adhesion_energy", "J/m^2", 0.1, "adhesion energy γ: pull-off force (3/2)πγR on retract"),
       non_negative("viscosity", "Pa*s", 100.0, "sample viscosity η: damping η √(R(a0 − d)) in contact"),
+      non_negative("release_tolerance", "nN", 0.0,
+                   "with hysteresis = contact: a difference of the branches up to this counts as none when placing "
+                   "the release gap (drag, baseline offset or noise above the pull-off); 0: 1e-9 of the largest "
+                   "force"),
   };
 }
 }  // namespace
@@ -114,9 +118,13 @@ LawRegistry LawRegistry::builtin() {
                                            v("intermolecular_distance"), v("viscosity"));
          }});
   r.add({"table", "measured force curve: approach and retract tables (--force-curve FILE), monotone interpolation",
-         {}, true, false, [=](const V&, const LawArguments& a) {
+         {"release_tolerance"}, true, false, [=](const V& v, const LawArguments& a) {
+           const bool velocity = a.hysteresis == "velocity";
+           if (velocity && v("release_tolerance") > 0.0)  // (commands pass the default 0 of every key a law reads)
+             throw InvalidParameter("release_tolerance", "release_tolerance applies only to hysteresis = contact "
+                                                         "(this run: hysteresis = velocity)");
            return make_law<TableLaw>(read_force_curve(a.force_curve), gain(a),
-                                     a.hysteresis == "velocity" ? Hysteresis::velocity : Hysteresis::contact);
+                                     velocity ? Hysteresis::velocity : Hysteresis::contact, v("release_tolerance"));
          }});
   return r;
 }

@@ -5,11 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <boost/math/quadrature/gauss.hpp>
 #include <gtest/gtest.h>
 
+#include "afmkit/core/error.hpp"
 #include "afmkit/impact/laws/table_law.hpp"
 #include "afmkit/tapping/observer.hpp"
 #include "afmkit/tapping/orbit.hpp"
@@ -280,4 +282,42 @@ TEST(ContactHysteresis, TimeSimulationSettlesOntoTheShotOrbit) {
     EXPECT_NEAR(r.state.velocity, o.initial.velocity, 1e-6 * a0);
     EXPECT_EQ(r.state.contact, o.initial.contact);
   }
+}
+
+// A measured curve's drag / baseline difference up to the table's end puts the release gap there; a release
+// tolerance above that difference puts it back at the neck's end, so a tip that touched is released at pull-off.
+TEST(ContactHysteresis, AReleaseToleranceIgnoresADragDifferenceAboveThePullOff) {
+  const auto curve = afmkit_test::neck_curve(0.02, 70.0);
+  const impact::TableLaw strict(curve);
+  EXPECT_NEAR(strict.release_gap(), 70.0, 1e-9);
+  const impact::TableLaw tolerant(curve, false, Hysteresis::contact, 0.03);
+  // independent: the largest sample where the neck (3 nN (1 − u)⁴) plus the drag still exceeds 0.03 nN, within a
+  // sample spacing (the interpolant between samples)
+  double last = -2.0;
+  for (std::size_t i = 0; i < curve.retract_gap.size(); ++i) {
+    const double d = curve.retract_gap[i];
+    if (afmkit_test::neck_force(d) + 0.02 > 0.03 && d > 0.5) last = d;
+  }
+  EXPECT_GE(tolerant.release_gap(), last - 1e-9);
+  EXPECT_LE(tolerant.release_gap(), last + 0.2 + 1e-9);
+  EXPECT_THROW(impact::TableLaw(curve, false, Hysteresis::contact, -1.0), InvalidParameter);
+  // the soft cantilever 25 nm away, started in contact (gap −0.5 nm, at rest): without the tolerance the tip stays
+  // "in contact" (never above 70 nm) and the drag dissipates at every turn; with it, it is released at pull-off and
+  // settles on the free orbit
+  auto settled = [&](double tolerance) {
+    const tapping::TappingModel m{kSoft.cantilever(), kSoft.drive(),
+                                  kSoft.normalised_law(impact::make_law<impact::TableLaw>(curve, false,
+                                                                                         Hysteresis::contact, tolerance)),
+                                  25.0};
+    const auto end = tapping::simulate(m, 0.0, {-25.5, 0.0, true}, 1500 * m.period(), {});
+    const auto o = tapping::shoot(m, end.state, 1, tight());
+    return std::pair{o, metrics(m, o)};
+  };
+  const auto [attached, ma] = settled(0.0);
+  const auto [released, mr] = settled(0.03);
+  EXPECT_TRUE(attached.initial.contact);
+  EXPECT_GT(ma.contact_dissipation, 0.02 * ma.viscous_dissipation);
+  EXPECT_FALSE(released.initial.contact);
+  EXPECT_LE(std::abs(mr.contact_dissipation), 1e-10 * mr.viscous_dissipation);
+  EXPECT_GT(mr.amplitude, 0.999 * kSoft.free_amplitude);
 }

@@ -642,14 +642,20 @@ std::pair<double, double> cubic_minimum(double y, double c1, double c2, double c
 }
 }  // namespace
 
-TableLaw::TableLaw(ForceCurve curve, bool allow_energy_gain, Hysteresis hysteresis)
+TableLaw::TableLaw(ForceCurve curve, bool allow_energy_gain, Hysteresis hysteresis, double release_tolerance)
     : curve_(std::move(curve)),
       allow_gain_(allow_energy_gain),
       approach_(build(curve_.approach_gap, curve_.approach_force, "approach branch", curve_.origin)),
       retract_(build(curve_.retract_gap, curve_.retract_force, "retract branch", curve_.origin)),
       hysteresis_(hysteresis) {
   switching_ = {approach_.x.back(), retract_.x.back()};
-  difference_end_ = compute_difference_end();
+  if (!(release_tolerance >= 0.0 && std::isfinite(release_tolerance)))
+    throw InvalidParameter("release_tolerance", fmt::format("release_tolerance = {} nN must be finite and >= 0",
+                                                            release_tolerance));
+  double scale = 0.0;
+  for (const auto* f : {&curve_.approach_force, &curve_.retract_force})
+    for (double v : *f) scale = std::max(scale, std::abs(v));
+  difference_end_ = compute_difference_end(release_tolerance > 0.0 ? release_tolerance : 1e-9 * scale);
   release_ = std::max(contact_gap(), difference_end_);
   if (hysteresis_ == Hysteresis::contact) {
     switching_.push_back(contact_gap());
@@ -667,11 +673,7 @@ TableLaw::TableLaw(ForceCurve curve, bool allow_energy_gain, Hysteresis hysteres
   }
 }
 
-double TableLaw::compute_difference_end() const {
-  double scale = 0.0;
-  for (const auto* f : {&curve_.approach_force, &curve_.retract_force})
-    for (double v : *f) scale = std::max(scale, std::abs(v));
-  const double tolerance = 1e-9 * scale;
+double TableLaw::compute_difference_end(double tolerance) const {
   std::vector<double> knots = approach_.x;
   knots.insert(knots.end(), retract_.x.begin(), retract_.x.end());
   std::sort(knots.begin(), knots.end());

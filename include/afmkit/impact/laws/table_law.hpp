@@ -77,7 +77,11 @@ class TableLaw final : public ForceLawModel {
   /// `hysteresis`: contact (the default: the retract branch applies only after the tip reached the contact gap,
   /// until it rises above the release gap; docs/force-laws.md#hysteresis) or velocity (seed-1 eq. 4: the branch
   /// by the sign of the gap rate alone, so any branch difference at positive gap dissipates at every turn).
-  explicit TableLaw(ForceCurve curve, bool allow_energy_gain = false, Hysteresis hysteresis = Hysteresis::contact);
+  /// `release_tolerance` [nN] (contact-aware only; finite, ≥ 0): a branch difference up to it counts as none when
+  /// placing the release gap (a measured curve's drag, baseline offset or noise above the pull-off); 0: 1e-9 of the
+  /// largest tabulated force. Above the release gap the law is H_a on both branches' behalf.
+  explicit TableLaw(ForceCurve curve, bool allow_energy_gain = false, Hysteresis hysteresis = Hysteresis::contact,
+                    double release_tolerance = 0.0);
 
   std::string name() const override { return "table"; }
   double approach(double gap) const override { return approach_.eval(gap); }
@@ -88,12 +92,13 @@ class TableLaw final : public ForceLawModel {
   std::vector<double> switching_gaps() const override { return switching_; }
   Hysteresis hysteresis() const override { return hysteresis_; }
   /// Contact-aware: the release gap d_r = max(contact gap, the largest distance below which the branches differ
-  /// by more than 1e-9·max|F| somewhere) — exact for the interpolant (the extrema of the cubic difference
+  /// by more than the release tolerance somewhere) — exact for the interpolant (the extrema of the cubic difference
   /// between consecutive knots of the union). Above it H_a = H_b to that tolerance (a measured curve whose
   /// branches differ by noise up to the end of the table has d_r = the end of the shorter table's branch
   /// difference, usually the table's end). NaN for velocity-sign switching.
   double release_gap() const override { return hysteresis_ == Hysteresis::contact ? release_ : std::numeric_limits<double>::quiet_NaN(); }
-  /// The largest distance at which the interpolated branches differ (by more than 1e-9·max|F|); −inf if never.
+  /// The largest distance at which the interpolated branches differ (by more than the release tolerance); −inf if
+  /// never.
   double branch_difference_end() const { return difference_end_; }
   /// Contact: below the bottom of the approach curve's adhesion well (the tabulated distance of its most negative
   /// force); a curve without attraction: below the largest distance where its force is positive.
@@ -146,7 +151,7 @@ class TableLaw final : public ForceLawModel {
   double difference_end_ = 0.0;  // largest distance where the branches differ (−inf: nowhere)
   double release_ = 0.0;         // max(contact gap, difference_end_)
   int dependent_regions_ = 0;    // regions below this index may have H_a ≠ H_b
-  double compute_difference_end() const;
+  double compute_difference_end(double tolerance) const;
 };
 
 }  // namespace afmkit::impact
