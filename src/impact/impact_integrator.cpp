@@ -251,7 +251,12 @@ class ImpactIntegrator {
 
   double gap(const State& z) const { return length_ * (z[2] - z[0]); }
   double rate(const State& z) const { return speed_ * (z[3] - z[1]); }
-  double branch(double d) const { return departure_ && touched_ ? law_.departure(d) : law_.approach(d); }
+  /// H_b while departing, except for a contact-aware law that did not touch, or above its release gap (there the
+  /// law is H_a: docs/force-laws.md#hysteresis)
+  double branch(double d) const {
+    const bool released = law_.contact_aware() && d >= law_.release_gap();
+    return departure_ && touched_ && !released ? law_.departure(d) : law_.approach(d);
+  }
   /// H of the current phase with the Kelvin–Voigt term −c(d)ḋ of laws that have one.
   double force_at(const State& z) const {
     const double d = gap(z);
