@@ -39,6 +39,9 @@
 //     interpolant's end value and slope (C¹);
 //   * above the largest distance: 0 — the table must reach out to where the interaction is negligible; the
 //     force jumps to 0 there, and that distance is a switching gap of the law.
+//   * branch selection: contact-aware by default (docs/force-laws.md#hysteresis) — the retract branch only after
+//     the tip reached the contact gap, until it rises above the release gap (where the branches become equal,
+//     to the release tolerance); Hysteresis::velocity gives the seed's rule (by the sign of the gap rate).
 // Evaluation allocates nothing: the interval is found in O(1) on an evenly spaced table (as AFM exports are), by
 // binary search otherwise (measured ≈ 16 ns / 38 ns latency per call for 200 knots, about that of the DMT law).
 // A noisy baseline makes the retract force exceed the approach force somewhere, which require_dissipative()
