@@ -33,9 +33,8 @@ struct Case {
 impact::LawArguments table_args() {
   impact::LawArguments a;
   a.force_curve = std::string(AFMKIT_SOURCE_DIR) + "/examples/force_curves/dmt_adhesion.csv";
-  // the seed's velocity-sign switching, as this file checks the integrators against the seed's semantics
-  // (the contact-aware default is checked in test_contact_hysteresis.cpp)
-  a.hysteresis = "velocity";
+  // the table law's default, contact-aware branch selection (docs/force-laws.md#hysteresis): the reference
+  // integrator models the memory of contact independently
   return a;
 }
 
@@ -88,8 +87,12 @@ TEST(LawFidelity, AdaptiveSimulationMatchesIndependentReferenceForEveryLaw) {
 }
 
 TEST(LawFidelity, EnergyBalanceOfConvergedOrbitsForEveryLaw) {
-  for (const auto& c : cases()) {
+  for (auto c : cases()) {
     SCOPED_TRACE(c.law);
+    // with the contact-aware rule the tip at 8 nm grazes the table's contact gap (lowest gap ≈ 0.2 nm against
+    // d_c = 0.166 nm): it touches on some cycles only, a motion with no periodic orbit to balance; the seed's
+    // velocity-sign rule has one (the contact-aware energy balance: test_contact_hysteresis.cpp)
+    if (c.law == "table") c.args.hysteresis = "velocity";
     const auto model = model_for(c);
     tapping::ShootingOptions so;
     so.tolerance = 1e-14;
