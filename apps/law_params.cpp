@@ -19,6 +19,11 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
       .file("force_curve", "",
             "[table] force-curve file: approach and retract force vs distance, units in the header "
             "(docs/force-laws.md)")
+      .text("hysteresis", "law",
+            "branch selection (docs/force-laws.md#hysteresis): law = the law's own (contact for table, velocity-sign "
+            "for the others); [table] contact = the retract branch only after the tip reached the contact gap, "
+            "until it rises above the release gap; velocity = by the sign of the gap rate alone (seed-1 eq. 4)",
+            {"law", "contact", "velocity"})
       .flag("allow_energy_gain", false,
             "accept a law that creates energy (retract branch above the approach branch somewhere: K_b > K_a, "
             "restitution > 1, departure_modulus > effective_modulus, ...)");
@@ -44,6 +49,7 @@ impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistr
   impact::LawArguments args;
   args.allow_energy_gain = p.flag("allow_energy_gain");
   args.force_curve = p.text("force_curve");
+  args.hysteresis = p.text("hysteresis");
   auto reads = [&](const std::string& key) { return std::find(spec.keys.begin(), spec.keys.end(), key) != spec.keys.end(); };
   std::vector<std::string> replaced;  // keys a given alternative stands for (restitution -> departure_stiffness)
   for (const auto& k : registry.keys())

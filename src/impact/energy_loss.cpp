@@ -66,6 +66,11 @@ double hysteresis_energy_loss(const ForceLaw& law, double minimum_gap, double re
   validate::finite("reference_gap", reference_gap);
   validate::require(minimum_gap <= reference_gap, "minimum_gap", minimum_gap,
                     fmt::format("<= reference_gap = {}", reference_gap));
+  // a contact-aware law dissipates only after an impact: nothing when the approach stops above the contact gap
+  // (docs/force-laws.md#hysteresis); above the release gap its branches are equal
+  if (law.contact_aware() && minimum_gap > law.contact_gap()) return 0.0;
+  // and nothing above its release gap, where the law is H_a (a release tolerance may hide a difference there)
+  if (law.contact_aware()) reference_gap = std::max(minimum_gap, std::min(reference_gap, law.release_gap()));
   const double closed_form = law.hysteresis_area(minimum_gap, reference_gap);
   if (!std::isnan(closed_form)) return closed_form;
   return quadrature_area(law, minimum_gap, reference_gap);

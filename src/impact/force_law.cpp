@@ -10,6 +10,8 @@
 
 namespace afmkit::impact {
 
+const char* hysteresis_name(Hysteresis h) { return h == Hysteresis::contact ? "contact" : "velocity"; }
+
 PiecewiseLinearLaw::PiecewiseLinearLaw(double ka, double kb, double fa, double fb, bool allow_gain)
     : approach_stiffness(validate::non_negative("approach_stiffness", ka)),
       departure_stiffness(validate::non_negative("departure_stiffness", kb)),
@@ -119,6 +121,22 @@ void ForceLaw::refresh() {
   switching_gaps_.erase(std::unique(switching_gaps_.begin(), switching_gaps_.end()), switching_gaps_.end());
   has_damping_ = model_->has_damping();
   contact_gap_ = model_->contact_gap();
+  hysteresis_ = model_->hysteresis();
+  if (hysteresis_ == Hysteresis::contact) {
+    // the mode switches of a contact-aware law are events: both gaps must be switching gaps, d_c ≤ d_r
+    release_gap_ = model_->release_gap();
+    const auto listed = [&](double g) {
+      return std::find(switching_gaps_.begin(), switching_gaps_.end(), g) != switching_gaps_.end();
+    };
+    if (!std::isfinite(contact_gap_) || !std::isfinite(release_gap_) || !(release_gap_ >= contact_gap_) ||
+        !listed(contact_gap_) || !listed(release_gap_))
+      throw InvalidParameter("force_law",
+                             fmt::format("force law '{}': a contact-aware law needs a finite contact gap ({}) and "
+                                         "release gap ({}) >= it, both among its switching gaps",
+                                         model_->name(), contact_gap_, release_gap_));
+  } else {
+    release_gap_ = std::numeric_limits<double>::quiet_NaN();
+  }
   scaled_linear_.reset();
   if (const auto* p = model_->piecewise_linear())
     scaled_linear_ = std::make_shared<PiecewiseLinearLaw>(p->approach_stiffness * scale_, p->departure_stiffness * scale_,
@@ -131,6 +149,11 @@ double ForceLaw::force(double gap, double rate) const {
   if (rate < 0) return approach(gap) + viscous;
   if (rate > 0) return departure(gap) + viscous;
   return 0.5 * (approach(gap) + departure(gap));
+}
+
+double ForceLaw::force(double gap, double rate, bool in_contact) const {
+  if (hysteresis_ == Hysteresis::velocity || in_contact) return force(gap, rate);
+  return approach(gap) + (has_damping_ ? -damping(gap) * rate : 0.0);
 }
 
 const PiecewiseLinearLaw* ForceLaw::piecewise_linear() const& { return scaled_linear_.get(); }

@@ -63,6 +63,7 @@ class ImpactIntegrator {
     r.min_force = std::numeric_limits<double>::infinity();
     events_.clear();
     departure_ = false;
+    touched_ = true;
     const double total = m1_ + m2_;
     State y{(problem_.body1().position - com_x0_) / length_, (problem_.body1().velocity - com_v0_) / speed_,
             (problem_.body2().position - com_x0_) / length_, (problem_.body2().velocity - com_v0_) / speed_};
@@ -197,6 +198,9 @@ class ImpactIntegrator {
           r.minimum_time = t;
           r.minimum_gap = gap(y);
           departure_ = true;
+          // a contact-aware law departs on H_b only after an impact: the approach (monotone in d) reached the
+          // contact gap iff its minimum did (docs/force-laws.md#hysteresis); else H_a, as above the release gap
+          touched_ = !law_.contact_aware() || r.minimum_gap <= law_.contact_gap();
           track_force(y);
           if (grid && history) (*history)(sample(t, y));  // departure-branch row at t̄
           next = static_cast<std::ptrdiff_t>(std::upper_bound(levels_.begin(), levels_.end(), r.minimum_gap) -
@@ -243,10 +247,16 @@ class ImpactIntegrator {
   std::vector<double> levels_;
   std::vector<double> events_;
   bool departure_ = false;
+  bool touched_ = true;  // contact-aware laws: the approach reached the contact gap (H_b applies on departure)
 
   double gap(const State& z) const { return length_ * (z[2] - z[0]); }
   double rate(const State& z) const { return speed_ * (z[3] - z[1]); }
-  double branch(double d) const { return departure_ ? law_.departure(d) : law_.approach(d); }
+  /// H_b while departing, except for a contact-aware law that did not touch, or above its release gap (there the
+  /// law is H_a: docs/force-laws.md#hysteresis)
+  double branch(double d) const {
+    const bool released = law_.contact_aware() && d >= law_.release_gap();
+    return departure_ && touched_ && !released ? law_.departure(d) : law_.approach(d);
+  }
   /// H of the current phase with the Kelvin–Voigt term −c(d)ḋ of laws that have one.
   double force_at(const State& z) const {
     const double d = gap(z);

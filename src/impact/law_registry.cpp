@@ -46,6 +46,10 @@ std::vector<LawKey> builtin_keys() {
       positive("intermolecular_distance", "nm", 0.165, "intermolecular distance a0 (contact gap)"),
       non_negative("adhesion_energy", "J/m^2", 0.1, "adhesion energy γ: pull-off force (3/2)πγR on retract"),
       non_negative("viscosity", "Pa*s", 100.0, "sample viscosity η: damping η √(R(a0 − d)) in contact"),
+      non_negative("release_tolerance", "nN", 0.0,
+                   "with hysteresis = contact: a difference of the branches up to this counts as none when placing "
+                   "the release gap (drag, baseline offset or noise above the pull-off); 0: 1e-9 of the largest "
+                   "force"),
   };
 }
 }  // namespace
@@ -114,8 +118,13 @@ LawRegistry LawRegistry::builtin() {
                                            v("intermolecular_distance"), v("viscosity"));
          }});
   r.add({"table", "measured force curve: approach and retract tables (--force-curve FILE), monotone interpolation",
-         {}, true, false, [=](const V&, const LawArguments& a) {
-           return make_law<TableLaw>(read_force_curve(a.force_curve), gain(a));
+         {"release_tolerance"}, true, false, [=](const V& v, const LawArguments& a) {
+           const bool velocity = a.hysteresis == "velocity";
+           if (velocity && v("release_tolerance") > 0.0)  // (commands pass the default 0 of every key a law reads)
+             throw InvalidParameter("release_tolerance", "release_tolerance applies only to hysteresis = contact "
+                                                         "(this run: hysteresis = velocity)");
+           return make_law<TableLaw>(read_force_curve(a.force_curve), gain(a),
+                                     velocity ? Hysteresis::velocity : Hysteresis::contact, v("release_tolerance"));
          }});
   return r;
 }
@@ -184,8 +193,19 @@ ForceLaw LawRegistry::build(const std::string& name, const LawArguments& args) c
   if (!spec.needs_force_curve && !args.force_curve.empty())
     throw InvalidParameter("force_curve", fmt::format("force_curve applies only to law = table (this run: law = {})",
                                                       name));
+  if (!args.hysteresis.empty() && args.hysteresis != "law" && args.hysteresis != "contact" &&
+      args.hysteresis != "velocity")
+    throw InvalidParameter("hysteresis", fmt::format("hysteresis = '{}' is not one of law, contact, velocity",
+                                                     args.hysteresis));
   const auto value = [&](const std::string& k) { return args.real(key(k), keys_); };
   ForceLaw law = spec.build(value, args);
+  if (!args.hysteresis.empty() && args.hysteresis != "law" && args.hysteresis != hysteresis_name(law.hysteresis()))
+    throw InvalidParameter("hysteresis",
+                           fmt::format("hysteresis = {} applies only to law = table; law = {} switches its branches "
+                                       "by the {} rule (docs/force-laws.md#hysteresis)",
+                                       args.hysteresis, name,
+                                       law.hysteresis() == Hysteresis::velocity ? "velocity-sign (seed-1 eq. 4)"
+                                                                                : "contact"));
   // every command alike: a law that creates energy (K_b > K_a, E*_b > E*_a, …) only with allow_energy_gain
   law.require_dissipative();
   return law;

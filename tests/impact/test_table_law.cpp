@@ -337,7 +337,7 @@ TEST(TableLaw, BelowTheTableContinuesLinearlyAboveItIsZero) {
   ForceCurve c = parse_force_curve(three_column, "a.csv");
   c.retract_gap.pop_back();  // retract ends at 3 nm, approach at 4 nm
   c.retract_force.pop_back();
-  const TableLaw law(c);
+  const TableLaw law(c, false, Hysteresis::velocity);  // (contact-aware: also the contact and release gaps)
   // above each branch's largest distance: 0; at it: the tabulated value
   EXPECT_EQ(law.approach(4.0), 0.0);
   EXPECT_EQ(law.approach(4.0 + 1e-12), 0.0);
@@ -361,7 +361,7 @@ TEST(TableLaw, BelowTheTableContinuesLinearlyAboveItIsZero) {
   EXPECT_TRUE(law.branch_dependent(0));
   EXPECT_TRUE(law.branch_dependent(1));
   EXPECT_FALSE(law.branch_dependent(2));
-  const ForceLaw wrapped = make_law<TableLaw>(parse_force_curve(three_column, "a.csv"));
+  const ForceLaw wrapped = make_law<TableLaw>(parse_force_curve(three_column, "a.csv"), false, Hysteresis::velocity);
   EXPECT_EQ(wrapped.switching_gaps(), std::vector<double>{4.0});
   EXPECT_EQ(wrapped.name(), "table");
 }

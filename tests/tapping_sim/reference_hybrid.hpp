@@ -3,6 +3,8 @@
 // (adaptive), and every event — the gap crossing a switching gap, ẋ changing sign where the branches differ —
 // located by bisection on the length of the last step. Within a mode the force is the mode's branch at the gap
 // clamped into the mode's region. Independent of the library's integrators, guards and Boost.Odeint.
+// A contact-aware law (docs/force-laws.md#hysteresis) adds the memory of contact to the mode: set when the gap
+// falls below the contact gap, cleared when it rises above the release gap; free, the force is H_a.
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -62,7 +64,15 @@ class ReferenceHybrid {
   struct Mode {
     int region;
     bool departure;
+    bool contact = false;
   };
+  bool aware() const { return m_.law.contact_aware(); }
+  bool memory_after(bool before, double d) const {
+    if (!aware()) return false;
+    if (d < m_.law.contact_gap()) return true;
+    if (d >= m_.law.release_gap()) return false;
+    return before;
+  }
   const afmkit::tapping::TappingModel& m_;
   std::vector<double> gaps_;
 
@@ -83,7 +93,7 @@ class ReferenceHybrid {
     const double wn = m_.cantilever.natural_frequency;
     double d = x + m_.separation;
     d = std::min(std::max(d, lo(mode.region)), std::nextafter(hi(mode.region), -INFINITY));
-    double force = mode.departure ? m_.law.departure(d) : m_.law.approach(d);
+    double force = mode.departure && (!aware() || mode.contact) ? m_.law.departure(d) : m_.law.approach(d);
     force -= m_.law.damping(d) * v;
     return m_.drive.amplitude * std::cos(m_.drive.frequency * t) - 2 * m_.cantilever.damping_ratio() * wn * v -
            wn * wn * x + force;
@@ -103,22 +113,22 @@ class ReferenceHybrid {
   bool fired(const Mode& mode, const HybridState& z) const {
     const double d = z.x + m_.separation;
     if (d < lo(mode.region) || d >= hi(mode.region)) return true;
-    if (differs(mode.region)) return mode.departure ? z.v < 0 : z.v > 0;
+    if (differs(mode.region) && (!aware() || mode.contact)) return mode.departure ? z.v < 0 : z.v > 0;
     return false;
   }
   Mode mode_of(double t, const HybridState& s) const {
-    Mode m{region(s.x + m_.separation), s.v > 0};
-    if (s.v == 0) m.departure = accel({m.region, true}, t, s.x, 0.0) > 0;
+    Mode m{region(s.x + m_.separation), s.v > 0, memory_after(false, s.x + m_.separation)};
+    if (s.v == 0) m.departure = accel({m.region, true, m.contact}, t, s.x, 0.0) > 0;
     return m;
   }
   Mode after_event(const Mode& mode, double t, const HybridState& s) const {
     const double d = s.x + m_.separation;
-    if (d < lo(mode.region) || d >= hi(mode.region)) return {region(d), s.v > 0};
+    if (d < lo(mode.region) || d >= hi(mode.region)) return {region(d), s.v > 0, memory_after(mode.contact, d)};
     // velocity sign change: the branch that moves away from ẋ = 0
     const bool dep = !mode.departure;
-    const double a = accel({mode.region, dep}, t, s.x, 0.0);
+    const double a = accel({mode.region, dep, mode.contact}, t, s.x, 0.0);
     if (dep ? a < 0 : a > 0) throw std::runtime_error("reference: sticking is not modelled");
-    return {mode.region, dep};
+    return {mode.region, dep, mode.contact};
   }
 };
 

@@ -33,6 +33,8 @@ struct Case {
 impact::LawArguments table_args() {
   impact::LawArguments a;
   a.force_curve = std::string(AFMKIT_SOURCE_DIR) + "/examples/force_curves/dmt_adhesion.csv";
+  // the table law's default, contact-aware branch selection (docs/force-laws.md#hysteresis): the reference
+  // integrator models the memory of contact independently
   return a;
 }
 
@@ -85,8 +87,12 @@ TEST(LawFidelity, AdaptiveSimulationMatchesIndependentReferenceForEveryLaw) {
 }
 
 TEST(LawFidelity, EnergyBalanceOfConvergedOrbitsForEveryLaw) {
-  for (const auto& c : cases()) {
+  for (auto c : cases()) {
     SCOPED_TRACE(c.law);
+    // with the contact-aware rule the tip at 8 nm grazes the table's contact gap (lowest gap ≈ 0.2 nm against
+    // d_c = 0.166 nm): it touches on some cycles only, a motion with no periodic orbit to balance; the seed's
+    // velocity-sign rule has one (the contact-aware energy balance: test_contact_hysteresis.cpp)
+    if (c.law == "table") c.args.hysteresis = "velocity";
     const auto model = model_for(c);
     tapping::ShootingOptions so;
     so.tolerance = 1e-14;
@@ -134,7 +140,7 @@ TEST(LawFidelity, TableSampledFromDmtAt200PointsReproducesItsSweep) {
   const tapping::PhysicalCantilever pc(40.0, 300.0, 400.0, 10.0, 1.0);
   const auto analytic = tapping::TappingModel(pc.cantilever(), pc.drive(), pc.normalised_law(dmt), 9.0);
   const auto table = tapping::TappingModel(pc.cantilever(), pc.drive(),
-                                           pc.normalised_law(impact::make_law<impact::TableLaw>(curve)), 9.0);
+                                           pc.normalised_law(impact::make_law<impact::TableLaw>(curve, false, impact::Hysteresis::velocity)), 9.0);
   const auto a = tapping::sweep_instrument(analytic, 6.0, 9.5, 8, {});
   const auto t = tapping::sweep_instrument(table, 6.0, 9.5, 8, {});
   ASSERT_EQ(a.approach.size(), t.approach.size());

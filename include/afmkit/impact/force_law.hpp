@@ -12,6 +12,16 @@
 
 namespace afmkit::impact {
 
+/// How a law chooses between its approach and departure branches (docs/force-laws.md#hysteresis).
+///   velocity — seed-1 eq. 4: H_a while ḋ < 0, H_b while ḋ > 0 (at every gap). The seed's laws.
+///   contact  — a law with memory of contact: the tip is *free* until the gap reaches the contact gap d_c, then
+///              *in contact* until the gap rises above the release gap d_r ≥ d_c (above which H_a = H_b). Free:
+///              H_a whatever ḋ (no hysteresis, conservative); in contact: the velocity sign selects loading
+///              (H_a, ḋ < 0) and unloading (H_b, ḋ > 0) as in eq. 4. A departure branch that differs from the
+///              approach above d_c (adhesion neck, pull-off) thus acts only after an impact. Table laws.
+enum class Hysteresis { velocity, contact };
+const char* hysteresis_name(Hysteresis h);
+
 /// Piecewise-linear hysteresis, seed-1 eqs. (10), (11), (26), in the tapping form
 ///   h = F_a + K_a·d (approach), h = F_b + K_b·d (departure) for d < 0, h = 0 for d ≥ 0,
 /// i.e. H_a(d) = −(F_a + K_a d), H_b(d) = −(F_b + K_b d) for d < 0.
@@ -119,6 +129,12 @@ class ForceLawModel {
   virtual void require_dissipative() const {}
   /// ∫_lo^hi (H_a − H_b) dd in closed form when the law has one (seed-1 eq. 6); NaN: use quadrature.
   virtual double hysteresis_area(double /*lo*/, double /*hi*/) const { return std::numeric_limits<double>::quiet_NaN(); }
+  /// The branch-selection semantics (see Hysteresis). A contact-aware law must list its contact gap and its
+  /// release gap among its switching gaps (entering and leaving contact are events of the integrators).
+  virtual Hysteresis hysteresis() const { return Hysteresis::velocity; }
+  /// Contact-aware laws: the release gap d_r ≥ contact_gap(), the smallest gap above which H_a = H_b
+  /// (contact ends when the gap rises above it). NaN for velocity-sign laws.
+  virtual double release_gap() const { return std::numeric_limits<double>::quiet_NaN(); }
 };
 
 /// A hysteresis force law as a value: a shared immutable ForceLawModel, times a force scale factor (used to
@@ -141,6 +157,14 @@ class ForceLaw {
   double damping(double gap) const { return has_damping_ ? damping_scale_ * model_->damping(gap) : 0.0; }
   bool has_damping() const { return has_damping_; }
   double force(double gap, double gap_rate) const;     // eq. (4) with the Kelvin–Voigt term
+  /// H with the memory of contact: for a contact-aware law not `in_contact`, the approach branch whatever the
+  /// rate (with the Kelvin–Voigt term); otherwise force(gap, gap_rate).
+  double force(double gap, double gap_rate, bool in_contact) const;
+  /// The branch-selection semantics (Hysteresis::velocity for the seed's laws).
+  Hysteresis hysteresis() const { return hysteresis_; }
+  bool contact_aware() const { return hysteresis_ == Hysteresis::contact; }
+  /// Contact-aware laws: the release gap (≥ contact_gap(); a switching gap); NaN otherwise.
+  double release_gap() const { return release_gap_; }
   /// Gaps at which a branch is non-smooth (sorted, distinct); crossings are events for the integrators.
   const std::vector<double>& switching_gaps() const& { return switching_gaps_; }
   std::vector<double> switching_gaps() const&& { return switching_gaps_; }
@@ -171,6 +195,8 @@ class ForceLaw {
   double damping_scale_ = 1.0;
   bool has_damping_ = false;
   double contact_gap_ = 0.0;
+  Hysteresis hysteresis_ = Hysteresis::velocity;
+  double release_gap_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> switching_gaps_;
   std::shared_ptr<const PiecewiseLinearLaw> scaled_linear_;  // cached scaled copy for piecewise_linear()
   void refresh();

@@ -163,6 +163,7 @@ ImpactResult simulate_impact(const ImpactProblem& problem, const ImpactOptions& 
 /// E*_a − E*_b, A_H,b − A_H,a (relative accuracy also when the branches nearly coincide, e → 1). Custom laws:
 /// adaptive Gauss–Kronrod quadrature of H_a − H_b split at the switching gaps, converged relative to the
 /// area itself or to the rounding floor ε ∫(|H_a| + |H_b|) of the branch values, whichever is larger.
+/// A contact-aware law (docs/force-laws.md#hysteresis) loses nothing when minimum_gap lies above its contact gap.
 double hysteresis_energy_loss(const ForceLaw& law, double minimum_gap, double reference_gap);
 
 /// Kinetic-energy loss of an isolated impact with restitution e (seed-1 eq. 3, t_i -> t_s):

@@ -34,6 +34,9 @@ struct LawArguments {
   std::map<std::string, double> values;
   std::string force_curve;          // file of a measured force curve (law = table)
   bool allow_energy_gain = false;   // accept laws that create energy (K_b > K_a, …)
+  /// Branch selection (docs/force-laws.md#hysteresis): "" or "law" (the law's own: contact for table, velocity
+  /// for the others), "contact" or "velocity" (law = table only; the other laws accept only their own).
+  std::string hysteresis;
 
   /// A given value, else the default (or followed key) from `key`.
   double real(const LawKey& key, const std::vector<LawKey>& all) const;

@@ -9,6 +9,7 @@
 //   region  — index of the gap interval between the law's switching gaps s_0 < … < s_{m−1}
 //             (region r: s_{r−1} ≤ x + l < s_r); region 0 = deepest (in contact).
 //   branch  — approach (ẋ < 0, H_a), departure (ẋ > 0, H_b), or sticking (ẋ = 0 held: the tip rests).
+//   contact — contact-aware laws only: the memory of contact (free: H_a whatever ẋ, no velocity guard).
 // Guards, each with the crossing direction that ends the mode (Drake-style witness functions):
 //   gap       x + l − s_i          falling (enter region below) or rising (enter region above)
 //   velocity  ẋ                    rising in approach, falling in departure (branch switch, or sticking)
@@ -19,10 +20,14 @@
 
 namespace afmkit::tapping {
 
-/// Tip state (x, ẋ) in model units.
+/// Tip state (x, ẋ) in model units, with the memory of a contact-aware law (docs/force-laws.md#hysteresis):
+/// `contact` says whether the tip has reached the contact gap and not yet risen above the release gap. It
+/// matters only for a contact-aware law with the gap between the contact and the release gaps (below the contact
+/// gap the tip is in contact, above the release gap it is free, whatever the flag); ignored by velocity-sign laws.
 struct TipState {
   double position = 0.0;  // x
   double velocity = 0.0;  // ẋ
+  bool contact = false;   // memory of contact (contact-aware laws)
 };
 
 /// Which force branch is active (seed-1 eq. 4 as corrected in docs/theory-tapping.md#impact).
@@ -32,6 +37,10 @@ const char* contact_branch_name(ContactBranch branch);
 struct Mode {
   int region = 0;  // gap interval index (0 = below the lowest switching gap)
   ContactBranch branch = ContactBranch::approach;
+  /// Contact-aware laws: in contact (branch by the velocity sign) or free (always the approach branch, no
+  /// velocity guard); set on the gap falling through the contact gap, cleared on it rising through the release
+  /// gap. Always false for velocity-sign laws.
+  bool contact = false;
   friend bool operator==(const Mode&, const Mode&) = default;
 };
 

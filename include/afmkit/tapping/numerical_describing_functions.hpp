@@ -9,6 +9,9 @@
 //   Im N1      =  (1/πB) ∫_0^π (H_a − H_b + 2c(d)Bω sin θ) sin θ dθ
 // — the same quantities and sign convention as DescribingFunctions (describing_functions.hpp): for a
 // piecewise-linear law they equal the closed forms of seed-1 eqs. (12)–(15), (26)–(31).
+// A contact-aware law (ForceLaw::contact_aware, docs/force-laws.md#hysteresis) uses H_b only on a cycle that
+// reaches its contact gap (g − B ≤ d_c: then it is the velocity-sign law, since H_a = H_b above the release gap);
+// a cycle above it is free: H_a on both halves, no dissipation through the law (Im N1 from c(d) only).
 //
 // Quadrature. [0, π] is split where d(θ) crosses a switching gap s of the law (θ_s = arccos((s − g)/B), computed
 // from the half-angle form so that it stays accurate at grazing) — the switching angles are located, never

@@ -30,6 +30,13 @@ class TappingSystem {
   double contact_gap() const { return std::isnan(model_.law.contact_gap()) ? 0.0 : model_.law.contact_gap(); }
   /// Whether the contact gap is a switching gap, i.e. the contact region is region 0 exactly.
   bool contact_is_region_zero() const { return !switching().empty() && switching().front() == contact_gap(); }
+  /// Whether the law is contact-aware (docs/force-laws.md#hysteresis): modes carry the memory of contact.
+  bool contact_aware() const { return contact_aware_; }
+  /// Whether `mode` selects its branch by the velocity sign: always for velocity-sign laws; for a
+  /// contact-aware law only in contact and where the branches may differ.
+  bool velocity_switched(const Mode& mode) const {
+    return branch_dependent(mode.region) && (!contact_aware_ || mode.contact);
+  }
   /// Whether approach and departure branches differ in `region` (else no velocity guard there).
   bool branch_dependent(int region) const {
     return region < 64 ? ((dependent_mask_ >> region) & 1u) != 0 : model_.law.branch_dependent(region);
@@ -61,8 +68,9 @@ class TappingSystem {
 
   /// Mode of a state at time t (region from the gap, branch from ẋ, or from the accelerations when ẋ = 0).
   Mode initial_mode(double t, TipState& s) const;
-  /// Mode when entering `region` at (t, s): branch from ẋ, or from the accelerations when ẋ = 0 (may stick).
-  Mode enter_region(int region, double t, TipState& s) const;
+  /// Mode when entering `region` at (t, s): branch from ẋ, or from the accelerations when ẋ = 0 (may stick);
+  /// `contact`: the memory of a contact-aware law (free: the approach branch whatever ẋ).
+  Mode enter_region(int region, double t, TipState& s, bool contact = false) const;
   /// Mode after ẋ reached 0 coming from branch `from`: the branch whose acceleration moves the tip away from
   /// ẋ = 0, or sticking (ẋ set to 0) when both push back onto it.
   Mode after_velocity_zero(int region, ContactBranch from, double t, TipState& s) const;
@@ -86,6 +94,9 @@ class TappingSystem {
   double separation_;
   const std::vector<double>& switching() const& { return model_.law.switching_gaps(); }
   unsigned long dependent_mask_ = 0;
+  bool contact_aware_ = false;
+  int contact_top_ = -1;    // contact-aware: regions ≤ this lie below the contact gap (in contact)
+  int release_region_ = 0;  // contact-aware: regions ≥ this lie above the release gap (free)
   std::optional<impact::PiecewiseLinearLaw> linear_;
   bool has_damping_ = false;
   double elastic_interaction(ContactBranch branch, double x, int region) const;

@@ -611,16 +611,6 @@ double TableLaw::hysteresis_area(double lo, double hi) const {
   return (approach_.integral(hi) - approach_.integral(lo)) - (retract_.integral(hi) - retract_.integral(lo));
 }
 
-TableLaw::TableLaw(ForceCurve curve, bool allow_energy_gain)
-    : curve_(std::move(curve)),
-      allow_gain_(allow_energy_gain),
-      approach_(build(curve_.approach_gap, curve_.approach_force, "approach branch", curve_.origin)),
-      retract_(build(curve_.retract_gap, curve_.retract_force, "retract branch", curve_.origin)) {
-  switching_ = {approach_.x.back(), retract_.x.back()};
-  if (switching_[0] > switching_[1]) std::swap(switching_[0], switching_[1]);
-  if (switching_[0] == switching_[1]) switching_.pop_back();
-}
-
 namespace {
 /// The smallest value of the cubic y + t (c1 + t (c2 + t c3)) on [0, len] and where it is taken: the ends and the
 /// zeros of its derivative c1 + 2 c2 t + 3 c3 t² inside (exact up to rounding: no sampling).
@@ -651,6 +641,61 @@ std::pair<double, double> cubic_minimum(double y, double c1, double c2, double c
   return best;
 }
 }  // namespace
+
+TableLaw::TableLaw(ForceCurve curve, bool allow_energy_gain, Hysteresis hysteresis, double release_tolerance)
+    : curve_(std::move(curve)),
+      allow_gain_(allow_energy_gain),
+      approach_(build(curve_.approach_gap, curve_.approach_force, "approach branch", curve_.origin)),
+      retract_(build(curve_.retract_gap, curve_.retract_force, "retract branch", curve_.origin)),
+      hysteresis_(hysteresis) {
+  switching_ = {approach_.x.back(), retract_.x.back()};
+  if (!(release_tolerance >= 0.0 && std::isfinite(release_tolerance)))
+    throw InvalidParameter("release_tolerance", fmt::format("release_tolerance = {} nN must be finite and >= 0",
+                                                            release_tolerance));
+  double scale = 0.0;
+  for (const auto* f : {&curve_.approach_force, &curve_.retract_force})
+    for (double v : *f) scale = std::max(scale, std::abs(v));
+  difference_end_ = compute_difference_end(release_tolerance > 0.0 ? release_tolerance : 1e-9 * scale);
+  release_ = std::max(contact_gap(), difference_end_);
+  if (hysteresis_ == Hysteresis::contact) {
+    switching_.push_back(contact_gap());
+    switching_.push_back(release_);
+  }
+  std::sort(switching_.begin(), switching_.end());
+  switching_.erase(std::unique(switching_.begin(), switching_.end()), switching_.end());
+  // regions (between consecutive switching gaps) where H_a and H_b may differ: up to the table's end, or (contact)
+  // up to the release gap, above which they are equal
+  const double top = hysteresis_ == Hysteresis::contact ? release_ : switching_.back();
+  dependent_regions_ = static_cast<int>(std::upper_bound(switching_.begin(), switching_.end(), top) - switching_.begin());
+  if (hysteresis_ == Hysteresis::contact) {
+    // region r covers [s_{r−1}, s_r): the regions up to and including the one ending at d_r
+    dependent_regions_ = static_cast<int>(std::lower_bound(switching_.begin(), switching_.end(), top) - switching_.begin()) + 1;
+  }
+}
+
+double TableLaw::compute_difference_end(double tolerance) const {
+  std::vector<double> knots = approach_.x;
+  knots.insert(knots.end(), retract_.x.begin(), retract_.x.end());
+  std::sort(knots.begin(), knots.end());
+  knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
+  // from the top down: the first knot interval (or knot) where |H_a − H_b| exceeds the tolerance; its upper end
+  // (beyond the last knot both branches are 0)
+  for (std::size_t k = knots.size(); k-- > 0;) {
+    const double a = knots[k];
+    if (k + 1 < knots.size()) {
+      const double b = knots[k + 1];
+      const Piece pa = approach_.local(a, b), pb = retract_.local(a, b);
+      const double len = b - a;
+      const auto [low, t_low] = cubic_minimum(pa.y - pb.y, pa.c1 - pb.c1, pa.c2 - pb.c2, pa.c3 - pb.c3, len);
+      const auto [neg_high, t_high] = cubic_minimum(pb.y - pa.y, pb.c1 - pa.c1, pb.c2 - pa.c2, pb.c3 - pa.c3, len);
+      (void)t_low, (void)t_high;
+      if (low < -tolerance || -neg_high > tolerance) return b;
+    }
+    if (std::abs(approach_.eval(a) - retract_.eval(a)) > tolerance) return a;
+  }
+  return -std::numeric_limits<double>::infinity();
+}
+
 
 TableLaw::Piece TableLaw::Branch::local(double a, double b) const {
   const std::size_t n = x.size();

@@ -247,6 +247,10 @@ DescribingFunctions DescribingFunctionQuadrature::at_gap(double mean_gap, double
   ends[n_ends++] = {pi, -1.0, 0.0, g - b};
   std::sort(ends, ends + n_ends, [](const End& x, const End& y) { return x.theta < y.theta; });
 
+  // A contact-aware law (docs/force-laws.md#hysteresis) over the cycle d = g + B cos θ: a cycle that reaches the
+  // contact gap (g − B ≤ d_c) is in contact from there on the way down, unloads on H_b and is released above d_r,
+  // where H_a = H_b — exactly the velocity-sign law; a cycle that does not reach it stays free: H_a throughout.
+  const bool touched = !law_.contact_aware() || g - b <= law_.contact_gap();
   std::vector<Piece> pieces;
   pieces.reserve(n_ends);
   for (int k = 0; k + 1 < n_ends; ++k) {
@@ -256,7 +260,7 @@ DescribingFunctions DescribingFunctionQuadrature::at_gap(double mean_gap, double
     const Map map = left && right ? Map::Both : left ? Map::Left : right ? Map::Right : Map::Linear;
     const double d_mid = g + b * std::cos(0.5 * (lo + hi));
     const int region = static_cast<int>(std::upper_bound(gaps_.begin(), gaps_.end(), d_mid) - gaps_.begin());
-    pieces.push_back({lo, hi, map, law_.branch_dependent(region), ends[k], ends[k + 1]});
+    pieces.push_back({lo, hi, map, touched && law_.branch_dependent(region), ends[k], ends[k + 1]});
   }
 
   Evaluator ev{law_, g, b, 2.0 * b * frequency_, law_.has_damping()};

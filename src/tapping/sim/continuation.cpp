@@ -31,9 +31,13 @@ struct Residual {
   Eigen::Vector2d value;
   Eigen::Matrix<double, 2, 3> jacobian;
   StroboscopicMap map;
+  bool memory = false;  // the memory of contact the map started with (contact-aware laws; docs/force-laws.md)
+  bool memory_repeats() const { return map.end.contact == memory; }
 };
 
-Residual residual(const TappingModel& base, const Eigen::Vector3d& z, const SimulationOptions& sim) {
+/// `memory`: the start memory of a contact-aware law; when the period ends with the other, the map is evaluated
+/// again from that one (as try_shoot does: a periodic orbit starts with the memory it ends with).
+Residual residual(const TappingModel& base, const Eigen::Vector3d& z, const SimulationOptions& sim, bool memory) {
   const double omega = base.drive.frequency;
   // a predictor along a tangent of a singular Jacobian (a tip held in contact: no motion to follow) gives NaN
   // unknowns; that is the continuation's failure, not a separation the user gave (issue 24 §2)
@@ -43,7 +47,12 @@ Residual residual(const TappingModel& base, const Eigen::Vector3d& z, const Simu
                                        z.x(), z.y(), z.z()));
   const TappingModel model = base.with_separation(z.z());
   Residual r;
-  r.map = stroboscopic_map(model, {z.x(), z.y() * omega}, 1, sim);
+  r.memory = memory;
+  r.map = stroboscopic_map(model, {z.x(), z.y() * omega, memory}, 1, sim);
+  if (!r.memory_repeats()) {
+    r.memory = r.map.end.contact;
+    r.map = stroboscopic_map(model, {z.x(), z.y() * omega, r.memory}, 1, sim);
+  }
   const Eigen::Matrix3d& s = r.map.sensitivity;
   r.value << r.map.end.position - z.x(), r.map.end.velocity / omega - z.y();
   r.jacobian << s(0, 0) - 1.0, omega * s(0, 1), s(0, 2),  //
@@ -65,7 +74,7 @@ SweepPoint make_point(const Eigen::Vector3d& z, const Residual& r, double omega,
   PeriodicOrbit& o = p.orbit;
   o.separation = z.z();
   o.period_multiple = 1;
-  o.initial = {z.x(), z.y() * omega};
+  o.initial = {z.x(), z.y() * omega, r.memory};
   o.monodromy = r.map.sensitivity.topLeftCorner<2, 2>();
   o.separation_sensitivity = r.map.sensitivity.topRightCorner<2, 1>();
   o.residual = r.value.cwiseAbs().maxCoeff() / std::max(1.0, z.head<2>().cwiseAbs().maxCoeff());
@@ -122,9 +131,9 @@ struct Tracer {
       bool converged = false;
       int it = 0;
       for (; it < options.max_corrector_iterations; ++it) {
-        rc = residual(base, zc, sim);
+        rc = residual(base, zc, sim, it == 0 ? r.memory : rc.memory);
         const double scale = std::max(1.0, zc.head<2>().cwiseAbs().maxCoeff());
-        if (it > 0 && rc.value.cwiseAbs().maxCoeff() <= options.tolerance * scale) {
+        if (it > 0 && rc.value.cwiseAbs().maxCoeff() <= options.tolerance * scale && rc.memory_repeats()) {
           converged = true;
           break;
         }
@@ -159,6 +168,7 @@ struct Tracer {
         f.point = out.points.size() - (std::abs(zc.z() - f.separation) <= std::abs(z.z() - f.separation) ? 0 : 1);
       }
       z = zc;
+      r = rc;  // (its memory of contact starts the next corrector)
       t = t_new;
       s = s_new;
       const bool left = z.z() < l_min || z.z() > l_max;
@@ -195,7 +205,7 @@ ContinuationResult continue_orbits(const TappingModel& base, const PeriodicOrbit
   Tracer tracer{base, options, l_min, l_max, sim, std::chrono::steady_clock::now(), out};
 
   Eigen::Vector3d z(start.initial.position, start.initial.velocity / omega, start.separation);
-  Residual r = residual(base, z, sim);
+  Residual r = residual(base, z, sim, start.initial.contact);
   Eigen::Vector3d t = tangent(r.jacobian);
   if ((t.z() > 0) != increasing) t = -t;
   Stop stop = tracer.trace(z, r, t);
@@ -212,7 +222,7 @@ ContinuationResult continue_orbits(const TappingModel& base, const PeriodicOrbit
       const TappingModel at = base.with_separation(l_graze);
       const TipState free = free_response_state(at);
       z = Eigen::Vector3d(free.position, free.velocity / omega, l_graze);
-      r = residual(base, z, sim);
+      r = residual(base, z, sim, false);
       if (r.value.cwiseAbs().maxCoeff() <= 1e3 * options.tolerance * std::max(1.0, z.head<2>().cwiseAbs().maxCoeff())) {
         tracer.s += (z - Eigen::Vector3d(last.orbit.initial.position, last.orbit.initial.velocity / omega,
                                          last.separation))

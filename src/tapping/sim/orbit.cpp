@@ -382,7 +382,8 @@ OrbitSearchResult search_orbits(const TappingModel& model, const OrbitSearchOpti
           } else if (da != 0.0 && (da < 0) != (db < 0)) {
             const double u = da / (da - db);
             crossings[r].push_back({a.orbit.initial.position + u * (b.orbit.initial.position - a.orbit.initial.position),
-                                    a.orbit.initial.velocity + u * (b.orbit.initial.velocity - a.orbit.initial.velocity)});
+                                    a.orbit.initial.velocity + u * (b.orbit.initial.velocity - a.orbit.initial.velocity),
+                                    a.orbit.initial.contact});
           }
         }
       } catch (const NumericalFailure&) {

@@ -67,14 +67,30 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   };
   Eigen::Vector2d y(guess.position, guess.velocity);
+  // The memory of a contact-aware law is part of the orbit's state (docs/force-laws.md#hysteresis): a periodic
+  // orbit starts with the memory it ends with. Newton runs with the guess's memory; when it has converged on a
+  // state whose period ends with the other memory (an orbit that touches, or rises above the release gap, fixes
+  // its end memory whatever it started with), it continues from there with that memory (at most twice). The
+  // memory never changes at an unconverged iterate: a wild Newton step that touches the sample cannot turn a
+  // free orbit between the contact and the release gaps into an attached one.
+  bool memory = guess.contact;
+  int memory_switches = 0;
   auto evaluate = [&](const Eigen::Vector2d& at) {
-    return stroboscopic_map(model, {at.x(), at.y()}, period_multiple, options.simulation);
+    return stroboscopic_map(model, {at.x(), at.y(), memory}, period_multiple, options.simulation);
   };
   StroboscopicMap map = evaluate(y);
   Eigen::Vector2d r = Eigen::Vector2d(map.end.position, map.end.velocity) - y;
   double norm = scaled_norm(r, y, omega);
   for (int it = 0; it <= options.max_iterations; ++it) {
-    if (norm <= tolerance) {
+    if (norm <= tolerance && map.end.contact != memory) {
+      if (memory_switches == 2) return std::nullopt;  // the memory does not repeat: no period-n orbit here
+      ++memory_switches;
+      memory = map.end.contact;
+      map = evaluate(y);
+      r = Eigen::Vector2d(map.end.position, map.end.velocity) - y;
+      norm = scaled_norm(r, y, omega);
+    }
+    if (norm <= tolerance && map.end.contact == memory) {
       // the last Newton step, from the map already evaluated, takes the state from a residual of size `norm` to
       // one of size O(norm²): without it the fixed point is off by (M − I)⁻¹ r, large when a multiplier is
       // near 1 (high Q)
@@ -86,7 +102,7 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
       PeriodicOrbit orbit;
       orbit.separation = model.separation;
       orbit.period_multiple = period_multiple;
-      orbit.initial = {y.x(), y.y()};
+      orbit.initial = {y.x(), y.y(), memory};
       orbit.monodromy = map.sensitivity.topLeftCorner<2, 2>();
       orbit.separation_sensitivity = map.sensitivity.topRightCorner<2, 1>();
       orbit.residual = norm;

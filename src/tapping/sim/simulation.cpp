@@ -71,6 +71,7 @@ SimulationResult simulate(const TappingModel& model, double t_begin, TipState st
   SimulationResult out;
   out.time = rs.t;
   out.state = rs.y;
+  out.state.contact = rs.mode.contact;  // the memory of a contact-aware law travels with the state
   out.mode = rs.mode;
   out.stats = rs.stats;
   out.sensitivity = rs.jacobian;

@@ -108,10 +108,10 @@ std::optional<Eigen::Vector2d> branch_slope(const PeriodicOrbit& orbit, double o
 /// Whether one Newton step for the fixed point of the stroboscopic map, taken from the scaled state `from`,
 /// lands ten times closer to the scaled state `target` than `from` is (or within Newton-level agreement).
 bool newton_heads_for(const TappingModel& model, const Eigen::Vector2d& from, const Eigen::Vector2d& target, int n,
-                      double omega, const SimulationOptions& simulation) {
+                      double omega, const SimulationOptions& simulation, bool memory) {
   const double before = (from - target).norm();
   try {
-    const StroboscopicMap m = stroboscopic_map(model, {from.x(), from.y() * omega}, n, simulation);
+    const StroboscopicMap m = stroboscopic_map(model, {from.x(), from.y() * omega, memory}, n, simulation);
     const Eigen::Matrix2d jac = m.sensitivity.topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity();
     const Eigen::FullPivLU<Eigen::Matrix2d> lu(jac);
     if (!lu.isInvertible()) return false;
@@ -204,7 +204,8 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
     std::optional<PeriodicOrbit> next;
     ++out.substeps;
     try {
-      next = try_shoot(base.with_separation(l_next), {predicted.x(), predicted.y() * omega}, n, quick);
+      next = try_shoot(base.with_separation(l_next), {predicted.x(), predicted.y() * omega, current.initial.contact}, n,
+                       quick);
     } catch (const NumericalFailure&) {
       next.reset();
     }
@@ -233,11 +234,11 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
         const TappingModel at_current = base.with_separation(current.separation);
         // usually one Newton step from the backward prediction shows where it goes: it closes 90 % of the
         // distance to the current orbit (quadratic convergence towards it). Otherwise Newton decides in full.
-        accepted = newton_heads_for(at_current, back_guess, z, n, omega, quick.simulation);
+        accepted = newton_heads_for(at_current, back_guess, z, n, omega, quick.simulation, current.initial.contact);
         if (!accepted) {
           std::optional<PeriodicOrbit> back;
           try {
-            back = try_shoot(at_current, {back_guess.x(), back_guess.y() * omega}, n, quick);
+            back = try_shoot(at_current, {back_guess.x(), back_guess.y() * omega, current.initial.contact}, n, quick);
           } catch (const NumericalFailure&) {
             back.reset();
           }

@@ -22,6 +22,13 @@ TappingSystem::TappingSystem(TappingModel model)
   for (int r = 0; r < regions && r < 64; ++r)
     if (model_.law.branch_dependent(r)) dependent_mask_ |= 1ul << r;
   has_damping_ = model_.law.has_damping();
+  if (model_.law.contact_aware()) {
+    // both gaps are switching gaps (ForceLaw checks it): region r spans [s_{r−1}, s_r)
+    contact_aware_ = true;
+    const auto& s = switching();
+    contact_top_ = static_cast<int>(std::lower_bound(s.begin(), s.end(), model_.law.contact_gap()) - s.begin());
+    release_region_ = static_cast<int>(std::lower_bound(s.begin(), s.end(), model_.law.release_gap()) - s.begin()) + 1;
+  }
 }
 
 int TappingSystem::region_of(double gap) const {
@@ -140,57 +147,71 @@ Mode TappingSystem::initial_mode(double t, TipState& s) const {
   int region = region_of(gap(s.position));
   // exactly on a switching gap and moving down: the motion continues in the region below
   if (region > 0 && gap(s.position) == switching()[region - 1] && s.velocity < 0) --region;
-  return enter_region(region, t, s);
+  // contact-aware: in contact below the contact gap, free above the release gap, the state's memory between
+  const bool contact = contact_aware_ && (region <= contact_top_ || (s.contact && region < release_region_));
+  return enter_region(region, t, s, contact);
 }
 
-Mode TappingSystem::enter_region(int region, double t, TipState& s) const {
-  if (s.velocity < 0) return {region, ContactBranch::approach};
-  if (s.velocity > 0) return {region, ContactBranch::departure};
+Mode TappingSystem::enter_region(int region, double t, TipState& s, bool contact) const {
+  if (contact_aware_ && !contact) return {region, ContactBranch::approach, false};  // free: H_a whatever ẋ
+  if (s.velocity < 0) return {region, ContactBranch::approach, contact};
+  if (s.velocity > 0) return {region, ContactBranch::departure, contact};
   if (!branch_dependent(region)) {
     const double a = acceleration(ContactBranch::approach, region, t, s);
-    return {region, a < 0 ? ContactBranch::approach : ContactBranch::departure};
+    return {region, a < 0 ? ContactBranch::approach : ContactBranch::departure, contact};
   }
   const double aa = acceleration(ContactBranch::approach, region, t, s);
   const double ab = acceleration(ContactBranch::departure, region, t, s);
-  if (aa < 0) return {region, ContactBranch::approach};
-  if (ab > 0) return {region, ContactBranch::departure};
+  if (aa < 0) return {region, ContactBranch::approach, contact};
+  if (ab > 0) return {region, ContactBranch::departure, contact};
   s.velocity = 0.0;
-  return {region, ContactBranch::sticking};
+  return {region, ContactBranch::sticking, contact};
 }
 
 Mode TappingSystem::after_velocity_zero(int region, ContactBranch from, double t, TipState& s) const {
   TipState rest{s.position, 0.0};
   const double aa = acceleration(ContactBranch::approach, region, t, rest);
   const double ab = acceleration(ContactBranch::departure, region, t, rest);
+  // (a velocity guard exists only in velocity-switched modes: in contact for a contact-aware law)
+  const bool contact = contact_aware_;
   if (from == ContactBranch::approach) {
-    if (ab > 0) return {region, ContactBranch::departure};
+    if (ab > 0) return {region, ContactBranch::departure, contact};
     if (aa < 0) {
       s.velocity = 0.0;
-      return {region, ContactBranch::approach};
+      return {region, ContactBranch::approach, contact};
     }
   } else {
-    if (aa < 0) return {region, ContactBranch::approach};
+    if (aa < 0) return {region, ContactBranch::approach, contact};
     if (ab > 0) {
       s.velocity = 0.0;
-      return {region, ContactBranch::departure};
+      return {region, ContactBranch::departure, contact};
     }
   }
   s.velocity = 0.0;  // both branches push back onto ẋ = 0: the tip sticks
-  return {region, ContactBranch::sticking};
+  return {region, ContactBranch::sticking, contact};
 }
 
 Mode TappingSystem::after_event(const Mode& mode, const Guard& guard, double t, TipState& s) const {
   switch (guard.kind) {
-    case GuardKind::gap:
-      return enter_region(guard.direction == CrossingDirection::falling ? mode.region - 1 : mode.region + 1, t, s);
+    case GuardKind::gap: {
+      const int region = guard.direction == CrossingDirection::falling ? mode.region - 1 : mode.region + 1;
+      // contact-aware: contact begins when the gap falls through the contact gap, ends when it rises through
+      // the release gap (the memory holds in between)
+      bool contact = mode.contact;
+      if (contact_aware_) {
+        if (region <= contact_top_) contact = true;
+        if (region >= release_region_) contact = false;
+      }
+      return enter_region(region, t, s, contact);
+    }
     case GuardKind::velocity:
       return after_velocity_zero(mode.region, mode.branch, t, s);
     case GuardKind::release_departure:
       s.velocity = 0.0;
-      return {mode.region, ContactBranch::departure};
+      return {mode.region, ContactBranch::departure, mode.contact};
     case GuardKind::release_approach:
       s.velocity = 0.0;
-      return {mode.region, ContactBranch::approach};
+      return {mode.region, ContactBranch::approach, mode.contact};
   }
   return mode;
 }
@@ -205,7 +226,7 @@ int TappingSystem::guards(const Mode& mode, std::array<Guard, 3>& out) const {
   if (mode.region > 0) out[n++] = {GuardKind::gap, CrossingDirection::falling, switching()[mode.region - 1]};
   if (mode.region < static_cast<int>(switching().size()))
     out[n++] = {GuardKind::gap, CrossingDirection::rising, switching()[mode.region]};
-  if (branch_dependent(mode.region)) {
+  if (velocity_switched(mode)) {
     out[n++] = {GuardKind::velocity,
                 mode.branch == ContactBranch::approach ? CrossingDirection::rising : CrossingDirection::falling, 0.0};
   }

@@ -39,6 +39,9 @@
 //     interpolant's end value and slope (C¹);
 //   * above the largest distance: 0 — the table must reach out to where the interaction is negligible; the
 //     force jumps to 0 there, and that distance is a switching gap of the law.
+//   * branch selection: contact-aware by default (docs/force-laws.md#hysteresis) — the retract branch only after
+//     the tip reached the contact gap, until it rises above the release gap (where the branches become equal,
+//     to the release tolerance); Hysteresis::velocity gives the seed's rule (by the sign of the gap rate).
 // Evaluation allocates nothing: the interval is found in O(1) on an evenly spaced table (as AFM exports are), by
 // binary search otherwise (measured ≈ 16 ns / 38 ns latency per call for 200 knots, about that of the DMT law).
 // A noisy baseline makes the retract force exceed the approach force somewhere, which require_dissipative()
@@ -47,6 +50,7 @@
 // retract, and a retract contact stiffer at the deepest point than the approach (its straight line rises above
 // the approach's below the tables).
 #include <cstddef>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -73,19 +77,38 @@ class TableLaw final : public ForceLawModel {
  public:
   /// Validates (InvalidParameter "force_curve"): each branch ≥ 4 points, equal lengths, finite values, strictly
   /// ascending gaps, and an interpolant that stays finite (distances not absurdly close for the forces).
-  explicit TableLaw(ForceCurve curve, bool allow_energy_gain = false);
+  /// `hysteresis`: contact (the default: the retract branch applies only after the tip reached the contact gap,
+  /// until it rises above the release gap; docs/force-laws.md#hysteresis) or velocity (seed-1 eq. 4: the branch
+  /// by the sign of the gap rate alone, so any branch difference at positive gap dissipates at every turn).
+  /// `release_tolerance` [nN] (contact-aware only; finite, ≥ 0): a branch difference up to it counts as none when
+  /// placing the release gap (a measured curve's drag, baseline offset or noise above the pull-off); 0: 1e-9 of the
+  /// largest tabulated force. Above the release gap the law is H_a on both branches' behalf.
+  explicit TableLaw(ForceCurve curve, bool allow_energy_gain = false, Hysteresis hysteresis = Hysteresis::contact,
+                    double release_tolerance = 0.0);
 
   std::string name() const override { return "table"; }
   double approach(double gap) const override { return approach_.eval(gap); }
   double departure(double gap) const override { return retract_.eval(gap); }
   bool smooth() const override { return false; }  // PCHIP: C¹ at the knots
   /// The largest distance of each branch (where the force jumps to 0); one value if both branches end together.
+  /// Contact-aware: also the contact gap and the release gap (the mode switches; the interpolant is C¹ there).
   std::vector<double> switching_gaps() const override { return switching_; }
+  Hysteresis hysteresis() const override { return hysteresis_; }
+  /// Contact-aware: the release gap d_r = max(contact gap, the largest distance below which the branches differ
+  /// by more than the release tolerance somewhere) — exact for the interpolant (the extrema of the cubic difference
+  /// between consecutive knots of the union). Above it H_a = H_b to that tolerance (a measured curve whose
+  /// branches differ by noise up to the end of the table has d_r = the end of the shorter table's branch
+  /// difference, usually the table's end). NaN for velocity-sign switching.
+  double release_gap() const override { return hysteresis_ == Hysteresis::contact ? release_ : std::numeric_limits<double>::quiet_NaN(); }
+  /// The largest distance at which the interpolated branches differ (by more than the release tolerance); −inf if
+  /// never.
+  double branch_difference_end() const { return difference_end_; }
   /// Contact: below the bottom of the approach curve's adhesion well (the tabulated distance of its most negative
   /// force); a curve without attraction: below the largest distance where its force is positive.
   double contact_gap() const override;
-  /// Below the highest switching gap the branches may differ; above it both are 0.
-  bool branch_dependent(int region) const override { return region < static_cast<int>(switching_.size()); }
+  /// Below the highest switching gap the branches may differ; above it both are 0 (contact-aware: above the
+  /// release gap they are equal).
+  bool branch_dependent(int region) const override { return region < dependent_regions_; }
   /// Unless allow_energy_gain: H_a(d) ≥ H_b(d) − 1e-9·max|F| for every distance d, as the law is evaluated —
   /// the cubics between the knots of either branch, the straight lines below the tables (where the difference is
   /// linear: the retract line may not be steeper than the approach line, slopes within 1e-9 counting as equal)
@@ -127,6 +150,11 @@ class TableLaw final : public ForceLawModel {
   bool allow_gain_;
   Branch approach_, retract_;
   std::vector<double> switching_;
+  Hysteresis hysteresis_ = Hysteresis::contact;
+  double difference_end_ = 0.0;  // largest distance where the branches differ (−inf: nowhere)
+  double release_ = 0.0;         // max(contact gap, difference_end_)
+  int dependent_regions_ = 0;    // regions below this index may have H_a ≠ H_b
+  double compute_difference_end(double tolerance) const;
 };
 
 }  // namespace afmkit::impact
