@@ -66,6 +66,7 @@ struct Evaluation {
   Eigen::Matrix3d sensitivity = Eigen::Matrix3d::Identity();  // ∂(x, ẋ, l)(T)/∂(x, ẋ, l)(0)
   OrbitMetrics metrics;
   double norm = 0.0;
+  bool end_contact = false;  // the memory of a contact-aware law at the end of the period
 };
 
 /// The FM conditions at a fixed separation (4 unknowns) or at a fixed gap of the lower turning point (5 unknowns:
@@ -89,6 +90,9 @@ class FmProblem {
   const Eigen::VectorXd& scale() const { return scale_; }
   long evaluations() const { return evaluations_; }
   double separation(const Eigen::VectorXd& z) const { return gap_ ? z(4) : separation_; }
+  /// The memory of contact the period starts with (contact-aware laws, docs/force-laws.md#hysteresis).
+  bool memory() const { return memory_; }
+  void set_memory(bool contact) { memory_ = contact; }
 
   Evaluation evaluate(const Eigen::VectorXd& z, bool sensitivity) {
     ++evaluations_;
@@ -97,7 +101,7 @@ class FmProblem {
     SimulationOptions o = options_.shooting.simulation;
     o.sensitivity = sensitivity;
     OrbitIntegrals integrals(quadrature_panel(model));
-    const SimulationResult r = simulate(model, 0.0, {z(0), z(1)}, period, o, &integrals);
+    const SimulationResult r = simulate(model, 0.0, {z(0), z(1), memory_}, period, o, &integrals);
     Evaluation e;
     const double a = setting_.amplitude;
     const std::complex<double> c1 = 2.0 * integrals.fourier[1] / period;  // x ≈ x̄ + Re(c1 e^{iωt}); want −iA
@@ -107,6 +111,7 @@ class FmProblem {
     if (gap_) e.residual(4) = (integrals.min_gap - *gap_) / a;
     e.norm = e.residual.cwiseAbs().maxCoeff();
     e.sensitivity = r.sensitivity;
+  e.end_contact = r.state.contact;
     OrbitMetrics& m = e.metrics;
     m.offset = integrals.fourier[0].real() / period;
     m.amplitude = std::abs(c1);
@@ -159,6 +164,7 @@ class FmProblem {
   Eigen::VectorXd scale_;
   double step_ = 1e-7;
   long evaluations_ = 0;
+  bool memory_ = false;
 };
 
 std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::optional<double> gap,
@@ -179,6 +185,10 @@ std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::o
       resolve_integrator(probe, options.shooting.simulation.integrator) == Integrator::adaptive
           ? std::max(options.shooting.tolerance, 10.0 * options.shooting.simulation.relative_tolerance)
           : options.shooting.tolerance;
+  // the memory of a contact-aware law is part of the orbit (as in shooting): Newton runs with the guess's memory,
+  // and a converged state whose period ends with the other memory continues with that one (at most twice)
+  problem.set_memory(guess.initial.contact);
+  int memory_switches = 0;
   Eigen::VectorXd z(problem.size());
   z.head<4>() << guess.initial.position, guess.initial.velocity, guess.frequency, guess.drive;
   if (gap) z(4) = separation;
@@ -188,11 +198,17 @@ std::optional<FmOrbit> solve(const FmSetting& setting, double separation, std::o
   bool fresh = !(reuse && reuse->matrix.rows() == problem.size());
   bool refresh = fresh;
   for (int it = 0;; ++it) {
-    if (e.norm <= tolerance) {
+    if (e.norm <= tolerance && e.end_contact != problem.memory()) {
+      if (memory_switches == 2) return std::nullopt;  // the memory does not repeat: no periodic orbit here
+      ++memory_switches;
+      problem.set_memory(e.end_contact);
+      e = problem.evaluate(z, true);
+    }
+    if (e.norm <= tolerance && e.end_contact == problem.memory()) {
       if (reuse && j.size() > 0) reuse->matrix = j;
       FmOrbit orbit;
       orbit.separation = problem.separation(z);
-      orbit.state = {{z(0), z(1)}, z(2), z(3)};
+      orbit.state = {{z(0), z(1), problem.memory()}, z(2), z(3)};
       orbit.natural_frequency = setting.cantilever.natural_frequency;
       orbit.free_drive = setting.free_drive();
       orbit.monodromy = e.sensitivity.topLeftCorner<2, 2>();
