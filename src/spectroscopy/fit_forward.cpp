@@ -4,12 +4,15 @@
 #include <cmath>
 #include <numeric>
 
+#include <Eigen/LU>
+
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/parallel.hpp"
 #include "afmkit/impact/law_registry.hpp"
 #include "afmkit/spectroscopy/fit_model.hpp"
+#include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/units.hpp"
 
 namespace afmkit::spectroscopy {
@@ -42,6 +45,44 @@ Point settle_at(const TappingModel& m, tapping::TipState start, const tapping::S
   return p;
 }
 
+double state_distance(tapping::TipState a, tapping::TipState b, double omega) {
+  return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
+}
+
+/// Where the tip lands when the followed branch ends just before m.separation. The transient from the last stable
+/// orbit decides (as in the sweep), unless Newton from the harmonic-balance solutions at m.separation finds exactly
+/// one stable orbit: then no other attractor of period 1 exists there and the transient would end on it (it may
+/// take thousands of drive periods at a high Q; a period-n or non-periodic attractor, which HB cannot see, is
+/// missed: documented in docs/fitting.md#model).
+Point land(const TappingModel& m, const PeriodicOrbit& last, const tapping::SweepOptions& o, long& solves) {
+  const double omega = m.drive.frequency;
+  std::vector<PeriodicOrbit> found;
+  try {
+    for (const tapping::HbPoint& h : tapping::harmonic_balance_solutions(m)) {
+      const tapping::TipState s{h.offset + h.amplitude * std::cos(h.phase), h.amplitude * omega * std::sin(h.phase)};
+      ++solves;
+      const std::optional<PeriodicOrbit> orbit = tapping::try_shoot(m, s, 1, o.shooting);
+      if (!orbit || !orbit->stable) continue;
+      const double scale = std::max(1.0, std::hypot(orbit->initial.position, orbit->initial.velocity / omega));
+      const bool known = std::any_of(found.begin(), found.end(), [&](const PeriodicOrbit& f) {
+        return state_distance(f.initial, orbit->initial, omega) <= 1e-6 * scale;
+      });
+      if (!known) found.push_back(*orbit);
+    }
+  } catch (const std::exception&) {
+    found.clear();
+  }
+  if (found.size() == 1) {
+    Point p;
+    p.orbit = found.front();
+    p.orbit.separation = m.separation;
+    p.jumped = true;
+    return p;
+  }
+  ++solves;
+  return settle_at(m, last.initial, o);
+}
+
 /// One step of the instrument sweep: from `prev` to separation l_to along the stable branch; where it ends, the
 /// transient from the last stable orbit just beyond (then followed on). The sweep's own step (tapping/sweep.cpp)
 /// without the classification of jumps (a fit needs the orbit, not whether the branch connects back).
@@ -63,8 +104,7 @@ Point step(const TappingModel& base, const Point& prev, double l_to, const tappi
       return p;
     }
     const double l_land = std::isfinite(f.failed_at) && pass + 1 < kMaxPasses ? f.failed_at : l_to;
-    ++solves;
-    Point landed = settle_at(base.with_separation(l_land), f.last.initial, o);
+    Point landed = land(base.with_separation(l_land), f.last, o, solves);
     if (l_land == l_to) return landed;
     cur = landed;
     cur.jumped = true;
@@ -78,6 +118,8 @@ AmForwardModel::AmForwardModel(const AmSettings& settings, const FitOptions& opt
     : settings_(settings), options_(options), distances_(std::move(distances)) {
   sweep_.harmonic_balance = false;
   sweep_.parallel = false;
+  sweep_.shooting.simulation.relative_tolerance = options.integrator_tolerance;
+  sweep_.shooting.tolerance = options.shooting_tolerance;
 }
 
 TappingModel AmForwardModel::model(const ModelValues& values) const {
@@ -177,7 +219,7 @@ CurveEvaluation AmForwardModel::walk(const ModelValues& values) const {
   return e;
 }
 
-CurveEvaluation AmForwardModel::warm(const ModelValues& values, const CurveEvaluation& from) const {
+CurveEvaluation AmForwardModel::warm(const ModelValues& values, const CurveEvaluation& from, bool chord) const {
   const std::size_t n = distances_.size();
   if (!from.ok || from.orbits.size() != n) return walk(values);
   for (std::size_t i = 0; i < n; ++i)
@@ -190,36 +232,66 @@ CurveEvaluation AmForwardModel::warm(const ModelValues& values, const CurveEvalu
   e.jumped = from.jumped;
   tapping::ShootingOptions quick = sweep_.shooting;
   quick.max_iterations = std::min(quick.max_iterations, 8);
+  tapping::SimulationOptions plain = sweep_.shooting.simulation;
+  plain.sensitivity = false;
   const double omega = m.drive.frequency;
   const double amplitude = m.free_amplitude();
   std::atomic<bool> failed{false};
   std::atomic<long> solves{0};
+  ExceptionCollector errors;
 #pragma omp parallel for schedule(dynamic) if (options_.parallel)
   for (std::size_t i = 0; i < n; ++i) {
     if (failed.load()) continue;
-    const PeriodicOrbit& old = from.orbits[i];
-    const double l = separation(values, i);
-    std::optional<PeriodicOrbit> o;
-    try {
-      o = tapping::try_shoot(m.with_separation(l), old.initial, old.period_multiple, quick);
-    } catch (const std::exception&) {
-      o.reset();
-    }
-    ++solves;
-    // the same branch: stable, of the same period, and near the previous orbit (a small change of the values
-    // moves the orbit a little; another branch is a finite distance away)
-    const bool near = o && o->stable && o->period_multiple == old.period_multiple &&
-                      std::hypot(o->initial.position - old.initial.position,
-                                 (o->initial.velocity - old.initial.velocity) / omega) <= 0.05 * amplitude;
-    if (!near) {
-      failed = true;
-      continue;
-    }
-    e.orbits[i] = *o;
-    e.orbits[i].separation = l;
+    errors.run([&] {
+      const PeriodicOrbit& old = from.orbits[i];
+      const TappingModel at = m.with_separation(separation(values, i));
+      ++solves;
+      std::optional<PeriodicOrbit> o;
+      if (chord) {
+        // one chord-Newton step with the monodromy of `old`: z' = z − (M − I)⁻¹ (P'(z) − z), off the perturbed
+        // orbit by O(|z' − z|²), the order of the forward difference's own error (docs/fitting.md#jacobian)
+        const int k = old.period_multiple;
+        const tapping::SimulationResult r = tapping::simulate(at, 0.0, old.initial, k * at.period(), plain);
+        const Eigen::Vector2d res(r.state.position - old.initial.position, r.state.velocity - old.initial.velocity);
+        const Eigen::Vector2d dz = (old.monodromy - Eigen::Matrix2d::Identity()).fullPivLu().solve(-res);
+        if (dz.allFinite() && std::hypot(dz.x(), dz.y() / omega) <= 0.01 * amplitude) {
+          o = old;
+          o->initial = {old.initial.position + dz.x(), old.initial.velocity + dz.y()};
+        }
+      }
+      if (!o) {
+        try {
+          o = tapping::try_shoot(at, old.initial, old.period_multiple, quick);
+        } catch (const NumericalFailure&) {
+          o.reset();
+        }
+      }
+      // the same branch: stable, of the same period, and near the previous orbit (a small change of the values
+      // moves the orbit a little; another branch is a finite distance away)
+      const bool near = o && o->stable && o->period_multiple == old.period_multiple &&
+                        state_distance(o->initial, old.initial, omega) <= 0.05 * amplitude;
+      if (!near) {
+        failed = true;
+        return;
+      }
+      e.orbits[i] = *o;
+      e.orbits[i].separation = at.separation;
+    });
   }
   orbits_ += solves.load();
-  if (failed.load()) return walk(values);
+  if (errors.failed() || failed.load()) return walk(values);
+  if (!chord) {
+    // where `from` jumped (its branch ended between the points i − 1 and i), the branch must still end there: the
+    // orbit at i − 1 followed to l_i must not arrive (else the jump moved past a point: the whole sweep decides)
+    tapping::SweepOptions check = sweep_;
+    check.jump_tolerance = 1e-2;  // only whether it arrives, not where it ends
+    for (std::size_t i = 1; i < n; ++i) {
+      if (!from.jumped[i] || from.jumped[i - 1]) continue;
+      const tapping::BranchFollow f = tapping::follow_stable_branch(m, e.orbits[i - 1], e.orbits[i].separation, check);
+      orbits_ += f.substeps;
+      if (f.reached) return walk(values);
+    }
+  }
   finish(m, values, e);
   return e;
 }

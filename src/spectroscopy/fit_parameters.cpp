@@ -98,6 +98,11 @@ void FitOptions::validate() const {
   validate::require(tolerance >= 1e-15 && tolerance <= 0.1, "tolerance", tolerance, "in [1e-15, 0.1]");
   validate::require(correlation_limit > 0.0 && correlation_limit < 1.0, "correlation_limit", correlation_limit,
                     "in (0, 1)");
+  validate::require(integrator_tolerance >= 1e-14 && integrator_tolerance <= 1e-4, "integrator_tolerance",
+                    integrator_tolerance, "in [1e-14, 1e-4]");
+  validate::require(shooting_tolerance >= 1e-14 && shooting_tolerance <= 1e-4, "shooting_tolerance",
+                    shooting_tolerance, "in [1e-14, 1e-4]");
+  validate::require(flat_column >= 0.0 && flat_column <= 1.0, "flat_column", flat_column, "in [0, 1]");
   validate::require(condition_limit > 1.0, "condition_limit", condition_limit, "> 1");
 }
 

@@ -4,6 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <cstdio>
+#include <cstdlib>
 #include <numeric>
 
 #include <Eigen/Core>
@@ -111,7 +114,8 @@ class Problem {
     const ModelValues v = values(u);
     CurveEvaluation e;
     try {
-      e = model_.walk(v);
+      // warm started from the best evaluation so far (the solver's current point), else the whole sweep
+      e = best_ ? model_.warm(v, *best_) : model_.walk(v);
     } catch (const InvalidParameter& ex) {  // a trial outside a law's valid set (e.g. energy gain)
       e.ok = false;
       e.error = ex.what();
@@ -122,6 +126,18 @@ class Problem {
     if (!e.ok) {
       ++failed_;
       last_error_ = e.error;
+    }
+    if (e.ok) {
+      const double cost = residuals(e, v).squaredNorm();
+      if (std::getenv("AFMKIT_FIT_DEBUG")) {
+        std::fprintf(stderr, "eval cost %.6g:", cost);
+        for (long j = 0; j < u.size(); ++j) std::fprintf(stderr, " %.6g", to_parameter(params_[j], u[j]));
+        int jumps = 0; for (bool b : e.jumped) jumps += b; std::fprintf(stderr, " jumped %d\n", jumps);
+      }
+      if (!best_ || cost < best_cost_) {
+        best_ = std::make_shared<CurveEvaluation>(e);
+        best_cost_ = cost;
+      }
     }
     if (cache_.size() >= 4) cache_.erase(cache_.begin());
     cache_.emplace_back(u, std::move(e));
@@ -148,7 +164,7 @@ class Problem {
       }
       CurveEvaluation e;
       try {
-        e = model_.warm(vj, b);
+        e = model_.warm(vj, b, true);
       } catch (const InvalidParameter& ex) {
         e.ok = false;
         e.error = ex.what();
@@ -159,7 +175,7 @@ class Problem {
       if (!e.ok) {  // the step leaves the law's valid set: the backward difference
         uj[j] = u[j] - h;
         const ModelValues vb = values(uj);
-        e = model_.warm(vb, b);
+        e = model_.warm(vb, b, true);
         if (!e.ok) return false;
         jac.col(j) = (r0 - residuals(e, vb)) / h;
         continue;
@@ -181,6 +197,8 @@ class Problem {
   double sigma_a_, sigma_p_;
   AmForwardModel model_;
   std::vector<std::pair<Eigen::VectorXd, CurveEvaluation>> cache_;
+  std::shared_ptr<const CurveEvaluation> best_;
+  double best_cost_ = 0.0;
   long failed_ = 0;
   std::string last_error_;
 };
@@ -254,11 +272,13 @@ void statistics(const Eigen::MatrixXd& jac, double s2, const Eigen::VectorXd& u,
   std::vector<long> live;  // parameters the data depend on
   r.identifiable.assign(static_cast<std::size_t>(p), true);
   for (long j = 0; j < p; ++j) {
-    if (!(d[j] > 1e-12 * dmax) || dmax == 0.0) {
+    // flat: a change of u by 1 (a factor e of a law parameter, 1 nm of offset, 1 rad of phase) moves the weighted
+    // residuals by less than flat_column (in units of the noise): what is left is the orbits' rounding
+    if (!(d[j] > options.flat_column) || !(d[j] > 1e-12 * dmax)) {
       r.identifiable[static_cast<std::size_t>(j)] = false;
       r.warnings.push_back(fmt::format("{} is not identifiable: the fitted curve does not depend on it (flat cost: "
-                                       "its Jacobian column is zero{})",
-                                       r.parameters[static_cast<std::size_t>(j)].name,
+                                       "the norm of its weighted Jacobian column is {:.2g} < {:.2g}{})",
+                                       r.parameters[static_cast<std::size_t>(j)].name, d[j], options.flat_column,
                                        r.parameters[static_cast<std::size_t>(j)].name == "effective_modulus" ||
                                                r.parameters[static_cast<std::size_t>(j)].name == "departure_modulus"
                                            ? "; the tip never reaches the contact gap"
@@ -404,6 +424,12 @@ FitResult fit_am_curve(const AmCurve& curve, const AmSettings& settings, const F
   lm.parameters.ftol = options.tolerance;
   lm.parameters.xtol = options.tolerance;
   lm.parameters.maxfev = 100000;  // the budget is max_evaluations, counted in curves (Functor)
+  // the trust region in u itself (each u is already a natural scale: an e-fold of a law parameter, 1 nm of offset,
+  // 1 rad of phase): the first step is at most |Δu| = 1 (MINPACK's own scaling by the Jacobian's column norms lets
+  // a weakly determined parameter leap by many decades)
+  lm.useExternalScaling = true;
+  lm.diag = Eigen::VectorXd::Ones(p);
+  lm.parameters.factor = 1.0;
   const int status = lm.minimize(u);
   r.iterations = static_cast<int>(lm.iter);
   r.solver_status = solver_status_text(status);

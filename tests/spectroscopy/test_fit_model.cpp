@@ -21,7 +21,7 @@ AmSettings settings() {
   s.spring_constant = 40.0;
   s.resonance_frequency = 300e3;
   s.quality_factor = 400.0;
-  s.free_amplitude = 10e-9;
+  s.free_amplitude = 20e-9;
   return s;
 }
 
@@ -36,13 +36,13 @@ FitOptions dmt() {
 
 TEST(FitModel, ApproachMatchesTheInstrumentSweep) {
   // the same cantilever and law through tapping::sweep_instrument (physical units: nm, kHz, GPa)
-  const tapping::PhysicalCantilever pc(40.0, 300.0, 400.0, 10.0, 1.0);
+  const tapping::PhysicalCantilever pc(40.0, 300.0, 100.0, 20.0, 1.0);  // Q = 100: short transients
   impact::LawArguments args;
   args.values = {{"effective_modulus", 1.0}, {"tip_radius", 10.0}, {"hamaker", 1e-19}};
   const tapping::TappingModel base(pc.cantilever(), pc.drive(),
                                    pc.normalised_law(impact::LawRegistry::builtin().build("dmt", args)), 0.0);
   std::vector<double> l_nm;
-  for (int i = 0; i < 41; ++i) l_nm.push_back(3.0 + 0.2 * i);
+  for (int i = 0; i < 41; ++i) l_nm.push_back(12.0 + 0.25 * i);  // from free to tapping in contact
   tapping::SweepOptions so;
   so.harmonic_balance = false;
   so.parallel = false;
@@ -50,9 +50,13 @@ TEST(FitModel, ApproachMatchesTheInstrumentSweep) {
 
   FitOptions o = dmt();
   o.initial["distance_offset"] = 0.5e-9;  // model separation = distance + 0.5 nm
+  o.integrator_tolerance = 1e-10;         // the sweep's defaults
+  o.shooting_tolerance = 1e-11;
   std::vector<double> z;
   for (double l : l_nm) z.push_back(l * 1e-9 - 0.5e-9);
-  const AmPrediction pred = predict_am_curve(z, settings(), o);
+  AmSettings q100 = settings();
+  q100.quality_factor = 100.0;
+  const AmPrediction pred = predict_am_curve(z, q100, o);
   int touching = 0;
   for (std::size_t i = 0; i < z.size(); ++i) {
     const std::size_t k = z.size() - 1 - i;  // the sweep's approach runs from the largest separation
@@ -63,6 +67,8 @@ TEST(FitModel, ApproachMatchesTheInstrumentSweep) {
   }
   EXPECT_GT(touching, 5);  // the curve reaches the contact
   EXPECT_LT(touching, 41);
+  for (bool j : pred.jumped) EXPECT_FALSE(j);  // Q = 100: no jump on this approach (neither in the sweep)
+  EXPECT_TRUE(sweep.approach_jumps.empty());
 }
 
 TEST(FitModel, CalibrationEntersAsDocumented) {
@@ -79,7 +85,7 @@ TEST(FitModel, CalibrationEntersAsDocumented) {
   o = dmt();
   o.initial["amplitude_scale"] = 1.2;
   const AmPrediction c = predict_am_curve({40e-9, 39e-9, 38e-9}, settings(), o);
-  EXPECT_NEAR(c.amplitude[0], 10e-9, 2e-12);
+  EXPECT_NEAR(c.amplitude[0], 20e-9, 4e-12);
 }
 
 TEST(FitModel, TransformsKeepTheRange) {

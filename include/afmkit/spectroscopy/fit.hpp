@@ -71,12 +71,17 @@ struct FitOptions {
   double amplitude_noise = 0.0;  // σ_A in A/A0 (0: estimated from the data)
   double phase_noise = 0.0;      // σ_φ [rad] (0: estimated)
   double fd_step = 1e-3;         // forward-difference step in the transformed coordinates u
-  int max_evaluations = 60;      // forward-model evaluations (curves, the Jacobian's columns included)
-  double tolerance = 1e-6;       // relative reduction of the cost and relative step (LM ftol and xtol)
+  int max_evaluations = 100;     // forward-model evaluations (curves, the Jacobian's columns included)
+  double tolerance = 1e-4;       // relative reduction of the cost and relative step (LM ftol and xtol)
   /// Identifiability thresholds (docs/fitting.md#identifiability).
   double correlation_limit = 0.99;
   double condition_limit = 1e10;
-  bool parallel = true;          // the Jacobian's perturbed orbits in parallel (OpenMP)
+  double flat_column = 1e-3;  // a parameter whose weighted Jacobian column is shorter is flat (not identifiable)
+  /// Accuracy of the orbits: the integrator's relative tolerance and the shooting tolerance (tapping/shooting.hpp;
+  /// the sweep's defaults are 1e-10 and 1e-11: a fit to data with noise ~1e-3 needs less).
+  double integrator_tolerance = 1e-9;
+  double shooting_tolerance = 1e-10;
+  bool parallel = true;          // the orbits of a warm-started evaluation in parallel (OpenMP)
   Cancellation cancellation;
   void validate() const;
 };

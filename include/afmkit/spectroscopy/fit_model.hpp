@@ -46,9 +46,12 @@ class AmForwardModel {
   /// Continuation along the curve from the free response (follow_stable_branch; a transient where a branch ends).
   CurveEvaluation walk(const ModelValues& values) const;
   /// Each point by Newton from the orbit of `from` at the same point (values close to those of `from`); falls back
-  /// to walk() when a point does not converge to a stable orbit near the previous one.
-  CurveEvaluation warm(const ModelValues& values, const CurveEvaluation& from) const;
+  /// to walk() when a point does not converge to a stable orbit near the previous one, or when a jump of `from`
+  /// moved past a point. `chord`: one chord-Newton step with the monodromy of `from` instead of Newton to the
+  /// tolerance (the Jacobian's perturbed curves: off by O(step²)).
+  CurveEvaluation warm(const ModelValues& values, const CurveEvaluation& from, bool chord = false) const;
 
+  const tapping::SweepOptions& sweep_options() const { return sweep_; }
   long curves() const { return curves_.load(); }
   long orbits() const { return orbits_.load(); }
 
