@@ -144,3 +144,46 @@ TEST(FitModel, RefusesWhatCannotBeFitted) {
   o.parameters = {};
   EXPECT_THROW(fit_parameter_info(o), InvalidParameter);
 }
+
+#include "afmkit/spectroscopy/fit_input.hpp"
+
+TEST(FitInput, ReadsUnitsFromTheHeader) {
+  const AmCurve c = parse_am_curve("# measured\ndistance (nm), amplitude (nm), phase (deg)\n10, 9.5, 90\n8, 7.9, "
+                                   "120\r\n\n6, 6.1, 135\n",
+                                   "curve.csv");
+  ASSERT_EQ(c.distance.size(), 3u);
+  EXPECT_DOUBLE_EQ(c.distance[1], 8e-9);
+  EXPECT_DOUBLE_EQ(c.amplitude[2], 6.1e-9);
+  EXPECT_DOUBLE_EQ(c.phase[0], M_PI / 2);
+  const AmCurve d = parse_am_curve("z_m\tamp_m\tphi_rad\n1e-8\t9e-9\t1.5\n2e-8\t1e-8\t1.6\n3e-8\t1e-8\t1.57\n", "t");
+  EXPECT_DOUBLE_EQ(d.distance[2], 3e-8);
+  EXPECT_DOUBLE_EQ(d.phase[1], 1.6);
+  const AmCurve e = parse_am_curve("distance (A)  amplitude (nm)\n100 9\n90 8\n80 7\n", "blank");
+  EXPECT_DOUBLE_EQ(e.distance[1], 9e-9);
+  EXPECT_TRUE(e.phase.empty());
+}
+
+TEST(FitInput, NamesLineAndColumnOfBadCells) {
+  const auto message = [](const std::string& text) {
+    try {
+      parse_am_curve(text, "f.csv");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message("distance (nm), amplitude (nm)\n1, 2\n2, x\n3, 4\n"),
+            "f.csv:3:4: 'x' is not a number (column amplitude (nm))");
+  EXPECT_EQ(message("distance (nm), amplitude (nm)\n1, 2\n2, nan\n3, 4\n").substr(0, 9), "f.csv:3:4");
+  EXPECT_NE(message("distance, amplitude (nm)\n1, 2\n").find("f.csv:1:1: column 'distance' has no unit"),
+            std::string::npos);
+  EXPECT_NE(message("distance (nm), amplitude (V)\n1, 2\n").find("f.csv:1:16: column 'amplitude (V)': unknown length"),
+            std::string::npos);
+  EXPECT_NE(message("distance (nm), amplitude (nm)\n1, 2\n1, 3\n2, 2\n").find("f.csv:3:1: distance 1e-09 m repeats line 2"),
+            std::string::npos);
+  EXPECT_NE(message("distance (nm), amplitude (nm)\n1, 2\n2, 3, 4\n").find("f.csv:3:7: 3 cells"), std::string::npos);
+  EXPECT_NE(message("distance (nm), amplitude (nm)\n1, 2\n2, 0\n3, 2\n").find("f.csv:3:4: amplitude 0 is out of range"),
+            std::string::npos);
+  EXPECT_NE(message("distance (nm), amplitude (nm)\n1, 2\n2, 3\n").find("at least 3"), std::string::npos);
+  EXPECT_NE(message("distance (nm), phase (deg)\n1, 2\n").find("no amplitude column"), std::string::npos);
+}
