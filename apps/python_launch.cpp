@@ -35,7 +35,8 @@ std::string python_package_dir(const std::string& module) {
   if (ec) return {};
   const fs::path prefix = exe.parent_path().parent_path();
   for (const fs::path& dir : {prefix / "python", prefix / AFMKIT_PYTHON_INSTALL_DIR})
-    if (fs::exists(dir / "afmkit" / module / "__main__.py", ec)) return dir.string();
+    if (fs::exists(dir / "afmkit" / module / "__main__.py", ec) || fs::exists(dir / "afmkit" / (module + ".py"), ec))
+      return dir.string();
   return {};
 }
 
