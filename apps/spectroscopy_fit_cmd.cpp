@@ -78,6 +78,7 @@ spectroscopy::FitOptions fit_options(const io::ParamSet& p) {
                                                  : spectroscopy::CurveDirection::approach;
   o.amplitude_noise = p.real("amplitude_noise");
   o.phase_noise = p.real("phase_noise") * kDeg;
+  o.huber = p.real("huber");
   o.fd_step = p.real("fd_step");
   o.max_evaluations = static_cast<int>(p.integer("max_evaluations"));
   o.tolerance = p.real("tolerance");
@@ -278,6 +279,9 @@ void register_spectroscopy_fit(CLI::App& spectroscopy) {
             .real("phase_noise", 0.0, "σ of the measured phase (0: estimated from the data's scatter)",
                   io::Range::non_negative())
             .unit("deg")
+            .real("huber", 5.0, "Huber's loss beyond this many σ: a point far off (another branch next to a jump) "
+                  "pulls linearly; 0: plain least squares", io::Range::non_negative())
+            .unit("dimensionless")
             .real("fd_step", 1e-3, "forward-difference step of the Jacobian in the transformed parameters",
                   io::Range::closed(1e-8, 0.1))
             .unit("dimensionless")

@@ -93,7 +93,8 @@ def _settings(spring_constant, resonance_frequency, quality_factor, free_amplitu
 
 def fit(distance, amplitude, phase=None, *, law: str = "dmt", parameters=DEFAULT_PARAMETERS, initial=None,
         fixed=None, spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency=None,
-        direction: str = "approach", amplitude_noise: float = 0.0, phase_noise: float = 0.0, force_curve: str = "",
+        direction: str = "approach", amplitude_noise: float = 0.0, phase_noise: float = 0.0, huber: float = 5.0,
+        force_curve: str = "",
         allow_energy_gain: bool = False, fd_step: float = 1e-3, max_evaluations: int = 100,
         tolerance: float = 1e-4, integrator_tolerance: float = 1e-9, shooting_tolerance: float = 1e-10,
         correlation_limit: float = 0.99, condition_limit: float = 1e10, flat_column: float = 1e-3,
@@ -105,7 +106,7 @@ def fit(distance, amplitude, phase=None, *, law: str = "dmt", parameters=DEFAULT
     initial: initial values of fitted parameters and fixed calibration values (SI); fixed: the law's other values
     (SI: hamaker J, effective_modulus Pa, tip_radius m, ...). spring_constant [N/m], resonance_frequency [Hz],
     quality_factor, free_amplitude [m], drive_frequency [Hz] (None: at resonance). amplitude_noise (A/A0) and
-    phase_noise [rad]: 0 estimates them from the data. Raises afmkit.InvalidParameter on bad input and
+    phase_noise [rad]: 0 estimates them from the data; huber: Huber's loss beyond this many σ (0: least squares). Raises afmkit.InvalidParameter on bad input and
     afmkit.NumericalFailure when the model fails at the initial values; a fit that does not converge returns
     status "not_converged".
     """
@@ -115,7 +116,7 @@ def fit(distance, amplitude, phase=None, *, law: str = "dmt", parameters=DEFAULT
         dict(fixed or {}), force_curve, bool(allow_energy_gain),
         **_settings(spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency),
         direction=direction, amplitude_noise=float(amplitude_noise), phase_noise=float(phase_noise),
-        fd_step=float(fd_step), max_evaluations=int(max_evaluations), tolerance=float(tolerance),
+        huber=float(huber), fd_step=float(fd_step), max_evaluations=int(max_evaluations), tolerance=float(tolerance),
         integrator_tolerance=float(integrator_tolerance), shooting_tolerance=float(shooting_tolerance),
         correlation_limit=float(correlation_limit), condition_limit=float(condition_limit),
         flat_column=float(flat_column), parallel=bool(parallel))

@@ -44,7 +44,7 @@ py::dict fit(const Array& distance, const Array& amplitude, const std::optional<
              const std::map<std::string, double>& fixed, const std::string& force_curve, bool allow_energy_gain,
              double spring_constant, double resonance_frequency, double quality_factor, double free_amplitude,
              double drive_frequency, const std::string& direction, double amplitude_noise, double phase_noise,
-             double fd_step, int max_evaluations, double tolerance, double integrator_tolerance,
+             double huber, double fd_step, int max_evaluations, double tolerance, double integrator_tolerance,
              double shooting_tolerance, double correlation_limit, double condition_limit, double flat_column,
              bool parallel) {
   spectroscopy::AmCurve curve;
@@ -64,6 +64,7 @@ py::dict fit(const Array& distance, const Array& amplitude, const std::optional<
   o.direction = direction == "retract" ? spectroscopy::CurveDirection::retract : spectroscopy::CurveDirection::approach;
   o.amplitude_noise = amplitude_noise;
   o.phase_noise = phase_noise;
+  o.huber = huber;
   o.fd_step = fd_step;
   o.max_evaluations = max_evaluations;
   o.tolerance = tolerance;
@@ -161,7 +162,7 @@ void bind_spectroscopy_fit(py::module_& m) {
         py::arg("parameters"), py::arg("initial"), py::arg("fixed"), py::arg("force_curve"),
         py::arg("allow_energy_gain"), py::arg("spring_constant"), py::arg("resonance_frequency"),
         py::arg("quality_factor"), py::arg("free_amplitude"), py::arg("drive_frequency"), py::arg("direction"),
-        py::arg("amplitude_noise"), py::arg("phase_noise"), py::arg("fd_step"), py::arg("max_evaluations"),
+        py::arg("amplitude_noise"), py::arg("phase_noise"), py::arg("huber"), py::arg("fd_step"), py::arg("max_evaluations"),
         py::arg("tolerance"), py::arg("integrator_tolerance"), py::arg("shooting_tolerance"),
         py::arg("correlation_limit"), py::arg("condition_limit"), py::arg("flat_column"), py::arg("parallel"),
         "The law fit of `afmkit spectroscopy fit` (SI units): use afmkit.spectroscopy_fit.fit.");

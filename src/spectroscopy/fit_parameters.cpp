@@ -92,6 +92,7 @@ void AmSettings::validate() const {
 void FitOptions::validate() const {
   validate::non_negative("amplitude_noise", amplitude_noise);
   validate::non_negative("phase_noise", phase_noise);
+  validate::non_negative("huber", huber);
   validate::require(fd_step >= 1e-8 && fd_step <= 0.1, "fd_step", fd_step, "in [1e-8, 0.1]");
   validate::require(max_evaluations >= 2 && max_evaluations <= 1000000, "max_evaluations", max_evaluations,
                     "in [2, 1000000]");

@@ -5,8 +5,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <cstdio>
-#include <cstdlib>
 #include <numeric>
 
 #include <Eigen/Core>
@@ -100,11 +98,20 @@ class Problem {
     Eigen::VectorXd r(size());
     const double a0 = settings_.free_amplitude;
     for (std::size_t i = 0; i < n; ++i) {
-      r[static_cast<long>(i)] = (data_.amplitude[i] - e.amplitude[i] / v.amplitude_scale) / a0 / sigma_a_;
+      r[static_cast<long>(i)] = robust((data_.amplitude[i] - e.amplitude[i] / v.amplitude_scale) / a0 / sigma_a_);
       if (!data_.phase.empty())
-        r[static_cast<long>(n + i)] = wrap(data_.phase[i] - e.phase[i] - v.phase_offset) / sigma_p_;
+        r[static_cast<long>(n + i)] = robust(wrap(data_.phase[i] - e.phase[i] - v.phase_offset) / sigma_p_);
     }
     return r;
+  }
+
+  /// Huber's loss as a residual: r for |r| ≤ c, sign(r)·√(2c|r| − c²) beyond (Σ r'² is Huber's cost), c =
+  /// options.huber noise units; 0: plain least squares. A point the model puts on another branch than the data
+  /// (next to a jump, hundreds of σ off in phase) then pulls linearly, not quadratically.
+  double robust(double x) const {
+    const double c = options_.huber;
+    if (c <= 0.0 || std::abs(x) <= c) return x;
+    return std::copysign(std::sqrt(2.0 * c * std::abs(x) - c * c), x);
   }
 
   /// The evaluation at u (cached: the solver asks for the Jacobian where it evaluated the residuals).
@@ -129,11 +136,6 @@ class Problem {
     }
     if (e.ok) {
       const double cost = residuals(e, v).squaredNorm();
-      if (std::getenv("AFMKIT_FIT_DEBUG")) {
-        std::fprintf(stderr, "eval cost %.6g:", cost);
-        for (long j = 0; j < u.size(); ++j) std::fprintf(stderr, " %.6g", to_parameter(params_[j], u[j]));
-        int jumps = 0; for (bool b : e.jumped) jumps += b; std::fprintf(stderr, " jumped %d\n", jumps);
-      }
       if (!best_ || cost < best_cost_) {
         best_ = std::make_shared<CurveEvaluation>(e);
         best_cost_ = cost;

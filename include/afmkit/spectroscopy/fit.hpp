@@ -69,6 +69,8 @@ struct FitOptions {
   std::map<std::string, double> initial;
   CurveDirection direction = CurveDirection::approach;
   double amplitude_noise = 0.0;  // σ_A in A/A0 (0: estimated from the data)
+  /// Huber's loss beyond this many σ (docs/fitting.md#weights; 0: plain least squares).
+  double huber = 5.0;
   double phase_noise = 0.0;      // σ_φ [rad] (0: estimated)
   double fd_step = 1e-3;         // forward-difference step in the transformed coordinates u
   int max_evaluations = 100;     // forward-model evaluations (curves, the Jacobian's columns included)
