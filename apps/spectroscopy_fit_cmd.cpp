@@ -104,8 +104,8 @@ Shown shown(const std::string& si_unit) {
 }
 
 void run_fit(const io::ParamSet& p, Captured* capture) {
-  if (p.text("input").empty())
-    throw InvalidParameter("input", "input is required: the measured curve file (distance, amplitude, phase with "
+  if (p.text("file").empty())
+    throw InvalidParameter("file", "file is required: the measured curve file (distance, amplitude, phase with "
                                     "units in the header; docs/fitting.md#input)");
   if (!p.text("plot").empty() && p.text("output").empty())
     throw InvalidParameter("plot", "plot needs output: the plot is drawn from the fitted curve's CSV file");
@@ -120,7 +120,7 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
   s.validate();
   const spectroscopy::FitOptions options = fit_options(p);
   spectroscopy::fit_parameter_info(options);  // refuses unknown names before the file is read
-  const spectroscopy::AmCurve curve = spectroscopy::read_am_curve(p.text("input"));
+  const spectroscopy::AmCurve curve = spectroscopy::read_am_curve(p.text("file"));
   curve.validate();
   spectroscopy::FitOptions run = options;
   run.cancellation = cancellation_of(capture);
@@ -237,7 +237,7 @@ void register_spectroscopy_fit(CLI::App& spectroscopy) {
       "amplitude/phase-versus-distance curve by weighted least squares over afmkit's periodic orbits",
       [](io::ParamSet& p) {
         p.group("Measured curve");
-        p.file("input", "", "measured curve: CSV of distance, amplitude and (optionally) phase with units in the "
+        p.file("file", "", "measured curve: CSV of distance, amplitude and (optionally) phase with units in the "
                             "header (docs/fitting.md#input)")
             .positional()
             .default_text("required")
