@@ -33,6 +33,10 @@ constexpr double kDeg = 3.14159265358979323846 / 180.0;
 /// The fitted names of `parameters` (comma-separated, blanks ignored).
 std::vector<std::string> parameter_list(const std::string& text) {
   std::vector<std::string> out;
+  if (!text.empty() && text.back() == ',')
+    throw InvalidParameter("parameters", fmt::format("parameters = '{}' ends with a comma: write names separated by "
+                                                     "commas, e.g. hamaker,effective_modulus,distance_offset",
+                                                     text));
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {

@@ -203,9 +203,9 @@ AmCurve parse_am_curve(std::string_view text, const std::string& origin) {
         case Role::distance:
           if (const auto it = seen.find(v); it != seen.end())
             fail(origin, line_no, cells[k].column,
-                 fmt::format("distance {} m repeats line {}: every distance must be distinct (average repeated "
-                             "rows first)",
-                             v, it->second));
+                 fmt::format("distance {} (column {}) repeats line {}: every distance must be distinct (average "
+                             "repeated rows first)",
+                             cells[k].text, names[k], it->second));
           seen[v] = line_no;
           c.distance.push_back(v);
           break;

@@ -179,7 +179,7 @@ TEST(FitInput, NamesLineAndColumnOfBadCells) {
             std::string::npos);
   EXPECT_NE(message("distance (nm), amplitude (V)\n1, 2\n").find("f.csv:1:16: column 'amplitude (V)': unknown length"),
             std::string::npos);
-  EXPECT_NE(message("distance (nm), amplitude (nm)\n1, 2\n1, 3\n2, 2\n").find("f.csv:3:1: distance 1e-09 m repeats line 2"),
+  EXPECT_NE(message("distance (nm), amplitude (nm)\n1, 2\n1, 3\n2, 2\n").find("f.csv:3:1: distance 1 (column distance (nm)) repeats line 2"),
             std::string::npos);
   EXPECT_NE(message("distance (nm), amplitude (nm)\n1, 2\n2, 3, 4\n").find("f.csv:3:7: 3 cells"), std::string::npos);
   EXPECT_NE(message("distance (nm), amplitude (nm)\n1, 2\n2, 0\n3, 2\n").find("f.csv:3:4: amplitude 0 is out of range"),
