@@ -13,7 +13,8 @@ using namespace afmkit_test;
 namespace {
 // options whose value is free text (paths are FILE, choices NAME): report's comma-separated list of figure ids
 const std::set<std::string> kTextOptions = {"figures",     // a list of figure ids
-                                            "scheduler"};  // serial, local or any Dask scheduler address
+                                            "scheduler",   // serial, local or any Dask scheduler address
+                                            "parameters"};  // spectroscopy fit: a list of parameter names
 }  // namespace
 
 class HelpText : public ::testing::TestWithParam<std::string> {};
