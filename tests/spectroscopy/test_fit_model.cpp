@@ -34,7 +34,7 @@ FitOptions dmt() {
 
 }  // namespace
 
-TEST(FitModel, ApproachMatchesTheInstrumentSweep) {
+TEST(FitModel, ApproachAndRetractMatchTheInstrumentSweep) {
   // the same cantilever and law through tapping::sweep_instrument (physical units: nm, kHz, GPa)
   const tapping::PhysicalCantilever pc(40.0, 300.0, 100.0, 20.0, 1.0);  // Q = 100: short transients
   impact::LawArguments args;
@@ -69,6 +69,14 @@ TEST(FitModel, ApproachMatchesTheInstrumentSweep) {
   EXPECT_LT(touching, 41);
   for (bool j : pred.jumped) EXPECT_FALSE(j);  // Q = 100: no jump on this approach (neither in the sweep)
   EXPECT_TRUE(sweep.approach_jumps.empty());
+  // the retract branch: after the approach down to the smallest distance
+  o.direction = CurveDirection::retract;
+  const AmPrediction back = predict_am_curve(z, q100, o);
+  for (std::size_t i = 0; i < z.size(); ++i) {
+    ASSERT_NEAR(sweep.retract[i].separation, l_nm[i], 1e-12);
+    EXPECT_NEAR(back.amplitude[i], sweep.retract[i].metrics.amplitude * 1e-9, 1e-16) << "l = " << l_nm[i];
+    EXPECT_NEAR(back.phase[i], sweep.retract[i].metrics.phase, 1e-7) << "l = " << l_nm[i];
+  }
 }
 
 TEST(FitModel, CalibrationEntersAsDocumented) {

@@ -51,7 +51,6 @@ class AmForwardModel {
   /// tolerance (the Jacobian's perturbed curves: off by O(step²)).
   CurveEvaluation warm(const ModelValues& values, const CurveEvaluation& from, bool chord = false) const;
 
-  const tapping::SweepOptions& sweep_options() const { return sweep_; }
   long curves() const { return curves_.load(); }
   long orbits() const { return orbits_.load(); }
 
