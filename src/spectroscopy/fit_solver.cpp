@@ -348,7 +348,11 @@ void statistics(const Eigen::MatrixXd& jac, double s2, const Eigen::VectorXd& u,
     }
   for (long a = 0; a < p; ++a) {
     const auto sa = static_cast<std::size_t>(a);
-    if (r.identifiable[sa] && !(r.standard_errors[sa] <= std::abs(r.estimates[sa])))
+    // an offset (identity transform) may be 0 at the truth: compared with its scale too (1 nm, 1 rad)
+    const double size = r.parameters[sa].transform == Transform::identity
+                            ? std::max(std::abs(r.estimates[sa]), r.parameters[sa].scale)
+                            : std::abs(r.estimates[sa]);
+    if (r.identifiable[sa] && !(r.standard_errors[sa] <= size))
       r.warnings.push_back(fmt::format("{}: the standard error ({:.3g} {}) exceeds the estimate ({:.3g} {}): poorly "
                                        "determined",
                                        r.parameters[sa].name, r.standard_errors[sa], r.parameters[sa].unit,
