@@ -24,5 +24,6 @@ void register_report(CLI::App& app);            // report_cmd.cpp:        afmkit
 void register_study(CLI::App& app);             // study_cmd.cpp:         afmkit study run (Python + Dask)
 void register_spectroscopy(CLI::App& app);      // spectroscopy_cmd.cpp:  afmkit spectroscopy …
 void register_spectroscopy_prepare(CLI::App& spectroscopy);  // spectroscopy_prepare_cmd.cpp: spectroscopy prepare
+void register_spectroscopy_fit(CLI::App& spectroscopy);  // spectroscopy_fit_cmd.cpp: spectroscopy fit
 
 }  // namespace afmkit::cli

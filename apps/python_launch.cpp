@@ -30,8 +30,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// The folder holding the Python package `afmkit` with its subpackage `module`: build/python next to build/bin in
-/// a build tree, or <prefix>/AFMKIT_PYTHON_INSTALL_DIR next to <prefix>/bin when installed.
 /// The folder holding the package afmkit when this code runs inside its compiled module (Python: the commands of
 /// afmkit._afmkit): the module file's folder's parent; empty otherwise.
 fs::path loaded_package_dir() {
@@ -42,6 +40,8 @@ fs::path loaded_package_dir() {
   return ec ? fs::path() : so.parent_path().parent_path();
 }
 
+/// The folder holding the Python package `afmkit` with its subpackage `module` (or module file `module`.py): build/python next to build/bin in
+/// a build tree, or <prefix>/AFMKIT_PYTHON_INSTALL_DIR next to <prefix>/bin when installed.
 std::string python_package_dir(const std::string& module, bool file = false) {
   std::error_code ec;
   std::vector<fs::path> dirs;
@@ -53,7 +53,8 @@ std::string python_package_dir(const std::string& module, bool file = false) {
   if (file) dirs.push_back(loaded_package_dir());  // inside Python, the interpreter is /proc/self/exe
   for (const fs::path& dir : dirs)
     if (!dir.empty() &&
-        fs::exists(file ? dir / "afmkit" / (module + ".py") : dir / "afmkit" / module / "__main__.py", ec))
+        (fs::exists(dir / "afmkit" / (module + ".py"), ec) ||
+         (!file && fs::exists(dir / "afmkit" / module / "__main__.py", ec))))
       return dir.string();
   return {};
 }

@@ -12,4 +12,5 @@ PYBIND11_MODULE(_afmkit, m) {
   afmkit::python::bind_realtime_filter(m);
   afmkit::python::bind_study(m);
   afmkit::python::bind_spectroscopy_prepare(m);
+  afmkit::python::bind_spectroscopy_fit(m);
 }

@@ -17,7 +17,8 @@ const std::set<std::string> kTextOptions = {"figures",     // a list of figure i
                                             // spectroscopy prepare: a column of a text export, by name or position
                                             "height-column", "deflection-column", "force-column", "segment-column",
                                             "retract-height-column", "retract-deflection-column",
-                                            "retract-force-column"};
+                                            "retract-force-column",
+                                            "parameters"};  // spectroscopy fit: a list of parameter names
 }  // namespace
 
 class HelpText : public ::testing::TestWithParam<std::string> {};

@@ -7,6 +7,7 @@ import pytest
 
 import afmkit
 from afmkit import _afmkit
+from afmkit import spectroscopy_fit
 
 # fast settings per command (each run takes well under a second)
 FAST = {
@@ -26,18 +27,30 @@ FAST = {
                  radial_speed=5e-4, harmonics=2),
     "demo": dict(points=5),
     "control export": dict(harmonics=3, sample_rate=1000.0),
+    "spectroscopy fit": dict(spring_constant=40.0, resonance_frequency=300.0, quality_factor=100.0,
+                             free_amplitude=10.0, parameters="phase_offset"),
 }
 # commands that write files whatever the output keys say: into the test's folder
-FILES = {"demo": lambda d: dict(output_dir=str(d / "demo")), "control export": lambda d: dict(output=str(d / "f.h"))}
+def _am_curve(d):
+    """A small free-oscillation AM curve (no contact: a fit of the phase offset alone)."""
+    path = d / "am.csv"
+    path.write_text("distance (nm), amplitude (nm), phase (deg)\n40, 10, 90.1\n38, 10, 90.3\n36, 10, 89.9\n"
+                    "34, 10, 90.2\n")
+    return dict(file=str(path))
+
+
+FILES = {"demo": lambda d: dict(output_dir=str(d / "demo")), "control export": lambda d: dict(output=str(d / "f.h")),
+         "spectroscopy fit": _am_curve}
 FUNCTIONS = {
     "impact": afmkit.impact, "tapping hb": afmkit.tapping.hb, "tapping orbit": afmkit.tapping.orbit,
     "tapping sweep": afmkit.tapping.sweep, "tapping fm": afmkit.tapping.fm, "control tf": afmkit.control.tf, "control roots": afmkit.control.roots,
     "control margin": afmkit.control.margin, "control chart": afmkit.control.chart,
     "control tune": afmkit.control.tune, "control simulate": afmkit.control.simulate, "scan": afmkit.scan,
-    "demo": afmkit.demo, "control export": afmkit.control.export,
+    "demo": afmkit.demo, "control export": afmkit.control.export, "spectroscopy fit": spectroscopy_fit.run,
 }
 # a value for the followed key, inside its range, other than its default
-NEW_VALUE = {"hamaker": 1e-19, "effective_modulus": 3.0, "plant_rate": 7.0, "delay": 0.05, "bandwidth": 5000.0}
+NEW_VALUE = {"hamaker": 1e-19, "effective_modulus": 3.0, "plant_rate": 7.0, "delay": 0.05, "bandwidth": 5000.0,
+             "resonance_frequency": 310.0}
 
 
 def replayable(command, params):

@@ -1,0 +1,320 @@
+// afmkit spectroscopy fit: a registered force law (and the calibration: distance offset, amplitude scale, phase
+// offset) fitted to a measured AM-AFM amplitude/phase-versus-distance curve by weighted nonlinear least squares over
+// afmkit's periodic orbits (docs/fitting.md). The plot (--plot) is drawn by the Python package (Matplotlib).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/impact/law_registry.hpp"
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/params.hpp"
+#include "afmkit/io/quantity.hpp"
+#include "afmkit/spectroscopy/fit.hpp"
+#include "afmkit/spectroscopy/fit_input.hpp"
+#include "command.hpp"
+#include "commands.hpp"
+#include "law_params.hpp"
+#include "python_launch.hpp"
+
+namespace afmkit::cli {
+
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+/// The fitted names of `parameters` (comma-separated, blanks ignored).
+std::vector<std::string> parameter_list(const std::string& text) {
+  std::vector<std::string> out;
+  if (!text.empty() && text.back() == ',')
+    throw InvalidParameter("parameters", fmt::format("parameters = '{}' ends with a comma: write names separated by "
+                                                     "commas, e.g. hamaker,effective_modulus,distance_offset",
+                                                     text));
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const auto b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
+    if (b == std::string::npos)
+      throw InvalidParameter("parameters", fmt::format("parameters = '{}' has an empty name: write names separated "
+                                                       "by commas, e.g. hamaker,effective_modulus,distance_offset",
+                                                       text));
+    out.push_back(item.substr(b, e - b + 1));
+  }
+  return out;
+}
+
+double required(const io::ParamSet& p, const std::string& key, const std::string& unit) {
+  const double v = p.real(key);
+  if (!(v > 0.0))
+    throw InvalidParameter(key, fmt::format("{} is required (the measured setting, {}): must be > 0", key, unit));
+  return v;
+}
+
+/// Every parameter of the run in the options of the library (SI).
+spectroscopy::FitOptions fit_options(const io::ParamSet& p) {
+  const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  spectroscopy::FitOptions o;
+  o.law = p.text("law");
+  const impact::LawSpec& spec = registry.find(o.law);
+  o.force_curve = p.text("force_curve");
+  o.allow_energy_gain = p.flag("allow_energy_gain");
+  o.parameters = parameter_list(p.text("parameters"));
+  for (const auto& k : registry.keys()) {
+    const bool reads = std::find(spec.keys.begin(), spec.keys.end(), k.key) != spec.keys.end();
+    if (p.was_set(k.key) && !reads)
+      throw InvalidParameter(k.key, fmt::format("{} does not apply to law = {} (it is a parameter of law {})", k.key,
+                                                o.law, fmt::join(registry.laws_using(k.key), ", ")));
+    // given values, and the command's defaults of keys that neither follow another nor are alternatives
+    if (reads && (p.was_set(k.key) || (k.follows.empty() && !k.only_if_given)))
+      o.law_values[k.key] = p.real(k.key) * spectroscopy::law_unit_to_si(k.unit);
+  }
+  o.initial["distance_offset"] = p.real("distance_offset") * 1e-9;
+  o.initial["amplitude_scale"] = p.real("amplitude_scale");
+  o.initial["phase_offset"] = p.real("phase_offset") * kDeg;
+  o.direction = p.text("direction") == "retract" ? spectroscopy::CurveDirection::retract
+                                                 : spectroscopy::CurveDirection::approach;
+  o.amplitude_noise = p.real("amplitude_noise");
+  o.phase_noise = p.real("phase_noise") * kDeg;
+  o.huber = p.real("huber");
+  o.fd_step = p.real("fd_step");
+  o.max_evaluations = static_cast<int>(p.integer("max_evaluations"));
+  o.tolerance = p.real("tolerance");
+  o.integrator_tolerance = p.real("integrator_tolerance");
+  o.shooting_tolerance = p.real("shooting_tolerance");
+  o.correlation_limit = p.real("correlation_limit");
+  o.condition_limit = p.real("condition_limit");
+  o.flat_column = p.real("flat_column");
+  o.validate();
+  return o;
+}
+
+/// A parameter's value in the units of the command's output (m -> nm, rad -> deg, Pa -> GPa, others SI).
+struct Shown {
+  double factor;
+  std::string unit;
+};
+Shown shown(const std::string& si_unit) {
+  if (si_unit == "m") return {1e9, "nm"};
+  if (si_unit == "rad") return {1.0 / kDeg, "deg"};
+  if (si_unit == "Pa") return {1e-9, "GPa"};  // the registry's unit of moduli
+  return {1.0, si_unit};
+}
+
+void run_fit(const io::ParamSet& p, Captured* capture) {
+  if (p.text("file").empty())
+    throw InvalidParameter("file", "file is required: the measured curve file (distance, amplitude, phase with "
+                                    "units in the header; docs/fitting.md#input)");
+  if (!p.text("plot").empty() && p.text("output").empty())
+    throw InvalidParameter("plot", "plot needs output: the plot is drawn from the fitted curve's CSV file");
+  if (!p.text("plot").empty() && capture)
+    throw InvalidParameter("plot", "plot is drawn by the command line; in Python call afmkit.spectroscopy_fit.plot");
+  spectroscopy::AmSettings s;
+  s.spring_constant = required(p, "spring_constant", "N/m");
+  s.resonance_frequency = required(p, "resonance_frequency", "kHz") * 1e3;
+  s.quality_factor = required(p, "quality_factor", "dimensionless");
+  s.free_amplitude = required(p, "free_amplitude", "nm") * 1e-9;
+  s.drive_frequency = p.real("drive_frequency") * 1e3;
+  s.validate();
+  const spectroscopy::FitOptions options = fit_options(p);
+  spectroscopy::fit_parameter_info(options);  // refuses unknown names before the file is read
+  const spectroscopy::AmCurve curve = spectroscopy::read_am_curve(p.text("file"));
+  curve.validate();
+  spectroscopy::FitOptions run = options;
+  run.cancellation = cancellation_of(capture);
+  const spectroscopy::FitResult r = spectroscopy::fit_am_curve(curve, s, run);
+
+  CommandOutput out(p, capture, "spectroscopy fit");
+  const bool phase = !r.phase.empty();
+  std::vector<io::Column> columns = {
+      {"distance", "nm", "measured distance (piezo separation; model separation = distance + distance_offset)"},
+      {"amplitude", "nm", "measured amplitude"},
+      {"fitted_amplitude", "nm", "model amplitude at the estimates, as measured (A_model / amplitude_scale)"},
+      {"amplitude_residual", "dimensionless", "(measured − fitted) amplitude / free_amplitude"}};
+  if (phase) {
+    columns.push_back({"phase", "deg", "measured phase"});
+    columns.push_back({"fitted_phase", "deg", "model phase at the estimates + phase_offset"});
+    columns.push_back({"phase_residual", "deg", "measured − fitted phase, wrapped to (−180, 180]"});
+  }
+  columns.push_back({"contact", "boolean (0/1)", "the orbit reaches the law's contact gap"});
+  columns.push_back({"jumped", "boolean (0/1)", "the response jumped to another branch before this point"});
+  out.open(columns);
+  for (std::size_t i = 0; i < r.distance.size(); ++i) {
+    const double ra = (r.amplitude[i] - r.fitted_amplitude[i]) / s.free_amplitude;
+    if (phase) {
+      const double rp = std::remainder(r.phase[i] - r.fitted_phase[i], 2.0 * 3.14159265358979323846);
+      out.row(r.distance[i] * 1e9, r.amplitude[i] * 1e9, r.fitted_amplitude[i] * 1e9, ra, r.phase[i] / kDeg,
+              r.fitted_phase[i] / kDeg, rp / kDeg, r.contact[i], r.jumped[i]);
+    } else {
+      out.row(r.distance[i] * 1e9, r.amplitude[i] * 1e9, r.fitted_amplitude[i] * 1e9, ra, r.contact[i], r.jumped[i]);
+    }
+  }
+
+  nlohmann::json results = nlohmann::json::object();
+  nlohmann::json estimates = nlohmann::json::object(), units = nlohmann::json::object();
+  std::vector<std::string> names;
+  std::string summary = fmt::format("fit of law {} to {} points ({}): status {} ({})", options.law, r.distance.size(),
+                                    p.text("direction"), spectroscopy::fit_status_name(r.status), r.solver_status);
+  for (std::size_t j = 0; j < r.parameters.size(); ++j) {
+    const auto& info = r.parameters[j];
+    const Shown sh = shown(info.unit);
+    names.push_back(info.name);
+    estimates[info.name] = {{"value", r.estimates[j] * sh.factor},
+                            {"standard_error", r.standard_errors[j] * sh.factor},
+                            {"initial", info.initial * sh.factor},
+                            {"identifiable", r.identifiable[j]},
+                            {"transform", spectroscopy::transform_name(info.transform)}};
+    units[info.name] = sh.unit;
+    summary += fmt::format("\n  {} = {} ± {}", info.name, io::quantity(r.estimates[j] * sh.factor, sh.unit),
+                           io::quantity(r.standard_errors[j] * sh.factor, sh.unit));
+  }
+  results["status"] = spectroscopy::fit_status_name(r.status);
+  results["note"] = r.status == spectroscopy::FitStatus::ok
+                        ? std::string()
+                        : fmt::format("the fit did not converge: {} (estimates at the best point found)",
+                                      r.solver_status);
+  results["solver_status"] = r.solver_status;
+  results["estimates"] = estimates;
+  results["parameters"] = names;
+  results["correlation"] = r.correlation;
+  results["warnings"] = r.warnings;
+  results["condition_number"] = r.condition_number;
+  results["rms_amplitude"] = r.rms_amplitude;
+  results["rms_phase"] = phase ? r.rms_phase / kDeg : std::numeric_limits<double>::quiet_NaN();
+  results["amplitude_noise"] = r.amplitude_noise;
+  results["phase_noise"] = phase ? r.phase_noise / kDeg : std::numeric_limits<double>::quiet_NaN();
+  results["noise_estimated"] = {{"amplitude", r.noise_estimated_amplitude}, {"phase", r.noise_estimated_phase}};
+  results["reduced_chi2"] = r.reduced_chi2;
+  results["iterations"] = r.iterations;
+  results["curve_evaluations"] = r.curve_evaluations;
+  results["orbit_evaluations"] = r.orbit_evaluations;
+  results["failed_evaluations"] = r.failed_evaluations;
+  results["seconds"] = r.seconds;
+  nlohmann::json law = nlohmann::json::object(), law_units = nlohmann::json::object();
+  for (const auto& [k, v] : r.law_values) law[k] = v;  // SI
+  {
+    const impact::LawRegistry registry = impact::LawRegistry::builtin();
+    for (const auto& k : registry.keys())
+      if (law.contains(k.key)) law_units[k.key] = spectroscopy::law_si_unit(k.unit);
+  }
+  results["law_values"] = law;
+  units["law_values"] = law_units;
+  units["rms_amplitude"] = "dimensionless (A/A0)";
+  units["rms_phase"] = "deg";
+  units["amplitude_noise"] = "dimensionless (A/A0)";
+  units["phase_noise"] = "deg";
+  units["correlation"] = "dimensionless";
+  units["condition_number"] = "dimensionless";
+  units["reduced_chi2"] = "dimensionless";
+  units["seconds"] = "s";
+  units["curve_evaluations"] = "count";
+  units["orbit_evaluations"] = "count";
+  units["failed_evaluations"] = "count";
+  units["iterations"] = "count";
+  results["units"] = units;
+  summary += fmt::format("\n  residual RMS: {:.4g} (A/A0){}; noise σ: {:.3g} (A/A0{}){}", r.rms_amplitude,
+                         phase ? fmt::format(", {:.4g} deg", r.rms_phase / kDeg) : std::string(), r.amplitude_noise,
+                         r.noise_estimated_amplitude ? ", estimated" : "",
+                         phase ? fmt::format(", {:.3g} deg{}", r.phase_noise / kDeg,
+                                             r.noise_estimated_phase ? " (estimated)" : "")
+                               : std::string());
+  summary += fmt::format("\n  {} iterations, {} curve evaluations, {} orbit evaluations, {}", r.iterations,
+                         r.curve_evaluations, r.orbit_evaluations, io::quantity(r.seconds, "s", 3));
+  for (const std::string& w : r.warnings) summary += "\n  warning: " + w;
+  out.finish(results, summary);
+  if (!p.text("plot").empty())  // data vs fit, drawn by Matplotlib from the table just written
+    exec_python_module("spectroscopy_fit", {"--plot", p.text("output"), p.text("plot")});
+}
+
+}  // namespace
+
+void register_spectroscopy_fit(CLI::App& spectroscopy) {
+  add_command(
+      spectroscopy, "fit",
+      "fit a force law (and the calibration: distance offset, amplitude scale, phase offset) to a measured AM-AFM "
+      "amplitude/phase-versus-distance curve by weighted least squares over afmkit's periodic orbits",
+      [](io::ParamSet& p) {
+        p.group("Measured curve");
+        p.file("file", "", "measured curve: CSV of distance, amplitude and (optionally) phase with units in the "
+                            "header (docs/fitting.md#input)")
+            .positional()
+            .default_text("required")
+            .real("spring_constant", 0.0, "cantilever spring constant k (required)", io::Range::non_negative())
+            .unit("N/m")
+            .default_text("required")
+            .real("resonance_frequency", 0.0, "resonance frequency f0 (required)", io::Range::non_negative())
+            .unit("kHz")
+            .default_text("required")
+            .real("quality_factor", 0.0, "quality factor Q (required)", io::Range::non_negative())
+            .unit("dimensionless")
+            .default_text("required")
+            .real("free_amplitude", 0.0, "free amplitude A0 at the drive frequency (required)",
+                  io::Range::non_negative())
+            .unit("nm")
+            .default_text("required")
+            .real("drive_frequency", 0.0, "drive frequency", io::Range::non_negative())
+            .unit("kHz")
+            .follows("resonance_frequency")
+            .text("direction", "approach", "the branch the curve is: approach (from the largest distance down) or "
+                                           "retract (after the approach down to the smallest distance)",
+                  {"approach", "retract"});
+        p.group("Fit")
+            .text("parameters", "hamaker,effective_modulus,distance_offset,phase_offset",
+                  "fitted parameters, comma-separated: keys of the law and/or distance_offset, amplitude_scale, "
+                  "phase_offset (the others stay at their given values)")
+            .real("distance_offset", 0.0, "d0: model separation = distance + d0 (initial or fixed value)",
+                  io::Range::closed(-1e6, 1e6))
+            .unit("nm")
+            .real("amplitude_scale", 1.0, "s: true amplitude = s × measured (an InvOLS error; initial or fixed)",
+                  io::Range::positive())
+            .unit("dimensionless")
+            .real("phase_offset", 0.0, "φ0: measured phase = model phase + φ0 (initial or fixed)",
+                  io::Range::closed(-360.0, 360.0))
+            .unit("deg")
+            .real("amplitude_noise", 0.0, "σ of the measured A/A0 (0: estimated from the data's scatter)",
+                  io::Range::non_negative())
+            .unit("dimensionless")
+            .real("phase_noise", 0.0, "σ of the measured phase (0: estimated from the data's scatter)",
+                  io::Range::non_negative())
+            .unit("deg")
+            .real("huber", 5.0, "Huber's loss beyond this many σ: a point far off (another branch next to a jump) "
+                  "pulls linearly; 0: plain least squares", io::Range::non_negative())
+            .unit("dimensionless")
+            .real("fd_step", 1e-3, "forward-difference step of the Jacobian in the transformed parameters",
+                  io::Range::closed(1e-8, 0.1))
+            .unit("dimensionless")
+            .integer("max_evaluations", 100, "budget of forward-model evaluations (curves, Jacobian columns included)",
+                     2, 1000000)
+            .real("tolerance", 1e-4, "Levenberg–Marquardt ftol and xtol (relative reduction of the cost, relative step)",
+                  io::Range::closed(1e-15, 0.1))
+            .unit("dimensionless")
+            .real("integrator_tolerance", 1e-9, "relative tolerance of the orbits' integrator",
+                  io::Range::closed(1e-14, 1e-4))
+            .unit("dimensionless")
+            .real("shooting_tolerance", 1e-10, "tolerance of the orbits' Newton shooting",
+                  io::Range::closed(1e-14, 1e-4))
+            .unit("dimensionless")
+            .real("correlation_limit", 0.99, "warn when |correlation| of two parameters exceeds this",
+                  {0.0, 1.0, true, true})
+            .unit("dimensionless")
+            .real("condition_limit", 1e10, "warn when the condition number of the scaled JᵀWJ exceeds this",
+                  {1.0, 1e300, true, false})
+            .unit("dimensionless")
+            .real("flat_column", 1e-3, "a parameter whose weighted Jacobian column is shorter is flat (not identifiable)",
+                  io::Range::closed(0.0, 1.0))
+            .unit("dimensionless");
+        add_law_params(p, impact::LawRegistry::builtin(), "dmt");
+        add_output_params(p, "out/spectroscopy_fit.csv", "measured and fitted curve");
+        p.file("plot", "", "PNG of data vs fit (Matplotlib, through the Python package; needs output); empty: none")
+            .writes();
+      },
+      run_fit);
+}
+
+}  // namespace afmkit::cli

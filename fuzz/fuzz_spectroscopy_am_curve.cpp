@@ -1,0 +1,49 @@
+// libFuzzer target: the reader of measured AM-AFM curves of `spectroscopy fit` (afmkit/spectroscopy/fit_input.hpp).
+// Input = the text of a curve file. Invariants: the text is either rejected with afmkit::InputError whose message
+// starts with "fuzz.csv:<line>:<column>: ", or it gives a curve of ≥ 3 rows — distance and amplitude of equal
+// lengths, phase empty or of the same length, every value finite, amplitudes > 0, distances distinct — that the
+// fit's own validation (AmCurve::validate) accepts. Nothing else (no crash, no other exception, no sanitizer report).
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <set>
+#include <string>
+#include <string_view>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/spectroscopy/fit_input.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  afmkit::spectroscopy::AmCurve c;
+  try {
+    c = afmkit::spectroscopy::parse_am_curve(text, "fuzz.csv");
+  } catch (const afmkit::InputError& e) {
+    const std::string_view m(e.what());
+    if (m.rfind("fuzz.csv:", 0) != 0) std::abort();
+    // fuzz.csv:<line>:<column>: …
+    std::size_t i = 9, colons = 0;
+    while (i < m.size() && colons < 2) {
+      if (m[i] == ':') ++colons;
+      else if (m[i] < '0' || m[i] > '9') std::abort();
+      ++i;
+    }
+    if (colons != 2) std::abort();
+    return 0;
+  }
+  const std::size_t n = c.distance.size();
+  if (n < 3 || c.amplitude.size() != n || (!c.phase.empty() && c.phase.size() != n)) std::abort();
+  std::set<double> seen;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!std::isfinite(c.distance[k]) || !std::isfinite(c.amplitude[k]) || !(c.amplitude[k] > 0.0)) std::abort();
+    if (!c.phase.empty() && !std::isfinite(c.phase[k])) std::abort();
+    if (!seen.insert(c.distance[k]).second) std::abort();
+  }
+  try {
+    c.validate();
+  } catch (...) {
+    std::abort();  // what the reader accepts, the fit accepts
+  }
+  return 0;
+}

@@ -1,0 +1,167 @@
+#pragma once
+// Fitting a force law to a measured AM-AFM amplitude/phase-versus-distance curve (docs/fitting.md).
+//
+// Forward model: afmkit's exact periodic orbits of the tapping cantilever (seed-1 eq. 8) at the measured settings
+// (k, f0, Q, A0, drive frequency), the force law built by impact::LawRegistry from the parameter values, the
+// orbits continued along the curve as an instrument sweeps it (follow_stable_branch from the previous orbit,
+// transients where a branch ends: the sweep engine of tapping/sweep.hpp).
+//
+// Calibration parameters beside the law's (all optional, fitted or fixed):
+//   distance_offset d0 [m]   model separation l = distance + d0 (the measured distance is a piezo position whose
+//                            zero is unknown)
+//   amplitude_scale s        true amplitude = s × measured amplitude (an InvOLS error): the model runs at the free
+//                            amplitude s·A0 and predicts the measured amplitude A_model / s
+//   phase_offset φ0 [rad]    measured phase = model phase + φ0 (model phase: lag of x behind the drive Γ cos ωt,
+//                            π/2 for the free response at resonance)
+//
+// Residuals (2n for n points; n without phase): (A_meas − A_model/s)/A0 / σ_A and wrap(φ_meas − φ_model − φ0) / σ_φ
+// (wrap to (−π, π]); σ_A (in A/A0) and σ_φ [rad] given, or estimated from the data's scatter about a smooth curve
+// (the median absolute second difference: robust to jumps).
+//
+// Solver: Eigen's Levenberg–Marquardt (unsupported/Eigen/NonLinearOptimization, the MINPACK lmder algorithm) in
+// transformed coordinates u (bounds kept by the transformation, see FitParameterInfo), the Jacobian by forward
+// differences with step fd_step in u (each perturbed orbit warm started from the current one at the same point).
+// Standard errors: C = s² (JᵀJ)⁻¹ of the weighted residuals with s² = Σr²/(N − P), carried to the parameters by
+// the transformation's derivative (delta method).
+#include <map>
+#include <string>
+#include <vector>
+
+#include "afmkit/core/cancellation.hpp"
+
+namespace afmkit::spectroscopy {
+
+/// A measured AM-AFM curve, SI units. Rows in any order; each row one distance.
+struct AmCurve {
+  std::vector<double> distance;   // [m] piezo separation / tip–sample distance up to an offset
+  std::vector<double> amplitude;  // [m] first-harmonic amplitude
+  std::vector<double> phase;      // [rad] phase lag (see above); empty: amplitude only
+  /// Validates (InvalidParameter naming the array and the index): ≥ 3 rows, equal lengths, finite values,
+  /// amplitude > 0, distinct distances.
+  void validate() const;
+};
+
+/// The measured settings, SI units.
+struct AmSettings {
+  double spring_constant = 0.0;      // k [N/m] > 0
+  double resonance_frequency = 0.0;  // f0 [Hz] > 0
+  double quality_factor = 0.0;       // Q > 0
+  double free_amplitude = 0.0;       // A0 [m] > 0, free amplitude at the drive frequency
+  double drive_frequency = 0.0;      // [Hz] > 0 (0: at f0)
+  void validate() const;             // InvalidParameter naming the setting
+};
+
+/// Which branch of the instrument sweep the data are: approach (distance decreasing) or retract (after the approach
+/// down to the smallest distance).
+enum class CurveDirection { approach, retract };
+
+struct FitOptions {
+  std::string law = "dmt";
+  /// Law parameters (registry keys, SI units: m, Pa, N, N/m, J, J/m², Pa·s), fixed or initial values. Keys not
+  /// given take the registry's defaults (or the key they follow).
+  std::map<std::string, double> law_values;
+  std::string force_curve;        // law = table: the force-curve file
+  bool allow_energy_gain = false;
+  /// The fitted parameters: law keys and/or distance_offset, amplitude_scale, phase_offset.
+  std::vector<std::string> parameters;
+  /// Initial (or fixed) values of the calibration parameters: distance_offset [m] (0), amplitude_scale (1),
+  /// phase_offset [rad] (0); initial values of fitted law keys may be given here too (SI).
+  std::map<std::string, double> initial;
+  CurveDirection direction = CurveDirection::approach;
+  double amplitude_noise = 0.0;  // σ_A in A/A0 (0: estimated from the data)
+  /// Huber's loss beyond this many σ (docs/fitting.md#weights; 0: plain least squares).
+  double huber = 5.0;
+  double phase_noise = 0.0;      // σ_φ [rad] (0: estimated)
+  double fd_step = 1e-3;         // forward-difference step in the transformed coordinates u
+  int max_evaluations = 100;     // forward-model evaluations (curves, the Jacobian's columns included)
+  double tolerance = 1e-4;       // relative reduction of the cost and relative step (LM ftol and xtol)
+  /// Identifiability thresholds (docs/fitting.md#identifiability).
+  double correlation_limit = 0.99;
+  double condition_limit = 1e10;
+  double flat_column = 1e-3;  // a parameter whose weighted Jacobian column is shorter is flat (not identifiable)
+  /// Accuracy of the orbits: the integrator's relative tolerance and the shooting tolerance (tapping/shooting.hpp;
+  /// the sweep's defaults are 1e-10 and 1e-11: a fit to data with noise ~1e-3 needs less).
+  double integrator_tolerance = 1e-9;
+  double shooting_tolerance = 1e-10;
+  bool parallel = true;          // the orbits of a warm-started evaluation in parallel (OpenMP)
+  Cancellation cancellation;
+  void validate() const;
+};
+
+/// How a parameter is kept in its valid range: p(u) with u the solver's coordinate.
+enum class Transform {
+  identity,  // p = p0 + u·scale              (unbounded: distance_offset, scale 1 nm; phase_offset, 1 rad)
+  log,       // p = lower + (p0 − lower)·e^u  (lower bound only: every registry key has lower 0)
+  logistic   // p = lower + (upper − lower)/(1 + e^−(u + u0))  (both bounds)
+};
+const char* transform_name(Transform t);  // "identity", "log", "logistic"
+
+struct FitParameterInfo {
+  std::string name;
+  std::string unit;  // SI unit ("m", "Pa", "J", "rad", "dimensionless", ...)
+  double initial = 0.0;
+  double lower = 0.0, upper = 0.0;  // valid range (±inf when open-ended)
+  Transform transform = Transform::identity;
+  double scale = 1.0;  // identity: the size of u = 1 in the parameter's unit
+};
+
+/// Status of a fit (docs/fitting.md#status): ok when the solver stopped on one of its tolerances.
+enum class FitStatus { ok, not_converged, failed };
+const char* fit_status_name(FitStatus s);  // "ok", "not_converged", "failed"
+
+struct FitResult {
+  FitStatus status = FitStatus::failed;
+  std::string solver_status;  // Eigen's LevenbergMarquardtSpace::Status in words
+  std::vector<FitParameterInfo> parameters;
+  std::vector<double> estimates;          // SI
+  std::vector<double> standard_errors;    // SI (inf: not identifiable)
+  std::vector<std::vector<double>> correlation;  // P×P (NaN where a parameter is not identifiable)
+  std::vector<std::string> warnings;      // identifiability and model warnings, in words
+  std::vector<bool> identifiable;         // per parameter
+  double condition_number = 0.0;          // of the scaled JᵀJ (unit diagonal)
+  // the data (sorted by the sweep's order) and the fit
+  std::vector<double> distance, amplitude, phase;             // measured, SI (phase empty when not given)
+  std::vector<double> fitted_amplitude, fitted_phase;         // model at the estimates, as measured (÷s, +φ0)
+  std::vector<bool> contact;                                  // orbit reaches the law's contact gap
+  std::vector<bool> jumped;                                   // the response jumped onto another branch there
+  double amplitude_noise = 0.0, phase_noise = 0.0;            // σ used (A/A0, rad)
+  bool noise_estimated_amplitude = false, noise_estimated_phase = false;
+  double rms_amplitude = 0.0;   // RMS of (A_meas − A_fit)/A0
+  double rms_phase = 0.0;       // RMS of the phase residual [rad]
+  double cost = 0.0;            // Σ r² (weighted) at the estimates
+  double reduced_chi2 = 0.0;    // Σ r² / (N − P)
+  long curve_evaluations = 0;   // forward-model evaluations (whole curves, Jacobian columns included)
+  long orbit_evaluations = 0;   // periodic orbits computed (every point of every evaluation)
+  long failed_evaluations = 0;  // trial points where the model could not be evaluated (rejected steps)
+  int iterations = 0;
+  double seconds = 0.0;
+  /// Every law value used (registry keys, SI), fitted ones at their estimates.
+  std::map<std::string, double> law_values;
+};
+
+/// The information of every parameter name the fit knows for `options.law` (transform, range, SI unit, initial).
+/// InvalidParameter("parameters", …) for an unknown name or one the law does not read; ("initial"/law key) for an
+/// initial value outside the range or 0 on a log scale.
+std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options);
+
+/// Weighted nonlinear least squares (see above). Bad input -> InvalidParameter; the model failing at the initial
+/// values -> NumericalFailure; a fit that stops on its budget -> status not_converged (the result still holds
+/// everything at the best point found).
+FitResult fit_am_curve(const AmCurve& curve, const AmSettings& settings, const FitOptions& options);
+
+/// The forward model alone: amplitude [m] and phase [rad] at each distance of `distance` (in the order given),
+/// for the law and calibration values of `options` (law_values + initial; parameters ignored). Synthetic data and
+/// checks. `orbits`: if given, receives the number of orbits computed.
+struct AmPrediction {
+  std::vector<double> amplitude, phase;
+  std::vector<bool> contact, jumped;
+};
+AmPrediction predict_am_curve(const std::vector<double>& distance, const AmSettings& settings,
+                              const FitOptions& options);
+
+/// Factor converting a registry law unit to SI ("nm" -> 1e-9, "GPa" -> 1e9, "nN" -> 1e-9, others 1) and the SI
+/// unit's name ("m", "Pa", "N", ...).
+double law_unit_to_si(const std::string& unit);
+std::string law_si_unit(const std::string& unit);
+
+}  // namespace afmkit::spectroscopy

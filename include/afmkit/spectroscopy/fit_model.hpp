@@ -1,0 +1,70 @@
+#pragma once
+// The forward model of `spectroscopy fit` (fit.hpp): amplitude and phase along a measured curve from afmkit's
+// periodic orbits, and the parameter transformations. Internal to the fit (its tests use it too).
+#include <atomic>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "afmkit/spectroscopy/fit.hpp"
+#include "afmkit/tapping/sweep.hpp"
+
+namespace afmkit::spectroscopy {
+
+bool is_calibration(const std::string& name);  // distance_offset, amplitude_scale, phase_offset
+/// The value of a calibration parameter in `options.initial`, else its default (0, 1, 0).
+double calibration_value(const FitOptions& options, const std::string& name);
+/// p(u) and dp/du of the parameter's transformation (fit.hpp: Transform).
+double to_parameter(const FitParameterInfo& p, double u);
+double parameter_derivative(const FitParameterInfo& p, double u);
+
+/// Every value the model needs: law values (registry keys, SI) and the calibration.
+struct ModelValues {
+  std::map<std::string, double> law;
+  double distance_offset = 0.0;  // m
+  double amplitude_scale = 1.0;
+  double phase_offset = 0.0;     // rad
+};
+
+/// One evaluation along the curve, in the sweep's order of the points.
+struct CurveEvaluation {
+  bool ok = false;
+  std::string error;  // why not ok
+  std::vector<tapping::PeriodicOrbit> orbits;
+  std::vector<bool> periodic;
+  std::vector<double> amplitude, phase;  // model amplitude [m] (not divided by s) and phase [rad] (without φ0)
+  std::vector<bool> contact, jumped;
+};
+
+/// The orbits along the measured distances as an instrument sweeps them (approach from the largest distance; for
+/// a retract curve, approach down to the smallest then retract).
+class AmForwardModel {
+ public:
+  /// `distances` [m] in the sweep's order (approach: decreasing; retract: increasing).
+  AmForwardModel(const AmSettings& settings, const FitOptions& options, std::vector<double> distances);
+
+  /// Continuation along the curve from the free response (follow_stable_branch; a transient where a branch ends).
+  CurveEvaluation walk(const ModelValues& values) const;
+  /// Each point by Newton from the orbit of `from` at the same point (values close to those of `from`); falls back
+  /// to walk() when a point does not converge to a stable orbit near the previous one, or when a jump of `from`
+  /// moved past a point. `chord`: one chord-Newton step with the monodromy of `from` instead of Newton to the
+  /// tolerance (the Jacobian's perturbed curves: off by O(step²)).
+  CurveEvaluation warm(const ModelValues& values, const CurveEvaluation& from, bool chord = false) const;
+
+  long curves() const { return curves_.load(); }
+  long orbits() const { return orbits_.load(); }
+
+ private:
+  AmSettings settings_;
+  FitOptions options_;
+  std::vector<double> distances_;
+  tapping::SweepOptions sweep_;
+  mutable std::atomic<long> curves_{0}, orbits_{0};
+  /// The model (law built from `values`, free amplitude s·A0) at separation 0; InvalidParameter for law values
+  /// outside their ranges.
+  tapping::TappingModel model(const ModelValues& values) const;
+  double separation(const ModelValues& values, std::size_t i) const;  // model units (nm)
+  void finish(const tapping::TappingModel& m, const ModelValues& values, CurveEvaluation& e) const;
+};
+
+}  // namespace afmkit::spectroscopy

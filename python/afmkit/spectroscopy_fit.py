@@ -1,0 +1,232 @@
+"""Fitting a force law to a measured AM-AFM amplitude/phase-versus-distance curve (docs/fitting.md).
+
+``fit(distance, amplitude, phase, *, law="dmt", parameters=[...], initial={...}, fixed={...}, spring_constant=...,
+resonance_frequency=..., quality_factor=..., free_amplitude=...)`` takes NumPy arrays in SI units (m, rad, N/m, Hz)
+and returns a :class:`FitResult`: estimates with standard errors, the correlation matrix, identifiability
+warnings, the fitted curves and the status. ``predict`` is the forward model alone (synthetic data), ``plot`` draws
+data vs fit (Matplotlib), and ``run`` is the command ``afmkit spectroscopy fit`` on a file (keyword arguments are
+its TOML keys, in the command's units).
+
+Command line: ``python3 -m afmkit.spectroscopy_fit --plot TABLE.csv OUT.png`` draws the plot of a table written by
+``afmkit spectroscopy fit`` (what its ``--plot`` does).
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+import sys
+import tempfile
+
+import numpy as np
+
+from . import _afmkit
+from ._commands import make_command
+
+run = make_command("spectroscopy fit")
+
+DEFAULT_PARAMETERS = ("hamaker", "effective_modulus", "distance_offset", "phase_offset")
+
+
+@dataclasses.dataclass
+class FitResult:
+    """What :func:`fit` found. Arrays of the curve are in the sweep's order (approach: distance decreasing).
+
+    ``estimates``, ``standard_errors``, ``units``: dicts by parameter name (SI: m, Pa, J, rad, ...);
+    ``correlation``: P×P array in the order of ``names``; ``identifiable``: dict of bool; ``warnings``: list of str;
+    ``status``: "ok" or "not_converged" (``solver_status`` says why); ``rms_amplitude`` (A/A0), ``rms_phase`` (rad);
+    ``curve_evaluations``, ``orbit_evaluations``, ``seconds``; ``law_values``: every law value used (SI).
+    """
+
+    status: str
+    solver_status: str
+    names: list
+    estimates: dict
+    standard_errors: dict
+    units: dict
+    initial: dict
+    transforms: dict
+    correlation: np.ndarray
+    identifiable: dict
+    warnings: list
+    condition_number: float
+    distance: np.ndarray
+    amplitude: np.ndarray
+    phase: np.ndarray | None
+    fitted_amplitude: np.ndarray
+    fitted_phase: np.ndarray
+    contact: np.ndarray
+    jumped: np.ndarray
+    amplitude_noise: float
+    phase_noise: float
+    rms_amplitude: float
+    rms_phase: float
+    reduced_chi2: float
+    iterations: int
+    curve_evaluations: int
+    orbit_evaluations: int
+    failed_evaluations: int
+    seconds: float
+    law_values: dict
+    free_amplitude: float
+
+    @property
+    def converged(self) -> bool:
+        return self.status == "ok"
+
+    def plot(self, path: str) -> str:
+        """Data vs fit as a PNG at ``path`` (see :func:`plot`)."""
+        return plot(self, path)
+
+    def __repr__(self) -> str:
+        lines = [f"FitResult(status={self.status!r}, {len(self.distance)} points)"]
+        for n in self.names:
+            lines.append(f"  {n} = {self.estimates[n]:.6g} ± {self.standard_errors[n]:.3g} {self.units[n]}")
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+
+def _settings(spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency):
+    return dict(spring_constant=float(spring_constant), resonance_frequency=float(resonance_frequency),
+                quality_factor=float(quality_factor), free_amplitude=float(free_amplitude),
+                drive_frequency=0.0 if drive_frequency is None else float(drive_frequency))
+
+
+def fit(distance, amplitude, phase=None, *, law: str = "dmt", parameters=DEFAULT_PARAMETERS, initial=None,
+        fixed=None, spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency=None,
+        direction: str = "approach", amplitude_noise: float = 0.0, phase_noise: float = 0.0, huber: float = 5.0,
+        force_curve: str = "",
+        allow_energy_gain: bool = False, fd_step: float = 1e-3, max_evaluations: int = 100,
+        tolerance: float = 1e-4, integrator_tolerance: float = 1e-9, shooting_tolerance: float = 1e-10,
+        correlation_limit: float = 0.99, condition_limit: float = 1e10, flat_column: float = 1e-3,
+        parallel: bool = True) -> FitResult:
+    """Weighted nonlinear least squares of a law (and calibration) to an AM-AFM curve, SI units throughout.
+
+    distance [m], amplitude [m], phase [rad] (phase lag, pi/2 at resonance; None: amplitude only): 1-D arrays.
+    parameters: the fitted names (law keys, distance_offset [m], amplitude_scale, phase_offset [rad]).
+    initial: initial values of fitted parameters and fixed calibration values (SI); fixed: the law's other values
+    (SI: hamaker J, effective_modulus Pa, tip_radius m, ...). spring_constant [N/m], resonance_frequency [Hz],
+    quality_factor, free_amplitude [m], drive_frequency [Hz] (None: at resonance). amplitude_noise (A/A0) and
+    phase_noise [rad]: 0 estimates them from the data; huber: Huber's loss beyond this many σ (0: least squares). Raises afmkit.InvalidParameter on bad input and
+    afmkit.NumericalFailure when the model fails at the initial values; a fit that does not converge returns
+    status "not_converged".
+    """
+    raw = _afmkit.spectroscopy_fit(
+        np.asarray(distance, dtype=float), np.asarray(amplitude, dtype=float),
+        None if phase is None else np.asarray(phase, dtype=float), law, list(parameters), dict(initial or {}),
+        dict(fixed or {}), force_curve, bool(allow_energy_gain),
+        **_settings(spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency),
+        direction=direction, amplitude_noise=float(amplitude_noise), phase_noise=float(phase_noise),
+        huber=float(huber), fd_step=float(fd_step), max_evaluations=int(max_evaluations), tolerance=float(tolerance),
+        integrator_tolerance=float(integrator_tolerance), shooting_tolerance=float(shooting_tolerance),
+        correlation_limit=float(correlation_limit), condition_limit=float(condition_limit),
+        flat_column=float(flat_column), parallel=bool(parallel))
+    names = list(raw["names"])
+    by_name = lambda values: {n: v for n, v in zip(names, values)}  # noqa: E731
+    return FitResult(
+        status=raw["status"], solver_status=raw["solver_status"], names=names,
+        estimates=by_name(float(x) for x in raw["estimates"]),
+        standard_errors=by_name(float(x) for x in raw["standard_errors"]), units=by_name(raw["units"]),
+        initial=by_name(float(x) for x in raw["initial"]), transforms=by_name(raw["transforms"]),
+        correlation=np.asarray(raw["correlation"]), identifiable=by_name(bool(b) for b in raw["identifiable"]),
+        warnings=list(raw["warnings"]), condition_number=raw["condition_number"], distance=raw["distance"],
+        amplitude=raw["amplitude"], phase=raw["phase"], fitted_amplitude=raw["fitted_amplitude"],
+        fitted_phase=raw["fitted_phase"], contact=raw["contact"], jumped=raw["jumped"],
+        amplitude_noise=raw["amplitude_noise"], phase_noise=raw["phase_noise"], rms_amplitude=raw["rms_amplitude"],
+        rms_phase=raw["rms_phase"], reduced_chi2=raw["reduced_chi2"], iterations=raw["iterations"],
+        curve_evaluations=raw["curve_evaluations"], orbit_evaluations=raw["orbit_evaluations"],
+        failed_evaluations=raw["failed_evaluations"], seconds=raw["seconds"], law_values=dict(raw["law_values"]),
+        free_amplitude=float(free_amplitude))
+
+
+def predict(distance, *, law: str = "dmt", values=None, calibration=None, spring_constant, resonance_frequency,
+            quality_factor, free_amplitude, drive_frequency=None, direction: str = "approach",
+            force_curve: str = "", allow_energy_gain: bool = False) -> dict:
+    """The fit's forward model: amplitude [m] and phase [rad] at each distance [m] (in the order given), for the law
+    values ``values`` (SI) and the calibration (distance_offset [m], amplitude_scale, phase_offset [rad])."""
+    return _afmkit.spectroscopy_predict(
+        np.asarray(distance, dtype=float), law, dict(values or {}), dict(calibration or {}), force_curve,
+        bool(allow_energy_gain),
+        **_settings(spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency),
+        direction=direction)
+
+
+def _draw(distance_nm, amplitude, fitted_amplitude, phase_deg, fitted_phase_deg, title, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = 2 if phase_deg is not None else 1
+    lines = title.count("\n") + 1
+    fig, axes = plt.subplots(rows, 1, figsize=(6.4, 2.6 * rows + 0.25 * lines + 0.4), sharex=True, squeeze=False)
+    ax = axes[0][0]
+    ax.plot(distance_nm, amplitude, "o", ms=3, color="0.55", label="data")
+    ax.plot(distance_nm, fitted_amplitude, "-", color="C3", lw=1.5, label="fit")
+    ax.set_ylabel("amplitude A / A0")
+    ax.legend(loc="best", frameon=False)
+    ax.set_title(title, fontsize=9)
+    if rows == 2:
+        ax = axes[1][0]
+        ax.plot(distance_nm, phase_deg, "o", ms=3, color="0.55", label="data")
+        ax.plot(distance_nm, fitted_phase_deg, "-", color="C0", lw=1.5, label="fit")
+        ax.set_ylabel("phase (deg)")
+    axes[-1][0].set_xlabel("distance (nm)")
+    fig.tight_layout()
+    # written through a temporary of its own, then moved into place: a reader never sees half a PNG
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".plot-", suffix=".png", dir=folder)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=120, format="png")
+        os.replace(tmp, path)
+    finally:
+        plt.close(fig)
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def plot(result: FitResult, path: str) -> str:
+    """Data vs fit (A/A0 and phase in degrees against distance in nm) as a PNG at ``path``."""
+    a0 = result.free_amplitude
+    phase = None if result.phase is None else np.degrees(result.phase)
+    fitted_phase = None if result.phase is None else np.degrees(result.fitted_phase)
+    title = "\n".join(f"{n} = {result.estimates[n]:.4g} ± {result.standard_errors[n]:.2g} {result.units[n]}"
+                       for n in result.names)
+    return _draw(result.distance * 1e9, result.amplitude / a0, result.fitted_amplitude / a0, phase, fitted_phase,
+                 title, path)
+
+
+def plot_table(table: str, path: str) -> str:
+    """The plot of a table written by ``afmkit spectroscopy fit`` (its sidecar gives A0 and the estimates)."""
+    import json
+
+    with open(table + ".json", encoding="utf-8") as f:
+        sidecar = json.load(f)
+    data = np.genfromtxt(table, delimiter=",", names=True)
+    a0 = float(sidecar["parameters"]["free_amplitude"])
+    results = sidecar["results"]
+    units = results.get("units", {})
+    title = "\n".join(f"{n} = {e['value']:.4g} ± {e['standard_error']:.2g} {units.get(n, '')}"
+                       for n, e in results["estimates"].items())
+    has_phase = "phase" in data.dtype.names
+    return _draw(data["distance"], data["amplitude"] / a0, data["fitted_amplitude"] / a0,
+                 data["phase"] if has_phase else None, data["fitted_phase"] if has_phase else None, title, path)
+
+
+def _main(argv) -> int:
+    if len(argv) != 3 or argv[0] != "--plot":
+        print("usage: python3 -m afmkit.spectroscopy_fit --plot TABLE.csv OUT.png", file=sys.stderr)
+        return 2
+    try:
+        plot_table(argv[1], argv[2])
+    except (OSError, ValueError, KeyError) as e:
+        print(f"afmkit: spectroscopy fit --plot: cannot draw {argv[2]} from {argv[1]}: {e}", file=sys.stderr)
+        return 1
+    print(f"wrote the plot to {argv[2]}")
+    return 0
+
+
+__all__ = ["fit", "predict", "plot", "plot_table", "run", "FitResult"]
+
+if __name__ == "__main__":
+    sys.exit(_main(sys.argv[1:]))

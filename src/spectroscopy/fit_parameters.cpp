@@ -1,0 +1,234 @@
+// The fitted parameters of `spectroscopy fit`: names, SI units, valid ranges and the transformations that keep
+// them there (docs/fitting.md#bounds); validation of the inputs.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/core/validate.hpp"
+#include "afmkit/impact/law_registry.hpp"
+#include "afmkit/spectroscopy/fit.hpp"
+#include "afmkit/spectroscopy/fit_model.hpp"
+
+namespace afmkit::spectroscopy {
+
+namespace {
+constexpr double inf = std::numeric_limits<double>::infinity();
+}  // namespace
+
+double law_unit_to_si(const std::string& unit) {
+  if (unit == "nm") return 1e-9;
+  if (unit == "GPa") return 1e9;
+  if (unit == "nN") return 1e-9;
+  return 1.0;  // N/m, J, J/m^2, Pa*s, dimensionless
+}
+
+std::string law_si_unit(const std::string& unit) {
+  if (unit == "nm") return "m";
+  if (unit == "GPa") return "Pa";
+  if (unit == "nN") return "N";
+  return unit.empty() ? "dimensionless" : unit;
+}
+
+const char* transform_name(Transform t) {
+  switch (t) {
+    case Transform::identity: return "identity";
+    case Transform::log: return "log";
+    case Transform::logistic: return "logistic";
+  }
+  return "?";
+}
+
+const char* fit_status_name(FitStatus s) {
+  switch (s) {
+    case FitStatus::ok: return "ok";
+    case FitStatus::not_converged: return "not_converged";
+    case FitStatus::failed: return "failed";
+  }
+  return "?";
+}
+
+void AmCurve::validate() const {
+  const std::size_t n = distance.size();
+  if (n < 3) throw InvalidParameter("distance", fmt::format("the curve has {} point(s): at least 3 are needed", n));
+  if (amplitude.size() != n)
+    throw InvalidParameter("amplitude", fmt::format("amplitude has {} values, distance {}: they must be equal",
+                                                    amplitude.size(), n));
+  if (!phase.empty() && phase.size() != n)
+    throw InvalidParameter("phase", fmt::format("phase has {} values, distance {}: they must be equal (or phase "
+                                                "empty: amplitude only)",
+                                                phase.size(), n));
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(distance[i]))
+      throw InvalidParameter("distance", fmt::format("distance[{}] = {} m is not a finite number", i, distance[i]));
+    if (!(std::isfinite(amplitude[i]) && amplitude[i] > 0.0))
+      throw InvalidParameter("amplitude", fmt::format("amplitude[{}] = {} m is out of range: must be > 0 and finite",
+                                                      i, amplitude[i]));
+    if (!phase.empty() && !std::isfinite(phase[i]))
+      throw InvalidParameter("phase", fmt::format("phase[{}] = {} rad is not a finite number", i, phase[i]));
+  }
+  std::vector<std::pair<double, std::size_t>> sorted;
+  for (std::size_t i = 0; i < n; ++i) sorted.emplace_back(distance[i], i);
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t k = 1; k < n; ++k)
+    if (sorted[k].first == sorted[k - 1].first)
+      throw InvalidParameter("distance", fmt::format("distance[{}] = distance[{}] = {} m: every distance must be "
+                                                     "distinct (average repeated rows first)",
+                                                     sorted[k - 1].second, sorted[k].second, sorted[k].first));
+}
+
+void AmSettings::validate() const {
+  validate::positive("spring_constant", spring_constant);
+  validate::positive("resonance_frequency", resonance_frequency);
+  validate::positive("quality_factor", quality_factor);
+  validate::positive("free_amplitude", free_amplitude);
+  validate::non_negative("drive_frequency", drive_frequency);
+}
+
+void FitOptions::validate() const {
+  validate::non_negative("amplitude_noise", amplitude_noise);
+  validate::non_negative("phase_noise", phase_noise);
+  validate::non_negative("huber", huber);
+  validate::require(fd_step >= 1e-8 && fd_step <= 0.1, "fd_step", fd_step, "in [1e-8, 0.1]");
+  validate::require(max_evaluations >= 2 && max_evaluations <= 1000000, "max_evaluations", max_evaluations,
+                    "in [2, 1000000]");
+  validate::require(tolerance >= 1e-15 && tolerance <= 0.1, "tolerance", tolerance, "in [1e-15, 0.1]");
+  validate::require(correlation_limit > 0.0 && correlation_limit < 1.0, "correlation_limit", correlation_limit,
+                    "in (0, 1)");
+  validate::require(integrator_tolerance >= 1e-14 && integrator_tolerance <= 1e-4, "integrator_tolerance",
+                    integrator_tolerance, "in [1e-14, 1e-4]");
+  validate::require(shooting_tolerance >= 1e-14 && shooting_tolerance <= 1e-4, "shooting_tolerance",
+                    shooting_tolerance, "in [1e-14, 1e-4]");
+  validate::require(flat_column >= 0.0 && flat_column <= 1.0, "flat_column", flat_column, "in [0, 1]");
+  validate::require(condition_limit > 1.0, "condition_limit", condition_limit, "> 1");
+}
+
+bool is_calibration(const std::string& name) {
+  return name == "distance_offset" || name == "amplitude_scale" || name == "phase_offset";
+}
+
+double calibration_default(const std::string& name) { return name == "amplitude_scale" ? 1.0 : 0.0; }
+
+double calibration_value(const FitOptions& options, const std::string& name) {
+  const auto it = options.initial.find(name);
+  return it != options.initial.end() ? it->second : calibration_default(name);
+}
+
+std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options) {
+  const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  const impact::LawSpec& spec = registry.find(options.law);
+  if (options.parameters.empty())
+    throw InvalidParameter("parameters", "no parameter to fit: name at least one (a key of the law, distance_offset, "
+                                         "amplitude_scale or phase_offset)");
+  for (const auto& [key, value] : options.initial)
+    if (!is_calibration(key) &&
+        std::find(options.parameters.begin(), options.parameters.end(), key) == options.parameters.end())
+      throw InvalidParameter(key, fmt::format("an initial value is given for {}, which is not fitted: give fixed law "
+                                              "values as law parameters, or add {} to the fitted parameters",
+                                              key, key));
+  std::set<std::string> seen;
+  std::vector<FitParameterInfo> out;
+  for (const std::string& name : options.parameters) {
+    if (!seen.insert(name).second)
+      throw InvalidParameter("parameters", fmt::format("parameter '{}' is named twice", name));
+    FitParameterInfo p;
+    p.name = name;
+    if (is_calibration(name)) {
+      p.initial = calibration_value(options, name);
+      if (name == "distance_offset") {
+        p.unit = "m", p.lower = -inf, p.upper = inf, p.transform = Transform::identity, p.scale = 1e-9;
+      } else if (name == "phase_offset") {
+        p.unit = "rad", p.lower = -inf, p.upper = inf, p.transform = Transform::identity, p.scale = 1.0;
+      } else {
+        p.unit = "dimensionless", p.lower = 0.0, p.upper = inf, p.transform = Transform::log;
+      }
+    } else {
+      if (std::find(spec.keys.begin(), spec.keys.end(), name) == spec.keys.end()) {
+        const auto users = registry.laws_using(name);
+        throw InvalidParameter(
+            "parameters",
+            users.empty() ? fmt::format("'{}' is not a parameter that can be fitted: law = {} reads {}; the "
+                                        "calibration parameters are distance_offset, amplitude_scale, phase_offset",
+                                        name, options.law, fmt::join(spec.keys, ", "))
+                          : fmt::format("'{}' is not a parameter of law = {} (it is one of law {}); law = {} reads {}",
+                                        name, options.law, fmt::join(users, ", "), options.law,
+                                        fmt::join(spec.keys, ", ")));
+      }
+      const impact::LawKey* key = nullptr;
+      for (const auto& k : registry.keys())
+        if (k.key == name) key = &k;
+      const double f = law_unit_to_si(key->unit);
+      p.unit = law_si_unit(key->unit);
+      p.lower = key->lower * f;
+      p.upper = key->upper * f;
+      if (const auto it = options.initial.find(name); it != options.initial.end()) p.initial = it->second;
+      else if (const auto lt = options.law_values.find(name); lt != options.law_values.end()) p.initial = lt->second;
+      else {
+        impact::LawArguments args;
+        for (const auto& [k, v] : options.law_values) {
+          double unit = 1.0;
+          for (const auto& d : registry.keys())
+            if (d.key == k) unit = law_unit_to_si(d.unit);
+          args.values[k] = v / unit;
+        }
+        p.initial = args.real(*key, registry.keys()) * f;
+      }
+      const bool bounded_below = std::isfinite(p.lower), bounded_above = std::isfinite(p.upper);
+      p.transform = bounded_below && bounded_above ? Transform::logistic
+                    : bounded_below               ? Transform::log
+                                                  : Transform::identity;
+      if (!bounded_below && bounded_above)  // not among the registry's keys; kept general: a mirrored log
+        p.transform = Transform::log;
+      p.scale = std::max(std::abs(p.initial), 1e-30);
+    }
+    if (!std::isfinite(p.initial))
+      throw InvalidParameter(name, fmt::format("initial value of {} = {} {} is not a finite number", name, p.initial,
+                                               p.unit));
+    const bool inside = p.transform == Transform::identity ||
+                        (p.initial > p.lower && p.initial < p.upper);
+    if (!inside)
+      throw InvalidParameter(name, fmt::format("initial value of {} = {} {} is out of range: a fitted {} must be "
+                                               "strictly inside ({}, {}) {} (it is fitted on a {} scale)",
+                                               name, p.initial, p.unit, name, p.lower, p.upper, p.unit,
+                                               transform_name(p.transform)));
+    out.push_back(p);
+  }
+  return out;
+}
+
+double to_parameter(const FitParameterInfo& p, double u) {
+  switch (p.transform) {
+    case Transform::identity: return p.initial + u * p.scale;
+    case Transform::log:
+      if (std::isfinite(p.lower)) return p.lower + (p.initial - p.lower) * std::exp(u);
+      return p.upper - (p.upper - p.initial) * std::exp(-u);
+    case Transform::logistic: {
+      const double w = p.upper - p.lower;
+      const double u0 = std::log((p.initial - p.lower) / (p.upper - p.initial));
+      return p.lower + w / (1.0 + std::exp(-(u + u0)));
+    }
+  }
+  return p.initial;
+}
+
+double parameter_derivative(const FitParameterInfo& p, double u) {
+  switch (p.transform) {
+    case Transform::identity: return p.scale;
+    case Transform::log:
+      if (std::isfinite(p.lower)) return (p.initial - p.lower) * std::exp(u);
+      return (p.upper - p.initial) * std::exp(-u);
+    case Transform::logistic: {
+      const double w = p.upper - p.lower;
+      const double u0 = std::log((p.initial - p.lower) / (p.upper - p.initial));
+      const double e = std::exp(-(u + u0));
+      return w * e / ((1.0 + e) * (1.0 + e));
+    }
+  }
+  return 1.0;
+}
+
+}  // namespace afmkit::spectroscopy
