@@ -392,12 +392,7 @@ void run_prepare_curves(const io::ParamSet& p, const std::vector<io::curves::Raw
     status = "law_refused";
     const std::string why = e.what();
     const std::string advice =
-        why.find("straight line") != std::string::npos
-            ? "the retract is stiffer than the approach at the deepest point (unloading usually is), which the table "
-              "law's straight continuation below the measured depth turns into an energy gain there: "
-              "--allow-energy-gain accepts it (give it to the orbit commands as well, and keep their orbits above "
-              "the measured depth)"
-            : fmt::format("a larger --bin-width averages the noise down{}, or --allow-energy-gain accepts it (give "
+            fmt::format("a larger --bin-width averages the noise down{}, or --allow-energy-gain accepts it (give "
                           "it to the orbit commands as well)",
                           p.flag("keep_baseline") ? ", leaving out --keep-baseline trims the far baseline" : "");
     note = fmt::format("the prepared table is refused by the table law: {} — {}", why, advice);

@@ -536,6 +536,7 @@ TableLaw::Branch TableLaw::build(const std::vector<double>& x, const std::vector
                   (m[i] + m[i + 1] - 2.0 * delta[i]) / h[i] / h[i]};
   }
   b.piece[n - 1] = {y[n - 1], m[n - 1], 0.0, 0.0};
+  b.below_slope = m[0];
   b.inverse_mean_step = static_cast<double>(n - 1) / (x[n - 1] - x[0]);  // may be inf or 0: eval() copes
   b.cumulative.assign(n, 0.0);
   for (std::size_t i = 0; i + 1 < n; ++i) {
@@ -571,9 +572,8 @@ std::size_t TableLaw::Branch::locate(double d) const {
 double TableLaw::Branch::eval(double d) const {
   const double* xs = x.data();
   const std::size_t n = x.size();
-  if (!(d >= xs[0])) {  // below the table (and NaN): the C¹ linear continuation
-    const Piece& p = piece[0];
-    return p.y + p.c1 * (d - xs[0]);
+  if (!(d >= xs[0])) {  // below the table (and NaN): the linear continuation
+    return piece[0].y + below_slope * (d - xs[0]);
   }
   if (d >= xs[n - 1]) return d > xs[n - 1] ? 0.0 : piece[n - 1].y;
   // the interval i with x_i ≤ d < x_{i+1}, i ∈ [0, n − 2]: first the guess of an evenly spaced table (AFM
@@ -596,9 +596,8 @@ double TableLaw::Branch::integral(double d) const {
   const double* xs = x.data();
   const std::size_t n = x.size();
   if (!(d >= xs[0])) {
-    const Piece& p = piece[0];
     const double t = d - xs[0];
-    return t * (p.y + 0.5 * p.c1 * t);
+    return t * (piece[0].y + 0.5 * below_slope * t);
   }
   if (d >= xs[n - 1]) return cumulative[n - 1];
   const std::size_t i = locate(d);
@@ -649,6 +648,12 @@ TableLaw::TableLaw(ForceCurve curve, bool allow_energy_gain, Hysteresis hysteres
       retract_(build(curve_.retract_gap, curve_.retract_force, "retract branch", curve_.origin)),
       hysteresis_(hysteresis) {
   switching_ = {approach_.x.back(), retract_.x.back()};
+  // a retract stiffer at its deepest point than the approach continues below its table with the approach's end
+  // slope (table_law.hpp): its kink there is a switching gap
+  if (retract_.below_slope < approach_.below_slope) {
+    retract_.below_slope = approach_.below_slope;
+    switching_.push_back(retract_.x.front());
+  }
   if (!(release_tolerance >= 0.0 && std::isfinite(release_tolerance)))
     throw InvalidParameter("release_tolerance", fmt::format("release_tolerance = {} nN must be finite and >= 0",
                                                             release_tolerance));
@@ -700,8 +705,7 @@ double TableLaw::compute_difference_end(double tolerance) const {
 TableLaw::Piece TableLaw::Branch::local(double a, double b) const {
   const std::size_t n = x.size();
   if (b <= x.front()) {  // the straight-line continuation below the table
-    const Piece& p = piece[0];
-    return {p.y + p.c1 * (a - x.front()), p.c1, 0.0, 0.0};
+    return {piece[0].y + below_slope * (a - x.front()), below_slope, 0.0, 0.0};
   }
   if (a >= x.back()) return {0.0, 0.0, 0.0, 0.0};  // beyond the table
   const std::size_t i = locate(a);                  // (a, b) lies inside [x_i, x_{i+1}]
@@ -747,26 +751,9 @@ void TableLaw::require_dissipative() const {
   std::sort(knots.begin(), knots.end());
   knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
 
-  // Below every knot both branches are straight lines: H_a − H_b = g0 + (s_a − s_b)(d − d0), which falls without
-  // bound as d → −∞ when the retract line is steeper (s_a − s_b > 0). Slopes equal to 1e-9 of the larger are
-  // taken as equal (the force error that allows is 1e-9 of the force at that depth).
-  {
-    const double d0 = knots.front();
-    const Piece pa = approach_.local(d0 - 1.0, d0), pb = retract_.local(d0 - 1.0, d0);
-    const double ga = pa.y + pa.c1, gb = pb.y + pb.c1;  // the lines' values at d0
-    const double rise = pa.c1 - pb.c1;
-    if (rise > 1e-9 * std::max(std::abs(pa.c1), std::abs(pb.c1))) {
-      const double onset = d0 - std::max(0.0, ga - gb + tolerance) / rise;  // below it H_b − H_a > tolerance
-      const double d = onset - std::max(1.0, std::abs(onset));
-      throw InvalidParameter(
-          "force_curve",
-          fmt::format("{}below {} nm, where both branches continue as straight lines with their end slopes, the "
-                      "retract slope {} nN/nm is steeper than the approach slope {} nN/nm, so the retract force "
-                      "exceeds the approach force at every distance below {} nm (e.g. {} nN against {} nN at {} nm): "
-                      "{}",
-                      prefix, d0, pb.c1, pa.c1, onset, retract_.eval(d), approach_.eval(d), d, remedy));
-    }
-  }
+  // Below every knot both branches are straight lines and the retract's is never steeper than the approach's (the
+  // constructor gives it the approach's slope then): H_a − H_b = g0 + (s_a − s_b)(d − d0) does not fall below its
+  // value g0 at the lowest knot, which the loop checks.
   for (std::size_t k = 0; k < knots.size(); ++k) {
     const double a = knots[k];
     {  // the knot itself (at a table's end the branch holds its last value)

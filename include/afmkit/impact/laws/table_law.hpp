@@ -36,7 +36,10 @@
 //     overshoots the data; slopes at the knots by the Fritsch–Butland weighted harmonic mean, at the two ends by
 //     the shape-preserving three-point formula);
 //   * below the smallest distance (deeper indentation than measured): the straight line continuing the
-//     interpolant's end value and slope (C¹);
+//     interpolant's end value and slope (C¹) — except the retract branch when it is stiffer at its deepest point
+//     than the approach (cells and polymers unload stiffer than they load): then it continues with the approach's
+//     end slope (C⁰, a kink at its smallest distance, which becomes a switching gap). How a contact unloads from a
+//     depth never measured is unknown; this rule keeps the law from creating energy there;
 //   * above the largest distance: 0 — the table must reach out to where the interaction is negligible; the
 //     force jumps to 0 there, and that distance is a switching gap of the law.
 //   * branch selection: contact-aware by default (docs/force-laws.md#hysteresis) — the retract branch only after
@@ -47,8 +50,7 @@
 // A noisy baseline makes the retract force exceed the approach force somewhere, which require_dissipative()
 // rejects unless allow_energy_gain is set (smooth or trim the baseline, or opt in); so do a retract table that
 // ends before an attractive approach (0 above an attraction), an approach table that ends before a repulsive
-// retract, and a retract contact stiffer at the deepest point than the approach (its straight line rises above
-// the approach's below the tables).
+// retract, and a retract above the approach at the deepest measured point.
 #include <cstddef>
 #include <limits>
 #include <string>
@@ -136,6 +138,7 @@ class TableLaw final : public ForceLawModel {
     std::vector<Piece> piece;
     std::vector<double> cumulative;  // ∫_{x_0}^{x_i} of the interpolant
     double inverse_mean_step = 0.0;   // (n − 1)/(x_{n−1} − x_0): the interval of an evenly spaced table in O(1)
+    double below_slope = 0.0;         // slope of the straight line below x_0 (the end slope, or see above)
     double eval(double d) const;
     std::size_t locate(double d) const;  // i with x_i ≤ d < x_{i+1} (binary search), for x_0 ≤ d < x_{n−1}
     /// The branch on an open interval (a, b) holding no knot, as a cubic in t = d − a: the piece's cubic shifted
