@@ -79,7 +79,9 @@ SweepPoint from_transient(const TappingModel& model, TipState state, SweepDirect
   p.separation = model.separation;
   p.direction = direction;
   p.jumped = true;
-  const TransientOutcome t = settle(model, state, options.transient, options.shooting);
+  TransientOptions transient = options.transient;
+  transient.cancellation = options.cancellation;  // a long transient stops within a chunk on request
+  const TransientOutcome t = settle(model, state, transient, options.shooting);
   if (t.orbit) {
     p.orbit = *t.orbit;
   } else {
@@ -401,7 +403,7 @@ namespace detail {
 void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
                    bool harmonic_balance, bool parallel, const Cancellation& cancellation) {
   std::optional<HarmonicBalance> hb;  // branch scan once, cheap queries
-  if (harmonic_balance) hb.emplace(base);  // any law (closed form for piecewise-linear ones)
+  if (harmonic_balance) hb.emplace(base, cancellation);  // any law (closed form for piecewise-linear ones)
   ExceptionCollector errors;
 #pragma omp parallel for schedule(dynamic) if (parallel)
   for (std::size_t i = 0; i < points.size(); ++i) {
