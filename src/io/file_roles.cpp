@@ -57,6 +57,49 @@ std::string shown(const Named& n) {
                                 : fmt::format("{} = '{}' (which writes '{}')", n.key, n.value, n.path.path);
 }
 
+/// What an existing path is, in words ("a folder", "a FIFO (named pipe)", …), for a path that cannot be written.
+std::string kind_of(const fs::file_status& st) {
+  switch (st.type()) {
+    case fs::file_type::directory: return "a folder";
+    case fs::file_type::fifo: return "a FIFO (named pipe)";
+    case fs::file_type::character: return "a character device";
+    case fs::file_type::block: return "a block device";
+    case fs::file_type::socket: return "a socket";
+    case fs::file_type::regular: return "a file";
+    default: return "not a regular file";
+  }
+}
+
+/// Refuses an output that cannot be written where it is named, before anything is computed: a file output whose
+/// path is an existing folder (or FIFO, device, socket: links followed), a folder output whose path is an existing
+/// file, and an output whose nearest existing parent is not a folder.
+void require_writable_kind(const Named& out) {
+  std::error_code ec;
+  const fs::path p(out.path.path);
+  const fs::file_status st = fs::status(p, ec);
+  if (fs::exists(st)) {
+    if (out.path.folder && !fs::is_directory(st))
+      throw InvalidParameter(out.key, fmt::format("{} is an existing file, not a folder: give a folder path (or "
+                                                  "remove the file)",
+                                                  shown(out)));
+    if (!out.path.folder && !fs::is_regular_file(st))
+      throw InvalidParameter(out.key, fmt::format("{}: '{}' is {}, not a file: give a file path", shown(out),
+                                                  out.path.path, kind_of(st)));
+    return;
+  }
+  for (fs::path parent = fs::absolute(p, ec).parent_path(); !parent.empty(); parent = parent.parent_path()) {
+    const fs::file_status ps = fs::status(parent, ec);
+    if (fs::exists(ps)) {
+      if (!fs::is_directory(ps))
+        throw InvalidParameter(out.key, fmt::format("{}: its folder '{}' is {}, not a folder: give a path in a "
+                                                    "folder",
+                                                    shown(out), parent.string(), kind_of(ps)));
+      return;
+    }
+    if (parent == parent.parent_path()) return;
+  }
+}
+
 }  // namespace
 
 std::vector<WrittenPath> table_and_sidecar(const std::string& path) { return {{path}, {path + ".json"}}; }
@@ -86,6 +129,7 @@ void ParamSet::check_files() const {
   }
   for (std::size_t o = 0; o < outputs.size(); ++o) {
     const Named& out = outputs[o];
+    require_writable_kind(out);
     auto clash = [&](const Named& in) {
       return out.path.folder ? inside(in.path.path, out.path.path) : same_file(out.path.path, in.path.path);
     };
