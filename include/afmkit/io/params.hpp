@@ -126,6 +126,7 @@ class ParamSet {
     std::string allowed;  ///< range or choices in words ("> 0", "integer in [1, 100]", "one of a, b")
     std::string group;
     std::vector<std::string> choices;
+    std::string follows;  ///< not empty: not given, the parameter takes the value of this one (follows())
   };
   /// Every parameter in declaration order.
   std::vector<Description> describe() const;
