@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
@@ -73,15 +74,22 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
   hb_options.q_min = -1.0;
   hb_options.q_max = 1.5;
   hb_options.points = 4000;
-  const auto curve = tapping::harmonic_balance_curve(model, hb_options);
-  const tapping::HarmonicBalance balance(model);
-  const nlohmann::json folds = hb_fold_records(balance, scales);  // sorted by separation, as `tapping hb`
+  // the input is checked (the model; the options are the demo's own): what is refused from here on was computed,
+  // a numerical failure naming the computation (exit 1), never the user's error (core/computed.hpp)
+  const auto curve =
+      computed("demo: the harmonic-balance curve", [&] { return tapping::harmonic_balance_curve(model, hb_options); });
+  const tapping::HarmonicBalance balance =
+      computed("demo: harmonic balance", [&] { return tapping::HarmonicBalance(model); });
+  const nlohmann::json folds =  // sorted by separation, as `tapping hb`
+      computed("demo: the harmonic-balance folds", [&] { return hb_fold_records(balance, scales); });
 
   // 2. Approach–retract sweep, each orbit continued from the previous one (shooting).
   io::Progress progress("demo sweep", 2L * points, true, 1.0);
   tapping::SweepOptions options;
   options.progress = [&progress](long n) { progress.advance(n); };
-  const tapping::SweepResult sweep = tapping::sweep_instrument(model, l_min, l_max, points, options);
+  options.validate();
+  const tapping::SweepResult sweep = computed(
+      "demo: instrument sweep", [&] { return tapping::sweep_instrument(model, l_min, l_max, points, options); });
   progress.finish();
 
   nlohmann::json jumps = {{"approach", sweep.approach_jumps}, {"retract", sweep.retract_jumps}};

@@ -70,21 +70,18 @@ std::string kind_of(const fs::file_status& st) {
   }
 }
 
-/// Refuses an output that cannot be written where it is named, before anything is computed: a file output whose
-/// path is an existing folder (or FIFO, device, socket: links followed), a folder output whose path is an existing
-/// file, and an output whose nearest existing parent is not a folder.
+/// Refuses a file output that cannot be written where it is named, before anything is computed: its path is an
+/// existing folder, FIFO, device or socket (links followed), or its nearest existing parent is not a folder. (A
+/// folder output — a Zarr store, the report's figures — is checked by its writer, also before computing.)
 void require_writable_kind(const Named& out) {
+  if (out.path.folder) return;
   std::error_code ec;
   const fs::path p(out.path.path);
   const fs::file_status st = fs::status(p, ec);
   if (fs::exists(st)) {
-    if (out.path.folder && !fs::is_directory(st))
-      throw InvalidParameter(out.key, fmt::format("{} is an existing file, not a folder: give a folder path (or "
-                                                  "remove the file)",
-                                                  shown(out)));
-    if (!out.path.folder && !fs::is_regular_file(st))
-      throw InvalidParameter(out.key, fmt::format("{}: '{}' is {}, not a file: give a file path", shown(out),
-                                                  out.path.path, kind_of(st)));
+    if (!fs::is_regular_file(st))
+      throw InvalidParameter(out.key, fmt::format("output '{}' is not a regular file ({}; {}): give a file path",
+                                                  out.path.path, kind_of(st), shown(out)));
     return;
   }
   for (fs::path parent = fs::absolute(p, ec).parent_path(); !parent.empty(); parent = parent.parent_path()) {
@@ -129,7 +126,6 @@ void ParamSet::check_files() const {
   }
   for (std::size_t o = 0; o < outputs.size(); ++o) {
     const Named& out = outputs[o];
-    require_writable_kind(out);
     auto clash = [&](const Named& in) {
       return out.path.folder ? inside(in.path.path, out.path.path) : same_file(out.path.path, in.path.path);
     };
@@ -146,6 +142,7 @@ void ParamSet::check_files() const {
                                                     shown(out), shown(in)));
     }
   }
+  for (const Named& out : outputs) require_writable_kind(out);  // after the clashes, which say more
 }
 
 }  // namespace afmkit::io

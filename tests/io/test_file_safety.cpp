@@ -353,19 +353,18 @@ TEST(OutputSafety, TheFoldersOfAKilledStoreCommitAreRemovedByTheNextCommit) {
 
 // issue 24 §3: an output path that is an existing folder was found only when the outputs were staged, after the
 // computation (`afmkit scan --output <folder>`); check_files refuses it before anything runs, and the same kind:
-// a folder output that is a file, a path under a file, a device.
+// a path under a file, a device. (Folder outputs are checked by their writers, before computing too.)
 TEST(FileRoles, AnOutputThatCannotBeWrittenWhereItIsNamedIsRefusedBeforeComputing) {
   const Folder dir("kinds");
   fs::create_directories(dir.path / "sub");
   dir.write("plain.txt", "x");
   const struct {
     std::string key, value, message;
-  } cases[] = {{"output", dir.file("sub"), "is a folder, not a file"},
-               {"points_output", dir.file("sub"), "is a folder, not a file"},
-               {"points_output", "/dev/zero", "is a character device, not a file"},
-               {"store", dir.file("plain.txt"), "is an existing file, not a folder"},
+  } cases[] = {{"output", dir.file("sub"), "output '" + dir.file("sub") + "' is not a regular file (a folder; output = '"},
+               {"points_output", dir.file("sub"), "is not a regular file (a folder; points_output = '"},
+               {"points_output", "/dev/zero", "output '/dev/zero' is not a regular file (a character device;"},
                {"output", dir.file("plain.txt/t.csv"), "its folder '" + dir.file("plain.txt") + "' is a file"},
-               {"store", dir.file("plain.txt/a/b.zarr"), "its folder '" + dir.file("plain.txt") + "' is a file"}};
+               {"points_output", dir.file("plain.txt/a/b"), "its folder '" + dir.file("plain.txt") + "' is a file"}};
   for (const auto& c : cases) {
     ParamSet p = files();
     p.set_value(c.key, c.value);

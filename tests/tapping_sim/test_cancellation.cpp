@@ -4,8 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
+#include <memory>
+#include <string>
 
 #include "afmkit/core/cancellation.hpp"
+#include "afmkit/core/error.hpp"
 #include "../counting_stop.hpp"
 #include "afmkit/tapping/continuation.hpp"
 #include "afmkit/tapping/orbit.hpp"
@@ -62,4 +66,44 @@ TEST(Cancellation, TheOrbitSearchPassesItsCancellationToItsTransients) {
   o.cancellation = stop.cancellation();
   EXPECT_THROW(find_orbits(model, o), Cancelled);
   EXPECT_EQ(stop.calls.load(), 12);
+}
+
+// issue 24 §2 (library level): what is refused inside a sweep, a continuation or a grid was computed — as the
+// predictor's NaN separation of a stuck tip was — and crosses the library's entry points as a NumericalFailure
+// naming the computation, never as the user's InvalidParameter. A hook that refuses a "separation" on its third
+// call stands in for a computed value refused deep inside (the hooks run where the computation runs).
+TEST(ComputedBoundary, WhatIsRefusedInsideASweepIsANumericalFailure) {
+  auto refusing = [] {
+    auto calls = std::make_shared<int>(0);
+    return Cancellation([calls]() -> bool {
+      if (++*calls == 3) throw InvalidParameter("separation", "separation = nan is out of range");
+      return false;
+    });
+  };
+  auto expect_numerical = [](auto&& run, const std::string& what) {
+    try {
+      run();
+      ADD_FAILURE() << what << ": the refusal did not reach the caller";
+    } catch (const NumericalFailure& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("not an error in the input"), std::string::npos) << e.what();
+    } catch (const InvalidParameter& e) {
+      ADD_FAILURE() << what << ": reported as the user's error: " << e.what();
+    }
+  };
+  SweepOptions s;
+  s.parallel = false;
+  s.cancellation = refusing();
+  expect_numerical([&] { sweep_instrument(repulsive_model(), 8.0, 11.0, 20, s); }, "instrument sweep");
+  ContinuationOptions c;
+  c.cancellation = refusing();
+  expect_numerical([&] { sweep_continuation(repulsive_model(), 8.8, 10.4, c); }, "");
+  OrbitSearchOptions o;
+  o.parallel = false;
+  o.cancellation = refusing();
+  expect_numerical([&] { sweep_grid(repulsive_model(), {9.0, 10.0}, o); }, "");
+  // the input itself is still the user's error
+  EXPECT_THROW(sweep_instrument(repulsive_model(), 11.0, 8.0, 20, SweepOptions{}), InvalidParameter);
+  EXPECT_THROW(sweep_continuation(repulsive_model(), 8.8, std::nan(""), ContinuationOptions{}), InvalidParameter);
+  EXPECT_THROW(sweep_grid(repulsive_model(), {9.0, std::nan("")}, OrbitSearchOptions{}), InvalidParameter);
 }

@@ -91,9 +91,9 @@ class ParamSet {
   ParamSet& writes(WrittenPaths paths = {});
   /// Refuses, before anything is computed, an output that would replace an input or another output: every path an
   /// output writes is compared with every input (the same file through a symbolic or hard link: st_dev/st_ino; a
-  /// path that does not exist yet: by canonical path; inside a written folder) and with the other outputs; and an
-  /// output that cannot be written where it is named (a file output that is an existing folder, FIFO or device, a
-  /// folder output that is an existing file, a path under a file). InvalidParameter naming the output. resolve() calls it; a front end that sets values
+  /// path that does not exist yet: by canonical path; inside a written folder) and with the other outputs; and a
+  /// file output that cannot be written where it is named (an existing folder, FIFO or device; a path under a
+  /// file). InvalidParameter naming the output. resolve() calls it; a front end that sets values
   /// after resolve() calls it again.
   void check_files() const;
   const std::string& unit_of(const std::string& key) const&;

@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/parallel.hpp"
 #include "afmkit/core/validate.hpp"
@@ -433,6 +434,15 @@ void finish_jumps(const TappingModel& base, std::vector<SweepJump>& jumps, const
 
 }  // namespace detail
 
+namespace {
+// the computations of sweep_instrument and sweep_grid on checked input (below)
+SweepResult sweep_checked(const TappingModel& base, const std::vector<double>& separations,
+                          const SweepOptions& options);
+std::vector<OrbitSearchResult> grid_checked(const TappingModel& base, const std::vector<double>& separations,
+                                            const OrbitSearchOptions& options,
+                                            const std::function<void(long)>& progress);
+}  // namespace
+
 SweepResult sweep_instrument(const TappingModel& base, double l_min, double l_max, int points,
                              const SweepOptions& options) {
   check_range(l_min, l_max, points);
@@ -450,6 +460,23 @@ SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separ
   validate::require(separations.size() >= 2, "separations", static_cast<double>(separations.size()),
                     "at least 2 distinct separations");
   options.validate();
+  // the input is checked: a separation or model refused from here on was computed (core/computed.hpp), never the
+  // user's error
+  return computed("instrument sweep", [&] { return sweep_checked(base, separations, options); });
+}
+
+std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::vector<double>& separations,
+                                          const OrbitSearchOptions& options,
+                                          const std::function<void(long)>& progress) {
+  for (double l : separations) validate::finite("separation", l);
+  options.validate();
+  return computed("grid of orbit searches", [&] { return grid_checked(base, separations, options, progress); });
+}
+
+namespace {
+
+SweepResult sweep_checked(const TappingModel& base, const std::vector<double>& separations,
+                          const SweepOptions& options) {
   const std::vector<double> up = separations;
   const std::vector<double> down(separations.rbegin(), separations.rend());
   const double l_max = up.back();
@@ -484,10 +511,9 @@ SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separ
   return result;
 }
 
-std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::vector<double>& separations,
-                                          const OrbitSearchOptions& options,
-                                          const std::function<void(long)>& progress) {
-  for (double l : separations) validate::finite("separation", l);
+std::vector<OrbitSearchResult> grid_checked(const TappingModel& base, const std::vector<double>& separations,
+                                            const OrbitSearchOptions& options,
+                                            const std::function<void(long)>& progress) {
   std::vector<OrbitSearchResult> out(separations.size());
   OrbitSearchOptions inner = options;
   inner.parallel = false;  // parallel over separations instead
@@ -506,5 +532,7 @@ std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::v
   errors.rethrow();
   return out;
 }
+
+}  // namespace
 
 }  // namespace afmkit::tapping
