@@ -14,6 +14,7 @@
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/sweep.hpp"
 #include "command.hpp"
@@ -113,15 +114,19 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
     return;
   }
 
-  const std::string unit = std::string(" ") + scales.length_unit;
+  // lengths by magnitude in physical units, said to be normalised otherwise (docs/units.md#summaries)
+  const std::string unit = scales.length_unit;
   fmt::print("afmkit demo: tapping cantilever, law '{}', Q = {}, drive at {} x resonance ({} units)\n",
              model.law.name(), model.cantilever.quality_factor, p.real("frequency_ratio"), p.text("units"));
-  fmt::print("  free amplitude {:.4f}{}\n", model.free_amplitude() * scales.length, unit);
+  fmt::print("  free amplitude {}\n", io::summary_value(model.free_amplitude() * scales.length, unit, 6));
   for (const auto& f : folds)
-    fmt::print("  harmonic balance fold (jump point) at separation {:.4f}{}, amplitude {:.4f}{}\n",
-               f["separation"].get<double>(), unit, f["amplitude"].get<double>(), unit);
-  for (double l : jumps["approach"]) fmt::print("  sweep: approach jumped at separation {:.4f}{}\n", l, unit);
-  for (double l : jumps["retract"]) fmt::print("  sweep: retract jumped at separation {:.4f}{}\n", l, unit);
+    fmt::print("  harmonic balance fold (jump point) at separation {}, amplitude {}\n",
+               io::summary_value(f["separation"].get<double>(), unit, 6),
+               io::summary_value(f["amplitude"].get<double>(), unit, 6));
+  for (double l : jumps["approach"])
+    fmt::print("  sweep: approach jumped at separation {}\n", io::summary_value(l, unit, 6));
+  for (double l : jumps["retract"])
+    fmt::print("  sweep: retract jumped at separation {}\n", io::summary_value(l, unit, 6));
   fmt::print("  wrote {}/demo_sweep.csv ({} orbits) and {}/demo_hb.csv ({} HB points); columns, units and results "
              "in the .json sidecars\n",
              dir, table.size(), dir, hb.size());

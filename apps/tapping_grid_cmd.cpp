@@ -18,6 +18,7 @@
 #include "afmkit/core/version.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "afmkit/io/zarr_store.hpp"
 #include "afmkit/tapping/sweep.hpp"
 #include "command.hpp"
@@ -163,9 +164,9 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
   store.commit();
   if (!note.empty()) fmt::print("tapping grid: {}\n", note);
   const auto bands = std::count_if(stable.values.begin(), stable.values.end(), [](double n) { return n > 1; });
-  fmt::print("tapping grid: {} separations in [{}, {}] {}, {} with more than one stable orbit; written to {} "
+  fmt::print("tapping grid: {} separations from {} to {}, {} with more than one stable orbit; written to {} "
              "(Zarr; xarray: xr.open_zarr)\n",
-             points, lo, hi, length, bands, store.path());
+             points, io::summary_value(lo, length, 6), io::summary_value(hi, length, 6), bands, store.path());
   require_answer({{"status", status}, {"note", note}});  // exit 1 when no separation has a tapping orbit
 }
 
