@@ -71,6 +71,9 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
   options.shooting = shooting_options_from(p);
   options.transient = transient_options_from(p);
   options.cancellation = cancellation_of(capture);
+  // at least 2 full transients per separation (the free response and rest: find_orbits); nothing computed yet
+  require_transient_work(p, options.transient, 2.0 * static_cast<double>(points),
+                         fmt::format("2 transients at each of {} separations", points));
   io::Progress progress("tapping grid", static_cast<long>(points), !p.flag("quiet"));
   const std::vector<tapping::OrbitSearchResult> results =
       tapping::sweep_grid(base, normalised, options, [&](long n) { progress.advance(n); });

@@ -25,13 +25,6 @@
 namespace afmkit::cli {
 
 namespace {
-// Time of one drive period of a transient: measured 4.1e-7 s (closed-form piecewise-linear law, no contact, the
-// fastest) to 3.5e-5 s (in contact every period; 2-core test machine under load, Release), taken as 2e-7 s: the
-// estimate is a lower bound, so only requests that cannot fit are refused.
-constexpr double kPeriodSeconds = 2e-7;
-}  // namespace
-
-namespace {
 
 /// Seeds of each kind (tapping::SeedKind names) among `seeds` (indices into the search report).
 nlohmann::json seeds_by_kind(const std::vector<int>& seeds, const tapping::OrbitSearchReport& report) {
@@ -146,13 +139,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   // cost model (docs/development.md#work-and-time): at least two full transients (the free response and rest),
   // each of up to max_transient_periods drive periods; a response decaying at the quality factor Q needs about Q
   // periods to settle, so min(max_transient_periods, Q) periods of about kPeriodSeconds each is a lower bound
-  const double quality = p.real("quality_factor");
-  const double periods = static_cast<double>(options.transient.max_periods);
-  const double estimate = require_work(
-      "max_transient_periods", periods, 2.0 * kPeriodSeconds * std::min(1.0, quality / periods),
-      fmt::format("2 transients of min(max_transient_periods, quality_factor) drive periods, quality_factor = {}, "
-                  "at least {:.2g} s per period",
-                  quality, kPeriodSeconds));
+  const double estimate = require_transient_work(p, options.transient, 2.0, "2 transients");
   io::Progress progress("tapping orbit (transient drive periods, of at most)", 5L * options.transient.max_periods,
                         estimate > kProgressAfterSeconds && !p.flag("json"));
   options.transient.on_periods = [&progress](int n) { progress.advance(n); };
