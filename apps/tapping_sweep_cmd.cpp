@@ -25,6 +25,7 @@
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
 #include "tapping_tables.hpp"
+#include "work_budget.hpp"
 
 namespace afmkit::cli {
 
@@ -161,6 +162,14 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     options.shooting = shooting_options_from(p);
     options.transient = transient_options_from(p);
     options.progress = [&progress](long n) { progress.advance(n); };
+    // a jump runs a transient of up to max_transient_periods drive periods (a response decaying at Q settles in
+    // about Q of them): when one can take seconds, its periods show as well (docs/development.md#work-and-time)
+    const double transient_seconds =
+        kTransientPeriodSeconds * std::min(static_cast<double>(options.transient.max_periods), p.real("quality_factor"));
+    io::Progress transient_progress("tapping sweep (drive periods of transients at jumps, of at most)",
+                                    2L * points * options.transient.max_periods,
+                                    !quiet && transient_seconds > kProgressAfterSeconds);
+    options.transient.on_periods = [&transient_progress](int n) { transient_progress.advance(n); };
     options.cancellation = cancellation_of(capture);
     options.validate();  // the input; what is refused inside the sweep was computed (core/computed.hpp)
     const tapping::SweepResult r = computed("instrument sweep", [&] {
@@ -168,6 +177,7 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
                           : tapping::sweep_instrument(base, list, options);
     });
     progress.finish();
+    transient_progress.finish();
     write_rows(r.approach);
     write_rows(r.retract);
     results["approach_jumps"] = scaled(r.approach_jumps, scales.length);
