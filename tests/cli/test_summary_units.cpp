@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <regex>
 #include <string>
 #include <vector>
@@ -82,7 +83,7 @@ TEST(SummaryUnits, NormalisedNumbersSayTheyAreNormalised) {
   ASSERT_TRUE(std::regex_search(margin.out, m, re)) << margin.out;
   const double in_periods = res.at("critical_delay").get<double>();
   EXPECT_NEAR(std::stod(m[1]), in_periods, 1e-5 * in_periods);
-  EXPECT_NEAR(std::stod(m[2]) * 1e-3, in_periods * 2.0 * M_PI / 314.159265, 1e-5 * in_periods * 0.02);
+  EXPECT_NEAR(std::stod(m[2]) * 1e-3, in_periods * 2.0 * std::numbers::pi / 314.159265, 1e-5 * in_periods * 0.02);
   const auto roots = run_cli("control roots --harmonics 3 --output ''", dir);
   EXPECT_NE(roots.out.find("(normalised, units of Omega; "), std::string::npos) << roots.out;
 }
