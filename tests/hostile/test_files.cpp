@@ -190,7 +190,10 @@ TEST(HostileFiles, AScanIsCommittedWholeOrNotAtAll) {
   fs::create_directories(dir.path / "out");
   for (const char* name : {"out/turns.csv", "out/turns.csv.json", "out/img_deflection.gsf", "out/img_deflection.png"})
     dir.write(name, "old");
-  fs::create_directories(dir.path / "out/img_tilt_free.png");  // the last image cannot be written
+  // the last image cannot be written: a link to a path under a file, which only writing finds (an output that is a
+  // folder is refused before computing, by ParamSet::check_files)
+  dir.write("plain.txt", "x");
+  fs::create_symlink(dir.path / "plain.txt/img.png", dir.path / "out/img_tilt_free.png");
   const auto r = run_shell("afmkit scan --recorded " + recorded_spiral() +
                                " --image-resolution 64 --image-output out/img --output out/turns.csv",
                            dir);
