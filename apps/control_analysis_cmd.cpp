@@ -154,10 +154,9 @@ void run_roots(const io::ParamSet& p, Captured* capture) {
   for (const auto& s : sp.structural)
     out.row(u.in_omega(s.value.real()), u.in_omega(s.value.imag()), static_cast<long>(s.multiplicity), true, 0.0,
             "structural");
-  out.finish(res, fmt::format("{} roots in the box (argument principle: {}{}); spectral abscissa {:.10g} Omega, {} "
-                              "unstable",
+  out.finish(res, fmt::format("{} roots in the box (argument principle: {}{}); spectral abscissa {}, {} unstable",
                               sp.roots.size(), sp.box_count, sp.complete ? ", complete" : ", INCOMPLETE",
-                              u.in_omega(sp.spectral_abscissa), sp.unstable_count));
+                              rate_summary(sp.spectral_abscissa, u, 10), sp.unstable_count));
 }
 
 // ------------------------------------------------------------------------------------------------ margin
@@ -258,8 +257,8 @@ void run_margin(const io::ParamSet& p, Captured* capture) {
   for (const auto& x : m.crossings)
     out.row(u.in_omega(x.frequency), u.in_periods(x.first_delay), u.in_periods(x.delay_period));
   out.finish(res, m.stable_at_reference
-                      ? fmt::format("critical delay tau_c = {:.6g} T (crossing at {:.6g} Omega, method {})",
-                                    u.in_periods(m.upper), u.in_omega(m.upper_frequency), m.method)
+                      ? fmt::format("critical delay tau_c = {} (crossing at {}, method {})",
+                                    delay_summary(m.upper, u, 6), rate_summary(m.upper_frequency, u, 6), m.method)
                       : m.note);
 }
 

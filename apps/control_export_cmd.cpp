@@ -95,10 +95,10 @@ void run_export(const io::ParamSet& p, Captured* capture) {
     return;
   }
   fmt::print("wrote {}: {} core, N = {}, {} state numbers, {} bytes (coefficients {} + state {} + handle {}), "
-             "spectral abscissa {:.4g} Omega{}\n",
+             "spectral abscissa {}{}\n",
              path, embed::to_string(spec.precision), spec.harmonics, design.state_size(), fp.total(),
              fp.coefficient_struct + fp.coefficient_arrays, fp.state, fp.filter_struct,
-             design.spectral_abscissa() / spec.rotation_frequency,
+             rate_summary(design.spectral_abscissa(), control::RotationUnits(spec.rotation_frequency)),
              samples ? fmt::format(", {} test vectors", samples) : std::string());
 }
 

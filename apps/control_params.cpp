@@ -1,11 +1,14 @@
 #include "control_params.hpp"
 
+#include "afmkit/io/quantity.hpp"
+
 #include <cmath>
 
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
+#include "afmkit/io/quantity.hpp"
 
 namespace afmkit::cli {
 
@@ -152,6 +155,16 @@ io::ParamSet params_as_run(const io::ParamSet& p, const control::ControlSettings
   run.set_from_string("model_delay", fmt::format("{}", c.model_delay_value()));
   for (const auto& [key, value] : values) run.set_from_string(key, fmt::format("{}", value));
   return run;
+}
+
+std::string rate_summary(double rad_per_s, const control::RotationUnits& units, int digits) {
+  return io::normalised(units.in_omega(rad_per_s), control::RotationUnits::rate_unit, digits,
+                        fmt::format("{:.{}g} rad/s", rad_per_s, digits));
+}
+
+std::string delay_summary(double seconds, const control::RotationUnits& units, int digits) {
+  return io::normalised(units.in_periods(seconds), control::RotationUnits::delay_unit, digits,
+                        io::quantity(seconds, "s", digits));
 }
 
 }  // namespace afmkit::cli

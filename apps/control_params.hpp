@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "afmkit/control/settings.hpp"
+#include "afmkit/control/units.hpp"
 #include "afmkit/io/params.hpp"
 
 namespace afmkit::cli {
@@ -41,5 +42,11 @@ nlohmann::json settings_si_json(const control::ControlSettings& settings);
 /// model_rate, model_delay) and `values` (key, value in the parameter's own unit) replacing the given ones.
 io::ParamSet params_as_run(const io::ParamSet& params, const control::ControlSettings& settings,
                            const std::vector<std::pair<std::string, double>>& values = {});
+
+/// A rate of a summary line (internally rad/s) said to be normalised, with its physical value: "-0.05 (normalised,
+/// units of Omega; -0.157 rad/s)" (docs/units.md#summaries).
+std::string rate_summary(double rad_per_s, const control::RotationUnits& units, int digits = 4);
+/// A delay or time of a summary line (internally s): "0.31 (normalised, units of T; 6.2 ms)".
+std::string delay_summary(double seconds, const control::RotationUnits& units, int digits = 4);
 
 }  // namespace afmkit::cli

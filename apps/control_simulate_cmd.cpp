@@ -183,10 +183,10 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
   if (res.report.delay_exceeds_period)
     fmt::print(stderr, "afmkit: warning: the delay reaches one rotation period (the paper assumes tau < T)\n");
   out.finish(report, fmt::format("|y_1| over the last period = {:.3e}, max harmonic error = {:.3e} (k <= {}), {:.3e} "
-                                 "above, growth rate = {:.4g} Omega",
+                                 "above, growth rate = {}",
                                  res.report.residual_first_harmonic, res.report.max_harmonic_error,
                                  res.report.bank_max_order, res.report.max_harmonic_error_above,
-                                 u.in_omega(res.report.growth_rate)));
+                                 rate_summary(res.report.growth_rate, u)));
 }
 
 }  // namespace

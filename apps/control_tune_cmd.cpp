@@ -111,10 +111,9 @@ void run_tune(const io::ParamSet& p, Captured* capture) {
                   {"worst_delay", "T"}, {"worst_gain_ratio", "dimensionless"}, {"window", "Omega"},
                   {"evaluations", "count"},
                   {"margins", {{"gain_ratio", "dimensionless"}, {"critical_delay", "T"}, {"crossing_frequency", "Omega"}}}};
-  out.finish(res, fmt::format("robust optimum {} = {:.5g} Omega, {} = {:.5g} Omega: worst-case decay rate {:.5g} Omega "
-                              "(certified {:.5g})",
-                              s.family.x_name(), u.in_omega(r.x), s.family.y_name(), u.in_omega(r.y),
-                              u.in_omega(r.worst_decay), u.in_omega(r.certified_worst_decay)));
+  out.finish(res, fmt::format("robust optimum {} = {}, {} = {}: worst-case decay rate {} (certified {})",
+                              s.family.x_name(), rate_summary(r.x, u, 5), s.family.y_name(), rate_summary(r.y, u, 5),
+                              rate_summary(r.worst_decay, u, 5), rate_summary(r.certified_worst_decay, u, 5)));
 }
 
 }  // namespace

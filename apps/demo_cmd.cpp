@@ -8,11 +8,13 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/sweep.hpp"
 #include "command.hpp"
@@ -73,15 +75,22 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
   hb_options.q_min = -1.0;
   hb_options.q_max = 1.5;
   hb_options.points = 4000;
-  const auto curve = tapping::harmonic_balance_curve(model, hb_options);
-  const tapping::HarmonicBalance balance(model);
-  const nlohmann::json folds = hb_fold_records(balance, scales);  // sorted by separation, as `tapping hb`
+  // the input is checked (the model; the options are the demo's own): what is refused from here on was computed,
+  // a numerical failure naming the computation (exit 1), never the user's error (core/computed.hpp)
+  const auto curve =
+      computed("demo: the harmonic-balance curve", [&] { return tapping::harmonic_balance_curve(model, hb_options); });
+  const tapping::HarmonicBalance balance =
+      computed("demo: harmonic balance", [&] { return tapping::HarmonicBalance(model); });
+  const nlohmann::json folds =  // sorted by separation, as `tapping hb`
+      computed("demo: the harmonic-balance folds", [&] { return hb_fold_records(balance, scales); });
 
   // 2. Approach–retract sweep, each orbit continued from the previous one (shooting).
   io::Progress progress("demo sweep", 2L * points, true, 1.0);
   tapping::SweepOptions options;
   options.progress = [&progress](long n) { progress.advance(n); };
-  const tapping::SweepResult sweep = tapping::sweep_instrument(model, l_min, l_max, points, options);
+  options.validate();
+  const tapping::SweepResult sweep = computed(
+      "demo: instrument sweep", [&] { return tapping::sweep_instrument(model, l_min, l_max, points, options); });
   progress.finish();
 
   nlohmann::json jumps = {{"approach", sweep.approach_jumps}, {"retract", sweep.retract_jumps}};
@@ -105,15 +114,19 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
     return;
   }
 
-  const std::string unit = std::string(" ") + scales.length_unit;
+  // lengths by magnitude in physical units, said to be normalised otherwise (docs/units.md#summaries)
+  const std::string unit = scales.length_unit;
   fmt::print("afmkit demo: tapping cantilever, law '{}', Q = {}, drive at {} x resonance ({} units)\n",
              model.law.name(), model.cantilever.quality_factor, p.real("frequency_ratio"), p.text("units"));
-  fmt::print("  free amplitude {:.4f}{}\n", model.free_amplitude() * scales.length, unit);
+  fmt::print("  free amplitude {}\n", io::summary_value(model.free_amplitude() * scales.length, unit, 6));
   for (const auto& f : folds)
-    fmt::print("  harmonic balance fold (jump point) at separation {:.4f}{}, amplitude {:.4f}{}\n",
-               f["separation"].get<double>(), unit, f["amplitude"].get<double>(), unit);
-  for (double l : jumps["approach"]) fmt::print("  sweep: approach jumped at separation {:.4f}{}\n", l, unit);
-  for (double l : jumps["retract"]) fmt::print("  sweep: retract jumped at separation {:.4f}{}\n", l, unit);
+    fmt::print("  harmonic balance fold (jump point) at separation {}, amplitude {}\n",
+               io::summary_value(f["separation"].get<double>(), unit, 6),
+               io::summary_value(f["amplitude"].get<double>(), unit, 6));
+  for (double l : jumps["approach"])
+    fmt::print("  sweep: approach jumped at separation {}\n", io::summary_value(l, unit, 6));
+  for (double l : jumps["retract"])
+    fmt::print("  sweep: retract jumped at separation {}\n", io::summary_value(l, unit, 6));
   fmt::print("  wrote {}/demo_sweep.csv ({} orbits) and {}/demo_hb.csv ({} HB points); columns, units and results "
              "in the .json sidecars\n",
              dir, table.size(), dir, hb.size());

@@ -313,6 +313,17 @@ scan::Surface surface_from(const io::ParamSet& p) {
     throw InvalidParameter("tilt_angle", fmt::format("tilt_angle = {} deg is out of range: must be in [0, 90) deg",
                                                      tilt_angle));
   const scan::Tilt tilt(tilt_angle * kDegree, p.real("tilt_azimuth") * kDegree);
+  // the tilt adds r·tan ψ to the heights along the spiral: at end_radius it must stay within the sample heights'
+  // bound (docs/scan.md#samples)
+  const double end_radius = p.real("end_radius"), tilt_height = end_radius * std::tan(tilt.angle);
+  if (!(tilt_height <= kMaxHeight))
+    throw InvalidParameter(
+        "tilt_angle",
+        fmt::format("tilt_angle = {} deg with end_radius = {} m tilts the sample by {:.6g} m at the end of the spiral "
+                    "(end_radius x tan(tilt_angle)); every height must lie in [-{}, {}] m: tilt_angle must be <= {:.6g} "
+                    "deg for this end_radius (or end_radius <= {:.6g} m for this tilt_angle)",
+                    tilt_angle, end_radius, tilt_height, kMaxHeight, kMaxHeight,
+                    std::atan(kMaxHeight / end_radius) / kDegree, kMaxHeight / std::tan(tilt.angle)));
   const std::string kind = p.text("sample");
   if (kind == "file") return scan::Surface(sample_from_file(p), tilt);
   if (p.was_set("sample_file"))

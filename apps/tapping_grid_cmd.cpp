@@ -18,6 +18,7 @@
 #include "afmkit/core/version.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "afmkit/io/zarr_store.hpp"
 #include "afmkit/tapping/sweep.hpp"
 #include "command.hpp"
@@ -70,6 +71,9 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
   options.shooting = shooting_options_from(p);
   options.transient = transient_options_from(p);
   options.cancellation = cancellation_of(capture);
+  // at least 2 full transients per separation (the free response and rest: find_orbits); nothing computed yet
+  require_transient_work(p, options.transient, 2.0 * static_cast<double>(points),
+                         fmt::format("2 transients at each of {} separations", points));
   io::Progress progress("tapping grid", static_cast<long>(points), !p.flag("quiet"));
   const std::vector<tapping::OrbitSearchResult> results =
       tapping::sweep_grid(base, normalised, options, [&](long n) { progress.advance(n); });
@@ -83,16 +87,18 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
     std::vector<double> values;
   };
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  std::array<Output, 4> outputs = {{{"max_amplitude_stable", "max(amplitude | stable)", true, {}},
+  std::array<Output, 5> outputs = {{{"max_amplitude_stable", "max(amplitude | stable)", true, {}},
                                     {"min_amplitude_stable", "min(amplitude | stable)", true, {}},
                                     {"count_amplitude_stable", "count(amplitude | stable)", false, {}},
-                                    {"count_amplitude", "count(amplitude)", false, {}}}};
-  auto& [max_stable, min_stable, stable, all] = outputs;
+                                    {"count_amplitude", "count(amplitude)", false, {}},
+                                    {"count_amplitude_trapped", "count(amplitude | trapped)", false, {}}}};
+  auto& [max_stable, min_stable, stable, all, trapped_orbits] = outputs;
   for (Output& o : outputs) o.values.assign(points, o.length ? nan : 0.0);
   for (std::size_t i = 0; i < points; ++i)
     for (const tapping::FoundOrbit& f : results[i].orbits) {
       const double amplitude = f.metrics.amplitude * scales.length;
       all.values[i] += 1;
+      if (tapping::tip_trapped(f.metrics)) trapped_orbits.values[i] += 1;
       if (!f.orbit.stable) continue;
       const bool first = stable.values[i] == 0;
       max_stable.values[i] = first ? amplitude : std::max(max_stable.values[i], amplitude);
@@ -112,6 +118,31 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
                                                 {"axes", {{"separation", separations}}},
                                                 {"outputs", selectors}}
                                      .dump();
+  // separations without a tapping answer (docs/conventions.md#statuses), counted as `tapping sweep` counts its
+  // trapped rows: every orbit found has the tip trapped, or no orbit was found; said in the store, the summary and
+  // the exit status (1 when no separation has a tapping orbit)
+  long trapped = 0, no_orbit = 0;
+  for (std::size_t i = 0; i < points; ++i) {
+    if (all.values[i] == 0) ++no_orbit;
+    else if (trapped_orbits.values[i] == all.values[i]) ++trapped;
+  }
+  const auto n_points = static_cast<long>(points);
+  const std::string status = no_orbit == n_points          ? "no_orbit"
+                             : trapped + no_orbit == n_points ? "tip_trapped"
+                                                              : "ok";
+  std::string note;
+  if (trapped > 0)
+    note = fmt::format("at {} of {} separations the tip is trapped on every orbit found (sticks to the sample or "
+                       "stays in contact over the whole period: no tapping; count_amplitude_trapped = count_amplitude "
+                       "there)",
+                       trapped, points);
+  if (no_orbit > 0)
+    note += fmt::format("{}at {} of {} separations no periodic orbit was found (count_amplitude = 0)",
+                        note.empty() ? "" : "; ", no_orbit, points);
+  store.attribute("status", status);
+  store.attribute("note", note);
+  store.attribute("trapped_separations", trapped);
+  store.attribute("no_orbit_separations", no_orbit);
   store.attribute("afmkit_study_format", kStudyFormat);
   store.attribute("study_name", "tapping_grid");
   store.attribute("study_definition", definition);
@@ -134,21 +165,12 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
                          "<i4", {{"units", "count"},
                                  {"description", "points of the chunk whose computation failed numerically"}});
   store.commit();
-  // separations where every orbit found has the tip trapped (docs/conventions.md#statuses): counted there as
-  // orbits, never stable; said here so that a count is not mistaken for tapping orbits
-  const auto trapped = std::count_if(results.begin(), results.end(), [](const tapping::OrbitSearchResult& r) {
-    return !r.orbits.empty() && std::all_of(r.orbits.begin(), r.orbits.end(), [](const tapping::FoundOrbit& f) {
-      return tapping::tip_trapped(f.metrics);
-    });
-  });
-  if (trapped > 0)
-    fmt::print("tapping grid: at {} of {} separations the tip is trapped on every orbit found (sticks to the sample "
-               "or stays in contact over the whole period: no tapping; their count_amplitude counts those orbits)\n",
-               trapped, points);
+  if (!note.empty()) fmt::print("tapping grid: {}\n", note);
   const auto bands = std::count_if(stable.values.begin(), stable.values.end(), [](double n) { return n > 1; });
-  fmt::print("tapping grid: {} separations in [{}, {}] {}, {} with more than one stable orbit; written to {} "
+  fmt::print("tapping grid: {} separations from {} to {}, {} with more than one stable orbit; written to {} "
              "(Zarr; xarray: xr.open_zarr)\n",
-             points, lo, hi, length, bands, store.path());
+             points, io::summary_value(lo, length, 6), io::summary_value(hi, length, 6), bands, store.path());
+  require_answer({{"status", status}, {"note", note}});  // exit 1 when no separation has a tapping orbit
 }
 
 }  // namespace

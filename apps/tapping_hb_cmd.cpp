@@ -13,6 +13,7 @@
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/hb_approximations.hpp"
 #include "command.hpp"
@@ -94,14 +95,14 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
                             {"rows", out.rows()},
                             {"status", hb_status(curve.empty(), solutions.empty())},
                             {"note", hb_note(curve.empty(), solutions.empty(), q_min, q_max,
-                                             fmt::format("{} {}", p.real("separation"), scales.length_unit))},
+                                             io::summary_value(p.real("separation"), scales.length_unit, 6))},
                             {"units", hb_units(scales)}};
   if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
     if (const auto limit = tapping::minimum_separation_limit(model))
       results["minimum_separation_limit"] = *limit * scales.length;  // −∞ is written "-inf"
   }
-  out.finish(results, fmt::format("{} fold(s), {} solution(s) at separation {} {}", folds.size(), solutions.size(),
-                                  p.real("separation"), scales.length_unit));
+  out.finish(results, fmt::format("{} fold(s), {} solution(s) at separation {}", folds.size(), solutions.size(),
+                                  io::summary_value(p.real("separation"), scales.length_unit, 6)));
 }
 
 }  // namespace

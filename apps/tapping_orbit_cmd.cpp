@@ -15,6 +15,7 @@
 #include "afmkit/io/params.hpp"
 #include "afmkit/tapping/orbit.hpp"
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "command.hpp"
 #include "work_budget.hpp"
 #include "commands.hpp"
@@ -22,13 +23,6 @@
 #include "tapping_sim_params.hpp"
 
 namespace afmkit::cli {
-
-namespace {
-// Time of one drive period of a transient: measured 4.1e-7 s (closed-form piecewise-linear law, no contact, the
-// fastest) to 3.5e-5 s (in contact every period; 2-core test machine under load, Release), taken as 2e-7 s: the
-// estimate is a lower bound, so only requests that cannot fit are refused.
-constexpr double kPeriodSeconds = 2e-7;
-}  // namespace
 
 namespace {
 
@@ -109,15 +103,15 @@ struct OrbitStatus {
 };
 OrbitStatus orbit_status(const tapping::OrbitSearchResult& r, double separation, const std::string& unit) {
   if (r.orbits.empty())
-    return {"no_orbit", fmt::format("no periodic orbit found at separation {} {} (see the search report)", separation,
-                                    unit)};
+    return {"no_orbit", fmt::format("no periodic orbit found at separation {} (see the search report)",
+                                    io::summary_value(separation, unit))};
   for (const tapping::FoundOrbit& f : r.orbits)
     if (!tapping::tip_trapped(f.metrics)) return {"ok", ""};
   return {"tip_trapped",
           fmt::format("tip trapped: on every orbit found ({}) the tip sticks to the sample or stays in contact over "
-                      "the whole period at separation {} {} (held by the sample: an attraction larger than the drive "
+                      "the whole period at separation {} (held by the sample: an attraction larger than the drive "
                       "can pull off); no tapping orbit",
-                      r.orbits.size(), separation, unit)};
+                      r.orbits.size(), io::summary_value(separation, unit))};
 }
 
 /// The unit of every number of orbit_json.
@@ -145,13 +139,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   // cost model (docs/development.md#work-and-time): at least two full transients (the free response and rest),
   // each of up to max_transient_periods drive periods; a response decaying at the quality factor Q needs about Q
   // periods to settle, so min(max_transient_periods, Q) periods of about kPeriodSeconds each is a lower bound
-  const double quality = p.real("quality_factor");
-  const double periods = static_cast<double>(options.transient.max_periods);
-  const double estimate = require_work(
-      "max_transient_periods", periods, 2.0 * kPeriodSeconds * std::min(1.0, quality / periods),
-      fmt::format("2 transients of min(max_transient_periods, quality_factor) drive periods, quality_factor = {}, "
-                  "at least {:.2g} s per period",
-                  quality, kPeriodSeconds));
+  const double estimate = require_transient_work(p, options.transient, 2.0, "2 transients");
   io::Progress progress("tapping orbit (transient drive periods, of at most)", 5L * options.transient.max_periods,
                         estimate > kProgressAfterSeconds && !p.flag("json"));
   options.transient.on_periods = [&progress](int n) { progress.advance(n); };
@@ -235,17 +223,19 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
     out.finish(summary, "");
     return;
   }
-  fmt::print("separation {} {}: {} HB solution(s), {} periodic orbit(s); amplitudes, offsets in {}, phases in rad\n",
-             p.real("separation"), length, hb.size(), r.orbits.size(), length);
+  // lengths by magnitude in physical units, said to be normalised otherwise (docs/units.md#summaries)
+  const auto len = [&](double model_length) { return io::summary_value(model_length * scales.length, length, 6); };
+  fmt::print("separation {}: {} HB solution(s), {} periodic orbit(s); phases in rad\n",
+             io::summary_value(p.real("separation"), length, 6), hb.size(), r.orbits.size());
   for (const tapping::HbPoint& h : r.harmonic_balance)
-    fmt::print("  HB {:5s} amplitude {:.6g}  offset {:.6g}  phase {:.6g}\n", tapping::branch_name(h.branch),
-               h.amplitude * scales.length, h.offset * scales.length, h.phase);
+    fmt::print("  HB {:5s} amplitude {}  offset {}  phase {:.6g} rad\n", tapping::branch_name(h.branch),
+               len(h.amplitude), len(h.offset), h.phase);
   for (const tapping::FoundOrbit& f : r.orbits)
-    fmt::print("  orbit ({}{}) amplitude {:.6g}  offset {:.6g}  phase {:.6g}  {}  |mu|max {:.4g}  contact {:.3g}  "
+    fmt::print("  orbit ({}{}) amplitude {}  offset {}  phase {:.6g} rad  {}  |mu|max {:.4g}  contact {:.3g}  "
                "found by {} seed(s)\n",
                tapping::orbit_source_name(f.source),
                f.orbit.period_multiple > 1 ? fmt::format(", period {}", f.orbit.period_multiple) : std::string(),
-               f.metrics.amplitude * scales.length, f.metrics.offset * scales.length, f.metrics.phase,
+               len(f.metrics.amplitude), len(f.metrics.offset), f.metrics.phase,
                f.orbit.stable ? "stable" : "unstable", f.orbit.floquet_max, f.metrics.contact_fraction,
                f.seeds.size());
   if (status.status != "ok") fmt::print("  {}\n", status.note);
@@ -260,10 +250,10 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
                            rep.converged_by_kind[k], rep.seeds_by_kind[k]);
       converged += rep.converged_by_kind[k];
     }
-    fmt::print("  search: {} seeds, {} converged (converged/seeds: {}); {} branch continuations over l in [{:.6g}, "
-               "{:.6g}] {}; {:.3g} s\n",
-               rep.seeds.size(), converged, kinds, rep.continuation_runs, rep.bracket_min * scales.length,
-               rep.bracket_max * scales.length, length, rep.seconds);
+    fmt::print("  search: {} seeds, {} converged (converged/seeds: {}); {} branch continuations over l from {} to "
+               "{}; {}\n",
+               rep.seeds.size(), converged, kinds, rep.continuation_runs, len(rep.bracket_min), len(rep.bracket_max),
+               io::quantity(rep.seconds, "s", 3));
   }
   out.finish(summary, "");
 }

@@ -1,5 +1,11 @@
 #include "tapping_sim_params.hpp"
 
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "work_budget.hpp"
+
 namespace afmkit::cli {
 
 void add_tapping_sim_params(io::ParamSet& p) {
@@ -42,6 +48,17 @@ tapping::TransientOptions transient_options_from(const io::ParamSet& p) {
   o.max_period_multiple = static_cast<int>(p.integer("max_period_multiple"));
   o.max_periods = static_cast<int>(p.integer("max_transient_periods"));
   return o;
+}
+
+double require_transient_work(const io::ParamSet& p, const tapping::TransientOptions& transient, double transients,
+                              const std::string& what) {
+  const double quality = p.real("quality_factor");
+  const double periods = static_cast<double>(transient.max_periods);
+  return require_work("max_transient_periods", periods,
+                      transients * kTransientPeriodSeconds * std::min(1.0, quality / periods),
+                      fmt::format("{} of min(max_transient_periods, quality_factor) drive periods, quality_factor = {}, "
+                                  "at least {:.2g} s per period",
+                                  what, quality, kTransientPeriodSeconds));
 }
 
 }  // namespace afmkit::cli

@@ -16,6 +16,7 @@
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/number_list.hpp"
 #include "afmkit/io/params.hpp"
+#include "afmkit/io/quantity.hpp"
 #include "afmkit/io/progress.hpp"
 #include "afmkit/tapping/continuation.hpp"
 #include "afmkit/tapping/sweep.hpp"
@@ -24,6 +25,7 @@
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
 #include "tapping_tables.hpp"
+#include "work_budget.hpp"
 
 namespace afmkit::cli {
 
@@ -33,6 +35,10 @@ nlohmann::json scaled(const std::vector<double>& v, double f) {
   nlohmann::json j = nlohmann::json::array();
   for (double x : v) j.push_back(x * f);
   return j;
+}
+std::vector<double> scaled_values(std::vector<double> v, double f) {
+  for (double& x : v) x *= f;
+  return v;
 }
 
 /// "contact" when the orbit spends part of its period below the law's contact gap, else "free".
@@ -156,6 +162,14 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     options.shooting = shooting_options_from(p);
     options.transient = transient_options_from(p);
     options.progress = [&progress](long n) { progress.advance(n); };
+    // a jump runs a transient of up to max_transient_periods drive periods (a response decaying at Q settles in
+    // about Q of them): when one can take seconds, its periods show as well (docs/development.md#work-and-time)
+    const double transient_seconds =
+        kTransientPeriodSeconds * std::min(static_cast<double>(options.transient.max_periods), p.real("quality_factor"));
+    io::Progress transient_progress("tapping sweep (drive periods of transients at jumps, of at most)",
+                                    2L * points * options.transient.max_periods,
+                                    !quiet && transient_seconds > kProgressAfterSeconds);
+    options.transient.on_periods = [&transient_progress](int n) { transient_progress.advance(n); };
     options.cancellation = cancellation_of(capture);
     options.validate();  // the input; what is refused inside the sweep was computed (core/computed.hpp)
     const tapping::SweepResult r = computed("instrument sweep", [&] {
@@ -163,6 +177,7 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
                           : tapping::sweep_instrument(base, list, options);
     });
     progress.finish();
+    transient_progress.finish();
     write_rows(r.approach);
     write_rows(r.retract);
     results["approach_jumps"] = scaled(r.approach_jumps, scales.length);
@@ -170,9 +185,10 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     results["jumps"] = jump_records(r.jumps, scales);
     const double tolerance = options.jump_tolerance * base.free_amplitude() * scales.length;
     results["jump_tolerance"] = tolerance;
-    summary += fmt::format("instrument sweep: jumps on approach at {}, on retract at {} ({}, located to ±{:.2g})",
-                           results["approach_jumps"].dump(), results["retract_jumps"].dump(), scales.length_unit,
-                           tolerance);
+    summary += fmt::format("instrument sweep: jumps on approach at {}; on retract at {} (located to ±{})",
+                           io::summary_values(scaled_values(r.approach_jumps, scales.length), scales.length_unit),
+                           io::summary_values(scaled_values(r.retract_jumps, scales.length), scales.length_unit),
+                           io::summary_value(tolerance, scales.length_unit, 3));
   }
   if (continuation) {
     tapping::ContinuationOptions options;
@@ -191,8 +207,9 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     results["continuation_points"] = c.points.size();
     std::vector<double> folds;
     for (const auto& f : results["folds"]) folds.push_back(f["separation"].get<double>());
-    summary += fmt::format("{}continuation: {} points, folds at {}, grazing at {} ({}; {})", summary.empty() ? "" : "\n",
-                           c.points.size(), scaled(folds, 1.0).dump(), results["grazing"].dump(), scales.length_unit,
+    summary += fmt::format("{}continuation: {} points, folds at {}; grazing at {} ({})", summary.empty() ? "" : "\n",
+                           c.points.size(), io::summary_values(folds, scales.length_unit),
+                           io::summary_values(scaled_values(c.grazing, scales.length), scales.length_unit),
                            c.stop_reason);
   }
   results["free_amplitude"] = base.free_amplitude() * scales.length;

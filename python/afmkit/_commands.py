@@ -50,18 +50,31 @@ class Result:
 _KINDS = {"real": float, "integer": int, "text": str, "file": str, "flag": bool, "reals": list}
 
 
+def _followed(p: dict, keys) -> str:
+    """The key whose value `p` takes when not given ("" if none): declared (follows) or chosen by the command and
+    said so in --help ("= plant_rate")."""
+    text = p["default_text"]
+    return p["follows"] or (text[2:] if text.startswith("= ") and text[2:] in keys else "")
+
+
 def _docstring(spec: dict) -> str:
+    keys = {p["key"] for p in spec["params"]}
     lines = [spec["help"], "", "Keyword arguments (the TOML keys of `afmkit " + spec["path"] + "`):", ""]
     group = None
     for p in spec["params"]:
         if p["group"] != group:
             group = p["group"]
             lines.append(f"{group}:")
-        default = p["default_text"] or repr(p["default"])
         facts = [p["kind"]]
         if p["unit"]:
             facts.append(f"unit {p['unit']}")
-        facts.append(f"default {default}")
+        if _followed(p, keys):
+            facts.append(f"default None: defaults to {_followed(p, keys)} (its value is used and recorded in "
+                         f"r.params)")
+        elif p["default_text"]:
+            facts.append(f"default None: {p['default_text']} (the value used is recorded in r.params)")
+        else:
+            facts.append(f"default {p['default']!r}")
         if p["allowed"]:
             facts.append(p["allowed"])
         lines.append(f"  {p['key']} ({'; '.join(facts)})")
@@ -71,12 +84,20 @@ def _docstring(spec: dict) -> str:
     return "\n".join(lines)
 
 
+def _signature_default(p: dict):
+    """The default a signature shows: the declared value when it is the value used, else None ("not given") — for
+    a key that follows another (departure_hamaker: the value of hamaker) and a default the command chooses from
+    other values (docstring: what it is; r.params records the value used)."""
+    return None if p["follows"] or p["default_text"] else p["default"]
+
+
 def make_command(path: str):
     """The Python function of command ``path`` ("tapping orbit")."""
     spec = next(s for s in _afmkit.commands() if s["path"] == path)
 
     def command(**kwargs) -> Result:
-        return Result(path, _afmkit.run(path, kwargs))
+        # None: not given (the default, which for some keys is another key's value or computed: _signature_default)
+        return Result(path, _afmkit.run(path, {k: v for k, v in kwargs.items() if v is not None}))
 
     name = path.split()[-1]
     command.__name__ = name
@@ -84,7 +105,7 @@ def make_command(path: str):
     command.__module__ = "afmkit." + path.split()[0] if " " in path else "afmkit"
     command.__doc__ = _docstring(spec)
     params = [inspect.Parameter("config", inspect.Parameter.KEYWORD_ONLY, default=None, annotation=str)]
-    params += [inspect.Parameter(p["key"], inspect.Parameter.KEYWORD_ONLY, default=p["default"],
+    params += [inspect.Parameter(p["key"], inspect.Parameter.KEYWORD_ONLY, default=_signature_default(p),
                                  annotation=_KINDS[p["kind"]]) for p in spec["params"]]
     command.__signature__ = inspect.Signature(params, return_annotation=Result)
     return command

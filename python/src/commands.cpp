@@ -89,6 +89,7 @@ py::list describe(const CommandSpec& s) {
     e["allowed"] = d.allowed;
     e["group"] = d.group;
     e["choices"] = d.choices;
+    e["follows"] = d.follows;
     out.append(e);
   }
   return out;

@@ -57,6 +57,46 @@ std::string shown(const Named& n) {
                                 : fmt::format("{} = '{}' (which writes '{}')", n.key, n.value, n.path.path);
 }
 
+/// What an existing path is, in words ("a folder", "a FIFO (named pipe)", …), for a path that cannot be written.
+std::string kind_of(const fs::file_status& st) {
+  switch (st.type()) {
+    case fs::file_type::directory: return "a folder";
+    case fs::file_type::fifo: return "a FIFO (named pipe)";
+    case fs::file_type::character: return "a character device";
+    case fs::file_type::block: return "a block device";
+    case fs::file_type::socket: return "a socket";
+    case fs::file_type::regular: return "a file";
+    default: return "not a regular file";
+  }
+}
+
+/// Refuses a file output that cannot be written where it is named, before anything is computed: its path is an
+/// existing folder, FIFO, device or socket (links followed), or its nearest existing parent is not a folder. (A
+/// folder output — a Zarr store, the report's figures — is checked by its writer, also before computing.)
+void require_writable_kind(const Named& out) {
+  if (out.path.folder) return;
+  std::error_code ec;
+  const fs::path p(out.path.path);
+  const fs::file_status st = fs::status(p, ec);
+  if (fs::exists(st)) {
+    if (!fs::is_regular_file(st))
+      throw InvalidParameter(out.key, fmt::format("output '{}' is not a regular file ({}; {}): give a file path",
+                                                  out.path.path, kind_of(st), shown(out)));
+    return;
+  }
+  for (fs::path parent = fs::absolute(p, ec).parent_path(); !parent.empty(); parent = parent.parent_path()) {
+    const fs::file_status ps = fs::status(parent, ec);
+    if (fs::exists(ps)) {
+      if (!fs::is_directory(ps))
+        throw InvalidParameter(out.key, fmt::format("{}: its folder '{}' is {}, not a folder: give a path in a "
+                                                    "folder",
+                                                    shown(out), parent.string(), kind_of(ps)));
+      return;
+    }
+    if (parent == parent.parent_path()) return;
+  }
+}
+
 }  // namespace
 
 std::vector<WrittenPath> table_and_sidecar(const std::string& path) { return {{path}, {path + ".json"}}; }
@@ -102,6 +142,7 @@ void ParamSet::check_files() const {
                                                     shown(out), shown(in)));
     }
   }
+  for (const Named& out : outputs) require_writable_kind(out);  // after the clashes, which say more
 }
 
 }  // namespace afmkit::io

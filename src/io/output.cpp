@@ -21,6 +21,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/version.hpp"
 #include "afmkit/io/params.hpp"
+#include "signals_held.hpp"
 
 namespace afmkit::io {
 
@@ -32,14 +33,12 @@ constexpr std::size_t flush_threshold = 1 << 16;  // bytes buffered before a wri
 
 // Temporaries being written, for the signal handler (SIGINT, SIGTERM, SIGHUP): fixed slots of fixed-size names so
 // that the handler only reads them and calls unlink (async-signal-safe). Process-wide by nature: a signal is.
-// While a set of outputs is being moved into place (commits_running > 0) the handler only notes the signal; the
-// commit delivers it when the set is in place.
+// While outputs are being moved into place (signals_held.hpp) the handler only notes the signal; the commit
+// delivers it when they are in place.
 constexpr int temporary_slots = 64;
 constexpr std::size_t temporary_name_size = 4096;
 std::atomic<bool> slot_used[temporary_slots];
 char slot_name[temporary_slots][temporary_name_size];
-std::atomic<int> commits_running{0};
-std::atomic<int> pending_signal{0};
 
 int register_temporary(const std::string& name) {
   if (name.size() >= temporary_name_size) return -1;
@@ -59,38 +58,12 @@ void release_temporary(int slot) {
 }
 
 extern "C" void remove_temporaries_and_reraise(int signal_number) {
-  if (commits_running.load() > 0) {  // a set is being moved into place: it completes first
-    pending_signal.store(signal_number);
-    return;
-  }
+  if (detail::defer_signal(signal_number)) return;  // outputs are being moved into place: they complete first
   for (int i = 0; i < temporary_slots; ++i)
     if (slot_used[i].load()) ::unlink(slot_name[i]);
   std::signal(signal_number, SIG_DFL);
   std::raise(signal_number);
 }
-
-/// SIGINT, SIGTERM and SIGHUP held back in this thread, and noted rather than acted on in the others, for the
-/// lifetime of the guard; a signal that came meanwhile is delivered when it ends.
-class CommitGuard {
- public:
-  CommitGuard() {
-    sigset_t set;
-    sigemptyset(&set);
-    for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, s);
-    pthread_sigmask(SIG_BLOCK, &set, &old_);
-    ++commits_running;
-  }
-  ~CommitGuard() {
-    if (--commits_running == 0)
-      if (const int s = pending_signal.exchange(0)) std::raise(s);
-    pthread_sigmask(SIG_SETMASK, &old_, nullptr);
-  }
-  CommitGuard(const CommitGuard&) = delete;
-  CommitGuard& operator=(const CommitGuard&) = delete;
-
- private:
-  sigset_t old_;
-};
 
 std::string host_name() {
   char name[256] = {};
@@ -266,7 +239,7 @@ void OutputSet::commit() {
   int error = 0;
   {
     FolderLocks locks(staged_);
-    CommitGuard guard;  // all in place, or none, before a signal is acted on
+    detail::SignalsHeld guard;  // all in place, or none, before a signal is acted on
     for (std::size_t i = 0; i < staged_.size(); ++i) {
       const Staged& s = staged_[i];
       const std::string backup = s.temporary + "-old";

@@ -414,7 +414,7 @@ std::vector<ParamSet::Description> ParamSet::describe() const {
   std::vector<Description> out;
   for (const auto& key : order_) {
     const Entry& e = entries_.at(key);
-    Description d{key, "", e.value, e.default_text, e.help, e.unit, "", e.group, e.choices};
+    Description d{key, "", e.value, e.default_text, e.help, e.unit, "", e.group, e.choices, e.follows};
     switch (e.value.index()) {
       case 0: d.kind = "real"; d.allowed = e.range.describe(); break;
       case 1: d.kind = "integer"; d.allowed = fmt::format("integer in [{}, {}]", e.ilo, e.ihi); break;

@@ -59,4 +59,33 @@ std::string quantity(double value, std::string_view unit, int digits) {
   return fmt::format("{:.{}g} {}{}", m, digits, p.text, base);
 }
 
+bool si_unit(std::string_view unit) { return split_unit(unit).has_value(); }
+
+namespace {
+/// `value` to `digits` significant digits, undefined values spelled as in docs/conventions.md#undefined-values.
+std::string number(double value, int digits) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  return fmt::format("{:.{}g}", value, std::clamp(digits, 1, 17));
+}
+}  // namespace
+
+std::string normalised(double value, std::string_view unit, int digits, std::string_view physical) {
+  return physical.empty() ? fmt::format("{} (normalised, units of {})", number(value, digits), unit)
+                          : fmt::format("{} (normalised, units of {}; {})", number(value, digits), unit, physical);
+}
+
+std::string summary_value(double value, std::string_view unit, int digits) {
+  return si_unit(unit) ? quantity(value, unit, digits) : normalised(value, unit, digits);
+}
+
+std::string summary_values(const std::vector<double>& values, std::string_view unit, int digits) {
+  if (values.empty()) return "none";
+  std::string out;
+  const bool si = si_unit(unit);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    out += (i ? ", " : "") + (si ? quantity(values[i], unit, digits) : number(values[i], digits));
+  return si ? out : fmt::format("{} (normalised, units of {})", out, unit);
+}
+
 }  // namespace afmkit::io

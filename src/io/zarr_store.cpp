@@ -18,6 +18,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/input_file.hpp"
 #include "afmkit/io/output.hpp"
+#include "signals_held.hpp"
 
 namespace afmkit::io {
 
@@ -49,23 +50,6 @@ void write_json(const fs::path& file, const nlohmann::json& j) {
   const std::string text = j.dump(4);
   write_file(file, text.data(), text.size());
 }
-
-/// SIGINT, SIGTERM and SIGHUP held back for the lifetime of the guard (delivered when it ends).
-class SignalsHeld {
- public:
-  SignalsHeld() {
-    sigset_t set;
-    sigemptyset(&set);
-    for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set, s);
-    pthread_sigmask(SIG_BLOCK, &set, &old_);
-  }
-  ~SignalsHeld() { pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
-  SignalsHeld(const SignalsHeld&) = delete;
-  SignalsHeld& operator=(const SignalsHeld&) = delete;
-
- private:
-  sigset_t old_;
-};
 
 /// Cleans up after an earlier commit to `target` by a process that no longer exists (killed by SIGKILL, a power
 /// cut): its new store's folder `.<name>.tmp.<pid>` is removed, and its moved-aside old store `.<name>.old.<pid>` is
@@ -179,7 +163,7 @@ void ZarrStoreWriter::commit() {
   if (ec) throw InputError(fmt::format("{} '{}': cannot create its folder: {}", parameter_, path_, ec.message()));
   const fs::path tmp = target.parent_path() / fmt::format(".{}.tmp.{}", target.filename().string(), ::getpid());
   const fs::path old = target.parent_path() / fmt::format(".{}.old.{}", target.filename().string(), ::getpid());
-  SignalsHeld held;  // complete or absent: an interrupt is delivered once the store is in place
+  detail::SignalsHeld held;  // complete or absent: an interrupt is delivered once the store is in place
   remove_stale_commits(target);
   try {
     fs::remove_all(tmp);

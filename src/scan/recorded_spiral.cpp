@@ -53,6 +53,8 @@ bool same_name(std::string_view cell, std::string_view name) {
   return true;
 }
 
+constexpr double kMaxDeflection = 1.0;  // [m]: every recorded deflection lies in [−1, 1] m
+
 enum Column { time_column, radius_column, deflection_column, angle_column, index_column, column_count };
 constexpr const char* column_names[column_count] = {"time", "radius", "deflection", "angle", "index"};
 
@@ -203,6 +205,11 @@ struct RecordedSpiralReader::State {
       if (comma != std::string_view::npos) rest.remove_prefix(comma + 1);
     }
     check_time(row.time);
+    // a deflection beyond ±1 m is no AFM signal, and near the double range it overflows the filter's sums
+    // (docs/scan.md#recorded-data: the same bound as the sample heights)
+    if (!(std::abs(row.deflection) <= kMaxDeflection))
+      fail_column(deflection_column, fmt::format("{} m is out of range: a recorded deflection must lie in [-{}, {}] m",
+                                                 row.deflection, kMaxDeflection, kMaxDeflection));
     if (row.radius < 0)
       fail_column(radius_column, fmt::format("{} m is negative (the distance from the spindle axis is >= 0)",
                                              row.radius));

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -197,6 +198,46 @@ TEST(HonestyStatus, OrbitStatusMatchesItsOrbits) {
   EXPECT_EQ(status, orbits.empty() ? "no_orbit" : tapping ? "ok" : "tip_trapped");
   EXPECT_EQ(r.status, status == "ok" ? 0 : 1) << r.err;
   if (status != "ok") EXPECT_NE(r.err.find("no answer: status " + status), std::string::npos) << r.err;
+}
+
+// `tapping grid`'s Zarr store said nothing of trapped tips or missing orbits, which the CSV outputs of `orbit` and
+// `sweep` report (issue 24): it now holds count(amplitude | trapped) per separation, the counts of separations
+// without a tapping orbit, a status and a note, and exits 1 when no separation has one.
+TEST(HonestyStatus, GridStoreCountsTrappedSeparationsAsTheOrbitCommandJudgesThem) {
+  TempDir dir;
+  write_sticky_curve(dir, "F.csv");
+  const auto g = run_cli("tapping grid " + kSticky + " --separation-min -0.5 --separation-max 0 --points 2 "
+                         "--store g.zarr --quiet", dir);
+  expect_not_blamed_on_input(g, "tapping grid");
+  const auto attrs = nlohmann::json::parse(slurp(dir.path / "g.zarr" / ".zattrs"));
+  auto read_f8 = [&](const std::string& name) {  // an uncompressed chunk of 2 little-endian doubles
+    const std::string raw = slurp(dir.path / "g.zarr" / name / "0");
+    std::vector<double> v(raw.size() / sizeof(double));
+    std::memcpy(v.data(), raw.data(), v.size() * sizeof(double));
+    return v;
+  };
+  const std::vector<double> trapped = read_f8("count_amplitude_trapped"), all = read_f8("count_amplitude");
+  ASSERT_EQ(trapped.size(), 2u);
+  // independently: `tapping orbit` at each separation of the grid, its status and its orbits' trapped column
+  long trapped_separations = 0, no_orbit_separations = 0;
+  for (int i = 0; i < 2; ++i) {
+    const std::string l = i == 0 ? "-0.5" : "0";
+    const auto o = run_cli("tapping orbit " + kSticky + " --separation " + l + " --output o.csv", dir);
+    const auto results = nlohmann::json::parse(slurp(dir.path / "o.csv.json")).at("results");
+    long n_trapped = 0;
+    for (const auto& orbit : results.at("orbits")) n_trapped += orbit.at("trapped").get<bool>() ? 1 : 0;
+    EXPECT_EQ(all[i], static_cast<double>(results.at("orbits").size())) << "separation " << l;
+    EXPECT_EQ(trapped[i], static_cast<double>(n_trapped)) << "separation " << l;
+    trapped_separations += results.at("status") == "tip_trapped" ? 1 : 0;
+    no_orbit_separations += results.at("status") == "no_orbit" ? 1 : 0;
+  }
+  EXPECT_GT(trapped_separations, 0) << "the tip sticks at and below contact";
+  EXPECT_EQ(attrs.at("trapped_separations").get<long>(), trapped_separations);
+  EXPECT_EQ(attrs.at("no_orbit_separations").get<long>(), no_orbit_separations);
+  const bool none = trapped_separations + no_orbit_separations == 2;
+  EXPECT_EQ(attrs.at("status"), !none ? "ok" : no_orbit_separations == 2 ? "no_orbit" : "tip_trapped");
+  EXPECT_EQ(g.status, none ? 1 : 0) << g.err;
+  EXPECT_NE(g.out.find("trapped"), std::string::npos) << g.out;  // the summary says so
 }
 
 // ------------------------------------------------------------------ 3. recorded parameters are those used

@@ -350,3 +350,36 @@ TEST(OutputSafety, TheFoldersOfAKilledStoreCommitAreRemovedByTheNextCommit) {
   EXPECT_FALSE(fs::exists(tmp));
   EXPECT_FALSE(fs::exists(old));
 }
+
+// issue 24 §3: an output path that is an existing folder was found only when the outputs were staged, after the
+// computation (`afmkit scan --output <folder>`); check_files refuses it before anything runs, and the same kind:
+// a path under a file, a device. (Folder outputs are checked by their writers, before computing too.)
+TEST(FileRoles, AnOutputThatCannotBeWrittenWhereItIsNamedIsRefusedBeforeComputing) {
+  const Folder dir("kinds");
+  fs::create_directories(dir.path / "sub");
+  dir.write("plain.txt", "x");
+  const struct {
+    std::string key, value, message;
+  } cases[] = {{"output", dir.file("sub"), "output '" + dir.file("sub") + "' is not a regular file (a folder; output = '"},
+               {"points_output", dir.file("sub"), "is not a regular file (a folder; points_output = '"},
+               {"points_output", "/dev/zero", "output '/dev/zero' is not a regular file (a character device;"},
+               {"output", dir.file("plain.txt/t.csv"), "its folder '" + dir.file("plain.txt") + "' is a file"},
+               {"points_output", dir.file("plain.txt/a/b"), "its folder '" + dir.file("plain.txt") + "' is a file"}};
+  for (const auto& c : cases) {
+    ParamSet p = files();
+    p.set_value(c.key, c.value);
+    try {
+      p.check_files();
+      ADD_FAILURE() << c.key << " = " << c.value << ": not refused";
+    } catch (const InvalidParameter& e) {
+      EXPECT_EQ(e.parameter(), c.key);
+      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << e.what();
+    }
+  }
+  // what can be written is not refused: a new file in a new folder, an existing file, an existing folder as a store
+  ParamSet p = files();
+  p.set_value("output", dir.file("new/deeper/t.csv"));
+  p.set_value("points_output", dir.file("plain.txt"));
+  p.set_value("store", dir.file("sub"));
+  EXPECT_NO_THROW(p.check_files());
+}

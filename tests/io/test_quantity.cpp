@@ -67,3 +67,24 @@ TEST(Quantity, TheValueSurvivesTheRoundTrip) {
     EXPECT_NEAR(mantissa * std::pow(10.0, e), v, 1e-9 * v) << s;
   }
 }
+
+// issue 24: every physical number of a summary by magnitude, and a normalised number said to be one (the tapping
+// model's L, t; the control commands' Omega, T) instead of printed as if it had a physical unit.
+TEST(Quantity, SummaryValuesArePrefixedOrSaidToBeNormalised) {
+  using afmkit::io::summary_value;
+  using afmkit::io::summary_values;
+  EXPECT_TRUE(afmkit::io::si_unit("nm"));
+  EXPECT_TRUE(afmkit::io::si_unit("aJ"));
+  EXPECT_FALSE(afmkit::io::si_unit("L"));
+  EXPECT_FALSE(afmkit::io::si_unit("Omega"));
+  EXPECT_FALSE(afmkit::io::si_unit("L/t^2"));
+  EXPECT_EQ(summary_value(0.35, "nm"), "350 pm");
+  EXPECT_EQ(summary_value(1500.0, "nm"), "1.5 \xC2\xB5m");
+  EXPECT_EQ(summary_value(0.35, "L"), "0.35 (normalised, units of L)");
+  EXPECT_EQ(summary_value(-0.0123456, "Omega", 3), "-0.0123 (normalised, units of Omega)");
+  EXPECT_EQ(summary_value(std::nan(""), "T"), "nan (normalised, units of T)");
+  EXPECT_EQ(summary_values({0.2, 0.45}, "nm"), "200 pm, 450 pm");
+  EXPECT_EQ(summary_values({0.2, 0.45}, "L"), "0.2, 0.45 (normalised, units of L)");
+  EXPECT_EQ(summary_values({}, "nm"), "none");
+  EXPECT_EQ(afmkit::io::normalised(0.31, "T", 4, "3.1 ms"), "0.31 (normalised, units of T; 3.1 ms)");
+}

@@ -363,6 +363,44 @@ def test_a_report_killed_outright_takes_its_workers_with_it(tmp_path):
     assert left == [], "workers outlived the report process"
 
 
+def test_a_study_killed_outright_takes_its_dask_workers_with_it(tmp_path):
+    """The study's LocalCluster (afmkit.study.run), its process killed by SIGKILL while a worker is busy in code
+    that holds the GIL (as a computation without a GIL release does): the worker ends with it at once (issue 24 §3).
+    Dask's own watch (a thread of the worker reading a pipe) cannot run while the GIL is held: the worker would
+    finish its task first (here 60 s); afmkit._parent ties it to the study process through the kernel."""
+    script = tmp_path / "study_parent.py"
+    script.write_text(
+        "import ctypes, os, time\n"
+        "from afmkit.study.run import _client\n"
+        "def busy():\n"
+        "    ctypes.PyDLL(None).sleep(60)  # a C call that keeps the GIL (PyDLL does not release it)\n"
+        "if __name__ == '__main__':\n"
+        "    client, cluster, _ = _client(None, 1)\n"
+        "    pids = list(client.run(os.getpid).values())\n"
+        "    future = client.submit(busy, pure=False)\n"
+        "    time.sleep(1.5)  # the task has started\n"
+        "    print(' '.join(map(str, pids)), flush=True)\n"
+        "    time.sleep(120)\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                            text=True, env=env)
+    import select
+    ready, _, _ = select.select([proc.stdout], [], [], 60)
+    workers = [int(p) for p in proc.stdout.readline().split()] if ready else []
+    if len(workers) != 1:
+        proc.kill()
+    assert len(workers) == 1 and _alive(workers[0]), "the worker did not start"
+    proc.kill()
+    proc.wait()
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline and any(_alive(p) for p in workers):
+        time.sleep(0.1)
+    left = [p for p in workers if _alive(p)]
+    for p in left:  # do not leave them to the rest of the test run
+        os.kill(p, signal.SIGKILL)
+    assert left == [], "a Dask worker outlived the study process"
+
+
 def test_a_store_removed_while_the_study_runs_is_named_without_zarrs_template(tmp_path):
     runner = sys.modules["afmkit.study.run"]
     study = Study.make(axes={"quality_factor": [50.0, 100.0]}, **BASE)

@@ -150,3 +150,43 @@ def test_computed_defaults_are_recorded_as_computed():
     assert again.params == r.params
     assert again.results["first_harmonic"]["abs"] == pytest.approx(r.results["first_harmonic"]["abs"], rel=1e-12)
     assert np.allclose(again["y"], r["y"], rtol=1e-12, atol=1e-15)
+
+
+def test_signatures_show_none_for_a_default_that_is_not_a_fixed_value():
+    """inspect.signature showed the declared default of a key that follows another (departure_hamaker = 6.4e-20,
+    while the run uses hamaker's value; issue 24): such keys, and defaults the command chooses from other values,
+    show None with the docstring saying what the default is; None given is the same as not given."""
+    import inspect
+    for command, fn in FUNCTIONS.items():
+        spec = next(s for s in _afmkit.commands() if s["path"] == command)
+        sig = inspect.signature(fn).parameters
+        for p in spec["params"]:
+            if p["key"] == "json":
+                continue
+            shown = sig[p["key"]].default
+            if p["follows"]:
+                assert shown is None, (command, p["key"])
+                assert f"{p['key']} (" in fn.__doc__ and f"defaults to {p['follows']}" in fn.__doc__
+            elif p["default_text"]:
+                assert shown is None, (command, p["key"])
+            else:
+                assert shown == p["default"], (command, p["key"])
+    for command, key, source in followers():  # declared (follows) or chosen by the command ("= plant_rate")
+        if command in FUNCTIONS:
+            assert inspect.signature(FUNCTIONS[command]).parameters[key].default is None
+            assert f"defaults to {source} (its value is used" in FUNCTIONS[command].__doc__, (command, key)
+    sig = inspect.signature(afmkit.tapping.hb).parameters
+    assert sig["departure_hamaker"].default is None and sig["hamaker"].default == 6.4e-20
+    # the default None stands for the value recorded: departure_hamaker = hamaker's value, as r.params records it
+    r = afmkit.tapping.hb(units="physical", law="dmt", hamaker=1e-19, departure_hamaker=None, points=50)
+    assert r.params["departure_hamaker"] == 1e-19
+
+
+def test_a_fixed_signature_default_is_the_value_recorded():
+    import inspect
+    for command in ("tapping hb", "control tf", "impact", "control simulate"):
+        r = FUNCTIONS[command](**FAST[command])
+        for key, p in inspect.signature(FUNCTIONS[command]).parameters.items():
+            if key in FAST[command] or p.default is None or key not in r.params:
+                continue
+            assert r.params[key] == p.default, (command, key, r.params[key], p.default)

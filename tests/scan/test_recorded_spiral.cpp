@@ -401,3 +401,16 @@ TEST(RecordedSpiral, FilesByPath) {
     EXPECT_EQ(std::string(e.what()), "recorded spiral '" + dir.path.string() + "' is a directory, not a regular file");
   }
 }
+
+// issue 24 §3: a recorded deflection near 1e300 was read as any finite number, and the filter's sums overflowed
+// (nan in every output row); deflections are bounded like the sample heights, [-1, 1] m, naming line and column.
+TEST(RecordedSpiral, ADeflectionBeyondOneMetreIsRefusedNamingLineAndColumn) {
+  const std::string h = "time,angle,radius,deflection\n";
+  EXPECT_EQ(error_of(h + "0,0,1e-6,0\n0.01,0.5,1e-6,8.39e197\n"),
+            "rec.csv:3: column 'deflection': 8.39e+197 m is out of range: a recorded deflection must lie in [-1, 1] m");
+  EXPECT_EQ(error_of(h + "0,0,1e-6,-1.5\n"),
+            "rec.csv:2: column 'deflection': -1.5 m is out of range: a recorded deflection must lie in [-1, 1] m");
+  EXPECT_EQ(error_of(h + "0,0,1e-6,-1\n"), "rec.csv:2: column 'angle': the data end after 0.000 revolutions: a recorded "
+                                           "spiral needs at least two revolutions")
+      << "a deflection of exactly 1 m is accepted (the error is the next rule's)";
+}

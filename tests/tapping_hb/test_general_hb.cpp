@@ -17,6 +17,7 @@
 #include "afmkit/tapping/harmonic_balance.hpp"
 #include "afmkit/tapping/numerical_describing_functions.hpp"
 #include "afmkit/tapping/units.hpp"
+#include "../counting_stop.hpp"
 #include "reference.hpp"
 
 namespace afmkit::tapping {
@@ -399,6 +400,16 @@ TEST(GeneralHarmonicBalance, ReproducesTheClosedFormOnPiecewiseLinearLaws) {
     std::printf("[ general HB ] closed form w=%-5g: %d solutions (worst %.1e), %zu folds (worst |Δq| %.1e), "
                 "%d/%zu curve points\n", c.w, n, worst, closed.folds().size(), worst_fold, matched, cc.size());
   }
+}
+
+// issue 24 §3: the first trace of the curve (thousands of describing-function evaluations, seconds for a finely
+// tabulated law) checks the cancellation, so Ctrl-C in Python stops it.
+TEST(GeneralHarmonicBalance, TheConstructionStopsOnRequest) {
+  afmkit_test::CountingStop stop(3);
+  EXPECT_THROW(HarmonicBalance(dmt_model(), stop.cancellation()), Cancelled);
+  EXPECT_EQ(stop.calls.load(), 3);  // one check per 64 evaluations: stopped at the third
+  const HarmonicBalance never(dmt_model(), Cancellation{});  // an empty cancellation never stops
+  EXPECT_FALSE(never.folds().empty());
 }
 
 }  // namespace

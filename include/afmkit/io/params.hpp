@@ -91,8 +91,9 @@ class ParamSet {
   ParamSet& writes(WrittenPaths paths = {});
   /// Refuses, before anything is computed, an output that would replace an input or another output: every path an
   /// output writes is compared with every input (the same file through a symbolic or hard link: st_dev/st_ino; a
-  /// path that does not exist yet: by canonical path; inside a written folder) and with the other outputs.
-  /// InvalidParameter naming the output and the other parameter. resolve() calls it; a front end that sets values
+  /// path that does not exist yet: by canonical path; inside a written folder) and with the other outputs; and a
+  /// file output that cannot be written where it is named (an existing folder, FIFO or device; a path under a
+  /// file). InvalidParameter naming the output. resolve() calls it; a front end that sets values
   /// after resolve() calls it again.
   void check_files() const;
   const std::string& unit_of(const std::string& key) const&;
@@ -125,6 +126,7 @@ class ParamSet {
     std::string allowed;  ///< range or choices in words ("> 0", "integer in [1, 100]", "one of a, b")
     std::string group;
     std::vector<std::string> choices;
+    std::string follows;  ///< not empty: not given, the parameter takes the value of this one (follows())
   };
   /// Every parameter in declaration order.
   std::vector<Description> describe() const;

@@ -12,7 +12,8 @@
 //   time        [s]    sample time, strictly increasing and uniformly sampled: every interval Δt within
 //                      1e-3 · Δt0 of the first interval Δt0 = t1 − t0 (sample_rate() = 1 / Δt0)
 //   radius      [m]    distance of the tip from the spindle axis, >= 0
-//   deflection  [m]    cantilever deflection (any finite number)
+//   deflection  [m]    cantilever deflection, in [−1, 1] m (far beyond any AFM signal; the bound keeps the
+//                      filter's sums finite)
 //   and exactly one of
 //   angle       [rad]  spindle angle, wrapped (e.g. into [−π, π) or [0, 2π)) or already unwrapped. The reader
 //                      unwraps it: a step below −π between two samples counts as one wrap (+2π); after that every

@@ -114,7 +114,9 @@ class GeneralHarmonicBalance;
 /// Queries are const and thread-safe in both cases.
 class HarmonicBalance {
  public:
-  explicit HarmonicBalance(const TappingModel& model);
+  /// `cancellation` is checked during the construction (every 64 describing-function evaluations of the general
+  /// curve trace, which can take seconds for a finely tabulated law; core/cancellation.hpp).
+  explicit HarmonicBalance(const TappingModel& model, const Cancellation& cancellation = {});
 
   /// Every solution at separation l (finite), sorted by increasing amplitude.
   std::vector<HbPoint> solutions(double separation) const;

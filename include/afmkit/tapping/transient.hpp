@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "afmkit/core/cancellation.hpp"
 #include "afmkit/tapping/shooting.hpp"
 
 namespace afmkit::tapping {
@@ -19,6 +20,9 @@ struct TransientOptions {
   /// If set, called after every chunk with the periods just simulated (progress of long transients; settle() may
   /// run on several threads at once, so it must be thread-safe).
   std::function<void(int)> on_periods{};
+  /// Checked after every chunk of chunk_periods periods (a long transient stops within a chunk on request;
+  /// core/cancellation.hpp). find_orbits and the sweeps pass their own cancellation here.
+  Cancellation cancellation{};
   void validate() const;
 };
 

@@ -13,6 +13,7 @@ import traceback
 from pathlib import Path
 
 from .._files import unique_temporary
+from .._parent import die_with_parent
 
 #: Figure modules (python/afmkit/figures/<name>.py), in report order; each lists its figures in FIGURES.
 FIGURE_MODULES = ["seed000", "seed003", "scan"]
@@ -44,32 +45,6 @@ def _check_writable(out: Path) -> None:
     except OSError as e:
         raise ReportError(f"output_dir '{out}' cannot be written: {e.strerror or e}: must be a writable folder"
                           ) from None
-
-
-def _die_with_parent(parent: int) -> None:
-    """In a worker: end when the report process ends, even by SIGKILL (no orphans computing on): the kernel sends
-    SIGKILL on the parent's death (Linux prctl PR_SET_PDEATHSIG); elsewhere, or if the parent is already gone, a
-    watchdog thread polls the parent's pid."""
-    import ctypes
-    import signal
-    import threading
-
-    armed = False
-    if sys.platform.startswith("linux"):
-        try:
-            libc = ctypes.CDLL(None, use_errno=True)
-            armed = libc.prctl(1, int(signal.SIGKILL), 0, 0, 0) == 0  # 1 = PR_SET_PDEATHSIG
-        except (OSError, AttributeError):
-            armed = False
-    if os.getppid() != parent:  # the parent died before the request took effect
-        os._exit(1)
-    if not armed:
-        def watch():
-            while os.getppid() == parent:
-                time.sleep(0.5)
-            os._exit(1)
-
-        threading.Thread(target=watch, daemon=True).start()
 
 
 def figure_ids() -> list:
@@ -125,7 +100,7 @@ def _run_figure(module: str, name: str, staging: str):
 
 
 def _worker_init(threads: int, parent: int) -> None:
-    _die_with_parent(parent)
+    die_with_parent(parent)
     os.environ["OMP_NUM_THREADS"] = str(threads)
 
 

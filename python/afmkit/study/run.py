@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .._files import unique_temporary
+from .._parent import TiedToParent
 from . import store as zstore
 from .definition import Study, StudyError, parameters_of, require_memory
 
@@ -211,10 +212,13 @@ def _client(scheduler, workers: int | None):
         return scheduler, None, False
     if scheduler in (None, "local"):
         n = workers or os.cpu_count() or 1
+        # every worker process ends with this one, even when it is killed outright (afmkit._parent: Linux
+        # PR_SET_PDEATHSIG, a watchdog elsewhere): no orphan keeps computing
         cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                           host="127.0.0.1",
-                                           env={"OMP_NUM_THREADS": "1"})
-        return distributed.Client(cluster), cluster, True
+                                           host="127.0.0.1", env={"OMP_NUM_THREADS": "1"})
+        client = distributed.Client(cluster)
+        client.register_worker_plugin(TiedToParent(os.getpid()))  # also applied to workers started later
+        return client, cluster, True
     try:
         return distributed.Client(scheduler, timeout="5s"), None, True
     except (OSError, TimeoutError) as e:

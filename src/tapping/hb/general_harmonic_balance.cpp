@@ -238,10 +238,11 @@ class GeneralHbBuilder {
   using Node = GeneralHarmonicBalance::Node;
   enum class End { Free, Deep, Small, Large, Loop, Budget, Failed };
 
-  explicit GeneralHbBuilder(GeneralHarmonicBalance& hb) : hb_(hb) {}
+  GeneralHbBuilder(GeneralHarmonicBalance& hb, const Cancellation& cancellation)
+      : hb_(hb), cancellation_(cancellation) {}
 
   Eval eval(double u, double v) {
-    ++count_;
+    if ((++count_ & 63) == 0) cancellation_.check();
     return hb_.evaluate(u, v);
   }
 
@@ -757,6 +758,7 @@ class GeneralHbBuilder {
 
  private:
   GeneralHarmonicBalance& hb_;
+  const Cancellation& cancellation_;
   long count_ = 0;
   std::vector<double> ug_, vg_, fg_;
   std::vector<bool> visited_;
@@ -764,7 +766,7 @@ class GeneralHbBuilder {
 
 // ---------------------------------------------------------------------------------------------------------------
 
-GeneralHarmonicBalance::GeneralHarmonicBalance(const TappingModel& model)
+GeneralHarmonicBalance::GeneralHarmonicBalance(const TappingModel& model, const Cancellation& cancellation)
     : df_(model.law, model.drive.frequency),
       static_gain_(model.cantilever.static_gain()),
       gamma_(model.drive.amplitude) {
@@ -777,7 +779,7 @@ GeneralHarmonicBalance::GeneralHarmonicBalance(const TappingModel& model)
   // B ≤ Γ/Im L(iω)⁻¹ for a dissipative law (Im N1 ≥ 0); margin for laws that gain energy.
   v_max_ = std::log(std::max(2.0, 1.5 * std::abs(inverse_) / inverse_.imag()));
   v_min_ = std::log(b_min_trace);
-  GeneralHbBuilder builder(*this);
+  GeneralHbBuilder builder(*this, cancellation);
   builder.build();
   construction_evaluations_ = builder.count();
   std::sort(folds_.begin(), folds_.end(), [](const HbFold& a, const HbFold& b) { return a.point.q < b.point.q; });

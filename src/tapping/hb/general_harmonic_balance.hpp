@@ -49,7 +49,8 @@ namespace afmkit::tapping::detail {
 
 class GeneralHarmonicBalance {
  public:
-  explicit GeneralHarmonicBalance(const TappingModel& model);
+  /// Traces the curve; `cancellation` is checked every 64 evaluations of F (core/cancellation.hpp).
+  explicit GeneralHarmonicBalance(const TappingModel& model, const Cancellation& cancellation = {});
 
   /// Every solution at separation l, sorted by increasing amplitude.
   std::vector<HbPoint> solutions(double separation) const;

@@ -103,9 +103,10 @@ HbBranchEvaluation HarmonicBalance::evaluate(const Node& like, double parameter,
                         : evaluate_branch_at_angle(*coefficients_, parameter, sign);
 }
 
-HarmonicBalance::HarmonicBalance(const TappingModel& model) : free_amplitude_(model.free_amplitude()) {
+HarmonicBalance::HarmonicBalance(const TappingModel& model, const Cancellation& cancellation)
+    : free_amplitude_(model.free_amplitude()) {
   if (model.law.piecewise_linear() == nullptr) {
-    general_ = std::make_shared<const detail::GeneralHarmonicBalance>(model);
+    general_ = std::make_shared<const detail::GeneralHarmonicBalance>(model, cancellation);
     folds_ = general_->folds();
     free_amplitude_ = general_->free_amplitude();
     return;

@@ -64,7 +64,7 @@ void general_curve(const TappingModel& model, const HbCurveOptions& options, std
   std::vector<double> qs;
   qs.reserve(options.points);
   for_each_sample(options, [&](double q, double) { qs.push_back(q); });
-  const detail::GeneralHarmonicBalance hb(model);
+  const detail::GeneralHarmonicBalance hb(model, options.cancellation);
   std::vector<HbPoint> lower;
   out.clear();
   hb.sample(qs, options.include_minus, out, lower, options.cancellation);

@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
 #include "sweep_points.hpp"
@@ -190,14 +191,11 @@ double orbit_min_gap(const TappingModel& base, const SweepPoint& p, const Simula
 
 }  // namespace
 
-ContinuationResult continue_orbits(const TappingModel& base, const PeriodicOrbit& start, double l_min, double l_max,
-                                   bool increasing, const ContinuationOptions& options) {
-  options.validate();
-  validate::finite("separation_min", l_min);
-  validate::finite("separation_max", l_max);
-  validate::require(l_min < l_max, "separation_min", l_min, fmt::format("< separation_max = {}", l_max));
-  validate::require(start.period_multiple == 1, "period_multiple", start.period_multiple,
-                    "1 (continuation follows period-1 orbits)");
+namespace {
+
+/// continue_orbits on checked input.
+ContinuationResult continue_checked(const TappingModel& base, const PeriodicOrbit& start, double l_min, double l_max,
+                                    bool increasing, const ContinuationOptions& options) {
   const double omega = base.drive.frequency;
   SimulationOptions sim = options.shooting.simulation;
   sim.sensitivity = true;
@@ -249,9 +247,28 @@ ContinuationResult continue_orbits(const TappingModel& base, const PeriodicOrbit
   return out;
 }
 
+}  // namespace
+
+ContinuationResult continue_orbits(const TappingModel& base, const PeriodicOrbit& start, double l_min, double l_max,
+                                   bool increasing, const ContinuationOptions& options) {
+  options.validate();
+  validate::finite("separation_min", l_min);
+  validate::finite("separation_max", l_max);
+  validate::require(l_min < l_max, "separation_min", l_min, fmt::format("< separation_max = {}", l_max));
+  validate::require(start.period_multiple == 1, "period_multiple", start.period_multiple,
+                    "1 (continuation follows period-1 orbits)");
+  // the input is checked: a separation or model refused from here on was computed (core/computed.hpp), e.g. a
+  // predictor step to a NaN separation, never the user's error
+  return computed("branch continuation",
+                  [&] { return continue_checked(base, start, l_min, l_max, increasing, options); });
+}
+
 ContinuationResult sweep_continuation(const TappingModel& base, double l_min, double l_max,
                                       const ContinuationOptions& options) {
   validate::finite("separation_min", l_min);
+  validate::finite("separation_max", l_max);
+  validate::require(l_min < l_max, "separation_min", l_min, fmt::format("< separation_max = {}", l_max));
+  options.validate();
   OrbitSearchOptions search;
   search.shooting = options.shooting;
   search.cancellation = options.cancellation;

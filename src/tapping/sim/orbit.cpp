@@ -249,7 +249,7 @@ OrbitSearchResult search_orbits(const TappingModel& model, const OrbitSearchOpti
   const double omega = model.drive.frequency, l = model.separation;
   const double free_amplitude = model.free_amplitude();
   if (options.from_harmonic_balance) {  // any law (closed form for piecewise-linear ones)
-    out.harmonic_balance = harmonic_balance_solutions(model);
+    out.harmonic_balance = HarmonicBalance(model, options.cancellation).solutions(model.separation);
     for (const HbPoint& p : out.harmonic_balance) {
       // x ≈ A + B cos(ωt − φ): x(0) = A + B cos φ, ẋ(0) = Bω sin φ
       const TipState guess{p.offset + p.amplitude * std::cos(p.phase), p.amplitude * omega * std::sin(p.phase)};
@@ -290,6 +290,8 @@ OrbitSearchResult search_orbits(const TappingModel& model, const OrbitSearchOpti
   sim.sensitivity = false;
   ShootingOptions quick = options.shooting;
   quick.max_iterations = std::min(quick.max_iterations, 10);
+  TransientOptions transient = options.transient;
+  transient.cancellation = options.cancellation;  // a long transient stops within a chunk on request
   std::vector<std::vector<PeriodicOrbit>> found(tasks.size());
   std::vector<std::optional<TransientOutcome>> outcomes(tasks.size());
   ExceptionCollector errors;  // a candidate that fails numerically is dropped; anything else is an error
@@ -300,7 +302,7 @@ OrbitSearchResult search_orbits(const TappingModel& model, const OrbitSearchOpti
     try {
       switch (tasks[i].kind) {
         case SeedKind::transient:
-          outcomes[i] = settle(model, tasks[i].start, options.transient, options.shooting);
+          outcomes[i] = settle(model, tasks[i].start, transient, options.shooting);
           if (outcomes[i]->orbit) found[i].push_back(*outcomes[i]->orbit);
           break;
         case SeedKind::harmonic_balance:

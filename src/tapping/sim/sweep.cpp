@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/parallel.hpp"
 #include "afmkit/core/validate.hpp"
@@ -79,7 +80,9 @@ SweepPoint from_transient(const TappingModel& model, TipState state, SweepDirect
   p.separation = model.separation;
   p.direction = direction;
   p.jumped = true;
-  const TransientOutcome t = settle(model, state, options.transient, options.shooting);
+  TransientOptions transient = options.transient;
+  transient.cancellation = options.cancellation;  // a long transient stops within a chunk on request
+  const TransientOutcome t = settle(model, state, transient, options.shooting);
   if (t.orbit) {
     p.orbit = *t.orbit;
   } else {
@@ -402,7 +405,7 @@ namespace detail {
 void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
                    bool harmonic_balance, bool parallel, const Cancellation& cancellation) {
   std::optional<HarmonicBalance> hb;  // branch scan once, cheap queries
-  if (harmonic_balance) hb.emplace(base);  // any law (closed form for piecewise-linear ones)
+  if (harmonic_balance) hb.emplace(base, cancellation);  // any law (closed form for piecewise-linear ones)
   ExceptionCollector errors;
 #pragma omp parallel for schedule(dynamic) if (parallel)
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -432,6 +435,15 @@ void finish_jumps(const TappingModel& base, std::vector<SweepJump>& jumps, const
 
 }  // namespace detail
 
+namespace {
+// the computations of sweep_instrument and sweep_grid on checked input (below)
+SweepResult sweep_checked(const TappingModel& base, const std::vector<double>& separations,
+                          const SweepOptions& options);
+std::vector<OrbitSearchResult> grid_checked(const TappingModel& base, const std::vector<double>& separations,
+                                            const OrbitSearchOptions& options,
+                                            const std::function<void(long)>& progress);
+}  // namespace
+
 SweepResult sweep_instrument(const TappingModel& base, double l_min, double l_max, int points,
                              const SweepOptions& options) {
   check_range(l_min, l_max, points);
@@ -449,6 +461,23 @@ SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separ
   validate::require(separations.size() >= 2, "separations", static_cast<double>(separations.size()),
                     "at least 2 distinct separations");
   options.validate();
+  // the input is checked: a separation or model refused from here on was computed (core/computed.hpp), never the
+  // user's error
+  return computed("instrument sweep", [&] { return sweep_checked(base, separations, options); });
+}
+
+std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::vector<double>& separations,
+                                          const OrbitSearchOptions& options,
+                                          const std::function<void(long)>& progress) {
+  for (double l : separations) validate::finite("separation", l);
+  options.validate();
+  return computed("grid of orbit searches", [&] { return grid_checked(base, separations, options, progress); });
+}
+
+namespace {
+
+SweepResult sweep_checked(const TappingModel& base, const std::vector<double>& separations,
+                          const SweepOptions& options) {
   const std::vector<double> up = separations;
   const std::vector<double> down(separations.rbegin(), separations.rend());
   const double l_max = up.back();
@@ -483,10 +512,9 @@ SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separ
   return result;
 }
 
-std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::vector<double>& separations,
-                                          const OrbitSearchOptions& options,
-                                          const std::function<void(long)>& progress) {
-  for (double l : separations) validate::finite("separation", l);
+std::vector<OrbitSearchResult> grid_checked(const TappingModel& base, const std::vector<double>& separations,
+                                            const OrbitSearchOptions& options,
+                                            const std::function<void(long)>& progress) {
   std::vector<OrbitSearchResult> out(separations.size());
   OrbitSearchOptions inner = options;
   inner.parallel = false;  // parallel over separations instead
@@ -505,5 +533,7 @@ std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::v
   errors.rethrow();
   return out;
 }
+
+}  // namespace
 
 }  // namespace afmkit::tapping

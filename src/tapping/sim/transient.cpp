@@ -61,6 +61,7 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
   std::optional<PeriodicOrbit> candidate;
   double candidate_distance = 0.0;
   while (k < options.max_periods) {
+    options.cancellation.check();
     advance(options.chunk_periods);
     if (options.on_periods) options.on_periods(options.chunk_periods);
     const int last = static_cast<int>(strobe.size()) - 1;
