@@ -1,0 +1,198 @@
+// AM-AFM force reconstruction: the equivalent frequency shift of the in-phase balance inverted by the method the
+// user picks, the dissipation as a branch difference, the round trip through exact orbits (reconstruct_am.hpp).
+#include "afmkit/spectroscopy/reconstruct_am.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "afmkit/core/computed.hpp"
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/quantity.hpp"
+#include "afmkit/spectroscopy/reconstruct_law.hpp"
+#include "reconstruct_am_round_trip.hpp"
+#include "reconstruct_checks.hpp"
+
+namespace afmkit::spectroscopy {
+
+const char* to_string(AmMethod method) {
+  switch (method) {
+    case AmMethod::katan: return "katan";
+    case AmMethod::hoelscher: return "hoelscher";
+    default: return "payam";
+  }
+}
+
+AmMethod am_method_from(const std::string& name) {
+  if (name == "katan") return AmMethod::katan;
+  if (name == "payam") return AmMethod::payam;
+  if (name == "hoelscher") return AmMethod::hoelscher;
+  throw InvalidParameter("method", fmt::format("method = '{}' is not an AM method: one of katan, payam, hoelscher", name));
+}
+
+AmSettings::AmSettings(double k, double f0, double q, double a0, double f)
+    : spring_constant(k), resonance_frequency(f0), quality_factor(q), free_amplitude(a0),
+      drive_frequency(f == 0.0 ? f0 : f) {
+  detail::require_positive("spring_constant", k, "N/m");
+  detail::require_positive("resonance_frequency", f0, "Hz");
+  detail::require_positive("quality_factor", q, "");
+  detail::require_positive("free_amplitude", a0, "m");
+  detail::require_positive("drive_frequency", drive_frequency, "Hz");
+}
+
+namespace {
+/// The Sader–Jarvis terms of each method (docs/reconstruction.md#am).
+SaderJarvisTerms terms_of(AmMethod m) {
+  switch (m) {
+    case AmMethod::katan: return {true, false};      // local amplitude in front of dΩ/dt
+    case AmMethod::hoelscher: return {false, true};  // large-amplitude limit: −√2 d/dD ∫ γ/√(t − D), γ = k A^{3/2} Ω
+    default: return {true, true};                    // amplitude inside the derivative: d(A^{3/2} Ω)/dt
+  }
+}
+}  // namespace
+
+AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const AmOptions& options) {
+  const std::size_t n = curve.separation.size();
+  if (curve.amplitude.size() != n || curve.phase.size() != n)
+    throw InvalidParameter("amplitude", fmt::format("the curve has {} separations, {} amplitudes and {} phases: one "
+                                                    "of each per point",
+                                                    n, curve.amplitude.size(), curve.phase.size()));
+  if (n < 5) throw InvalidParameter("separation", fmt::format("the curve has {} points: at least 5 are needed", n));
+  detail::require_finite("separation", curve.separation);
+  detail::require_finite("amplitude", curve.amplitude);
+  detail::require_finite("phase", curve.phase);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(curve.amplitude[i] > 0.0))
+      throw InvalidParameter("amplitude", fmt::format("amplitude[{}] = {} m is out of range: must be > 0", i,
+                                                      curve.amplitude[i]));
+    if (!(curve.phase[i] > 0.0 && curve.phase[i] < std::numbers::pi))
+      throw InvalidParameter("phase", fmt::format("phase[{}] = {} rad ({}°) is out of range: must be in (0, π) rad, "
+                                                  "the lag of the response behind the drive (afmkit's convention, "
+                                                  "docs/conventions.md; π/2 for the free cantilever at resonance)",
+                                                  i, curve.phase[i], curve.phase[i] * 180.0 / std::numbers::pi));
+  }
+  if (options.round_trip_points < 0 || options.round_trip_points == 1 || options.round_trip_points > 100000)
+    throw InvalidParameter("round_trip_points", fmt::format("round_trip_points = {} is out of range: 0 (all) or an "
+                                                            "integer in [2, 100000]",
+                                                            options.round_trip_points));
+  const auto order = detail::monotone_order("separation", curve.separation);
+
+  AmReconstruction r;
+  r.method = to_string(options.method);
+  r.separation = detail::permuted(curve.separation, order);
+  r.amplitude = detail::permuted(curve.amplitude, order);
+  r.phase = detail::permuted(curve.phase, order);
+  return computed("force reconstruction (AM)", [&] {
+    std::size_t negative = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      r.dissipation.push_back(dissipated_energy(r.amplitude[i], r.phase[i], s));
+      if (r.dissipation[i] < 0.0) ++negative;
+    }
+    // the points whose lower turning point D = l − A increases with l (from the free end inwards)
+    std::vector<std::size_t> kept;
+    double d_last = std::numeric_limits<double>::infinity();
+    for (std::size_t i = n; i-- > 0;) {
+      const double d = r.separation[i] - r.amplitude[i];
+      if (d < d_last) {
+        kept.push_back(i);
+        d_last = d;
+      }
+    }
+    std::reverse(kept.begin(), kept.end());
+    r.dropped = n - kept.size();
+    if (kept.size() < 5)
+      throw InvalidParameter("separation", fmt::format("only {} points have a lower turning point D = l − A that "
+                                                       "increases with l: at least 5 are needed",
+                                                       kept.size()));
+    std::vector<double> amp;
+    for (std::size_t i : kept) {
+      r.gap.push_back(r.separation[i] - r.amplitude[i]);
+      amp.push_back(r.amplitude[i]);
+      r.omega.push_back(equivalent_frequency_shift(r.amplitude[i], r.phase[i], s));
+      r.gap_dissipation.push_back(r.dissipation[i]);
+    }
+    ExponentialTail tail;
+    if (options.tail == TailModel::exponential) {
+      tail = fit_exponential_tail(r.gap, r.omega);
+      if (!tail.active)
+        r.notes.push_back("tail = exponential: the last points do not decay exponentially; the equivalent Δf is "
+                          "taken as 0 beyond the last point instead");
+    }
+    r.force = sader_jarvis_force(r.gap, r.omega, amp, s.spring_constant, terms_of(options.method), tail);
+
+    // dissipation → branch difference over the contact part
+    double e_max = 0.0;
+    for (double e : r.gap_dissipation) e_max = std::max(e_max, e);
+    // below the noise of E_dis, 0.1 % of its largest value, or what a phase error of 2e-4 rad makes of the drive
+    // work π k A0²/Q: no dissipation
+    const double drive_work = std::numbers::pi * s.spring_constant * s.free_amplitude * s.free_amplitude / s.quality_factor;
+    const double threshold = std::max({3.0 * estimate_noise(r.gap_dissipation), 1e-3 * e_max, 2e-4 * drive_work});
+    const std::vector<double> delta = branch_difference(r.gap, r.gap_dissipation, threshold, r.contact_gap);
+    for (std::size_t i = 0; i < r.gap.size(); ++i) {
+      r.approach_force.push_back(r.force[i] + 0.5 * delta[i]);
+      r.retract_force.push_back(r.force[i] - 0.5 * delta[i]);
+    }
+    r.law = force_curve_from_si(r.gap, r.approach_force, r.retract_force, "reconstructed force");
+    bool dissipative = true;
+    try {
+      impact::TableLaw(r.law, false).require_dissipative();
+    } catch (const InvalidParameter&) {
+      dissipative = false;
+      r.notes.push_back("the interpolated branches cross between points (the retract force exceeds the approach "
+                        "force somewhere): the law needs allow_energy_gain to be used");
+    }
+
+    // notes: ill-posedness and what was assumed
+    if (r.dropped > 0)
+      r.notes.push_back(fmt::format("{} of {} points left out: the lower turning point D = l − A did not increase "
+                                    "with l there (the tip barely indents in the repulsive regime, or the response "
+                                    "jumped between branches)",
+                                    r.dropped, n));
+    if (negative > 0)
+      r.notes.push_back(fmt::format("{} points dissipate less than the free cantilever (E_dis < 0: a phase offset, a "
+                                    "wrong Q or A0, or a phase convention other than afmkit's lag): set to 0",
+                                    negative));
+    const double a_ratio_far = r.amplitude.back() / s.free_amplitude;
+    if (std::abs(a_ratio_far - 1.0) > 0.02)
+      r.notes.push_back(fmt::format("the curve does not reach the free region: A/A0 = {:.3f} at the largest "
+                                    "separation; the force is biased near the end of the curve",
+                                    a_ratio_far));
+    double a_min = amp.front(), a_max = amp.front();
+    for (double a : amp) a_min = std::min(a_min, a), a_max = std::max(a_max, a);
+    if (options.method == AmMethod::hoelscher) {
+      // interaction length: where |Ω| falls to 1/e of its largest value
+      std::size_t peak = 0;
+      for (std::size_t i = 1; i < r.omega.size(); ++i)
+        if (std::abs(r.omega[i]) > std::abs(r.omega[peak])) peak = i;
+      double length = std::numeric_limits<double>::quiet_NaN();
+      for (std::size_t i = peak; i < r.omega.size(); ++i)
+        if (std::abs(r.omega[i]) < std::abs(r.omega[peak]) / std::numbers::e) {
+          length = r.gap[i] - r.gap[peak];
+          break;
+        }
+      if (!(a_min > 10.0 * length))
+        r.notes.push_back(fmt::format("the large-amplitude limit (hoelscher) needs A ≫ the interaction length: A "
+                                      "goes down to {}, the interaction length is {}",
+                                      io::quantity(a_min, "m"), io::quantity(length, "m")));
+    }
+    const double noise = estimate_noise(r.omega);
+    double om_max = 0.0;
+    for (double o : r.omega) om_max = std::max(om_max, std::abs(o));
+    if (noise > 0.01 * om_max)
+      r.notes.push_back(fmt::format("noisy data: the equivalent frequency shift has noise {:.1f} % of its largest "
+                                    "value; the inversion differentiates it",
+                                    100.0 * noise / om_max));
+
+    if (options.round_trip) {
+      am_round_trip(r, s, dissipative, options.round_trip_points);
+    } else {
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      r.rms_amplitude_ratio = r.rms_phase = nan;
+    }
+    return r;
+  });
+}
+
+}  // namespace afmkit::spectroscopy
