@@ -21,5 +21,7 @@ void register_demo(CLI::App& app);              // demo_cmd.cpp:          afmkit
 void register_scan(CLI::App& app);              // scan_cmd.cpp:          afmkit scan
 void register_report(CLI::App& app);            // report_cmd.cpp:        afmkit report (the Python report)
 void register_study(CLI::App& app);             // study_cmd.cpp:         afmkit study run (Python + Dask)
+void register_spectroscopy(CLI::App& app);      // spectroscopy_cmd.cpp:  afmkit spectroscopy …
+void register_spectroscopy_reconstruct(CLI::App& spectroscopy);  // spectroscopy_reconstruct_cmd.cpp
 
 }  // namespace afmkit::cli

@@ -24,6 +24,7 @@ void register_all(CLI::App& app) {
   register_control(app);
   register_scan(app);
   register_study(app);
+  register_spectroscopy(app);
 }
 
 std::vector<CommandSpec> command_specs() { return Program().commands; }
