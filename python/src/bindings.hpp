@@ -8,5 +8,6 @@ void bind_errors(pybind11::module_& m);           // errors.cpp: InvalidParamete
 void bind_commands(pybind11::module_& m);         // commands.cpp: every command as run(path, kwargs)
 void bind_realtime_filter(pybind11::module_& m);  // realtime_filter.cpp: the streaming filter on NumPy buffers
 void bind_study(pybind11::module_& m);            // study_batch.cpp: one chunk of a parameter study, in C++
+void bind_spectroscopy_reconstruct(pybind11::module_& m);  // spectroscopy_reconstruct.cpp: force reconstruction
 
 }  // namespace afmkit::python

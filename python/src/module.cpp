@@ -11,4 +11,5 @@ PYBIND11_MODULE(_afmkit, m) {
   afmkit::python::bind_commands(m);
   afmkit::python::bind_realtime_filter(m);
   afmkit::python::bind_study(m);
+  afmkit::python::bind_spectroscopy_reconstruct(m);
 }
