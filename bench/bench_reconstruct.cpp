@@ -63,4 +63,5 @@ void am(benchmark::State& state) {
 
 BENCHMARK_CAPTURE(fm, sader_jarvis_1000, sp::FmMethod::sader_jarvis)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(fm, matrix_1000, sp::FmMethod::matrix)->Unit(benchmark::kMillisecond);
-BENCHMARK(am)->Arg(40)->Arg(0)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(am)->Arg(40)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_MAIN();

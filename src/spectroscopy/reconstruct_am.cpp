@@ -3,6 +3,7 @@
 #include "afmkit/spectroscopy/reconstruct_am.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <numbers>
 
@@ -90,12 +91,20 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
       r.dissipation.push_back(dissipated_energy(r.amplitude[i], r.phase[i], s));
       if (r.dissipation[i] < 0.0) ++negative;
     }
-    // the points whose lower turning point D = l − A increases with l (from the free end inwards)
+    // the points whose lower turning point D = l − A increases with l (from the free end inwards), at least
+    // 1/2000 of the range of D apart: nearly coincident D (the repulsive regime, dense sampling) would turn the
+    // orbits' or the instrument's noise into huge derivatives
+    double d_lo = std::numeric_limits<double>::infinity(), d_hi = -d_lo;
+    for (std::size_t i = 0; i < n; ++i) {
+      d_lo = std::min(d_lo, r.separation[i] - r.amplitude[i]);
+      d_hi = std::max(d_hi, r.separation[i] - r.amplitude[i]);
+    }
+    const double min_step = (d_hi - d_lo) / 2000.0;
     std::vector<std::size_t> kept;
     double d_last = std::numeric_limits<double>::infinity();
     for (std::size_t i = n; i-- > 0;) {
       const double d = r.separation[i] - r.amplitude[i];
-      if (d < d_last) {
+      if (d < d_last - min_step) {
         kept.push_back(i);
         d_last = d;
       }
@@ -129,7 +138,11 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
     // work π k A0²/Q: no dissipation
     const double drive_work = std::numbers::pi * s.spring_constant * s.free_amplitude * s.free_amplitude / s.quality_factor;
     const double threshold = std::max({3.0 * estimate_noise(r.gap_dissipation), 1e-3 * e_max, 2e-4 * drive_work});
-    const std::vector<double> delta = branch_difference(r.gap, r.gap_dissipation, threshold, r.contact_gap);
+    std::vector<double> delta = branch_difference(r.gap, r.gap_dissipation, threshold, r.contact_gap);
+    // the same difference at the three deepest points: both branches then have the same end slope, and their
+    // straight continuations below the table stay parallel (the law dissipates there too, never creates energy)
+    const double deep = (delta[0] + delta[1] + delta[2]) / 3.0;
+    delta[0] = delta[1] = delta[2] = deep;
     for (std::size_t i = 0; i < r.gap.size(); ++i) {
       r.approach_force.push_back(r.force[i] + 0.5 * delta[i]);
       r.retract_force.push_back(r.force[i] - 0.5 * delta[i]);
@@ -138,7 +151,8 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
     bool dissipative = true;
     try {
       impact::TableLaw(r.law, false).require_dissipative();
-    } catch (const InvalidParameter&) {
+    } catch (const InvalidParameter& e) {
+      if (std::getenv("AFMKIT_DEBUG_RECON")) fmt::print(stderr, "{}\n", e.what());
       dissipative = false;
       r.notes.push_back("the interpolated branches cross between points (the retract force exceeds the approach "
                         "force somewhere): the law needs allow_energy_gain to be used");
@@ -147,8 +161,8 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
     // notes: ill-posedness and what was assumed
     if (r.dropped > 0)
       r.notes.push_back(fmt::format("{} of {} points left out: the lower turning point D = l − A did not increase "
-                                    "with l there (the tip barely indents in the repulsive regime, or the response "
-                                    "jumped between branches)",
+                                    "with l there by 1/2000 of its range (the tip barely indents in the repulsive "
+                                    "regime, or the response jumped between branches)",
                                     r.dropped, n));
     if (negative > 0)
       r.notes.push_back(fmt::format("{} points dissipate less than the free cantilever (E_dis < 0: a phase offset, a "
