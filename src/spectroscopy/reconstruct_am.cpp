@@ -3,7 +3,6 @@
 #include "afmkit/spectroscopy/reconstruct_am.hpp"
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
 #include <numbers>
 
@@ -152,10 +151,10 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
     try {
       impact::TableLaw(r.law, false).require_dissipative();
     } catch (const InvalidParameter& e) {
-      if (std::getenv("AFMKIT_DEBUG_RECON")) fmt::print(stderr, "{}\n", e.what());
       dissipative = false;
-      r.notes.push_back("the interpolated branches cross between points (the retract force exceeds the approach "
-                        "force somewhere): the law needs allow_energy_gain to be used");
+      r.notes.push_back(fmt::format("the interpolated branches cross (the retract force exceeds the approach force "
+                                    "somewhere): the law needs allow_energy_gain to be used ({})",
+                                    e.what()));
     }
 
     // notes: ill-posedness and what was assumed

@@ -5,11 +5,16 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "afmkit/core/error.hpp"
+#include "afmkit/tapping/orbit.hpp"
+#include "afmkit/tapping/shooting.hpp"
 #include "afmkit/tapping/sweep.hpp"
+#include "afmkit/tapping/transient.hpp"
 #include "afmkit/tapping/units.hpp"
 
 namespace afmkit::spectroscopy {
@@ -31,17 +36,48 @@ void am_round_trip(AmReconstruction& r, const AmSettings& s, bool dissipative, i
   const tapping::TappingModel model(pc.cantilever(), pc.drive(), pc.normalised_law(physical), l_nm.back());
   tapping::SweepOptions options;
   options.harmonic_balance = false;
-  const tapping::SweepResult sweep = tapping::sweep_instrument(model, visit, options);
-  // the approach visits the separations from the largest down: match each measured separation
+  // a transient after a jump settles within a few Q periods; 20 Q bounds one that does not (instead of 20000)
+  options.transient.max_periods = static_cast<int>(std::clamp(20.0 * s.quality_factor, 500.0, 20000.0));
+  // the approach only (an instrument sweep would also retract): from the free orbit at the largest separation,
+  // each orbit continued from the previous one along its branch (tapping::follow_stable_branch, as the sweep does);
+  // where the branch ends, the transient from the last stable orbit settles on another (a jump)
   const std::size_t n = l.size();
   r.round_trip_amplitude_ratio.assign(n, std::numeric_limits<double>::quiet_NaN());
   r.round_trip_phase = r.residual_amplitude_ratio = r.residual_phase = r.round_trip_amplitude_ratio;
-  for (const tapping::SweepPoint& p : sweep.approach) {
-    const auto it = std::lower_bound(l_nm.begin(), l_nm.end(), p.separation - 1e-9 * std::max(1.0, std::abs(p.separation)));
-    if (it == l_nm.end()) continue;
-    const std::size_t i = static_cast<std::size_t>(it - l_nm.begin());
-    r.round_trip_amplitude_ratio[i] = p.metrics.amplitude / (s.free_amplitude * 1e9);
-    r.round_trip_phase[i] = p.metrics.phase;
+  std::vector<double> jumps;
+  std::optional<tapping::PeriodicOrbit> orbit;
+  tapping::TipState state;
+  for (std::size_t v = visit.size(); v-- > 0;) {
+    const double at = visit[v];
+    const tapping::TappingModel here = model.with_separation(at);
+    if (!orbit) {
+      const tapping::TipState start = v + 1 == visit.size() ? tapping::free_response_state(here) : state;
+      try {
+        if (v + 1 == visit.size()) orbit = tapping::try_shoot(here, start, 1, options.shooting);
+      } catch (const NumericalFailure&) {
+        orbit.reset();
+      }
+      if (!orbit || !orbit->stable) {
+        const tapping::TransientOutcome t = tapping::settle(here, start, options.transient, options.shooting);
+        orbit = t.orbit;
+        state = t.final_state;
+      }
+    } else {
+      const tapping::BranchFollow f = tapping::follow_stable_branch(model, *orbit, at, options);
+      if (f.reached) {
+        orbit = f.reached;
+      } else {
+        const tapping::TransientOutcome t = tapping::settle(here, f.last.initial, options.transient, options.shooting);
+        jumps.push_back(at);
+        orbit = t.orbit;
+        state = t.final_state;
+      }
+    }
+    if (!orbit) continue;  // not settled: no value at this separation
+    const tapping::OrbitMetrics metrics = tapping::analyse_orbit(here, *orbit, options.shooting.simulation);
+    const std::size_t i = static_cast<std::size_t>(std::lower_bound(l_nm.begin(), l_nm.end(), at) - l_nm.begin());
+    r.round_trip_amplitude_ratio[i] = metrics.amplitude / (s.free_amplitude * 1e9);
+    r.round_trip_phase[i] = metrics.phase;
   }
   double sa = 0.0, sp = 0.0;
   std::size_t count = 0;
@@ -58,11 +94,11 @@ void am_round_trip(AmReconstruction& r, const AmSettings& s, bool dissipative, i
   r.round_trip_model = fmt::format("exact periodic orbits of the table law (tapping sweep, approach) at {} of the {} "
                                    "measured separations; branches chosen by the sign of the velocity",
                                    count, n);
-  if (!sweep.approach_jumps.empty())
+  if (!jumps.empty())
     r.notes.push_back(fmt::format("the round trip jumped to another branch at l = {} nm (approach): where the measured "
                                   "curve stays on one branch, the reconstructed law does not hold it there (the law "
                                   "below the smallest D reached is an extrapolation)",
-                                  fmt::join(sweep.approach_jumps, ", ")));
+                                  fmt::join(jumps, ", ")));
 }
 
 }  // namespace afmkit::spectroscopy
