@@ -127,6 +127,7 @@ void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurv
             {"dissipation", "aJ", "energy dissipated per cycle (first-harmonic balance)"},
             {"gap", "nm", "lower turning point D = l − A (empty: point not used)"},
             {"force", "nN", "reconstructed conservative force at D"},
+            {"force_uncertainty", "nN", "1σ of the force from the noise estimated in amplitude and phase"},
             {"approach_force", "nN", "approach branch of the law at D"},
             {"retract_force", "nN", "retract branch of the law at D"},
             {"round_trip_amplitude_ratio", "dimensionless", "A/A0 of the law's exact orbit (approach sweep)"},
@@ -140,7 +141,8 @@ void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurv
     const double d = r.separation[i] - r.amplitude[i];
     const bool used = k < r.gap.size() && std::abs(r.gap[k] - d) <= 1e-15;
     out.row(r.separation[i] * 1e9, r.amplitude[i] / s.free_amplitude, r.phase[i], r.dissipation[i] * 1e18,
-            used ? d * 1e9 : nan, used ? r.force[k] * 1e9 : nan, used ? r.approach_force[k] * 1e9 : nan,
+            used ? d * 1e9 : nan, used ? r.force[k] * 1e9 : nan, used ? r.force_uncertainty[k] * 1e9 : nan,
+            used ? r.approach_force[k] * 1e9 : nan,
             used ? r.retract_force[k] * 1e9 : nan, r.round_trip_amplitude_ratio.empty() ? nan : r.round_trip_amplitude_ratio[i],
             r.round_trip_phase.empty() ? nan : r.round_trip_phase[i],
             r.residual_amplitude_ratio.empty() ? nan : r.residual_amplitude_ratio[i],

@@ -22,7 +22,7 @@ _FM_UNITS = {
 }
 _AM_UNITS = {
     "separation": "m", "amplitude": "m", "phase": "rad", "dissipation": "J", "gap": "m",
-    "equivalent_frequency_shift": "dimensionless", "force": "N", "gap_dissipation": "J", "approach_force": "N",
+    "equivalent_frequency_shift": "dimensionless", "force": "N", "force_uncertainty": "N", "gap_dissipation": "J", "approach_force": "N",
     "retract_force": "N", "contact_gap": "m", "round_trip_amplitude_ratio": "dimensionless",
     "round_trip_phase": "rad", "residual_amplitude_ratio": "dimensionless", "residual_phase": "rad",
     "rms_amplitude_ratio": "dimensionless", "rms_phase": "rad", "dropped": "count",

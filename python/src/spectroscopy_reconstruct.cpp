@@ -111,6 +111,7 @@ void bind_spectroscopy_reconstruct(py::module_& m) {
         d["gap"] = arr(r.gap);
         d["equivalent_frequency_shift"] = arr(r.omega);
         d["force"] = arr(r.force);
+        d["force_uncertainty"] = arr(r.force_uncertainty);
         d["gap_dissipation"] = arr(r.gap_dissipation);
         d["approach_force"] = arr(r.approach_force);
         d["retract_force"] = arr(r.retract_force);

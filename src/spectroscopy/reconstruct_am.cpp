@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include <fmt/format.h>
 
@@ -51,6 +52,37 @@ SaderJarvisTerms terms_of(AmMethod m) {
     default: return {true, true};                    // amplitude inside the derivative: d(A^{3/2} Ω)/dt
   }
 }
+/// The points whose lower turning point D = l − A increases with l (from the free end inwards), at least 1/2000
+/// of the range of D apart; l ascending.
+std::vector<std::size_t> used_points(const std::vector<double>& l, const std::vector<double>& a) {
+  const std::size_t n = l.size();
+  double d_lo = std::numeric_limits<double>::infinity(), d_hi = -d_lo;
+  for (std::size_t i = 0; i < n; ++i) {
+    d_lo = std::min(d_lo, l[i] - a[i]);
+    d_hi = std::max(d_hi, l[i] - a[i]);
+  }
+  const double min_step = (d_hi - d_lo) / 2000.0;
+  std::vector<std::size_t> kept;
+  double d_last = std::numeric_limits<double>::infinity();
+  for (std::size_t i = n; i-- > 0;) {
+    const double d = l[i] - a[i];
+    if (d < d_last - min_step) {
+      kept.push_back(i);
+      d_last = d;
+    }
+  }
+  std::reverse(kept.begin(), kept.end());
+  return kept;
+}
+
+/// Linear interpolation of (x, y) (x ascending) at t, constant beyond the ends.
+double interpolate(const std::vector<double>& x, const std::vector<double>& y, double t) {
+  if (t <= x.front()) return y.front();
+  if (t >= x.back()) return y.back();
+  const std::size_t j = static_cast<std::size_t>(std::upper_bound(x.begin(), x.end(), t) - x.begin());
+  const double w = (t - x[j - 1]) / (x[j] - x[j - 1]);
+  return y[j - 1] + w * (y[j] - y[j - 1]);
+}
 }  // namespace
 
 AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const AmOptions& options) {
@@ -93,22 +125,7 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
     // the points whose lower turning point D = l − A increases with l (from the free end inwards), at least
     // 1/2000 of the range of D apart: nearly coincident D (the repulsive regime, dense sampling) would turn the
     // orbits' or the instrument's noise into huge derivatives
-    double d_lo = std::numeric_limits<double>::infinity(), d_hi = -d_lo;
-    for (std::size_t i = 0; i < n; ++i) {
-      d_lo = std::min(d_lo, r.separation[i] - r.amplitude[i]);
-      d_hi = std::max(d_hi, r.separation[i] - r.amplitude[i]);
-    }
-    const double min_step = (d_hi - d_lo) / 2000.0;
-    std::vector<std::size_t> kept;
-    double d_last = std::numeric_limits<double>::infinity();
-    for (std::size_t i = n; i-- > 0;) {
-      const double d = r.separation[i] - r.amplitude[i];
-      if (d < d_last - min_step) {
-        kept.push_back(i);
-        d_last = d;
-      }
-    }
-    std::reverse(kept.begin(), kept.end());
+    const std::vector<std::size_t> kept = used_points(r.separation, r.amplitude);
     r.dropped = n - kept.size();
     if (kept.size() < 5)
       throw InvalidParameter("separation", fmt::format("only {} points have a lower turning point D = l − A that "
@@ -190,13 +207,45 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
                                       "goes down to {}, the interaction length is {}",
                                       io::quantity(a_min, "m"), io::quantity(length, "m")));
     }
-    const double noise = estimate_noise(r.omega);
-    double om_max = 0.0;
-    for (double o : r.omega) om_max = std::max(om_max, std::abs(o));
-    if (noise > 0.01 * om_max)
-      r.notes.push_back(fmt::format("noisy data: the equivalent frequency shift has noise {:.1f} % of its largest "
-                                    "value; the inversion differentiates it",
-                                    100.0 * noise / om_max));
+    // noise: estimated in A and φ along the measured (evenly stepped) separations, propagated through the whole
+    // inversion (D = l − A, the points used, Ω_eq, the integral) by 8 synthetic realisations with a fixed seed
+    const double noise_a = estimate_noise(r.amplitude), noise_p = estimate_noise(r.phase);
+    r.force_uncertainty.assign(r.gap.size(), 0.0);
+    if (noise_a > 0.0 || noise_p > 0.0) {
+      std::mt19937_64 rng(1);
+      std::normal_distribution<double> na(0.0, noise_a > 0.0 ? noise_a : 1e-300), np(0.0, noise_p > 0.0 ? noise_p : 1e-300);
+      const int realisations = 8;
+      for (int k = 0; k < realisations; ++k) {
+        std::vector<double> a2 = r.amplitude, p2 = r.phase;
+        for (double& v : a2) v = std::max(v + na(rng), 1e-3 * v);
+        for (double& v : p2) v = std::clamp(v + np(rng), 1e-6, std::numbers::pi - 1e-6);
+        const auto kept2 = used_points(r.separation, a2);
+        if (kept2.size() < 5) continue;
+        std::vector<double> g2, o2, amp2;
+        for (std::size_t i : kept2) {
+          g2.push_back(r.separation[i] - a2[i]);
+          amp2.push_back(a2[i]);
+          o2.push_back(equivalent_frequency_shift(a2[i], p2[i], s));
+        }
+        const auto f2 = sader_jarvis_force(g2, o2, amp2, s.spring_constant, terms_of(options.method), tail);
+        for (std::size_t i = 0; i < r.gap.size(); ++i) {
+          const double d = interpolate(g2, f2, r.gap[i]) - r.force[i];
+          r.force_uncertainty[i] += d * d / realisations;
+        }
+      }
+      for (double& u : r.force_uncertainty) u = std::sqrt(u);
+    }
+    double f_abs = 0.0, sigma_max = 0.0;
+    for (std::size_t i = 0; i < r.force.size(); ++i) {
+      f_abs = std::max(f_abs, std::abs(r.force[i]));
+      sigma_max = std::max(sigma_max, r.force_uncertainty[i]);
+    }
+    if (sigma_max > 0.05 * f_abs)
+      r.notes.push_back(fmt::format("noisy data: the noise estimated in the amplitude ({}) and phase ({:.2g}°) makes "
+                                    "the force uncertain by up to {} (1σ, {:.0f} % of its largest value): the "
+                                    "inversion differentiates the data, and D = l − A moves with the amplitude's noise",
+                                    io::quantity(noise_a, "m"), noise_p * 180.0 / std::numbers::pi,
+                                    io::quantity(sigma_max, "N"), 100.0 * sigma_max / f_abs));
 
     if (options.round_trip) {
       am_round_trip(r, s, dissipative, options.round_trip_points);

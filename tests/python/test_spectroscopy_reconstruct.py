@@ -88,3 +88,29 @@ def test_am_round_trip_on_an_exact_orbit_curve(tmp_path):
     with pytest.raises(afmkit.InvalidParameter, match="phase"):
         sr.reconstruct_am(l, a, phi + 4.0, spring_constant=40.0, resonance_frequency=300e3, quality_factor=400.0,
                           free_amplitude=10e-9)
+
+
+def test_cli_writes_the_table_and_a_law_the_tapping_commands_read(tmp_path):
+    cli = os.environ.get("AFMKIT_CLI", "afmkit")
+    a = 0.5e-9
+    z, df = _exponential_curve(a, 200)
+    src = tmp_path / "df.csv"
+    src.write_text("distance (nm), frequency shift (Hz)\n" +
+                   "".join(f"{zi * 1e9:.12g}, {dfi:.12g}\n" for zi, dfi in zip(z, df)))
+    out, law = tmp_path / "force.csv", tmp_path / "law.csv"
+    p = subprocess.run([cli, "spectroscopy", "reconstruct", str(src), "--spring-constant", "1800",
+                        "--resonance-frequency", "25", "--amplitude", "0.5", "--method", "matrix",
+                        "--output", str(out), "--law-output", str(law), "--json"],
+                       capture_output=True, text=True, check=False)
+    assert p.returncode == 0, p.stderr
+    import json
+    results = json.loads(p.stdout)
+    assert results["mode"] == "fm" and results["method"] == "matrix" and results["units"]["residual_rms"] == "Hz"
+    side = json.loads((tmp_path / "force.csv.json").read_text())
+    assert [c["unit"] for c in side["columns"]][:3] == ["nm", "Hz", "nN"]
+    data = np.genfromtxt(out, delimiter=",", names=True)
+    np.testing.assert_allclose(data["force"], -1.0 * np.exp(-data["distance"] / 0.1), atol=0.01)  # nN
+    q = subprocess.run([cli, "tapping", "orbit", "--units", "physical", "--law", "table", "--force-curve", str(law),
+                        "--spring-constant", "1800", "--resonance-frequency", "25", "--free-amplitude", "0.5",
+                        "--separation", "1", "--output", ""], capture_output=True, text=True, check=False)
+    assert q.returncode == 0, q.stderr

@@ -58,6 +58,7 @@ struct AmReconstruction {
   std::vector<double> gap;             ///< D = l − A [m]
   std::vector<double> omega;           ///< the equivalent Ω = Δf/f0 of the in-phase balance
   std::vector<double> force;           ///< conservative F(D) [N]
+  std::vector<double> force_uncertainty;  ///< 1σ of F from the noise estimated in Ω_eq (8 realisations) [N]
   std::vector<double> gap_dissipation; ///< E_dis at those points [J] (monotone fit, 0 above the contact part)
   std::vector<double> approach_force;  ///< F + ΔF/2 [N]
   std::vector<double> retract_force;   ///< F − ΔF/2 [N]
