@@ -191,6 +191,18 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
                                     a_ratio_far));
     double a_min = amp.front(), a_max = amp.front();
     for (double a : amp) a_min = std::min(a_min, a), a_max = std::max(a_max, a);
+    if (options.method == AmMethod::katan) {
+      // the amplitude outside the derivative: biased where A changes faster than D (the term (1/√2) Ω dA^{3/2}/dD
+      // that payam keeps and katan drops)
+      double rate = 0.0;
+      for (std::size_t i = 0; i + 1 < amp.size(); ++i)
+        rate = std::max(rate, std::abs(amp[i + 1] - amp[i]) / (r.gap[i + 1] - r.gap[i]));
+      if (rate > 1.0)
+        r.notes.push_back(fmt::format("the amplitude changes up to {:.3g} times faster than the lower turning point "
+                                      "D: katan (amplitude outside the derivative) is biased there; payam keeps the "
+                                      "amplitude inside it",
+                                      rate));
+    }
     if (options.method == AmMethod::hoelscher) {
       // interaction length: where |Ω| falls to 1/e of its largest value
       std::size_t peak = 0;
