@@ -184,6 +184,9 @@ void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurv
 }
 
 void run_reconstruct(const io::ParamSet& p, Captured* capture) {
+  if (p.text("input").empty())
+    throw InvalidParameter("input", "input is empty: give the measured curve, a CSV file with 'distance (nm), "
+                                    "frequency shift (Hz)' (FM) or 'separation (nm), amplitude (nm), phase (deg)' (AM)");
   const spectroscopy::MeasuredCurve m = spectroscopy::read_measured_curve(p.text("input"));
   const std::string& method = p.text("method");
   const bool fm_method = method == "sader_jarvis" || method == "matrix";
