@@ -12,8 +12,13 @@ from __future__ import annotations
 import numpy as np
 
 from . import _afmkit
+from ._commands import make_command
 
-__all__ = ["Reconstruction", "reconstruct_fm", "reconstruct_am"]
+__all__ = ["Reconstruction", "reconstruct_fm", "reconstruct_am", "reconstruct"]
+
+#: The command ``afmkit spectroscopy reconstruct`` on a file (keyword arguments = its TOML keys, e.g.
+#: ``reconstruct(input="df.csv", amplitude=0.5, output="")``): the command line's units (nm, kHz, nN).
+reconstruct = make_command("spectroscopy reconstruct")
 
 _FM_UNITS = {
     "distance": "m", "frequency_shift": "Hz", "force": "N", "energy": "J", "force_uncertainty": "N",

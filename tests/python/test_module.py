@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import afmkit
+import afmkit.spectroscopy_reconstruct
 
 CLI = os.environ["AFMKIT_CLI"]
 
@@ -35,7 +36,8 @@ def test_every_command_of_the_program_is_a_function_with_its_toml_keys():
                  "tapping sweep": afmkit.tapping.sweep, "control tf": afmkit.control.tf,
                  "control roots": afmkit.control.roots, "control margin": afmkit.control.margin,
                  "control chart": afmkit.control.chart, "control tune": afmkit.control.tune,
-                 "control simulate": afmkit.control.simulate, "control export": afmkit.control.export}
+                 "control simulate": afmkit.control.simulate, "control export": afmkit.control.export,
+                 "spectroscopy reconstruct": afmkit.spectroscopy_reconstruct.reconstruct}
     # `report` is afmkit.report.build, `study run` afmkit.study.run, `tapping grid` a study: not command functions
     assert paths == set(functions)
     for path, fn in functions.items():
