@@ -64,7 +64,9 @@ std::vector<std::string> split(const std::string& line, char sep) {
 
 std::optional<double> length_factor(const std::string& u) {
   static const std::map<std::string, double> f = {{"m", 1.0},      {"um", 1e-6},  {"µm", 1e-6}, {"nm", 1e-9},
-                                                  {"pm", 1e-12},   {"a", 1e-10},  {"å", 1e-10}, {"angstrom", 1e-10}};
+                                                  {"pm", 1e-12},   {"a", 1e-10},  {"å", 1e-10}, {"angstrom", 1e-10},
+                                                  // not lowered by tolower (multi-byte): Å, Greek mu
+                                                  {"Å", 1e-10},    {"μm", 1e-6}};
   const auto it = f.find(u);
   return it == f.end() ? std::nullopt : std::optional<double>(it->second);
 }
