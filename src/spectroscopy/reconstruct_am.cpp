@@ -163,7 +163,19 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
       r.approach_force.push_back(r.force[i] + 0.5 * delta[i]);
       r.retract_force.push_back(r.force[i] - 0.5 * delta[i]);
     }
-    r.law = force_curve_from_si(r.gap, r.approach_force, r.retract_force, "reconstructed force");
+    {
+      // the law: the points used, and an exponential tail continued over 10 λ (F decays as Ω_eq does)
+      std::vector<double> lz = r.gap, la = r.approach_force, lr = r.retract_force;
+      if (tail.active)
+        for (int k = 1; k <= 20; ++k) {
+          const double x = r.gap.back() + 0.5 * k * tail.decay_length;
+          const double f = r.force.back() * std::exp(-(x - r.gap.back()) / tail.decay_length);
+          lz.push_back(x);
+          la.push_back(f);
+          lr.push_back(f);
+        }
+      r.law = force_curve_from_si(lz, la, lr, "reconstructed force");
+    }
     bool dissipative = true;
     try {
       impact::TableLaw(r.law, false).require_dissipative();

@@ -141,6 +141,23 @@ TEST(ReconstructAm, NoisyCurveStaysWithinItsBoundAndSaysSo) {
   EXPECT_TRUE(noted) << "the result must say the data are noisy";
 }
 
+TEST(ReconstructAm, ExponentialTailContinuesTheLaw) {
+  // the curve stops at l = 9 nm, where the van der Waals attraction is still felt: the exponential tail continues
+  // the law beyond the last D (20 points over 10 λ), the zero tail ends it there
+  const im::ForceLaw law(im::DmtLaw(1.0, 1.0, 10.0, 1e-19, 1e-19, 0.165));
+  const Synthetic s = synthetic(law, 6.0, 9.0, 30);
+  const sp::AmSettings set(k, f0, Q, A0);
+  sp::AmOptions zero, expo;
+  zero.round_trip = expo.round_trip = false;
+  expo.tail = sp::TailModel::exponential;
+  const auto rz = sp::reconstruct_am(s.curve, set, zero), re = sp::reconstruct_am(s.curve, set, expo);
+  EXPECT_EQ(rz.law.approach_gap.size(), rz.gap.size());
+  ASSERT_EQ(re.law.approach_gap.size(), re.gap.size() + 20);
+  EXPECT_GT(re.law.approach_gap.back(), re.gap.back() * 1e9);
+  EXPECT_LT(re.law.approach_force.back(), 0.0);  // still attractive, decaying
+  EXPECT_GT(re.law.approach_force.back(), re.law.approach_force[re.gap.size() - 1]);
+}
+
 TEST(ReconstructAm, BadInputNamesTheParameter) {
   sp::AmCurve c{{1e-9, 2e-9, 3e-9, 4e-9, 5e-9}, {1e-9, 2e-9, 3e-9, 4e-9, 5e-9}, {2.0, 1.9, 1.8, 1.7, 1.6}};
   const sp::AmSettings set(k, f0, Q, A0);
