@@ -25,5 +25,6 @@ void register_study(CLI::App& app);             // study_cmd.cpp:         afmkit
 void register_spectroscopy(CLI::App& app);      // spectroscopy_cmd.cpp:  afmkit spectroscopy …
 void register_spectroscopy_prepare(CLI::App& spectroscopy);  // spectroscopy_prepare_cmd.cpp: spectroscopy prepare
 void register_spectroscopy_fit(CLI::App& spectroscopy);  // spectroscopy_fit_cmd.cpp: spectroscopy fit
+void register_spectroscopy_reconstruct(CLI::App& spectroscopy);  // spectroscopy_reconstruct_cmd.cpp
 
 }  // namespace afmkit::cli

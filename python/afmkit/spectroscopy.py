@@ -11,6 +11,11 @@ Keyword options are the command's keys (``afmkit spectroscopy prepare --help``),
 ``invols`` [m/V], ``tip_radius`` [m], ``bin_width`` [m]; e.g. ``contact_method="dmt"``, ``baseline_fraction=0.3``,
 ``noise_multiple=3``, ``poisson_ratio=0.5``, ``keep_baseline=True``, ``allow_energy_gain=True``, ``output="law.csv"``
 (writes the law file and its sidecar), ``plot="curve.png"`` (raw vs prepared curves, Matplotlib).
+
+Also here: ``reconstruct_fm(distance, frequency_shift, ...)`` and ``reconstruct_am(distance, amplitude, phase, ...)``
+(the force from FM-AFM and AM-AFM curves, with the round trip: docs/reconstruction.md; ``reconstruct`` is the
+command on a file), and ``fit(distance, amplitude, phase, ...)`` (a law's parameters fitted over afmkit's exact
+orbits: docs/fitting.md; ``fit_file`` is the command on a file, ``plot_fit`` draws data vs fit).
 """
 from __future__ import annotations
 
@@ -248,4 +253,10 @@ def plot_main(argv) -> int:
     return 0
 
 
-__all__ = ["prepare", "prepare_file", "PreparedCurve", "plot"]
+from .spectroscopy_reconstruct import Reconstruction, reconstruct, reconstruct_am, reconstruct_fm  # noqa: E402
+from .spectroscopy_fit import FitResult, fit, predict  # noqa: E402
+from .spectroscopy_fit import plot as plot_fit  # noqa: E402
+from .spectroscopy_fit import run as fit_file  # noqa: E402
+
+__all__ = ["prepare", "prepare_file", "PreparedCurve", "plot", "reconstruct_fm", "reconstruct_am", "reconstruct",
+           "Reconstruction", "fit", "fit_file", "predict", "plot_fit", "FitResult"]

@@ -10,5 +10,6 @@ void bind_realtime_filter(pybind11::module_& m);  // realtime_filter.cpp: the st
 void bind_study(pybind11::module_& m);            // study_batch.cpp: one chunk of a parameter study, in C++
 void bind_spectroscopy_prepare(pybind11::module_& m);  // spectroscopy_prepare.cpp: prepare() on NumPy arrays
 void bind_spectroscopy_fit(pybind11::module_& m); // spectroscopy_fit.cpp: the law fit on NumPy arrays
+void bind_spectroscopy_reconstruct(pybind11::module_& m);  // spectroscopy_reconstruct.cpp: force reconstruction
 
 }  // namespace afmkit::python

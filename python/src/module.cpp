@@ -13,4 +13,5 @@ PYBIND11_MODULE(_afmkit, m) {
   afmkit::python::bind_study(m);
   afmkit::python::bind_spectroscopy_prepare(m);
   afmkit::python::bind_spectroscopy_fit(m);
+  afmkit::python::bind_spectroscopy_reconstruct(m);
 }

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import afmkit
+import afmkit.spectroscopy_reconstruct
 
 CLI = os.environ["AFMKIT_CLI"]
 
@@ -37,7 +38,8 @@ def test_every_command_of_the_program_is_a_function_with_its_toml_keys():
                  "control roots": afmkit.control.roots, "control margin": afmkit.control.margin,
                  "control chart": afmkit.control.chart, "control tune": afmkit.control.tune,
                  "control simulate": afmkit.control.simulate, "control export": afmkit.control.export,
-                 "spectroscopy prepare": afmkit.spectroscopy.prepare_file}
+                 "spectroscopy prepare": afmkit.spectroscopy.prepare_file,
+                 "spectroscopy reconstruct": afmkit.spectroscopy.reconstruct}
     # `report` is afmkit.report.build, `study run` afmkit.study.run, `tapping grid` a study: not command functions;
     # `spectroscopy fit` is afmkit.spectroscopy_fit.run (and .fit on arrays)
     assert paths - {"spectroscopy fit"} == set(functions)

@@ -24,7 +24,8 @@ namespace odeint = boost::numeric::odeint;
 /// 1e-19 for |ωτ| ≤ 0.35; beyond that std::cos).
 class DriveClock {
  public:
-  explicit DriveClock(double omega = 0.0) : omega_(omega) {}
+  DriveClock() = default;  // not explicit: value-initialised members ({}) need an implicit default constructor (clang)
+  explicit DriveClock(double omega) : omega_(omega) {}
   void begin(double t0) {
     t0_ = t0;
     c0_ = std::cos(omega_ * t0);
@@ -48,7 +49,7 @@ class DriveClock {
   }
 
  private:
-  double omega_, t0_ = 0.0, c0_ = 1.0, s0_ = 0.0;
+  double omega_ = 0.0, t0_ = 0.0, c0_ = 1.0, s0_ = 0.0;
 };
 
 /// Vector field of one mode; N = 2 (x, ẋ) or 8 (+ ∂(x,ẋ)/∂(x0,ẋ0) column-major, ∂(x,ẋ)/∂l).

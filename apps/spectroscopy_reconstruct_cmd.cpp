@@ -1,0 +1,265 @@
+// afmkit spectroscopy reconstruct: a measured FM (distance, Δf) or AM (separation, amplitude, phase) curve → the
+// tip–sample force, a table law, and the round trip (docs/reconstruction.md).
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/io/output.hpp"
+#include "afmkit/io/params.hpp"
+#include "afmkit/io/quantity.hpp"
+#include "afmkit/spectroscopy/reconstruct_am.hpp"
+#include "afmkit/spectroscopy/reconstruct_fm.hpp"
+#include "afmkit/spectroscopy/reconstruct_input.hpp"
+#include "afmkit/spectroscopy/reconstruct_law.hpp"
+#include "command.hpp"
+#include "commands.hpp"
+
+namespace afmkit::cli {
+
+namespace {
+
+double nan_if(bool missing, double v) { return missing ? std::numeric_limits<double>::quiet_NaN() : v; }
+
+nlohmann::json notes_json(const std::vector<std::string>& notes) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& n : notes) j.push_back(n);
+  return j;
+}
+
+std::string notes_text(const std::vector<std::string>& notes) {
+  std::string s;
+  for (const auto& n : notes) s += "\nnote: " + n;
+  return s;
+}
+
+void run_fm(const io::ParamSet& p, Captured* capture, const spectroscopy::MeasuredCurve& m) {
+  std::string method = p.text("method");
+  if (method == "auto") method = "sader_jarvis";
+  const spectroscopy::FmSettings s(p.real("spring_constant"), p.real("resonance_frequency") * 1e3,
+                                   p.real("amplitude") * 1e-9);
+  spectroscopy::FmOptions o;
+  o.method = spectroscopy::fm_method_from(method);
+  o.tail = spectroscopy::tail_model_from(p.text("tail"));
+  o.noise_realisations = static_cast<int>(p.integer("noise_realisations"));
+  const auto r = spectroscopy::reconstruct_fm({m.distance, m.frequency_shift}, s, o);
+
+  CommandOutput out(p, capture, "spectroscopy reconstruct");
+  out.open({{"distance", "nm", "closest tip–sample distance of the oscillation"},
+            {"frequency_shift", "Hz", "measured frequency shift"},
+            {"force", "nN", "reconstructed tip–sample force (positive repulsive)"},
+            {"force_uncertainty", "nN", "1σ of the force from the noise estimated in the frequency shift"},
+            {"energy", "aJ", "interaction energy U(z) = ∫_z^∞ F dt"},
+            {"round_trip_frequency_shift", "Hz",
+             "frequency shift of the reconstructed law by the first-order large-amplitude formula"},
+            {"residual", "Hz", "round trip − measured"}});
+  for (std::size_t i = 0; i < r.distance.size(); ++i)
+    out.row(r.distance[i] * 1e9, r.frequency_shift[i], r.force[i] * 1e9, r.force_uncertainty[i] * 1e9,
+            r.energy[i] * 1e18, r.round_trip_frequency_shift[i], r.residual[i]);
+  const std::string law_path = p.text("law_output");
+  if (!law_path.empty())
+    out.outputs().add(law_path, spectroscopy::table_law_text(
+                                    r.law, fmt::format("force reconstructed by afmkit spectroscopy reconstruct ({}, "
+                                                       "FM) from {}",
+                                                       r.method, p.text("input"))));
+  double f_min = 0.0;
+  for (double f : r.force) f_min = std::min(f_min, f);
+  nlohmann::json results = {{"mode", "fm"},
+                            {"method", r.method},
+                            {"tail", spectroscopy::to_string(r.tail.active ? spectroscopy::TailModel::exponential
+                                                                           : spectroscopy::TailModel::zero)},
+                            {"points", r.distance.size()},
+                            {"largest_attraction", f_min * 1e9},
+                            {"noise", r.noise},
+                            {"interaction_length", r.interaction_length * 1e9},
+                            {"tail_sensitivity", r.tail_sensitivity * 1e9},
+                            {"residual_rms", r.residual_rms},
+                            {"residual_max", r.residual_max},
+                            {"round_trip_model", r.round_trip_model},
+                            {"law_output", law_path},
+                            {"status", "ok"},
+                            {"notes", notes_json(r.notes)},
+                            {"units",
+                             {{"largest_attraction", "nN"}, {"noise", "Hz"}, {"interaction_length", "nm"},
+                              {"tail_sensitivity", "nN"}, {"residual_rms", "Hz"}, {"residual_max", "Hz"},
+                              {"points", "count"}}}};
+  const std::string summary = fmt::format(
+      "FM reconstruction ({}, {} points): largest attraction {}; round trip ({}): residual {} rms, {} max; noise "
+      "{}{}",
+      r.method, r.distance.size(), io::quantity(f_min, "N"), "first-order formula", io::quantity(r.residual_rms, "Hz"),
+      io::quantity(r.residual_max, "Hz"), io::quantity(r.noise, "Hz"), notes_text(r.notes));
+  out.finish(results, summary);
+}
+
+void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurve m) {
+  const std::string& file = p.text("input");
+  const bool mirrored = p.text("phase_convention") == "mirrored";
+  for (std::size_t i = 0; i < m.phase.size(); ++i) {
+    if (mirrored) m.phase[i] = std::numbers::pi - m.phase[i];
+    if (!(m.amplitude[i] > 0.0))
+      throw InputError(fmt::format("{}:{}: column amplitude: {} m is out of range: the amplitude must be > 0", file,
+                                   m.lines[i], m.amplitude[i]));
+    if (!(m.phase[i] > 0.0 && m.phase[i] < std::numbers::pi))
+      throw InputError(fmt::format("{}:{}: column phase: {}° ({}) is out of range: must be in (0°, 180°), the lag "
+                                   "of the response behind the drive (phase_convention = lag; docs/conventions.md)",
+                                   file, m.lines[i], m.phase[i] * 180.0 / std::numbers::pi,
+                                   mirrored ? "after mirroring" : "as given"));
+  }
+  std::string method = p.text("method");
+  if (method == "auto") method = "payam";
+  const double f0 = p.real("resonance_frequency") * 1e3;
+  const spectroscopy::AmSettings s(p.real("spring_constant"), f0, p.real("quality_factor"),
+                                   p.real("free_amplitude") * 1e-9, p.real("drive_frequency") * 1e3);
+  spectroscopy::AmOptions o;
+  o.method = spectroscopy::am_method_from(method);
+  o.tail = spectroscopy::tail_model_from(p.text("tail"));
+  o.round_trip_points = static_cast<int>(p.integer("round_trip_points"));
+  const auto r = spectroscopy::reconstruct_am({m.distance, m.amplitude, m.phase}, s, o);
+
+  CommandOutput out(p, capture, "spectroscopy reconstruct");
+  out.open({{"separation", "nm", "measured separation l (rest position of the tip above the sample)"},
+            {"amplitude_ratio", "dimensionless", "measured A/A0"},
+            {"phase", "rad", "measured phase lag (afmkit's convention)"},
+            {"dissipation", "aJ", "energy dissipated per cycle (first-harmonic balance)"},
+            {"gap", "nm", "lower turning point D = l − A (empty: point not used)"},
+            {"force", "nN", "reconstructed conservative force at D"},
+            {"force_uncertainty", "nN", "1σ of the force from the noise estimated in amplitude and phase"},
+            {"approach_force", "nN", "approach branch of the law at D"},
+            {"retract_force", "nN", "retract branch of the law at D"},
+            {"round_trip_amplitude_ratio", "dimensionless", "A/A0 of the law's exact orbit (approach sweep)"},
+            {"round_trip_phase", "rad", "phase of the law's exact orbit"},
+            {"residual_amplitude_ratio", "dimensionless", "round trip − measured"},
+            {"residual_phase", "rad", "round trip − measured"}});
+  // the per-point force lives on the points used (ascending D = ascending l among them)
+  std::size_t k = 0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < r.separation.size(); ++i) {
+    const double d = r.separation[i] - r.amplitude[i];
+    const bool used = k < r.gap.size() && std::abs(r.gap[k] - d) <= 1e-15;
+    out.row(r.separation[i] * 1e9, r.amplitude[i] / s.free_amplitude, r.phase[i], r.dissipation[i] * 1e18,
+            used ? d * 1e9 : nan, used ? r.force[k] * 1e9 : nan, used ? r.force_uncertainty[k] * 1e9 : nan,
+            used ? r.approach_force[k] * 1e9 : nan,
+            used ? r.retract_force[k] * 1e9 : nan, r.round_trip_amplitude_ratio.empty() ? nan : r.round_trip_amplitude_ratio[i],
+            r.round_trip_phase.empty() ? nan : r.round_trip_phase[i],
+            r.residual_amplitude_ratio.empty() ? nan : r.residual_amplitude_ratio[i],
+            r.residual_phase.empty() ? nan : r.residual_phase[i]);
+    if (used) ++k;
+  }
+  const std::string law_path = p.text("law_output");
+  if (!law_path.empty())
+    out.outputs().add(law_path, spectroscopy::table_law_text(
+                                    r.law, fmt::format("force reconstructed by afmkit spectroscopy reconstruct ({}, "
+                                                       "AM) from {}",
+                                                       r.method, file)));
+  double f_min = 0.0, e_max = 0.0;
+  for (double f : r.force) f_min = std::min(f_min, f);
+  for (double e : r.dissipation) e_max = std::max(e_max, e);
+  nlohmann::json results = {{"mode", "am"},
+                            {"method", r.method},
+                            {"points", r.separation.size()},
+                            {"points_used", r.gap.size()},
+                            {"largest_attraction", f_min * 1e9},
+                            {"largest_dissipation", e_max * 1e18},
+                            {"contact_gap", r.contact_gap * 1e9},
+                            {"rms_amplitude_ratio", r.rms_amplitude_ratio},
+                            {"rms_phase", r.rms_phase},
+                            {"round_trip_model", r.round_trip_model},
+                            {"law_output", law_path},
+                            {"status", "ok"},
+                            {"notes", notes_json(r.notes)},
+                            {"units",
+                             {{"largest_attraction", "nN"}, {"largest_dissipation", "aJ"}, {"contact_gap", "nm"},
+                              {"rms_amplitude_ratio", "dimensionless"}, {"rms_phase", "rad"}, {"points", "count"},
+                              {"points_used", "count"}}}};
+  const std::string summary = fmt::format(
+      "AM reconstruction ({}, {} of {} points used): largest attraction {}, largest dissipation {} per cycle; round "
+      "trip (exact orbits): A/A0 {:.2g} rms, phase {:.3g}° rms{}",
+      r.method, r.gap.size(), r.separation.size(), io::quantity(f_min, "N"), io::quantity(e_max, "J"),
+      r.rms_amplitude_ratio, r.rms_phase * 180.0 / std::numbers::pi, notes_text(r.notes));
+  out.finish(results, summary);
+}
+
+void run_reconstruct(const io::ParamSet& p, Captured* capture) {
+  if (p.text("input").empty())
+    throw InvalidParameter("input", "input is empty: give the measured curve, a CSV file with 'distance (nm), "
+                                    "frequency shift (Hz)' (FM) or 'separation (nm), amplitude (nm), phase (deg)' (AM)");
+  const spectroscopy::MeasuredCurve m = spectroscopy::read_measured_curve(p.text("input"));
+  const std::string& method = p.text("method");
+  const bool fm_method = method == "sader_jarvis" || method == "matrix";
+  if (m.frequency_modulation) {
+    if (method != "auto" && !fm_method)
+      throw InvalidParameter("method", fmt::format("method = {} is an AM method, and '{}' holds an FM curve (distance, "
+                                                   "frequency shift): sader_jarvis or matrix",
+                                                   method, p.text("input")));
+    if (!p.was_set("amplitude"))
+      throw InvalidParameter("amplitude", "an FM curve needs the oscillation amplitude: give amplitude (nm, > 0)");
+    run_fm(p, capture, m);
+  } else {
+    if (fm_method)
+      throw InvalidParameter("method", fmt::format("method = {} is an FM method, and '{}' holds an AM curve "
+                                                   "(separation, amplitude, phase): katan, payam or hoelscher",
+                                                   method, p.text("input")));
+    if (!p.was_set("free_amplitude") || !p.was_set("quality_factor"))
+      throw InvalidParameter(p.was_set("free_amplitude") ? "quality_factor" : "free_amplitude",
+                             "an AM curve needs free_amplitude (nm) and quality_factor");
+    run_am(p, capture, m);
+  }
+}
+
+io::Range positive_below(double hi) { return {0.0, hi, true, false}; }
+
+}  // namespace
+
+void register_spectroscopy_reconstruct(CLI::App& spectroscopy) {
+  add_command(
+      spectroscopy, "reconstruct",
+      "tip–sample force from a measured FM (distance, Δf) or AM (separation, amplitude, phase) curve, as a table law, "
+      "with the round trip",
+      [](io::ParamSet& p) {
+        p.group("Input")
+            .file("input", "", "measured curve CSV: 'distance (nm), frequency shift (Hz)' or 'separation (nm), "
+                               "amplitude (nm), phase (deg)' (docs/reconstruction.md#input)")
+            .positional()
+            .text("method", "auto",
+                  "auto (sader_jarvis for FM, payam for AM), sader_jarvis, matrix (FM); katan, payam, hoelscher (AM)",
+                  {"auto", "sader_jarvis", "matrix", "katan", "payam", "hoelscher"})
+            .text("tail", "zero", "the signal beyond the largest distance: zero, or exponential (fitted to the last "
+                                  "points)",
+                  {"zero", "exponential"})
+            .text("phase_convention", "lag",
+                  "AM phase: lag (afmkit's: 90° free at resonance, above 90° attractive) or mirrored (180° − phase)",
+                  {"lag", "mirrored"});
+        p.group("Cantilever")
+            .real("spring_constant", 40.0, "cantilever spring constant k", positive_below(1e6))
+            .unit("N/m")
+            .real("resonance_frequency", 300.0, "resonance frequency f0", positive_below(1e7))
+            .unit("kHz")
+            .real("amplitude", 1.0, "FM: oscillation amplitude A (required for FM curves)", positive_below(1e6))
+            .unit("nm")
+            .real("free_amplitude", 10.0, "AM: free amplitude A0 at the drive frequency (required for AM curves)",
+                  positive_below(1e6))
+            .unit("nm")
+            .real("quality_factor", 400.0, "AM: quality factor Q (required for AM curves)", positive_below(1e9))
+            .unit("dimensionless")
+            .real("drive_frequency", 0.0, "AM: drive frequency (0: f0)", io::Range::closed(0.0, 1e7))
+            .unit("kHz");
+        p.group("Reconstruction")
+            .integer("noise_realisations", 8, "FM: synthetic noise realisations for the force uncertainty (0: none)",
+                     0, 1000)
+            .integer("round_trip_points", 40,
+                     "AM: separations of the round trip through exact orbits, spread over the curve (0: all)", 0,
+                     100000);
+        p.group("Law output")
+            .file("law_output", "out/reconstructed_law.csv",
+                  "table-law file (distance, approach, retract) for --law table --force-curve (empty: none)")
+            .writes();
+        add_output_params(p, "out/spectroscopy_reconstruct.csv", "reconstruction");
+      },
+      run_reconstruct);
+}
+
+}  // namespace afmkit::cli

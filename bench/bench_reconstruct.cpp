@@ -1,0 +1,67 @@
+// Speed of the force reconstructions with their round trips (docs/reconstruction.md#speed). Target (issue 25):
+// a 1000-point curve reconstructed with its round trip ≤ 1 s.
+//   FM: qPlus sensor (k = 1800 N/m, f0 = 25 kHz), exponential force (F0 = 1 nN, λ = 0.1 nm), A = 0.5 nm, 1000
+//       points on [0.05, 2.05] nm; Sader–Jarvis and matrix, 8 noise realisations, round trip by the first-order
+//       formula at every point.
+//   AM: k = 40 N/m, f0 = 300 kHz, Q = 400, A0 = 10 nm, DMT + vdW (R = 10 nm, E* = 1 GPa, A_H = 1e-19 J), 1000
+//       separations on [6, 12] nm from afmkit's exact orbits; payam, round trip through exact orbits at 40 (the
+//       default) separations; counter round_trip_points.
+#include <cmath>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "afmkit/spectroscopy/reconstruct_am.hpp"
+#include "afmkit/spectroscopy/reconstruct_fm.hpp"
+#include "afmkit/tapping/sweep.hpp"
+#include "afmkit/tapping/units.hpp"
+
+namespace {
+
+namespace sp = afmkit::spectroscopy;
+
+void fm(benchmark::State& state, sp::FmMethod method) {
+  const sp::FmSettings s(1800.0, 25e3, 0.5e-9);
+  sp::FmCurve c;
+  for (int i = 0; i < 1000; ++i) {
+    const double z = 0.05e-9 + 2e-9 * i / 999.0;
+    c.distance.push_back(z);
+    c.frequency_shift.push_back(sp::exponential_force_frequency_shift(z, 1e-9, 0.1e-9, s) + 1e-3 * std::sin(7.0 * i));
+  }
+  sp::FmOptions o;
+  o.method = method;
+  for (auto _ : state) benchmark::DoNotOptimize(sp::reconstruct_fm(c, s, o));
+  state.counters["points"] = 1000;
+}
+
+void am(benchmark::State& state) {
+  const afmkit::tapping::PhysicalCantilever pc(40.0, 300.0, 400.0, 10.0, 1.0);
+  const afmkit::impact::ForceLaw law(afmkit::impact::DmtLaw(1.0, 1.0, 10.0, 1e-19, 1e-19, 0.165));
+  std::vector<double> l;
+  for (int i = 0; i < 1000; ++i) l.push_back(6.0 + 6.0 * i / 999.0);
+  const afmkit::tapping::TappingModel m(pc.cantilever(), pc.drive(), pc.normalised_law(law), l.back());
+  afmkit::tapping::SweepOptions so;
+  so.harmonic_balance = false;
+  const auto sw = afmkit::tapping::sweep_instrument(m, l, so);
+  sp::AmCurve c;
+  for (const auto& p : sw.approach) {
+    c.separation.push_back(p.separation * 1e-9);
+    c.amplitude.push_back(p.metrics.amplitude * 1e-9);
+    c.phase.push_back(p.metrics.phase);
+  }
+  const sp::AmSettings s(40.0, 300e3, 400.0, 10e-9);
+  sp::AmOptions o;
+  o.round_trip_points = static_cast<int>(state.range(0));
+  double rms = 0.0;
+  for (auto _ : state) rms = sp::reconstruct_am(c, s, o).rms_phase;
+  state.counters["points"] = 1000;
+  state.counters["round_trip_points"] = static_cast<double>(state.range(0));
+  state.counters["rms_phase_rad"] = rms;
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(fm, sader_jarvis_1000, sp::FmMethod::sader_jarvis)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(fm, matrix_1000, sp::FmMethod::matrix)->Unit(benchmark::kMillisecond);
+BENCHMARK(am)->Arg(40)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK_MAIN();
