@@ -115,7 +115,7 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
     throw InvalidParameter("plot", "plot needs output: the plot is drawn from the fitted curve's CSV file");
   if (!p.text("plot").empty() && capture)
     throw InvalidParameter("plot", "plot is drawn by the command line; in Python call afmkit.spectroscopy_fit.plot");
-  spectroscopy::AmSettings s;
+  spectroscopy::FitSettings s;
   s.spring_constant = required(p, "spring_constant", "N/m");
   s.resonance_frequency = required(p, "resonance_frequency", "kHz") * 1e3;
   s.quality_factor = required(p, "quality_factor", "dimensionless");
@@ -124,7 +124,7 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
   s.validate();
   const spectroscopy::FitOptions options = fit_options(p);
   spectroscopy::fit_parameter_info(options);  // refuses unknown names before the file is read
-  const spectroscopy::AmCurve curve = spectroscopy::read_am_curve(p.text("file"));
+  const spectroscopy::FitCurve curve = spectroscopy::read_am_curve(p.text("file"));
   curve.validate();
   spectroscopy::FitOptions run = options;
   run.cancellation = cancellation_of(capture);

@@ -11,8 +11,8 @@ using namespace afmkit::spectroscopy;
 
 namespace {
 
-AmSettings settings() {
-  AmSettings s;
+FitSettings settings() {
+  FitSettings s;
   s.spring_constant = 40.0;
   s.resonance_frequency = 300e3;
   s.quality_factor = 400.0;
@@ -20,11 +20,11 @@ AmSettings settings() {
   return s;
 }
 
-AmCurve synthetic(int n) {
+FitCurve synthetic(int n) {
   FitOptions truth;
   truth.law_values = {{"effective_modulus", 1e9}, {"tip_radius", 10e-9}, {"hamaker", 1e-19}};
   truth.initial = {{"distance_offset", 0.7e-9}, {"phase_offset", 0.1}};
-  AmCurve c;
+  FitCurve c;
   for (int i = 0; i < n; ++i) c.distance.push_back(21e-9 - 17e-9 * i / (n - 1));
   const AmPrediction p = predict_am_curve(c.distance, settings(), truth);
   std::mt19937 rng(11);
@@ -37,7 +37,7 @@ AmCurve synthetic(int n) {
 }
 
 void BM_FitAmCurve(benchmark::State& state) {
-  const AmCurve data = synthetic(static_cast<int>(state.range(0)));
+  const FitCurve data = synthetic(static_cast<int>(state.range(0)));
   FitOptions o;
   o.law_values = {{"tip_radius", 10e-9}, {"effective_modulus", 0.7e9}, {"hamaker", 1.3e-19}};
   o.parameters = {"hamaker", "effective_modulus", "distance_offset", "phase_offset"};

@@ -2,7 +2,7 @@
 // Input = the text of a curve file. Invariants: the text is either rejected with afmkit::InputError whose message
 // starts with "fuzz.csv:<line>:<column>: ", or it gives a curve of ≥ 3 rows — distance and amplitude of equal
 // lengths, phase empty or of the same length, every value finite, amplitudes > 0, distances distinct — that the
-// fit's own validation (AmCurve::validate) accepts. Nothing else (no crash, no other exception, no sanitizer report).
+// fit's own validation (FitCurve::validate) accepts. Nothing else (no crash, no other exception, no sanitizer report).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -16,7 +16,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  afmkit::spectroscopy::AmCurve c;
+  afmkit::spectroscopy::FitCurve c;
   try {
     c = afmkit::spectroscopy::parse_am_curve(text, "fuzz.csv");
   } catch (const afmkit::InputError& e) {

@@ -47,11 +47,11 @@ py::dict fit(const Array& distance, const Array& amplitude, const std::optional<
              double huber, double fd_step, int max_evaluations, double tolerance, double integrator_tolerance,
              double shooting_tolerance, double correlation_limit, double condition_limit, double flat_column,
              bool parallel) {
-  spectroscopy::AmCurve curve;
+  spectroscopy::FitCurve curve;
   curve.distance = vector_of(distance, "distance");
   curve.amplitude = vector_of(amplitude, "amplitude");
   if (phase) curve.phase = vector_of(*phase, "phase");
-  spectroscopy::AmSettings s{spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency};
+  spectroscopy::FitSettings s{spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency};
   spectroscopy::FitOptions o;
   o.law = law;
   o.parameters = parameters;
@@ -132,7 +132,7 @@ py::dict predict(const Array& distance, const std::string& law, const std::map<s
                  const std::map<std::string, double>& calibration, const std::string& force_curve,
                  bool allow_energy_gain, double spring_constant, double resonance_frequency, double quality_factor,
                  double free_amplitude, double drive_frequency, const std::string& direction) {
-  spectroscopy::AmSettings s{spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency};
+  spectroscopy::FitSettings s{spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency};
   spectroscopy::FitOptions o;
   o.law = law;
   o.law_values = values;

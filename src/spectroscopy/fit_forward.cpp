@@ -114,7 +114,7 @@ Point step(const TappingModel& base, const Point& prev, double l_to, const tappi
 
 }  // namespace
 
-AmForwardModel::AmForwardModel(const AmSettings& settings, const FitOptions& options, std::vector<double> distances)
+AmForwardModel::AmForwardModel(const FitSettings& settings, const FitOptions& options, std::vector<double> distances)
     : settings_(settings), options_(options), distances_(std::move(distances)) {
   sweep_.harmonic_balance = false;
   sweep_.parallel = false;

@@ -138,9 +138,9 @@ double parse_number(const Cell& cell, const std::string& column, const std::stri
 
 }  // namespace
 
-AmCurve parse_am_curve(std::string_view text, const std::string& origin) {
+FitCurve parse_am_curve(std::string_view text, const std::string& origin) {
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
-  AmCurve c;
+  FitCurve c;
   std::vector<Column> columns;
   std::vector<std::string> names;
   char sep = ',';
@@ -227,7 +227,7 @@ AmCurve parse_am_curve(std::string_view text, const std::string& origin) {
   return c;
 }
 
-AmCurve read_am_curve(const std::string& path) {
+FitCurve read_am_curve(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("cannot open file '{}'", path));
   std::ostringstream ss;

@@ -52,7 +52,7 @@ const char* fit_status_name(FitStatus s) {
   return "?";
 }
 
-void AmCurve::validate() const {
+void FitCurve::validate() const {
   const std::size_t n = distance.size();
   if (n < 3) throw InvalidParameter("distance", fmt::format("the curve has {} point(s): at least 3 are needed", n));
   if (amplitude.size() != n)
@@ -81,7 +81,7 @@ void AmCurve::validate() const {
                                                      sorted[k - 1].second, sorted[k].second, sorted[k].first));
 }
 
-void AmSettings::validate() const {
+void FitSettings::validate() const {
   validate::positive("spring_constant", spring_constant);
   validate::positive("resonance_frequency", resonance_frequency);
   validate::positive("quality_factor", quality_factor);

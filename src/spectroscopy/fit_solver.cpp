@@ -66,7 +66,7 @@ std::string solver_status_text(int s) {
 /// The problem as the solver sees it: u -> weighted residuals.
 class Problem {
  public:
-  Problem(const AmCurve& sorted, const AmSettings& settings, const FitOptions& options,
+  Problem(const FitCurve& sorted, const FitSettings& settings, const FitOptions& options,
           std::vector<FitParameterInfo> params, double sigma_a, double sigma_p)
       : data_(sorted), settings_(settings), options_(options), params_(std::move(params)), sigma_a_(sigma_a),
         sigma_p_(sigma_p), model_(settings, options, sorted.distance) {}
@@ -192,8 +192,8 @@ class Problem {
   const std::string& last_error() const { return last_error_; }
 
  private:
-  const AmCurve& data_;
-  AmSettings settings_;
+  const FitCurve& data_;
+  FitSettings settings_;
   FitOptions options_;
   std::vector<FitParameterInfo> params_;
   double sigma_a_, sigma_p_;
@@ -248,13 +248,13 @@ struct Functor {
 namespace {
 
 /// The data sorted in the sweep's order.
-AmCurve sorted_curve(const AmCurve& c, CurveDirection direction) {
+FitCurve sorted_curve(const FitCurve& c, CurveDirection direction) {
   std::vector<std::size_t> idx(c.distance.size());
   std::iota(idx.begin(), idx.end(), 0);
   std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) {
     return direction == CurveDirection::approach ? c.distance[a] > c.distance[b] : c.distance[a] < c.distance[b];
   });
-  AmCurve s;
+  FitCurve s;
   for (std::size_t i : idx) {
     s.distance.push_back(c.distance[i]);
     s.amplitude.push_back(c.amplitude[i]);
@@ -362,14 +362,14 @@ void statistics(const Eigen::MatrixXd& jac, double s2, const Eigen::VectorXd& u,
 
 }  // namespace
 
-AmPrediction predict_am_curve(const std::vector<double>& distance, const AmSettings& settings,
+AmPrediction predict_am_curve(const std::vector<double>& distance, const FitSettings& settings,
                               const FitOptions& options) {
   settings.validate();
-  AmCurve c;
+  FitCurve c;
   c.distance = distance;
   c.amplitude.assign(distance.size(), 1.0);
   c.validate();
-  const AmCurve s = sorted_curve(c, options.direction);
+  const FitCurve s = sorted_curve(c, options.direction);
   const AmForwardModel model(settings, options, s.distance);
   ModelValues v;
   v.law = options.law_values;
@@ -394,14 +394,14 @@ AmPrediction predict_am_curve(const std::vector<double>& distance, const AmSetti
   return out;
 }
 
-FitResult fit_am_curve(const AmCurve& curve, const AmSettings& settings, const FitOptions& options) {
+FitResult fit_am_curve(const FitCurve& curve, const FitSettings& settings, const FitOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   curve.validate();
   settings.validate();
   options.validate();
   FitResult r;
   r.parameters = fit_parameter_info(options);
-  const AmCurve data = sorted_curve(curve, options.direction);
+  const FitCurve data = sorted_curve(curve, options.direction);
   const long n = static_cast<long>(data.distance.size());
   const long p = static_cast<long>(r.parameters.size());
   const long m = n * (data.phase.empty() ? 1 : 2);

@@ -22,7 +22,11 @@ namespace afmkit::spectroscopy {
 void am_round_trip(AmReconstruction& r, const AmSettings& s, bool dissipative, int points) {
   const tapping::PhysicalCantilever pc(s.spring_constant, s.resonance_frequency * 1e-3, s.quality_factor,
                                        s.free_amplitude * 1e9, s.frequency_ratio());
-  const impact::ForceLaw physical = impact::make_law<impact::TableLaw>(r.law, !dissipative);
+  // velocity-sign switching (seed-1 eq. 4), not the table law's contact-aware default: the inversion turns the
+  // dissipation measured at lower turning point D into the branch difference at D, which an orbit reaching D
+  // dissipates under that rule whether or not it reached the contact gap (docs/reconstruction.md#round-trip)
+  const impact::ForceLaw physical =
+      impact::make_law<impact::TableLaw>(r.law, !dissipative, impact::Hysteresis::velocity);
   const std::vector<double>& l = r.separation;
   std::vector<double> l_nm;
   for (double x : l) l_nm.push_back(x * 1e9);
@@ -92,7 +96,8 @@ void am_round_trip(AmReconstruction& r, const AmSettings& s, bool dissipative, i
   r.rms_amplitude_ratio = count ? std::sqrt(sa / static_cast<double>(count)) : std::numeric_limits<double>::quiet_NaN();
   r.rms_phase = count ? std::sqrt(sp / static_cast<double>(count)) : std::numeric_limits<double>::quiet_NaN();
   r.round_trip_model = fmt::format("exact periodic orbits of the table law (tapping sweep, approach) at {} of the {} "
-                                   "measured separations; branches chosen by the sign of the velocity",
+                                   "measured separations; branches chosen by the sign of the velocity (run the law with "
+                                   "--hysteresis velocity to reproduce it)",
                                    count, n);
   if (!jumps.empty())
     r.notes.push_back(fmt::format("the round trip jumped to another branch at l = {} nm (approach): where the measured "

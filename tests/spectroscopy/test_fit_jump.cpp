@@ -36,7 +36,7 @@ TEST(FitJump, LandsWhereTheTransientSettles) {
   ASSERT_TRUE(t.orbit);
   const tapping::OrbitMetrics settled = tapping::analyse_orbit(at, *t.orbit);
 
-  AmSettings s;
+  FitSettings s;
   s.spring_constant = 40.0;
   s.resonance_frequency = 300e3;
   s.quality_factor = q;

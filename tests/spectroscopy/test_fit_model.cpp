@@ -16,8 +16,8 @@ using namespace afmkit::spectroscopy;
 
 namespace {
 
-AmSettings settings() {
-  AmSettings s;
+FitSettings settings() {
+  FitSettings s;
   s.spring_constant = 40.0;
   s.resonance_frequency = 300e3;
   s.quality_factor = 400.0;
@@ -54,7 +54,7 @@ TEST(FitModel, ApproachAndRetractMatchTheInstrumentSweep) {
   o.shooting_tolerance = 1e-11;
   std::vector<double> z;
   for (double l : l_nm) z.push_back(l * 1e-9 - 0.5e-9);
-  AmSettings q100 = settings();
+  FitSettings q100 = settings();
   q100.quality_factor = 100.0;
   const AmPrediction pred = predict_am_curve(z, q100, o);
   int touching = 0;
@@ -156,17 +156,17 @@ TEST(FitModel, RefusesWhatCannotBeFitted) {
 #include "afmkit/spectroscopy/fit_input.hpp"
 
 TEST(FitInput, ReadsUnitsFromTheHeader) {
-  const AmCurve c = parse_am_curve("# measured\ndistance (nm), amplitude (nm), phase (deg)\n10, 9.5, 90\n8, 7.9, "
+  const FitCurve c = parse_am_curve("# measured\ndistance (nm), amplitude (nm), phase (deg)\n10, 9.5, 90\n8, 7.9, "
                                    "120\r\n\n6, 6.1, 135\n",
                                    "curve.csv");
   ASSERT_EQ(c.distance.size(), 3u);
   EXPECT_DOUBLE_EQ(c.distance[1], 8e-9);
   EXPECT_DOUBLE_EQ(c.amplitude[2], 6.1e-9);
   EXPECT_DOUBLE_EQ(c.phase[0], M_PI / 2);
-  const AmCurve d = parse_am_curve("z_m\tamp_m\tphi_rad\n1e-8\t9e-9\t1.5\n2e-8\t1e-8\t1.6\n3e-8\t1e-8\t1.57\n", "t");
+  const FitCurve d = parse_am_curve("z_m\tamp_m\tphi_rad\n1e-8\t9e-9\t1.5\n2e-8\t1e-8\t1.6\n3e-8\t1e-8\t1.57\n", "t");
   EXPECT_DOUBLE_EQ(d.distance[2], 3e-8);
   EXPECT_DOUBLE_EQ(d.phase[1], 1.6);
-  const AmCurve e = parse_am_curve("distance (A)  amplitude (nm)\n100 9\n90 8\n80 7\n", "blank");
+  const FitCurve e = parse_am_curve("distance (A)  amplitude (nm)\n100 9\n90 8\n80 7\n", "blank");
   EXPECT_DOUBLE_EQ(e.distance[1], 9e-9);
   EXPECT_TRUE(e.phase.empty());
 }

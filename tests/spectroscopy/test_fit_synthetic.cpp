@@ -14,8 +14,8 @@ using namespace afmkit::spectroscopy;
 
 namespace {
 
-AmSettings settings() {
-  AmSettings s;
+FitSettings settings() {
+  FitSettings s;
   s.spring_constant = 40.0;
   s.resonance_frequency = 300e3;
   s.quality_factor = 400.0;
@@ -40,11 +40,11 @@ std::vector<double> distances(double from, double to, int n) {
   return z;
 }
 
-AmCurve synthetic(const std::vector<double>& z, unsigned seed) {
+FitCurve synthetic(const std::vector<double>& z, unsigned seed) {
   const AmPrediction p = predict_am_curve(z, settings(), truth());
   std::mt19937 rng(seed);
   std::normal_distribution<double> g(0.0, 1.0);
-  AmCurve c;
+  FitCurve c;
   c.distance = z;
   for (std::size_t i = 0; i < z.size(); ++i) {
     c.amplitude.push_back(p.amplitude[i] + kSigmaA * settings().free_amplitude * g(rng));
@@ -70,7 +70,7 @@ const double kTruth[] = {kHamaker, kModulus, kOffset, kPhase};
 }  // namespace
 
 TEST(FitSynthetic, DmtEstimatesNearTheTruth) {
-  const AmCurve data = synthetic(distances(4e-9, 21e-9, 60), 7);
+  const FitCurve data = synthetic(distances(4e-9, 21e-9, 60), 7);
   const FitResult r = fit_am_curve(data, settings(), start());
   for (std::size_t j = 0; j < r.estimates.size(); ++j)
     std::printf("%s = %g ± %g (truth %g)\n", r.parameters[j].name.c_str(), r.estimates[j], r.standard_errors[j], kTruth[j]);
@@ -140,7 +140,7 @@ TEST(FitSynthetic, StandardErrorsMatchTheScatterOverSeeds) {
 TEST(FitSynthetic, ModulusWithoutContactIsNotIdentifiable) {
   // the tip stays above the contact gap at every distance (A0 = 20 nm, separations ≥ 22.2 nm): the curve does not
   // depend on E*
-  const AmCurve data = synthetic(distances(21.5e-9, 28e-9, 30), 3);
+  const FitCurve data = synthetic(distances(21.5e-9, 28e-9, 30), 3);
   FitOptions o = start();
   const FitResult r = fit_am_curve(data, settings(), o);
   for (bool c : r.contact) ASSERT_FALSE(c);
@@ -155,7 +155,7 @@ TEST(FitSynthetic, ModulusWithoutContactIsNotIdentifiable) {
 TEST(FitSynthetic, CorrelatedPairIsWarned) {
   // without contact, the Hamaker constant and the tip radius enter the vdW force only as their product A_H·R:
   // fitted together they are perfectly correlated
-  const AmCurve data = synthetic(distances(21.5e-9, 28e-9, 30), 5);
+  const FitCurve data = synthetic(distances(21.5e-9, 28e-9, 30), 5);
   FitOptions o = start();
   o.parameters = {"hamaker", "tip_radius"};
   const FitResult r = fit_am_curve(data, settings(), o);

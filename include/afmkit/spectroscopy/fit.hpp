@@ -32,7 +32,7 @@
 namespace afmkit::spectroscopy {
 
 /// A measured AM-AFM curve, SI units. Rows in any order; each row one distance.
-struct AmCurve {
+struct FitCurve {
   std::vector<double> distance;   // [m] piezo separation / tip–sample distance up to an offset
   std::vector<double> amplitude;  // [m] first-harmonic amplitude
   std::vector<double> phase;      // [rad] phase lag (see above); empty: amplitude only
@@ -42,7 +42,7 @@ struct AmCurve {
 };
 
 /// The measured settings, SI units.
-struct AmSettings {
+struct FitSettings {
   double spring_constant = 0.0;      // k [N/m] > 0
   double resonance_frequency = 0.0;  // f0 [Hz] > 0
   double quality_factor = 0.0;       // Q > 0
@@ -147,7 +147,7 @@ std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options);
 /// Weighted nonlinear least squares (see above). Bad input -> InvalidParameter; the model failing at the initial
 /// values -> NumericalFailure; a fit that stops on its budget -> status not_converged (the result still holds
 /// everything at the best point found).
-FitResult fit_am_curve(const AmCurve& curve, const AmSettings& settings, const FitOptions& options);
+FitResult fit_am_curve(const FitCurve& curve, const FitSettings& settings, const FitOptions& options);
 
 /// The forward model alone: amplitude [m] and phase [rad] at each distance of `distance` (in the order given),
 /// for the law and calibration values of `options` (law_values + initial; parameters ignored). Synthetic data and
@@ -156,7 +156,7 @@ struct AmPrediction {
   std::vector<double> amplitude, phase;
   std::vector<bool> contact, jumped;
 };
-AmPrediction predict_am_curve(const std::vector<double>& distance, const AmSettings& settings,
+AmPrediction predict_am_curve(const std::vector<double>& distance, const FitSettings& settings,
                               const FitOptions& options);
 
 /// Factor converting a registry law unit to SI ("nm" -> 1e-9, "GPa" -> 1e9, "nN" -> 1e-9, others 1) and the SI

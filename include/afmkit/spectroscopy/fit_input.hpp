@@ -18,8 +18,8 @@
 namespace afmkit::spectroscopy {
 
 /// Parses the text of an AM curve file (SI units out); `origin` names it in messages.
-AmCurve parse_am_curve(std::string_view text, const std::string& origin);
+FitCurve parse_am_curve(std::string_view text, const std::string& origin);
 /// Reads the file `path` (InputError naming it when it cannot be read).
-AmCurve read_am_curve(const std::string& path);
+FitCurve read_am_curve(const std::string& path);
 
 }  // namespace afmkit::spectroscopy

@@ -41,7 +41,7 @@ struct CurveEvaluation {
 class AmForwardModel {
  public:
   /// `distances` [m] in the sweep's order (approach: decreasing; retract: increasing).
-  AmForwardModel(const AmSettings& settings, const FitOptions& options, std::vector<double> distances);
+  AmForwardModel(const FitSettings& settings, const FitOptions& options, std::vector<double> distances);
 
   /// Continuation along the curve from the free response (follow_stable_branch; a transient where a branch ends).
   CurveEvaluation walk(const ModelValues& values) const;
@@ -55,7 +55,7 @@ class AmForwardModel {
   long orbits() const { return orbits_.load(); }
 
  private:
-  AmSettings settings_;
+  FitSettings settings_;
   FitOptions options_;
   std::vector<double> distances_;
   tapping::SweepOptions sweep_;
