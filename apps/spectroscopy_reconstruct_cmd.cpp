@@ -23,6 +23,24 @@ namespace afmkit::cli {
 
 namespace {
 
+/// The table-law file (3 columns, nm and nN) and its sidecar: the columns, where the law came from and the
+/// hysteresis rule its round trip used (docs/reconstruction.md#round-trip).
+void add_law_file(CommandOutput& out, const std::string& path, const impact::ForceCurve& law, const std::string& origin,
+                  const std::string& hysteresis) {
+  out.outputs().add(path, spectroscopy::table_law_text(law, ""));
+  const nlohmann::json sidecar = {
+      {"program", "afmkit"},
+      {"command", "spectroscopy reconstruct"},
+      {"what", "table law (afmkit tapping … --law table --force-curve FILE; docs/force-laws.md)"},
+      {"origin", origin},
+      {"hysteresis", hysteresis},
+      {"columns",
+       {{{"name", "distance (nm)"}, {"unit", "nm"}, {"description", "tip–sample distance (gap d; d < 0 in contact)"}},
+        {{"name", "approach force (nN)"}, {"unit", "nN"}, {"description", "approach branch H_a (> 0 repulsive)"}},
+        {{"name", "retract force (nN)"}, {"unit", "nN"}, {"description", "retract branch H_b (> 0 repulsive)"}}}}};
+  out.outputs().add(path + ".json", sidecar.dump(2) + "\n");
+}
+
 double nan_if(bool missing, double v) { return missing ? std::numeric_limits<double>::quiet_NaN() : v; }
 
 nlohmann::json notes_json(const std::vector<std::string>& notes) {
@@ -62,10 +80,8 @@ void run_fm(const io::ParamSet& p, Captured* capture, const spectroscopy::Measur
             r.energy[i] * 1e18, r.round_trip_frequency_shift[i], r.residual[i]);
   const std::string law_path = p.text("law_output");
   if (!law_path.empty())
-    out.outputs().add(law_path, spectroscopy::table_law_text(
-                                    r.law, fmt::format("force reconstructed by afmkit spectroscopy reconstruct ({}, "
-                                                       "FM) from {}",
-                                                       r.method, p.text("input"))));
+    add_law_file(out, law_path, r.law, fmt::format("force reconstructed by afmkit spectroscopy reconstruct ({}, FM) "
+                                                   "from {}", r.method, p.text("input")), "any (a conservative law: both branches equal)");
   double f_min = 0.0;
   for (double f : r.force) f_min = std::min(f_min, f);
   nlohmann::json results = {{"mode", "fm"},
@@ -151,10 +167,8 @@ void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurv
   }
   const std::string law_path = p.text("law_output");
   if (!law_path.empty())
-    out.outputs().add(law_path, spectroscopy::table_law_text(
-                                    r.law, fmt::format("force reconstructed by afmkit spectroscopy reconstruct ({}, "
-                                                       "AM) from {}",
-                                                       r.method, file)));
+    add_law_file(out, law_path, r.law, fmt::format("force reconstructed by afmkit spectroscopy reconstruct ({}, AM) "
+                                                   "from {}", r.method, file), "velocity");
   double f_min = 0.0, e_max = 0.0;
   for (double f : r.force) f_min = std::min(f_min, f);
   for (double e : r.dissipation) e_max = std::max(e_max, e);

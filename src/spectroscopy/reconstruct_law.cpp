@@ -19,10 +19,10 @@ impact::ForceCurve force_curve_from_si(const std::vector<double>& distance, cons
 }
 
 std::string table_law_text(const impact::ForceCurve& curve, const std::string& comment) {
-  std::string out = "# " + comment + "\n";
-  out += "distance (nm), approach force (nN), retract force (nN)\n";
+  std::string out = comment.empty() ? std::string() : "# " + comment + "\n";
+  out += "distance (nm),approach force (nN),retract force (nN)\n";
   for (std::size_t i = 0; i < curve.approach_gap.size(); ++i)
-    out += fmt::format("{:.17g}, {:.17g}, {:.17g}\n", curve.approach_gap[i], curve.approach_force[i],
+    out += fmt::format("{:.17g},{:.17g},{:.17g}\n", curve.approach_gap[i], curve.approach_force[i],
                        curve.retract_force[i]);
   return out;
 }

@@ -104,13 +104,15 @@ std::vector<std::vector<std::string>> csv_records(const std::string& text) {
   return records;
 }
 
-/// Runs the example config `name` with every output key redirected into `dir`/redirected/ and its input `file` (a
+/// Runs the example config `name` with every output key redirected into `dir`/redirected/ and its input `file` or `input` (a
 /// path relative to the source tree, as the header's command runs there) made absolute; returns the result.
 RunResult run_config(const std::string& name, const TempDir& dir) {
   const fs::path config = kConfigDir / (name + ".toml");
   std::string args = command_of(name) + " --config '" + config.string() + "'";
-  if (const auto input = toml::parse_file(config.string())["file"].value<std::string>())
-    args += " --file '" + (fs::path(AFMKIT_SOURCE_DIR) / *input).string() + "'";
+  const auto table = toml::parse_file(config.string());
+  for (const char* key : {"file", "input"})  // the input file keys (scan, spectroscopy fit: file; prepare: input)
+    if (const auto input = table[key].value<std::string>())
+      args += std::string(" --") + key + " '" + (fs::path(AFMKIT_SOURCE_DIR) / *input).string() + "'";
   for (const auto& [key, value] : output_keys(config)) {
     std::string flag = key;
     std::replace(flag.begin(), flag.end(), '_', '-');

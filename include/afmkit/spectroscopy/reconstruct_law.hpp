@@ -12,7 +12,8 @@ namespace afmkit::spectroscopy {
 impact::ForceCurve force_curve_from_si(const std::vector<double>& distance, const std::vector<double>& approach,
                                        const std::vector<double>& retract, const std::string& origin);
 
-/// The table-law file text (3-column layout, a comment line first): read back by impact::parse_force_curve.
+/// The table-law file text (3-column layout; a '#' comment line first unless `comment` is empty): read back by
+/// impact::parse_force_curve.
 std::string table_law_text(const impact::ForceCurve& curve, const std::string& comment);
 
 }  // namespace afmkit::spectroscopy
