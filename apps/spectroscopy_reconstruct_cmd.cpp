@@ -41,8 +41,6 @@ void add_law_file(CommandOutput& out, const std::string& path, const impact::For
   out.outputs().add(path + ".json", sidecar.dump(2) + "\n");
 }
 
-double nan_if(bool missing, double v) { return missing ? std::numeric_limits<double>::quiet_NaN() : v; }
-
 nlohmann::json notes_json(const std::vector<std::string>& notes) {
   nlohmann::json j = nlohmann::json::array();
   for (const auto& n : notes) j.push_back(n);
