@@ -62,6 +62,9 @@ void run_fm(const io::ParamSet& p, Captured* capture, const spectroscopy::Measur
   o.method = spectroscopy::fm_method_from(method);
   o.tail = spectroscopy::tail_model_from(p.text("tail"));
   o.noise_realisations = static_cast<int>(p.integer("noise_realisations"));
+  o.exact_round_trip = p.text("round_trip") == "exact";
+  o.round_trip_points = static_cast<int>(p.integer("round_trip_points"));
+  o.quality_factor = p.real("quality_factor");
   const auto r = spectroscopy::reconstruct_fm({m.distance, m.frequency_shift}, s, o);
 
   CommandOutput out(p, capture, "spectroscopy reconstruct");
@@ -104,7 +107,8 @@ void run_fm(const io::ParamSet& p, Captured* capture, const spectroscopy::Measur
   const std::string summary = fmt::format(
       "FM reconstruction ({}, {} points): largest attraction {}; round trip ({}): residual {} rms, {} max; noise "
       "{}{}",
-      r.method, r.distance.size(), io::quantity(f_min, "N"), "first-order formula", io::quantity(r.residual_rms, "Hz"),
+      r.method, r.distance.size(), io::quantity(f_min, "N"), o.exact_round_trip ? "exact FM orbits" : "first-order formula",
+      io::quantity(r.residual_rms, "Hz"),
       io::quantity(r.residual_max, "Hz"), io::quantity(r.noise, "Hz"), notes_text(r.notes));
   out.finish(results, summary);
 }
@@ -255,7 +259,10 @@ void register_spectroscopy_reconstruct(CLI::App& spectroscopy) {
             .real("free_amplitude", 10.0, "AM: free amplitude A0 at the drive frequency (required for AM curves)",
                   positive_below(1e6))
             .unit("nm")
-            .real("quality_factor", 400.0, "AM: quality factor Q (required for AM curves)", positive_below(1e9))
+            .real("quality_factor", 400.0,
+                  "quality factor Q (AM: required; FM: of the cantilever of the exact round trip, which Δf hardly "
+                  "depends on)",
+                  positive_below(1e9))
             .unit("dimensionless")
             .real("drive_frequency", 0.0, "AM: drive frequency (0: f0)", io::Range::closed(0.0, 1e7))
             .unit("kHz");
@@ -263,8 +270,13 @@ void register_spectroscopy_reconstruct(CLI::App& spectroscopy) {
             .integer("noise_realisations", 8, "FM: synthetic noise realisations for the force uncertainty (0: none)",
                      0, 1000)
             .integer("round_trip_points", 40,
-                     "AM: separations of the round trip through exact orbits, spread over the curve (0: all)", 0,
-                     100000);
+                     "separations (AM) or distances (FM) of the round trip through exact orbits, spread over the "
+                     "curve (0: all)",
+                     0, 100000)
+            .text("round_trip", "exact",
+                  "FM: the round trip's forward model: exact (the FM orbits of tapping fm) or first_order (Giessibl's "
+                  "large-amplitude formula by quadrature)",
+                  {"exact", "first_order"});
         p.group("Law output")
             .file("law_output", "out/reconstructed_law.csv",
                   "table-law file (distance, approach, retract) for --law table --force-curve (empty: none)")

@@ -1,8 +1,8 @@
 // Speed of the force reconstructions with their round trips (docs/reconstruction.md#speed). Target (issue 25):
 // a 1000-point curve reconstructed with its round trip ≤ 1 s.
 //   FM: qPlus sensor (k = 1800 N/m, f0 = 25 kHz), exponential force (F0 = 1 nN, λ = 0.1 nm), A = 0.5 nm, 1000
-//       points on [0.05, 2.05] nm; Sader–Jarvis and matrix, 8 noise realisations, round trip by the first-order
-//       formula at every point.
+//       points on [0.05, 2.05] nm; Sader–Jarvis and matrix, 8 noise realisations, round trip through the exact FM
+//       orbits at 40 (the default) distances, or by the first-order formula at every point (…_first_order).
 //   AM: k = 40 N/m, f0 = 300 kHz, Q = 400, A0 = 10 nm, DMT + vdW (R = 10 nm, E* = 1 GPa, A_H = 1e-19 J), 1000
 //       separations on [6, 12] nm from afmkit's exact orbits; payam, round trip through exact orbits at 40 (the
 //       default) separations; counter round_trip_points.
@@ -20,7 +20,7 @@ namespace {
 
 namespace sp = afmkit::spectroscopy;
 
-void fm(benchmark::State& state, sp::FmMethod method) {
+void fm(benchmark::State& state, sp::FmMethod method, bool exact) {
   const sp::FmSettings s(1800.0, 25e3, 0.5e-9);
   sp::FmCurve c;
   for (int i = 0; i < 1000; ++i) {
@@ -30,6 +30,7 @@ void fm(benchmark::State& state, sp::FmMethod method) {
   }
   sp::FmOptions o;
   o.method = method;
+  o.exact_round_trip = exact;
   for (auto _ : state) benchmark::DoNotOptimize(sp::reconstruct_fm(c, s, o));
   state.counters["points"] = 1000;
 }
@@ -61,7 +62,9 @@ void am(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK_CAPTURE(fm, sader_jarvis_1000, sp::FmMethod::sader_jarvis)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(fm, matrix_1000, sp::FmMethod::matrix)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(fm, sader_jarvis_1000, sp::FmMethod::sader_jarvis, true)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(fm, matrix_1000, sp::FmMethod::matrix, true)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(fm, sader_jarvis_1000_first_order, sp::FmMethod::sader_jarvis, false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(fm, matrix_1000_first_order, sp::FmMethod::matrix, false)->Unit(benchmark::kMillisecond);
 BENCHMARK(am)->Arg(40)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK_MAIN();

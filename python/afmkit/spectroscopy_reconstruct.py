@@ -73,14 +73,18 @@ def _array(name, value):
 
 
 def reconstruct_fm(distance, frequency_shift, *, spring_constant, resonance_frequency, amplitude,
-                   method="sader_jarvis", tail="zero", noise_realisations=8, seed=1, round_trip=True):
+                   method="sader_jarvis", tail="zero", noise_realisations=8, seed=1, round_trip=True,
+                   round_trip_model="exact", round_trip_points=40, quality_factor=1e4):
     """FM-AFM: the force F(z) [N] from the frequency shift Δf(z) [Hz] measured at constant amplitude ``amplitude``
     [m] against the closest distance z [m], by ``method`` = "sader_jarvis" (Sader & Jarvis 2004) or "matrix"
     (Giessibl 2001); ``tail`` = "zero" (default) or "exponential" beyond the last point. The round trip runs the
-    law through the first-order large-amplitude formula (not an exact orbit)."""
+    law through afmkit's exact FM orbits (``round_trip_model="exact"``: the self-excited cantilever of
+    ``afmkit.tapping.fm`` with quality factor ``quality_factor``, at ``round_trip_points`` of the distances, 0: all)
+    or Giessibl's first-order large-amplitude formula (``"first_order"``)."""
     d = _afmkit._reconstruct_fm(_array("distance", distance), _array("frequency_shift", frequency_shift),
                                 float(spring_constant), float(resonance_frequency), float(amplitude), str(method),
-                                str(tail), int(noise_realisations), int(seed), bool(round_trip))
+                                str(tail), int(noise_realisations), int(seed), bool(round_trip),
+                                str(round_trip_model), int(round_trip_points), float(quality_factor))
     return Reconstruction(d, _FM_UNITS)
 
 

@@ -46,7 +46,7 @@ void bind_spectroscopy_reconstruct(py::module_& m) {
       "_reconstruct_fm",
       [](const Array& distance, const Array& frequency_shift, double k, double f0, double amplitude,
          const std::string& method, const std::string& tail, int noise_realisations, std::uint64_t seed,
-         bool round_trip) {
+         bool round_trip, const std::string& round_trip_model, int round_trip_points, double quality_factor) {
         const spectroscopy::FmSettings s(k, f0, amplitude);
         spectroscopy::FmOptions o;
         o.method = spectroscopy::fm_method_from(method);
@@ -54,6 +54,12 @@ void bind_spectroscopy_reconstruct(py::module_& m) {
         o.noise_realisations = noise_realisations;
         o.seed = seed;
         o.round_trip = round_trip;
+        if (round_trip_model != "exact" && round_trip_model != "first_order")
+          throw InvalidParameter("round_trip_model", "round_trip_model = '" + round_trip_model +
+                                                         "' must be one of: exact, first_order");
+        o.exact_round_trip = round_trip_model == "exact";
+        o.round_trip_points = round_trip_points;
+        o.quality_factor = quality_factor;
         spectroscopy::FmReconstruction r;
         {
           const spectroscopy::FmCurve c{vec(distance, "distance"), vec(frequency_shift, "frequency_shift")};
@@ -84,7 +90,7 @@ void bind_spectroscopy_reconstruct(py::module_& m) {
       },
       py::arg("distance"), py::arg("frequency_shift"), py::arg("spring_constant"), py::arg("resonance_frequency"),
       py::arg("amplitude"), py::arg("method"), py::arg("tail"), py::arg("noise_realisations"), py::arg("seed"),
-      py::arg("round_trip"));
+      py::arg("round_trip"), py::arg("round_trip_model"), py::arg("round_trip_points"), py::arg("quality_factor"));
   m.def(
       "_reconstruct_am",
       [](const Array& separation, const Array& amplitude, const Array& phase, double k, double f0, double q,

@@ -12,7 +12,10 @@
 #include "afmkit/core/computed.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/quantity.hpp"
+#include "afmkit/impact/laws/table_law.hpp"
 #include "afmkit/spectroscopy/reconstruct_law.hpp"
+#include "afmkit/tapping/fm.hpp"
+#include "afmkit/tapping/units.hpp"
 #include "reconstruct_checks.hpp"
 
 namespace afmkit::spectroscopy {
@@ -76,6 +79,54 @@ std::vector<std::vector<double>> invert(const std::vector<double>& z, const std:
   out = matrix_method_force(grid, rhs, s.amplitude, s.spring_constant);
   for (auto& f : out) f.resize(n);
   return out;
+}
+
+}  // namespace
+
+namespace {
+
+/// The round trip through afmkit's exact FM orbits (tapping::sweep_fm at the measured closest distances, the
+/// table law in physical units nm and nN on the normalised cantilever ω_n = 1): Δf = (ω − 1)·f0.
+void fm_exact_round_trip(FmReconstruction& r, const std::vector<double>& z, const FmSettings& s,
+                         const FmOptions& options) {
+  const std::size_t n = z.size();
+  const tapping::PhysicalCantilever pc(s.spring_constant, s.resonance_frequency * 1e-3, options.quality_factor,
+                                       s.amplitude * 1e9, 1.0);
+  const impact::ForceLaw physical = impact::make_law<impact::TableLaw>(r.law, true);
+  const tapping::FmSetting setting(pc.cantilever(), pc.normalised_law(physical), s.amplitude * 1e9);
+  // the distances visited, largest first (an approach): every one, or `round_trip_points` evenly spread
+  std::vector<std::size_t> visit;
+  const std::size_t m = options.round_trip_points > 0 ? std::min<std::size_t>(n, options.round_trip_points) : n;
+  for (std::size_t j = 0; j < m; ++j)
+    visit.push_back(m == n ? j : static_cast<std::size_t>(std::llround(static_cast<double>(j) * (n - 1) / (m - 1))));
+  visit.erase(std::unique(visit.begin(), visit.end()), visit.end());
+  std::reverse(visit.begin(), visit.end());
+  std::vector<double> targets;
+  for (std::size_t i : visit) targets.push_back(z[i] * 1e9);
+  tapping::FmSweepOptions o;
+  o.axis = tapping::FmAxis::min_gap;
+  const tapping::FmSweepResult sweep = tapping::sweep_fm(setting, targets, o);
+  double sum2 = 0.0, mx = 0.0;
+  std::size_t count = 0;
+  for (std::size_t j = 0; j < visit.size(); ++j) {
+    const tapping::FmPoint& point = sweep.points[j];
+    if (point.status != tapping::FmStatus::converged || !point.orbit) continue;
+    const std::size_t i = visit[j];
+    r.round_trip_frequency_shift[i] = point.orbit->frequency_shift() * s.resonance_frequency;
+    r.residual[i] = r.round_trip_frequency_shift[i] - r.frequency_shift[i];
+    sum2 += r.residual[i] * r.residual[i];
+    mx = std::max(mx, std::abs(r.residual[i]));
+    ++count;
+  }
+  r.residual_rms = count ? std::sqrt(sum2 / static_cast<double>(count)) : std::numeric_limits<double>::quiet_NaN();
+  r.residual_max = count ? mx : std::numeric_limits<double>::quiet_NaN();
+  r.round_trip_model = fmt::format("exact FM orbits of the table law (tapping fm: self-excited cantilever, ideal "
+                                   "loops, Q = {:g}) at {} of the {} measured distances",
+                                   options.quality_factor, count, n);
+  if (count < visit.size())
+    r.notes.push_back(fmt::format("the round trip found no FM orbit at {} of the {} distances it visited (the "
+                                  "reconstructed law holds no orbit of amplitude {} there: residual nan)",
+                                  visit.size() - count, visit.size(), io::quantity(s.amplitude, "m")));
 }
 
 }  // namespace
@@ -178,7 +229,9 @@ FmReconstruction reconstruct_fm(const FmCurve& curve, const FmSettings& s, const
     r.round_trip_frequency_shift.assign(n, std::numeric_limits<double>::quiet_NaN());
     r.residual.assign(n, std::numeric_limits<double>::quiet_NaN());
     r.residual_rms = r.residual_max = std::numeric_limits<double>::quiet_NaN();
-    if (options.round_trip) {
+    if (options.round_trip && options.exact_round_trip) {
+      fm_exact_round_trip(r, z, s, options);
+    } else if (options.round_trip) {
       const impact::TableLaw law(r.law, true);
       const double end = r.law.approach_gap.back() * 1e-9;
       const auto force = [&law](double x) { return law.approach(x * 1e9) * 1e-9; };

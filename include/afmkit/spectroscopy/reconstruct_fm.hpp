@@ -39,6 +39,13 @@ struct FmOptions {
   int noise_realisations = 8;  ///< noise propagated by this many synthetic realisations (0: none)
   std::uint64_t seed = 1;      ///< of those realisations
   bool round_trip = true;
+  /// The round trip's forward model: the exact FM orbits of afmkit tapping fm (self-excited cantilever, ideal
+  /// loops, at the measured closest distances), or Giessibl's first-order large-amplitude formula by quadrature.
+  bool exact_round_trip = true;
+  /// Exact round trip: at this many of the measured distances, evenly spread (0: all of them).
+  int round_trip_points = 40;
+  /// Exact round trip: the cantilever's quality factor (Δf hardly depends on it when Q ≫ 1).
+  double quality_factor = 1e4;
 };
 
 /// The measured curve (any distance order; strictly monotone, finite, ≥ 5 points).
@@ -54,7 +61,7 @@ struct FmReconstruction {
   std::vector<double> force;             ///< F [N]
   std::vector<double> energy;            ///< U(z) = ∫_z^∞ F dt [J]
   std::vector<double> force_uncertainty; ///< 1σ of F from the noise estimated in Δf [N] (0 without noise)
-  std::vector<double> round_trip_frequency_shift;  ///< Δf of the table law by the forward formula [Hz] (NaN: none)
+  std::vector<double> round_trip_frequency_shift;  ///< Δf of the table law by the forward model [Hz] (NaN: none)
   std::vector<double> residual;          ///< round trip − measured [Hz]
   double residual_rms = 0.0;             ///< [Hz]
   double residual_max = 0.0;             ///< [Hz]
