@@ -69,8 +69,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const afmkit::impact::TableLaw law(curve);
     check_law(law, true, curve.approach_gap, curve.approach_force);
     check_law(law, false, curve.retract_gap, curve.retract_force);
+    // the switching gaps: sorted and distinct; both tables' ends, and at most the retract's kink below its table
+    // (table_law.hpp) and the contact and release gaps of the contact-aware default (docs/force-laws.md)
     const std::vector<double> gaps = law.switching_gaps();
-    if (gaps.empty() || gaps.size() > 2) std::abort();
+    if (gaps.empty() || gaps.size() > 5 || !std::is_sorted(gaps.begin(), gaps.end()) ||
+        std::adjacent_find(gaps.begin(), gaps.end()) != gaps.end())
+      std::abort();
+    for (double end : {curve.approach_gap.back(), curve.retract_gap.back()})
+      if (std::find(gaps.begin(), gaps.end(), end) == gaps.end()) std::abort();
     (void)law.hysteresis_area(std::min(curve.approach_gap[0], curve.retract_gap[0]), gaps.back());
     law.require_dissipative();
   } catch (const afmkit::InvalidParameter& e) {
