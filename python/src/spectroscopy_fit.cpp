@@ -13,25 +13,13 @@
 #include "afmkit/spectroscopy/fit.hpp"
 #include "bindings.hpp"
 #include "interrupts.hpp"
+#include "numpy_arrays.hpp"
 
 namespace py = pybind11;
 
 namespace afmkit::python {
 
 namespace {
-
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-std::vector<double> vector_of(const Array& a, const char* name) {
-  if (a.ndim() != 1) throw InvalidParameter(name, std::string(name) + " must be a 1-D array");
-  return {a.data(), a.data() + a.size()};
-}
-
-py::array_t<double> array_of(const std::vector<double>& v) {
-  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
-  std::copy(v.begin(), v.end(), a.mutable_data());
-  return a;
-}
 
 py::array_t<bool> bools_of(const std::vector<bool>& v) {
   py::array_t<bool> a(static_cast<py::ssize_t>(v.size()));

@@ -11,20 +11,13 @@
 #include "afmkit/spectroscopy/reconstruct_fm.hpp"
 #include "afmkit/spectroscopy/reconstruct_law.hpp"
 #include "bindings.hpp"
+#include "numpy_arrays.hpp"
 
 namespace py = pybind11;
 
 namespace afmkit::python {
 
 namespace {
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-std::vector<double> vec(const Array& a, const char* name) {
-  if (a.ndim() != 1) throw InvalidParameter(name, std::string(name) + " must be a one-dimensional array");
-  return {a.data(), a.data() + a.size()};
-}
-
-py::array_t<double> arr(const std::vector<double>& v) { return py::array_t<double>(v.size(), v.data()); }
 
 py::dict law_dict(const impact::ForceCurve& c) {
   std::vector<double> d, fa, fr;
@@ -34,9 +27,9 @@ py::dict law_dict(const impact::ForceCurve& c) {
     fr.push_back(c.retract_force[i] * 1e-9);
   }
   py::dict law;
-  law["distance"] = arr(d);
-  law["approach_force"] = arr(fa);
-  law["retract_force"] = arr(fr);
+  law["distance"] = array_of(d);
+  law["approach_force"] = array_of(fa);
+  law["retract_force"] = array_of(fr);
   return law;
 }
 }  // namespace
@@ -62,19 +55,19 @@ void bind_spectroscopy_reconstruct(py::module_& m) {
         o.quality_factor = quality_factor;
         spectroscopy::FmReconstruction r;
         {
-          const spectroscopy::FmCurve c{vec(distance, "distance"), vec(frequency_shift, "frequency_shift")};
+          const spectroscopy::FmCurve c{vector_of(distance, "distance"), vector_of(frequency_shift, "frequency_shift")};
           py::gil_scoped_release release;
           r = spectroscopy::reconstruct_fm(c, s, o);
         }
         py::dict d;
         d["method"] = r.method;
-        d["distance"] = arr(r.distance);
-        d["frequency_shift"] = arr(r.frequency_shift);
-        d["force"] = arr(r.force);
-        d["energy"] = arr(r.energy);
-        d["force_uncertainty"] = arr(r.force_uncertainty);
-        d["round_trip_frequency_shift"] = arr(r.round_trip_frequency_shift);
-        d["residual"] = arr(r.residual);
+        d["distance"] = array_of(r.distance);
+        d["frequency_shift"] = array_of(r.frequency_shift);
+        d["force"] = array_of(r.force);
+        d["energy"] = array_of(r.energy);
+        d["force_uncertainty"] = array_of(r.force_uncertainty);
+        d["round_trip_frequency_shift"] = array_of(r.round_trip_frequency_shift);
+        d["residual"] = array_of(r.residual);
         d["residual_rms"] = r.residual_rms;
         d["residual_max"] = r.residual_max;
         d["noise"] = r.noise;
@@ -104,29 +97,29 @@ void bind_spectroscopy_reconstruct(py::module_& m) {
         o.round_trip = round_trip;
         spectroscopy::AmReconstruction r;
         {
-          const spectroscopy::AmCurve c{vec(separation, "separation"), vec(amplitude, "amplitude"), vec(phase, "phase")};
+          const spectroscopy::AmCurve c{vector_of(separation, "separation"), vector_of(amplitude, "amplitude"), vector_of(phase, "phase")};
           py::gil_scoped_release release;
           r = spectroscopy::reconstruct_am(c, s, o);
         }
         py::dict d;
         d["method"] = r.method;
-        d["separation"] = arr(r.separation);
-        d["amplitude"] = arr(r.amplitude);
-        d["phase"] = arr(r.phase);
-        d["dissipation"] = arr(r.dissipation);
-        d["gap"] = arr(r.gap);
-        d["equivalent_frequency_shift"] = arr(r.omega);
-        d["force"] = arr(r.force);
-        d["force_uncertainty"] = arr(r.force_uncertainty);
-        d["gap_dissipation"] = arr(r.gap_dissipation);
-        d["approach_force"] = arr(r.approach_force);
-        d["retract_force"] = arr(r.retract_force);
+        d["separation"] = array_of(r.separation);
+        d["amplitude"] = array_of(r.amplitude);
+        d["phase"] = array_of(r.phase);
+        d["dissipation"] = array_of(r.dissipation);
+        d["gap"] = array_of(r.gap);
+        d["equivalent_frequency_shift"] = array_of(r.omega);
+        d["force"] = array_of(r.force);
+        d["force_uncertainty"] = array_of(r.force_uncertainty);
+        d["gap_dissipation"] = array_of(r.gap_dissipation);
+        d["approach_force"] = array_of(r.approach_force);
+        d["retract_force"] = array_of(r.retract_force);
         d["dropped"] = r.dropped;
         d["contact_gap"] = r.contact_gap;
-        d["round_trip_amplitude_ratio"] = arr(r.round_trip_amplitude_ratio);
-        d["round_trip_phase"] = arr(r.round_trip_phase);
-        d["residual_amplitude_ratio"] = arr(r.residual_amplitude_ratio);
-        d["residual_phase"] = arr(r.residual_phase);
+        d["round_trip_amplitude_ratio"] = array_of(r.round_trip_amplitude_ratio);
+        d["round_trip_phase"] = array_of(r.round_trip_phase);
+        d["residual_amplitude_ratio"] = array_of(r.residual_amplitude_ratio);
+        d["residual_phase"] = array_of(r.residual_phase);
         d["rms_amplitude_ratio"] = r.rms_amplitude_ratio;
         d["rms_phase"] = r.rms_phase;
         d["round_trip_model"] = r.round_trip_model;
