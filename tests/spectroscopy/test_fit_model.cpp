@@ -10,20 +10,14 @@
 #include "afmkit/spectroscopy/fit_model.hpp"
 #include "afmkit/tapping/sweep.hpp"
 #include "afmkit/tapping/units.hpp"
+#include "fit_settings.hpp"
 
 using namespace afmkit;
 using namespace afmkit::spectroscopy;
 
 namespace {
 
-FitSettings settings() {
-  FitSettings s;
-  s.spring_constant = 40.0;
-  s.resonance_frequency = 300e3;
-  s.quality_factor = 400.0;
-  s.free_amplitude = 20e-9;
-  return s;
-}
+FitSettings settings() { return afmkit_test::fit_settings(); }
 
 FitOptions dmt() {
   FitOptions o;

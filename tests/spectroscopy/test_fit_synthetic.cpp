@@ -8,20 +8,14 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
+#include "fit_settings.hpp"
 
 using namespace afmkit;
 using namespace afmkit::spectroscopy;
 
 namespace {
 
-FitSettings settings() {
-  FitSettings s;
-  s.spring_constant = 40.0;
-  s.resonance_frequency = 300e3;
-  s.quality_factor = 400.0;
-  s.free_amplitude = 20e-9;
-  return s;
-}
+FitSettings settings() { return afmkit_test::fit_settings(); }
 
 constexpr double kHamaker = 1e-19, kModulus = 1e9, kOffset = 0.7e-9, kPhase = 0.1;
 constexpr double kSigmaA = 0.003, kSigmaP = 0.005;  // A/A0 and rad (0.29°)
