@@ -226,7 +226,7 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
                                                             "in contact over the whole period; column trapped)",
                                                             trapped, out.rows())
                                               : std::string();
-  if (trapped > 0) summary += "\n" + results["note"].get<std::string>();
+  if (trapped > 0) summary += fmt::format("\n{}", results["note"].get<std::string>());
   results["units"] = sweep_units(scales);
   out.finish(results, summary);
 }

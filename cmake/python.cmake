@@ -25,6 +25,7 @@ file(GLOB _pysrc CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/python/src/*.cpp)
 # NO_EXTRAS: no link-time optimisation (the bindings call the library, whose code is optimised already; LTO made
 # the module's link the longest step of the main-job build) and no strip.
 pybind11_add_module(afmkit_python MODULE NO_EXTRAS ${_pysrc})
+afmkit_unity(afmkit_python)
 set_target_properties(afmkit_python PROPERTIES OUTPUT_NAME _afmkit
   LIBRARY_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/python/afmkit)
 target_link_libraries(afmkit_python PRIVATE afmkit_commands)

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/core/validate.hpp"
 #include "impact_detail.hpp"
@@ -15,7 +16,7 @@
 namespace afmkit::impact {
 
 namespace {
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using afmkit::numbers::nan;
 
 Body validated(const Body& b, const char* index) {
   const std::string i(index);

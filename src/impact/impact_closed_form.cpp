@@ -12,13 +12,14 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/numbers.hpp"
 #include "impact_detail.hpp"
 
 namespace afmkit::impact::detail {
 
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using afmkit::numbers::nan;
 
 /// One analytic arc d(τ) on [t0, t1] of d̈ = accel − w2·d.
 struct Arc {

@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/numbers.hpp"
 #include "impact_detail.hpp"
 
 namespace afmkit::impact::detail {
@@ -27,7 +28,7 @@ namespace {
 
 namespace odeint = boost::numeric::odeint;
 using State = std::array<double, 4>;  // scaled x1, v1, x2, v2 in the initial centre-of-mass frame
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using afmkit::numbers::nan;
 
 enum class Event { none, level, turning, end };
 

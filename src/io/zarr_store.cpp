@@ -210,7 +210,10 @@ void ZarrStoreWriter::commit() {
           std::memcpy(chunk.data() + i * a.item, inside ? a.data.data() + flat * a.item : a.fill.data(), a.item);
         }
         std::string key;
-        for (std::size_t k = 0; k < dims; ++k) key += (k ? "." : "") + std::to_string(index[k]);
+        for (std::size_t k = 0; k < dims; ++k) {
+          if (k) key += '.';
+          key += std::to_string(index[k]);
+        }
         write_file(dir / key, chunk.data(), chunk.size());
       }
     }

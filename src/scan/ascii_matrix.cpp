@@ -12,7 +12,7 @@
 namespace afmkit::scan {
 
 namespace {
-constexpr std::uintmax_t max_file_bytes = std::uintmax_t{512} << 20;
+constexpr std::uintmax_t ascii_max_file_bytes = std::uintmax_t{512} << 20;
 bool blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 }  // namespace
 
@@ -72,7 +72,7 @@ AsciiMatrix parse_ascii_matrix(std::string_view text, const std::string& origin)
 }
 
 AsciiMatrix read_ascii_matrix(const std::string& path) {
-  return parse_ascii_matrix(detail::read_file_bytes(path, "ASCII matrix", max_file_bytes), path);
+  return parse_ascii_matrix(detail::read_file_bytes(path, "ASCII matrix", ascii_max_file_bytes), path);
 }
 
 }  // namespace afmkit::scan

@@ -17,9 +17,9 @@ namespace afmkit::scan {
 
 namespace {
 
-constexpr std::size_t alignment = 4;
+constexpr std::size_t gsf_alignment = 4;
 constexpr long max_resolution = 1L << 24;
-constexpr std::uintmax_t max_file_bytes = std::uintmax_t{2} << 30;
+constexpr std::uintmax_t gsf_max_file_bytes = std::uintmax_t{2} << 30;
 
 std::string header_of(const HeightMap& map, std::string_view z_unit, const std::string& title) {
   std::string h(gsf_magic);
@@ -29,7 +29,7 @@ std::string header_of(const HeightMap& map, std::string_view z_unit, const std::
   h += "XYUnits = m\n";
   if (!z_unit.empty()) h += fmt::format("ZUnits = {}\n", z_unit);
   if (!title.empty()) h += fmt::format("Title = {}\n", title);
-  h.append(alignment - h.size() % alignment, '\0');
+  h.append(gsf_alignment - h.size() % gsf_alignment, '\0');
   return h;
 }
 
@@ -56,7 +56,7 @@ struct RawGsf {
 
 RawGsf parse_raw(std::string_view bytes, const std::string& origin) {
   RawGsf raw;
-  raw.header = detail::parse_binary_header(bytes, gsf_magic, alignment, "Gwyddion Simple Field", origin);
+  raw.header = detail::parse_binary_header(bytes, gsf_magic, gsf_alignment, "Gwyddion Simple Field", origin);
   const detail::BinaryHeader& h = raw.header;
   raw.grid.x_resolution = detail::header_count(h, "XRes", max_resolution, true, origin);
   raw.grid.y_resolution = detail::header_count(h, "YRes", max_resolution, true, origin);
@@ -70,7 +70,7 @@ RawGsf parse_raw(std::string_view bytes, const std::string& origin) {
   const auto count = static_cast<std::size_t>(raw.grid.x_resolution) * static_cast<std::size_t>(raw.grid.y_resolution);
   const std::size_t data_bytes = count * 4;  // < 2^50: no overflow
   if (bytes.size() - h.data_start != data_bytes)
-    detail::throw_size_mismatch(h, bytes.size(), alignment,
+    detail::throw_size_mismatch(h, bytes.size(), gsf_alignment,
                                 fmt::format("XRes · YRes = {} · {} float32 values", raw.grid.x_resolution,
                                             raw.grid.y_resolution),
                                 data_bytes, origin);
@@ -185,12 +185,12 @@ GsfField parse_gsf_with_mask(std::string_view bytes, const std::string& origin, 
 }
 
 GsfField read_gsf(const std::string& path) {
-  return parse_gsf(detail::read_file_bytes(path, "GSF", max_file_bytes), path);
+  return parse_gsf(detail::read_file_bytes(path, "GSF", gsf_max_file_bytes), path);
 }
 
 GsfField read_gsf_with_mask(const std::string& path, const std::string& mask_path) {
-  return parse_gsf_with_mask(detail::read_file_bytes(path, "GSF", max_file_bytes), path,
-                             detail::read_file_bytes(mask_path, "GSF mask", max_file_bytes), mask_path);
+  return parse_gsf_with_mask(detail::read_file_bytes(path, "GSF", gsf_max_file_bytes), path,
+                             detail::read_file_bytes(mask_path, "GSF mask", gsf_max_file_bytes), mask_path);
 }
 
 }  // namespace afmkit::scan

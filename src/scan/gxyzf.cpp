@@ -13,10 +13,10 @@
 namespace afmkit::scan {
 
 namespace {
-constexpr std::size_t alignment = 8;
+constexpr std::size_t gxyzf_alignment = 8;
 constexpr long max_channels = 1024;
 constexpr long max_points = 1L << 40;
-constexpr std::uintmax_t max_file_bytes = std::uintmax_t{2} << 30;
+constexpr std::uintmax_t gxyzf_max_file_bytes = std::uintmax_t{2} << 30;
 
 void check_finite(const std::vector<double>& v, const std::string& name) {
   for (std::size_t k = 0; k < v.size(); ++k)
@@ -55,7 +55,7 @@ std::string format_gxyzf(const XyzField& field) {
     if (!field.channels()[c].unit.empty()) out += fmt::format("ZUnits{} = {}\n", c + 1, field.channels()[c].unit);
     if (!field.channels()[c].title.empty()) out += fmt::format("Title{} = {}\n", c + 1, field.channels()[c].title);
   }
-  out.append(alignment - out.size() % alignment, '\0');
+  out.append(gxyzf_alignment - out.size() % gxyzf_alignment, '\0');
   out.reserve(out.size() + 8 * field.size() * (field.channels().size() + 2));
   for (std::size_t k = 0; k < field.size(); ++k) {
     detail::append_le64(out, field.x()[k]);
@@ -69,7 +69,7 @@ void write_gxyzf(const std::string& path, const XyzField& field) { io::write_fil
 
 XyzField parse_gxyzf(std::string_view bytes, const std::string& origin) {
   const detail::BinaryHeader h =
-      detail::parse_binary_header(bytes, gxyzf_magic, alignment, "Gwyddion XYZ Field", origin);
+      detail::parse_binary_header(bytes, gxyzf_magic, gxyzf_alignment, "Gwyddion XYZ Field", origin);
   const long nchannels = detail::header_count(h, "NChannels", max_channels, true, origin);
   const long npoints = detail::header_count(h, "NPoints", max_points, true, origin);
   const std::string xy_unit = detail::header_text(h, "XYUnits", origin);
@@ -78,7 +78,7 @@ XyzField parse_gxyzf(std::string_view bytes, const std::string& origin) {
   const auto count = static_cast<std::size_t>(npoints);
   const std::size_t data_bytes = count * columns * 8;  // < 2^51: no overflow
   if (bytes.size() - h.data_start != data_bytes)
-    detail::throw_size_mismatch(h, bytes.size(), alignment,
+    detail::throw_size_mismatch(h, bytes.size(), gxyzf_alignment,
                                 fmt::format("NPoints · (NChannels + 2) = {} · {} float64 values", npoints, columns),
                                 data_bytes, origin);
   std::vector<double> x(count), y(count);
@@ -112,7 +112,7 @@ XyzField parse_gxyzf(std::string_view bytes, const std::string& origin) {
 }
 
 XyzField read_gxyzf(const std::string& path) {
-  return parse_gxyzf(detail::read_file_bytes(path, "GXYZF", max_file_bytes), path);
+  return parse_gxyzf(detail::read_file_bytes(path, "GXYZF", gxyzf_max_file_bytes), path);
 }
 
 }  // namespace afmkit::scan

@@ -24,7 +24,7 @@ namespace afmkit::scan {
 
 namespace {
 
-constexpr std::uintmax_t max_file_bytes = std::uintmax_t{512} << 20;
+constexpr std::uintmax_t png_max_file_bytes = std::uintmax_t{512} << 20;
 constexpr unsigned long max_pixels = 1UL << 26;
 
 struct Context {
@@ -150,7 +150,7 @@ Grey16 parse_png16(std::string_view bytes, const std::string& origin) {
 }
 
 Grey16 read_png16(const std::string& path) {
-  return parse_png16(detail::read_file_bytes(path, "PNG", max_file_bytes), path);
+  return parse_png16(detail::read_file_bytes(path, "PNG", png_max_file_bytes), path);
 }
 
 std::string format_png16(const Grey16& image) {

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/control/realtime_filter.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/scan/recorded_spiral.hpp"
@@ -15,7 +16,7 @@
 namespace afmkit::scan {
 
 namespace {
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
+using afmkit::numbers::two_pi;
 
 // Turn metrics on the tilt-free signal, with the recorded one as the reference column.
 class SwappedMetrics final : public ScanObserver {
@@ -54,7 +55,7 @@ RecordedSurvey survey_recorded(const std::string& path) {
   while (reader.next(sample)) {
     ++s.samples;
     s.max_radius = std::max(s.max_radius, sample.radius);
-    const auto k = static_cast<std::int64_t>(std::floor(sample.angle / kTwoPi));
+    const auto k = static_cast<std::int64_t>(std::floor(sample.angle / two_pi));
     if (s.samples == 1 || k != turn) {
       if (s.samples > 1) {
         turn_min = std::min(turn_min, sample.radius);  // the turn ends where the next one starts
@@ -103,7 +104,7 @@ control::RealtimeFilter filter_for(const RecordedSurvey& survey, const RecordedF
     throw InvalidParameter("harmonics",
                            fmt::format("harmonics = {} is out of range: harmonic N at N x {:.6g} Hz (the recorded "
                                        "spindle) must lie below the Nyquist frequency {:.6g} Hz of the recording; must "
-                                       "be an integer in [1, {}]", spec.harmonics, omega / kTwoPi,
+                                       "be an integer in [1, {}]", spec.harmonics, omega / two_pi,
                                        0.5 * survey.sample_rate,
                                        static_cast<long>(std::ceil(std::numbers::pi * survey.sample_rate / omega)) - 1));
   return control::RealtimeFilter::with_couplings(survey.sample_rate, omega, spec.harmonics, spec.alpha * omega,
@@ -126,7 +127,7 @@ RecordedScan filter_recorded_scan(const std::string& path, const RecordedSurvey&
   const double omega = survey.rotation_frequency;
   control::RealtimeFilter filter = filter_for(survey, spec);
 
-  const auto per_turn = static_cast<int>(std::clamp(std::round(kTwoPi * survey.sample_rate / omega), 16.0, 4194304.0));
+  const auto per_turn = static_cast<int>(std::clamp(std::round(two_pi * survey.sample_rate / omega), 16.0, 4194304.0));
   SpiralImager imager(grid, {"m", "m"}, per_turn);
   std::int64_t turns = 0;
   TurnMetrics metrics(0.0, [&](const TurnRecord& r) {

@@ -19,6 +19,7 @@
 
 #include <fmt/format.h>
 
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/input_file.hpp"
 #include "afmkit/io/number.hpp"
@@ -28,12 +29,12 @@ namespace afmkit::scan {
 
 namespace {
 
-constexpr double two_pi = 6.283185307179586;  // 2π
-constexpr double pi = 3.141592653589793;
+using afmkit::numbers::two_pi;
+using std::numbers::pi;
 constexpr std::size_t max_line_bytes = std::size_t{1} << 20;
 constexpr std::size_t max_revolution_samples = std::size_t{1} << 24;
 constexpr double sampling_tolerance = 1e-3;  // |Δt − Δt0| <= 1e-3 · Δt0
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using afmkit::numbers::nan;
 
 bool blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 

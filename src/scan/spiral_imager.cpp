@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
 #include "file_bytes.hpp"
@@ -19,7 +20,7 @@ namespace afmkit::scan {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
+using afmkit::numbers::two_pi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kMaxTablePosition = 9007199254740992.0;  // 2^53: table indices stay exact in a double
 constexpr int kMinTable = 16;
@@ -99,7 +100,7 @@ SpiralImager::SpiralImager(const Grid& grid, std::vector<std::string> channel_un
     for (std::size_t n = 0; n < pixels; ++n) {
       const auto [x, y] = centre(order[n].second);
       double a = std::atan2(y, x);
-      if (a < 0) a += kTwoPi;
+      if (a < 0) a += two_pi;
       pixel_radius_[n] = order[n].first;
       pixel_angle_[n] = a;
       pixel_index_[n] = order[n].second;
@@ -110,7 +111,7 @@ SpiralImager::SpiralImager(const Grid& grid, std::vector<std::string> channel_un
   lower_.assign(table, kNaN);
   upper_.assign(table, kNaN);
   last_values_.assign(units_.size(), kNaN);
-  per_radian_ = static_cast<double>(table_size_) / kTwoPi;
+  per_radian_ = static_cast<double>(table_size_) / two_pi;
 }
 
 void SpiralImager::add(double angle, double radius, std::span<const double> values) {
@@ -127,8 +128,8 @@ void SpiralImager::add(double angle, double radius, std::span<const double> valu
 
   if (samples_ == 0) {
     first_angle_ = angle;
-    first_phase_ = angle - kTwoPi * std::floor(angle / kTwoPi);
-    if (!(first_phase_ < kTwoPi)) first_phase_ = 0.0;  // rounding of a tiny negative angle
+    first_phase_ = angle - two_pi * std::floor(angle / two_pi);
+    if (!(first_phase_ < two_pi)) first_phase_ = 0.0;  // rounding of a tiny negative angle
     upper_[0] = radius;
     for (std::size_t c = 0; c < channels; ++c) upper_[(c + 1) * stride] = values[c];
     next_entry_ = 1;
@@ -239,7 +240,7 @@ void SpiralImager::fill_strip(const std::vector<double>& lower, const std::vecto
     const double rho = pixel_radius_[static_cast<std::size_t>(p)];
     if (!(rho < hi)) break;
     double u = pixel_angle_[static_cast<std::size_t>(p)] - first_phase_;
-    if (u < 0) u += kTwoPi;
+    if (u < 0) u += two_pi;
     u = std::min(u * per_radian_, mm);  // table coordinate in [0, M]
     if (u > upper_end) continue;
 

@@ -18,6 +18,7 @@
 #include <limits>
 #include <numbers>
 
+#include "afmkit/core/numbers.hpp"
 #include "spectra_detail.hpp"
 
 namespace afmkit::control {
@@ -25,12 +26,12 @@ namespace afmkit::control {
 using spectra_detail::LoopView;
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using afmkit::numbers::infinity;
 
 double inv_plant_factor(PlantKind kind, double rate, double re_min, double im_abs_min) {
   if (kind == PlantKind::Static) return 1.0;
   const double lower = std::max(im_abs_min, rate + re_min);  // |γ + s| ≥ …
-  return lower > 0.0 ? rate / lower : kInf;
+  return lower > 0.0 ? rate / lower : infinity;
 }
 
 // Upper bound of |c_N/c_D| for Re s ≥ re_min, |Im s| ≥ im_abs_min.
@@ -112,8 +113,8 @@ std::optional<double> neutral_spectrum_bound(const LoopSpec& loop) {
   if (!v.infinite) return std::nullopt;
   const double pi = std::numbers::pi, omega = v.infinite->rotation_frequency;
   const double a4 = 1.0 + pi * v.infinite->alpha / omega, b4 = 1.0 - pi * v.infinite->alpha / omega;
-  if (a4 == 0.0) return kInf;
-  if (b4 == 0.0) return -kInf;
+  if (a4 == 0.0) return infinity;
+  if (b4 == 0.0) return -infinity;
   return std::log(std::abs(b4 / a4)) / (2.0 * pi / omega);
 }
 

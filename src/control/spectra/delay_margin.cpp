@@ -9,6 +9,7 @@
 #include <boost/math/tools/toms748_solve.hpp>
 #include <fmt/format.h>
 
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/control/spectrum.hpp"
 #include "afmkit/control/stability_tau0.hpp"
 #include "afmkit/core/error.hpp"
@@ -21,14 +22,14 @@ namespace afmkit::control {
 using spectra_detail::cplx;
 
 namespace {
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using afmkit::numbers::two_pi;
+using afmkit::numbers::infinity;
 
 // τ0 ∈ (0, 2π/ν]: the smallest positive delay with e^{−iντ} = w.
 DelayCrossing crossing_from_phase(double nu, cplx w) {
-  double t = std::fmod(-std::arg(w), kTwoPi);
-  if (t <= 1e-14) t += kTwoPi;
-  return {nu, t / nu, kTwoPi / nu};
+  double t = std::fmod(-std::arg(w), two_pi);
+  if (t <= 1e-14) t += two_pi;
+  return {nu, t / nu, two_pi / nu};
 }
 
 bool is_single_oscillator(const LoopSpec& loop) {
@@ -163,7 +164,7 @@ DelayMargin delay_margin(const LoopSpec& loop, const MarginOptions& o) {
     m.crossings = delay_crossings(loop, o);
   }
   const double ref = m.reference_delay;
-  m.upper = kInf;
+  m.upper = infinity;
   m.lower = 0.0;
   bool lower_found = false;
   for (const auto& c : m.crossings) {

@@ -8,12 +8,9 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
 #include "afmkit/impact/laws/contact_laws.hpp"
+#include "law_units.hpp"
 
 namespace afmkit::impact {
-
-namespace {
-constexpr double joule_per_nm_in_nN = 1e18;  // 1 J / 1 nm = 1e18 nN
-}
 
 AdhesionHysteresisLaw::AdhesionHysteresisLaw(double e, double r, double hamaker, double a0, double gamma,
                                              bool allow_gain)

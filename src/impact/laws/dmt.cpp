@@ -8,6 +8,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
 #include "afmkit/impact/force_law.hpp"
+#include "law_units.hpp"
 
 namespace afmkit::impact {
 
@@ -37,7 +38,6 @@ void DmtLaw::require_dissipative() const {
 }
 
 namespace {
-constexpr double joule_per_nm_in_nN = 1e18;  // 1 J / 1 nm = 1e9 N = 1e18 nN
 
 // force in nN for gap d [nm], modulus [GPa], radius [nm], Hamaker [J]
 double dmt(double d, double modulus, double radius, double hamaker, double a0) {
@@ -53,7 +53,6 @@ double dmt(double d, double modulus, double radius, double hamaker, double a0) {
 ///                                                      -> ΔA R/(6a0²)(u − lo) + (8/15) ΔE √R ((a0−lo)^{5/2} − (a0−u)^{5/2})
 ///           with u = min(hi, a0).
 double dmt_area(const DmtLaw& m, double lo, double hi) {
-  constexpr double joule_per_nm_in_nN = 1e18;
   const double a0 = m.intermolecular_distance, r = m.tip_radius;
   const double da = (m.hamaker_departure - m.hamaker_approach) * joule_per_nm_in_nN;
   const double de = m.effective_modulus_approach - m.effective_modulus_departure;

@@ -10,15 +10,11 @@
 #include "afmkit/core/input_file.hpp"
 #include "binary_readers.hpp"
 #include "text_reader.hpp"
+#include "text_table.hpp"
 
 namespace afmkit::io::curves {
 
 namespace {
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 std::string extension_of(const std::string& path) {
   const auto slash = path.find_last_of('/');
@@ -30,7 +26,7 @@ std::string extension_of(const std::string& path) {
 // The format of `bytes` when the options say "auto": the content first (a zip archive is a JPK file, an Igor
 // binary wave starts with its version), then the extension.
 std::string detect_format(std::string_view bytes, const std::string& extension) {
-  const std::string ext = lower(extension);
+  const std::string ext = detail::lower(extension);
   if (bytes.size() >= 4 && bytes.substr(0, 4) == std::string_view("PK\x03\x04", 4)) return "jpk-force";
   if (ext == ".jpk-force" || ext == ".jpk-force-map" || ext == ".jpk-qi-data") return "jpk-force";
   // An Igor binary wave: version 5 (either byte order) in its first two bytes and room for its headers.

@@ -1,4 +1,5 @@
 #include "text_presets.hpp"
+#include "text_table.hpp"
 
 #include <array>
 #include <cctype>
@@ -32,12 +33,6 @@ Role role(const char* name, std::vector<Candidate> candidates, const std::vector
 MetadataKey key(MetadataKey::Target target, std::string name) {
   MetadataKey k{target, std::move(name), 1.0, false, std::nullopt};
   return k;
-}
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
 }
 
 // The roles every preset has unless it says otherwise (not required, no candidates).

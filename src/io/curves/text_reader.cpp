@@ -20,12 +20,6 @@ namespace afmkit::io::curves::detail {
 
 namespace {
 
-std::string lower(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return out;
-}
-
 // A header cell split into its name and unit: "Height (nm)", "Defl [V]", "Calc_Ramp_Ex_nm" (the unit among the
 // '_'-separated words: "Defl_nm_Ex" -> "Defl_Ex", "nm"), "Height/nm", "Z-Sense(nm)"; no unit: "Height".
 struct HeaderCell {

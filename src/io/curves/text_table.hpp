@@ -47,6 +47,9 @@ std::vector<std::string_view> split_cells(std::string_view line, char separator)
 /// `s` without leading and trailing blanks (space, tab, CR).
 std::string_view trim(std::string_view s);
 
+/// `s` in lower case (ASCII letters only: headers, units, extensions).
+std::string lower(std::string_view s);
+
 /// Parses one cell: true with the value (NaN for an empty cell or "nan"), false when it is not a number.
 bool parse_cell(std::string_view cell, bool decimal_comma, double& value);
 

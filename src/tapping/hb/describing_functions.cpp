@@ -13,7 +13,7 @@ namespace afmkit::tapping {
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;  // (a using-declaration: repeatable in a unity build)
 constexpr double series_threshold = 0.5;  // contact angle below which the cancelling differences use series
 
 // Series of the two cancelling differences, in x = a²:

@@ -16,7 +16,7 @@ namespace afmkit::tapping::detail {
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;  // (a using-declaration: repeatable in a unity build)
 constexpr double u_far = 14.5;         // q_c ≈ cosh(14.5) ≈ 1e6: far end of the free branch (u = −u_far)
 constexpr double u_deep = 9.9;         // q_c ≈ −cosh(9.9) ≈ −1e4: deepest permanent contact traced (u = π + u_deep)
 constexpr double f_tolerance = 1e-13;  // |F| accepted as a root (F is relative to Γ)

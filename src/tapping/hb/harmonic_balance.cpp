@@ -19,7 +19,7 @@ namespace afmkit::tapping {
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;  // (a using-declaration: repeatable in a unity build)
 // Scan grid. Contact angle a = arccos q: node at a = 0 (grazing), log grid on [1e-8, 0.3] (1 − q ≈ a²/2 down
 // to 5e-17, i.e. q = 1 to double precision), uniform grid on [0.3, π]. Permanent contact: q = −10^(k/40),
 // k = 0 … 280 (down to q = −1e7; l is then within ~1e-7 (relative) of its limit E8; further out dl/dq ~ 1/q² is

@@ -18,7 +18,7 @@ namespace afmkit::tapping {
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;  // (a using-declaration: repeatable in a unity build)
 
 const impact::PiecewiseLinearLaw& require_repulsive(const TappingModel& model, const char* equation) {
   const impact::PiecewiseLinearLaw& law = require_piecewise_linear(model.law);

@@ -12,7 +12,7 @@ namespace afmkit::tapping {
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;  // (a using-declaration: repeatable in a unity build)
 
 // A point of the q-axis with the bar functions and their derivatives in the curve parameter θ.
 struct Location {

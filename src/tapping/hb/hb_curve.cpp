@@ -55,7 +55,7 @@ void for_each_sample(const HbCurveOptions& o, Visit visit) {
   }
 }
 
-HbPoint to_point(const HbBranchEvaluation& e, HbBranch branch) {
+HbPoint curve_point(const HbBranchEvaluation& e, HbBranch branch) {
   return {e.q, e.separation, e.amplitude, e.offset, e.phase, branch};
 }
 
@@ -93,8 +93,8 @@ void curve_of_checked(const TappingModel& model, const HbCurveOptions& options, 
       return;
     }
     const HbRoots roots = evaluate_branches_at_gap(c, gap, false);
-    if (roots.plus.exists) out[n_plus++] = to_point(roots.plus, HbBranch::Plus);
-    if (options.include_minus && roots.minus.exists) out[n + n_minus++] = to_point(roots.minus, HbBranch::Minus);
+    if (roots.plus.exists) out[n_plus++] = curve_point(roots.plus, HbBranch::Plus);
+    if (options.include_minus && roots.minus.exists) out[n + n_minus++] = curve_point(roots.minus, HbBranch::Minus);
   });
   std::copy(out.begin() + static_cast<std::ptrdiff_t>(n), out.begin() + static_cast<std::ptrdiff_t>(n + n_minus),
             out.begin() + static_cast<std::ptrdiff_t>(n_plus));

@@ -17,7 +17,7 @@ namespace afmkit::tapping {
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;  // (a using-declaration: repeatable in a unity build)
 constexpr int rule_points = 31;  // Kronrod nodes per panel (the 15-point Gauss rule embedded)
 constexpr int rule_half = (rule_points + 1) / 2;  // abscissae x_0 = 0 < x_1 < … (each ±)
 constexpr int hard_panel_limit = 1024;

@@ -16,6 +16,7 @@
 #include "afmkit/core/validate.hpp"
 #include "afmkit/tapping/continuation.hpp"
 #include "afmkit/tapping/observer.hpp"
+#include "phase_space.hpp"
 
 namespace afmkit::tapping {
 
@@ -108,9 +109,6 @@ OrbitMetrics analyse_orbit(const TappingModel& model, const PeriodicOrbit& orbit
 
 namespace {
 
-double distance(TipState a, TipState b, double omega) {
-  return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
-}
 
 /// Same orbit: one of the n stroboscopic points of `a` coincides with b.initial.
 bool same_orbit(const TappingModel& model, const PeriodicOrbit& a, const PeriodicOrbit& b, double tol,
@@ -120,7 +118,7 @@ bool same_orbit(const TappingModel& model, const PeriodicOrbit& a, const Periodi
   const double scale = std::max({1.0, std::hypot(a.initial.position, a.initial.velocity / omega)});
   TipState p = a.initial;
   for (int j = 0; j < a.period_multiple; ++j) {
-    if (distance(p, b.initial, omega) <= tol * scale) return true;
+    if (detail::phase_distance(p, b.initial, omega) <= tol * scale) return true;
     if (j + 1 < a.period_multiple) p = simulate(model, 0.0, p, model.period(), sim).state;
   }
   return false;

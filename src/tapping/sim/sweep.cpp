@@ -15,6 +15,7 @@
 #include "afmkit/core/parallel.hpp"
 #include "afmkit/core/validate.hpp"
 #include "sweep_points.hpp"
+#include "phase_space.hpp"
 
 namespace afmkit::tapping {
 
@@ -59,10 +60,6 @@ void attach_harmonic_balance(const TappingModel& base, SweepPoint& point) {
 
 namespace {
 
-double distance(TipState a, TipState b, double omega) {
-  return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
-}
-double magnitude(TipState a, double omega) { return std::hypot(a.position, a.velocity / omega); }
 /// The length scale of the sweep's tolerances: the free amplitude.
 double base_amplitude(const TappingModel& model) { return std::max(model.free_amplitude(), 1e-300); }
 
@@ -287,9 +284,9 @@ bool connects_back(const TappingModel& model, const PeriodicOrbit& p, const Peri
                    const SweepOptions& options) {
   const double omega = model.drive.frequency;
   const auto back = follow_stable_branch(model, p, previous.separation, options).reached;
-  const double scale = std::max(1.0, magnitude(previous.initial, omega));
+  const double scale = std::max(1.0, detail::phase_magnitude(previous.initial, omega));
   return back && back->period_multiple == previous.period_multiple &&
-         distance(back->initial, previous.initial, omega) <= 1e-6 * scale;
+         detail::phase_distance(back->initial, previous.initial, omega) <= 1e-6 * scale;
 }
 
 SweepJump make_jump(double separation, double tolerance, SweepDirection direction, bool located,

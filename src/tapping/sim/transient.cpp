@@ -8,6 +8,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
+#include "phase_space.hpp"
 
 namespace afmkit::tapping {
 
@@ -25,10 +26,6 @@ const char* response_kind_name(ResponseKind kind) {
 
 namespace {
 
-double distance(TipState a, TipState b, double omega) {
-  return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
-}
-double magnitude(TipState a, double omega) { return std::hypot(a.position, a.velocity / omega); }
 
 }  // namespace
 
@@ -65,14 +62,14 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
     advance(options.chunk_periods);
     if (options.on_periods) options.on_periods(options.chunk_periods);
     const int last = static_cast<int>(strobe.size()) - 1;
-    const double scale = std::max(1e-9, magnitude(y, omega));
+    const double scale = std::max(1e-9, detail::phase_magnitude(y, omega));
     if (candidate) {
       // verify the capture: the distance to the candidate orbit point of the same phase keeps decreasing
       const int n = candidate->period_multiple;
       double d = 1e300;
       TipState p = candidate->initial;
       for (int j = 0; j < n; ++j) {
-        d = std::min(d, distance(y, p, omega));
+        d = std::min(d, detail::phase_distance(y, p, omega));
         p = simulate(model, 0.0, p, period, sim).state;
       }
       if (d < candidate_distance || d <= 1e3 * shooting.tolerance * scale) {
@@ -86,7 +83,7 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
     }
     // stroboscopic differences over n periods suggest which period to look for
     std::vector<double> diff(nmax + 1, 1e300);
-    for (int n = 1; n <= nmax && n <= last; ++n) diff[n] = distance(strobe[last], strobe[last - n], omega);
+    for (int n = 1; n <= nmax && n <= last; ++n) diff[n] = detail::phase_distance(strobe[last], strobe[last - n], omega);
     for (int n = 1; n <= nmax && n <= last; ++n) {
       if (n > 1 && !(diff[n] < 0.5 * diff[1])) continue;
       std::optional<PeriodicOrbit> orbit;
@@ -96,7 +93,7 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
         orbit.reset();
       }
       if (!orbit) continue;
-      const double d = distance(y, orbit->initial, omega);
+      const double d = detail::phase_distance(y, orbit->initial, omega);
       // The simulated response itself repeats after n periods to the shooting tolerance (e.g. a tip resting in
       // the sticking mode: neutrally stable, multipliers 1 and 0): it is that orbit, whatever its multipliers.
       if (diff[n] <= 100.0 * shooting.tolerance * scale && d <= 100.0 * shooting.tolerance * scale) {
@@ -107,7 +104,7 @@ TransientOutcome settle(const TappingModel& model, TipState start, const Transie
         return out;
       }
       if (!orbit->stable) continue;
-      if (d <= options.capture_distance * std::max(scale, magnitude(orbit->initial, omega))) {
+      if (d <= options.capture_distance * std::max(scale, detail::phase_magnitude(orbit->initial, omega))) {
         candidate = orbit;
         candidate_distance = d;
         break;
