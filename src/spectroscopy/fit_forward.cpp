@@ -45,10 +45,6 @@ Point settle_at(const TappingModel& m, tapping::TipState start, const tapping::S
   return p;
 }
 
-double state_distance(tapping::TipState a, tapping::TipState b, double omega) {
-  return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
-}
-
 /// Where the tip lands when the followed branch ends just before m.separation. The transient from the last stable
 /// orbit decides (as in the sweep), unless Newton from the harmonic-balance solutions at m.separation finds exactly
 /// one stable orbit: then no other attractor of period 1 exists there and the transient would end on it (it may
@@ -114,6 +110,10 @@ Point step(const TappingModel& base, const Point& prev, double l_to, const tappi
 
 }  // namespace
 
+double state_distance(tapping::TipState a, tapping::TipState b, double omega) {
+  return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
+}
+
 AmForwardModel::AmForwardModel(const FitSettings& settings, const FitOptions& options, std::vector<double> distances)
     : settings_(settings), options_(options), distances_(std::move(distances)) {
   sweep_.harmonic_balance = false;
@@ -122,22 +122,26 @@ AmForwardModel::AmForwardModel(const FitSettings& settings, const FitOptions& op
   sweep_.shooting.tolerance = options.shooting_tolerance;
 }
 
-TappingModel AmForwardModel::model(const ModelValues& values) const {
+impact::ForceLaw build_law(const FitOptions& options, const ModelValues& values) {
   const impact::LawRegistry registry = impact::LawRegistry::builtin();
   impact::LawArguments args;
-  args.force_curve = options_.force_curve;
-  args.allow_energy_gain = options_.allow_energy_gain;
+  args.force_curve = options.force_curve;
+  args.allow_energy_gain = options.allow_energy_gain;
   for (const auto& [key, value] : values.law) {
     double f = 1.0;
     for (const auto& k : registry.keys())
       if (k.key == key) f = law_unit_to_si(k.unit);
     args.values[key] = value / f;  // registry units (nm, GPa, nN, J, ...)
   }
+  return registry.build(options.law, args);
+}
+
+TappingModel AmForwardModel::model(const ModelValues& values) const {
   const double drive = settings_.drive_frequency > 0.0 ? settings_.drive_frequency : settings_.resonance_frequency;
   const tapping::PhysicalCantilever pc(settings_.spring_constant, settings_.resonance_frequency * 1e-3,
                                        settings_.quality_factor, settings_.free_amplitude * values.amplitude_scale * 1e9,
                                        drive / settings_.resonance_frequency);
-  return TappingModel(pc.cantilever(), pc.drive(), pc.normalised_law(registry.build(options_.law, args)), 0.0);
+  return TappingModel(pc.cantilever(), pc.drive(), pc.normalised_law(build_law(options_, values)), 0.0);
 }
 
 double AmForwardModel::separation(const ModelValues& values, std::size_t i) const {
