@@ -164,3 +164,40 @@ TEST(FitFm, RefusesWhatCannotBeFitted) {
   o.parameters = {"hamaker", "effective_modulus", "distance_offset"};  // 3 parameters, 3 residuals
   EXPECT_THROW(fit_fm_curve(c, settings(), o), InvalidParameter);
 }
+
+#include "afmkit/spectroscopy/fit_input.hpp"
+
+TEST(FitFmInput, TheFrequencyShiftColumnMakesAnFmCurve) {
+  const FitCurveFile f =
+      parse_fit_curve("# FM\ndistance (nm); frequency shift (kHz); dissipation (eV)\n10; -0.002; 0.5\n8; -0.01; 1\n"
+                      "6; -0.1; 2\n",
+                      "fm.csv");
+  ASSERT_EQ(f.mode, FitMode::fm);
+  ASSERT_EQ(f.fm.distance.size(), 3u);
+  EXPECT_DOUBLE_EQ(f.fm.distance[1], 8e-9);
+  EXPECT_DOUBLE_EQ(f.fm.frequency_shift[2], -100.0);
+  EXPECT_DOUBLE_EQ(f.fm.dissipation[0], 0.5 * 1.602176634e-19);
+  EXPECT_TRUE(f.am.distance.empty());
+  const FitCurveFile g = parse_fit_curve("z_pm df_mHz\n1000 -500\n900 -600\n800 -700\n", "b");
+  EXPECT_EQ(g.mode, FitMode::fm);
+  EXPECT_DOUBLE_EQ(g.fm.frequency_shift[1], -0.6);
+  EXPECT_TRUE(g.fm.dissipation.empty());
+  EXPECT_EQ(parse_fit_curve("distance (nm), amplitude (nm)\n1, 2\n2, 3\n3, 4\n", "a").mode, FitMode::am);
+  const auto message = [](const std::string& text) {
+    try {
+      parse_fit_curve(text, "f.csv");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message("distance (nm), df (Hz)\n1, -2\n2, nan\n3, -4\n").substr(0, 10), "f.csv:3:4:");
+  EXPECT_NE(message("distance (nm), amplitude (nm), df (Hz)\n1, 2, 3\n").find("f.csv:1:32: both an amplitude"),
+            std::string::npos);
+  EXPECT_NE(message("distance (nm), df (Hz), phase (deg)\n1, 2, 3\n").find("f.csv:1:25: a phase column in an FM"),
+            std::string::npos);
+  EXPECT_NE(message("distance (nm), df (V)\n1, 2\n").find("f.csv:1:16: column 'df (V)': unknown frequency unit"),
+            std::string::npos);
+  EXPECT_NE(message("distance (nm), df (Hz)\n1, 2\n2, 3\n").find("at least 3"), std::string::npos);
+  EXPECT_THROW(parse_am_curve("distance (nm), df (Hz)\n1, 2\n2, 3\n3, 4\n", "x"), InputError);
+}
