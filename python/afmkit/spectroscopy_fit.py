@@ -122,35 +122,41 @@ def _settings(spring_constant, resonance_frequency, quality_factor, free_amplitu
                 drive_frequency=0.0 if drive_frequency is None else float(drive_frequency))
 
 
-def fit(distance, amplitude, phase=None, *, law: str = "dmt", parameters=DEFAULT_PARAMETERS, initial=None,
-        fixed=None, spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency=None,
-        direction: str = "approach", amplitude_noise: float = 0.0, phase_noise: float = 0.0, huber: float = 5.0,
-        force_curve: str = "",
-        allow_energy_gain: bool = False, fd_step: float = 1e-3, max_evaluations: int = 100,
-        tolerance: float = 1e-4, integrator_tolerance: float = 1e-9, shooting_tolerance: float = 1e-10,
-        correlation_limit: float = 0.99, condition_limit: float = 1e10, flat_column: float = 1e-3,
-        parallel: bool = True) -> FitResult:
+def _options(law="dmt", parameters=DEFAULT_PARAMETERS, initial=None, fixed=None, direction="approach",
+             huber=5.0, force_curve="", allow_energy_gain=False, fd_step=1e-3, max_evaluations=100, tolerance=1e-4,
+             integrator_tolerance=1e-9, shooting_tolerance=1e-10, correlation_limit=0.99, condition_limit=1e10,
+             flat_column=1e-3, parallel=True) -> dict:
+    """The options :func:`fit` and :func:`fit_fm` share, with their defaults (docs/fitting.md)."""
+    return dict(law=str(law), parameters=[str(p) for p in parameters], initial=dict(initial or {}),
+                fixed=dict(fixed or {}), direction=str(direction), huber=float(huber), force_curve=str(force_curve),
+                allow_energy_gain=bool(allow_energy_gain), fd_step=float(fd_step),
+                max_evaluations=int(max_evaluations), tolerance=float(tolerance),
+                integrator_tolerance=float(integrator_tolerance), shooting_tolerance=float(shooting_tolerance),
+                correlation_limit=float(correlation_limit), condition_limit=float(condition_limit),
+                flat_column=float(flat_column), parallel=bool(parallel))
+
+
+def fit(distance, amplitude, phase=None, *, spring_constant, resonance_frequency, quality_factor, free_amplitude,
+        drive_frequency=None, amplitude_noise: float = 0.0, phase_noise: float = 0.0, **options) -> FitResult:
     """Weighted nonlinear least squares of a law (and calibration) to an AM-AFM curve, SI units throughout.
 
     distance [m], amplitude [m], phase [rad] (phase lag, pi/2 at resonance; None: amplitude only): 1-D arrays.
-    parameters: the fitted names (law keys, distance_offset [m], amplitude_scale, phase_offset [rad]).
-    initial: initial values of fitted parameters and fixed calibration values (SI); fixed: the law's other values
-    (SI: hamaker J, effective_modulus Pa, tip_radius m, ...). spring_constant [N/m], resonance_frequency [Hz],
-    quality_factor, free_amplitude [m], drive_frequency [Hz] (None: at resonance). amplitude_noise (A/A0) and
-    phase_noise [rad]: 0 estimates them from the data; huber: Huber's loss beyond this many σ (0: least squares). Raises afmkit.InvalidParameter on bad input and
-    afmkit.NumericalFailure when the model fails at the initial values; a fit that does not converge returns
-    status "not_converged".
+    spring_constant [N/m], resonance_frequency [Hz], quality_factor, free_amplitude [m], drive_frequency [Hz] (None:
+    at resonance). amplitude_noise (A/A0) and phase_noise [rad]: 0 estimates them from the data. Options (keyword):
+    law ("dmt"); parameters: the fitted names (law keys, distance_offset [m], amplitude_scale, phase_offset [rad];
+    default hamaker, effective_modulus, distance_offset, phase_offset); initial: initial values of fitted parameters
+    and fixed calibration values (SI); fixed: the law's other values (SI: hamaker J, effective_modulus Pa,
+    tip_radius m, ...); direction ("approach" or "retract"); huber (5: Huber's loss beyond this many σ, 0: least
+    squares); force_curve, allow_energy_gain; fd_step (1e-3), max_evaluations (100), tolerance (1e-4),
+    integrator_tolerance (1e-9), shooting_tolerance (1e-10), correlation_limit (0.99), condition_limit (1e10),
+    flat_column (1e-3), parallel (True). Raises afmkit.InvalidParameter on bad input and afmkit.NumericalFailure when
+    the model fails at the initial values; a fit that does not converge returns status "not_converged".
     """
     raw = _afmkit.spectroscopy_fit(
         np.asarray(distance, dtype=float), np.asarray(amplitude, dtype=float),
-        None if phase is None else np.asarray(phase, dtype=float), law, list(parameters), dict(initial or {}),
-        dict(fixed or {}), force_curve, bool(allow_energy_gain),
+        None if phase is None else np.asarray(phase, dtype=float),
         **_settings(spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency),
-        direction=direction, amplitude_noise=float(amplitude_noise), phase_noise=float(phase_noise),
-        huber=float(huber), fd_step=float(fd_step), max_evaluations=int(max_evaluations), tolerance=float(tolerance),
-        integrator_tolerance=float(integrator_tolerance), shooting_tolerance=float(shooting_tolerance),
-        correlation_limit=float(correlation_limit), condition_limit=float(condition_limit),
-        flat_column=float(flat_column), parallel=bool(parallel))
+        amplitude_noise=float(amplitude_noise), phase_noise=float(phase_noise), options=_options(**options))
     result = _result(raw)
     result.free_amplitude = float(free_amplitude)
     return result
@@ -171,35 +177,39 @@ def _result(raw: dict) -> FitResult:
     return FitResult(**common, **rest)
 
 
-def fit_fm(distance, frequency_shift, dissipation=None, *, law: str = "dmt", parameters=DEFAULT_FM_PARAMETERS,
-           initial=None, fixed=None, spring_constant, resonance_frequency, quality_factor, amplitude,
-           direction: str = "approach", frequency_shift_noise: float = 0.0, dissipation_noise: float = 0.0,
-           huber: float = 5.0, force_curve: str = "", allow_energy_gain: bool = False, fd_step: float = 1e-3,
-           max_evaluations: int = 100, tolerance: float = 1e-4, integrator_tolerance: float = 1e-9,
-           shooting_tolerance: float = 1e-10, correlation_limit: float = 0.99, condition_limit: float = 1e10,
-           flat_column: float = 1e-3, parallel: bool = True) -> FitResult:
+def fit_fm(distance, frequency_shift, dissipation=None, *, spring_constant, resonance_frequency, quality_factor,
+           amplitude, frequency_shift_noise: float = 0.0, dissipation_noise: float = 0.0, **options) -> FitResult:
     """Weighted nonlinear least squares of a law (and calibration) to an FM-AFM curve, SI units throughout.
 
     distance [m], frequency_shift [Hz] (Δf = f − f0 at constant amplitude), dissipation [J per cycle] (None: Δf only):
-    1-D arrays. parameters: the fitted names (law keys, distance_offset [m], frequency_shift_offset [Hz]). initial:
-    initial values of fitted parameters and fixed calibration values (SI); fixed: the law's other values (SI).
-    spring_constant [N/m], resonance_frequency [Hz], quality_factor, amplitude [m] (the oscillation amplitude held
-    by the amplitude loop). frequency_shift_noise [Hz] and dissipation_noise [J]: 0 estimates them from the data.
-    The forward model is the exact FM orbits of ``afmkit tapping fm`` (docs/fitting.md#fm-afm). Raises
-    afmkit.InvalidParameter on bad input and afmkit.NumericalFailure when the model fails at the initial values.
+    1-D arrays. spring_constant [N/m], resonance_frequency [Hz], quality_factor, amplitude [m] (the oscillation
+    amplitude held by the amplitude loop). frequency_shift_noise [Hz] and dissipation_noise [J]: 0 estimates them
+    from the data. Options as :func:`fit`, except parameters: law keys, distance_offset [m] and
+    frequency_shift_offset [Hz] (default hamaker, effective_modulus, distance_offset). The forward model is the
+    exact FM orbits of ``afmkit tapping fm`` (docs/fitting.md#fm-afm). Raises afmkit.InvalidParameter on bad input
+    and afmkit.NumericalFailure when the model fails at the initial values.
     """
+    options.setdefault("parameters", DEFAULT_FM_PARAMETERS)
     raw = _afmkit.spectroscopy_fit_fm(
         np.asarray(distance, dtype=float), np.asarray(frequency_shift, dtype=float),
-        None if dissipation is None else np.asarray(dissipation, dtype=float), law, list(parameters),
-        dict(initial or {}), dict(fixed or {}), force_curve, bool(allow_energy_gain),
+        None if dissipation is None else np.asarray(dissipation, dtype=float),
         spring_constant=float(spring_constant), resonance_frequency=float(resonance_frequency),
-        quality_factor=float(quality_factor), amplitude=float(amplitude), direction=direction,
+        quality_factor=float(quality_factor), amplitude=float(amplitude),
         frequency_shift_noise=float(frequency_shift_noise), dissipation_noise=float(dissipation_noise),
-        huber=float(huber), fd_step=float(fd_step), max_evaluations=int(max_evaluations), tolerance=float(tolerance),
-        integrator_tolerance=float(integrator_tolerance), shooting_tolerance=float(shooting_tolerance),
-        correlation_limit=float(correlation_limit), condition_limit=float(condition_limit),
-        flat_column=float(flat_column), parallel=bool(parallel))
+        options=_options(**options))
     return _result(raw)
+
+
+def predict(distance, *, law: str = "dmt", values=None, calibration=None, spring_constant, resonance_frequency,
+            quality_factor, free_amplitude, drive_frequency=None, direction: str = "approach",
+            force_curve: str = "", allow_energy_gain: bool = False) -> dict:
+    """The fit's forward model: amplitude [m] and phase [rad] at each distance [m] (in the order given), for the law
+    values ``values`` (SI) and the calibration (distance_offset [m], amplitude_scale, phase_offset [rad])."""
+    return _afmkit.spectroscopy_predict(
+        np.asarray(distance, dtype=float), law, dict(values or {}), dict(calibration or {}), force_curve,
+        bool(allow_energy_gain),
+        **_settings(spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency),
+        direction=direction)
 
 
 def predict_fm(distance, *, law: str = "dmt", values=None, calibration=None, spring_constant, resonance_frequency,
@@ -213,18 +223,6 @@ def predict_fm(distance, *, law: str = "dmt", values=None, calibration=None, spr
         bool(allow_energy_gain), spring_constant=float(spring_constant),
         resonance_frequency=float(resonance_frequency), quality_factor=float(quality_factor),
         amplitude=float(amplitude), direction=direction)
-
-
-def predict(distance, *, law: str = "dmt", values=None, calibration=None, spring_constant, resonance_frequency,
-            quality_factor, free_amplitude, drive_frequency=None, direction: str = "approach",
-            force_curve: str = "", allow_energy_gain: bool = False) -> dict:
-    """The fit's forward model: amplitude [m] and phase [rad] at each distance [m] (in the order given), for the law
-    values ``values`` (SI) and the calibration (distance_offset [m], amplitude_scale, phase_offset [rad])."""
-    return _afmkit.spectroscopy_predict(
-        np.asarray(distance, dtype=float), law, dict(values or {}), dict(calibration or {}), force_curve,
-        bool(allow_energy_gain),
-        **_settings(spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency),
-        direction=direction)
 
 
 def _draw(distance_nm, panels, title, path):

@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
-#include "afmkit/core/parallel.hpp"
 #include "afmkit/spectroscopy/fit_model.hpp"
 #include "afmkit/tapping/units.hpp"
 
@@ -100,34 +99,26 @@ FmCurveEvaluation FmForwardModel::warm(const ModelValues& values, const FmCurveE
   e.jacobians = from.jacobians;
   e.jumped.assign(n, false);
   const double a = s.amplitude;
-  std::atomic<bool> failed{false};
   std::atomic<long> solves{0};
-  ExceptionCollector errors;
-#pragma omp parallel for schedule(dynamic) if (options_.parallel)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (failed.load()) continue;
-    errors.run([&] {
-      const tapping::FmOrbit& old = from.orbits[i];
-      ++solves;
-      std::optional<tapping::FmOrbit> o;
-      try {
-        o = tapping::try_solve_fm(s, separation(values, i), old.state, quick, &e.jacobians[i]);
-      } catch (const NumericalFailure&) {
-        o.reset();
-      }
-      // the same branch: near the previous orbit in state and frequency (a small change of the values moves the
-      // orbit a little; another branch is a finite distance away)
-      const bool near = o && state_distance(o->state.initial, old.state.initial, old.state.frequency) <= 0.05 * a &&
-                        std::abs(o->state.frequency - old.state.frequency) <= 0.05 * old.state.frequency;
-      if (!near) {
-        failed = true;
-        return;
-      }
-      e.orbits[i] = *o;
-    });
-  }
+  const bool all = each_point(n, options_.parallel, [&](std::size_t i) {
+    const tapping::FmOrbit& old = from.orbits[i];
+    ++solves;
+    std::optional<tapping::FmOrbit> o;
+    try {
+      o = tapping::try_solve_fm(s, separation(values, i), old.state, quick, &e.jacobians[i]);
+    } catch (const NumericalFailure&) {
+      o.reset();
+    }
+    // the same branch: near the previous orbit in state and frequency (a small change of the values moves the
+    // orbit a little; another branch is a finite distance away)
+    const bool near = o && state_distance(o->state.initial, old.state.initial, old.state.frequency) <= 0.05 * a &&
+                      std::abs(o->state.frequency - old.state.frequency) <= 0.05 * old.state.frequency;
+    if (!near) return false;
+    e.orbits[i] = *o;
+    return true;
+  });
   orbits_ += solves.load();
-  if (errors.failed() || failed.load()) return walk(values);
+  if (!all) return walk(values);
   finish(e);
   return e;
 }

@@ -240,50 +240,42 @@ CurveEvaluation AmForwardModel::warm(const ModelValues& values, const CurveEvalu
   plain.sensitivity = false;
   const double omega = m.drive.frequency;
   const double amplitude = m.free_amplitude();
-  std::atomic<bool> failed{false};
   std::atomic<long> solves{0};
-  ExceptionCollector errors;
-#pragma omp parallel for schedule(dynamic) if (options_.parallel)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (failed.load()) continue;
-    errors.run([&] {
-      const PeriodicOrbit& old = from.orbits[i];
-      const TappingModel at = m.with_separation(separation(values, i));
-      ++solves;
-      std::optional<PeriodicOrbit> o;
-      if (chord) {
-        // one chord-Newton step with the monodromy of `old`: z' = z − (M − I)⁻¹ (P'(z) − z), off the perturbed
-        // orbit by O(|z' − z|²), the order of the forward difference's own error (docs/fitting.md#jacobian)
-        const int k = old.period_multiple;
-        const tapping::SimulationResult r = tapping::simulate(at, 0.0, old.initial, k * at.period(), plain);
-        const Eigen::Vector2d res(r.state.position - old.initial.position, r.state.velocity - old.initial.velocity);
-        const Eigen::Vector2d dz = (old.monodromy - Eigen::Matrix2d::Identity()).fullPivLu().solve(-res);
-        if (dz.allFinite() && std::hypot(dz.x(), dz.y() / omega) <= 0.01 * amplitude) {
-          o = old;
-          o->initial = {old.initial.position + dz.x(), old.initial.velocity + dz.y()};
-        }
+  const bool all = each_point(n, options_.parallel, [&](std::size_t i) {
+    const PeriodicOrbit& old = from.orbits[i];
+    const TappingModel at = m.with_separation(separation(values, i));
+    ++solves;
+    std::optional<PeriodicOrbit> o;
+    if (chord) {
+      // one chord-Newton step with the monodromy of `old`: z' = z − (M − I)⁻¹ (P'(z) − z), off the perturbed
+      // orbit by O(|z' − z|²), the order of the forward difference's own error (docs/fitting.md#jacobian)
+      const int k = old.period_multiple;
+      const tapping::SimulationResult r = tapping::simulate(at, 0.0, old.initial, k * at.period(), plain);
+      const Eigen::Vector2d res(r.state.position - old.initial.position, r.state.velocity - old.initial.velocity);
+      const Eigen::Vector2d dz = (old.monodromy - Eigen::Matrix2d::Identity()).fullPivLu().solve(-res);
+      if (dz.allFinite() && std::hypot(dz.x(), dz.y() / omega) <= 0.01 * amplitude) {
+        o = old;
+        o->initial = {old.initial.position + dz.x(), old.initial.velocity + dz.y()};
       }
-      if (!o) {
-        try {
-          o = tapping::try_shoot(at, old.initial, old.period_multiple, quick);
-        } catch (const NumericalFailure&) {
-          o.reset();
-        }
+    }
+    if (!o) {
+      try {
+        o = tapping::try_shoot(at, old.initial, old.period_multiple, quick);
+      } catch (const NumericalFailure&) {
+        o.reset();
       }
-      // the same branch: stable, of the same period, and near the previous orbit (a small change of the values
-      // moves the orbit a little; another branch is a finite distance away)
-      const bool near = o && o->stable && o->period_multiple == old.period_multiple &&
-                        state_distance(o->initial, old.initial, omega) <= 0.05 * amplitude;
-      if (!near) {
-        failed = true;
-        return;
-      }
-      e.orbits[i] = *o;
-      e.orbits[i].separation = at.separation;
-    });
-  }
+    }
+    // the same branch: stable, of the same period, and near the previous orbit (a small change of the values
+    // moves the orbit a little; another branch is a finite distance away)
+    const bool near = o && o->stable && o->period_multiple == old.period_multiple &&
+                      state_distance(o->initial, old.initial, omega) <= 0.05 * amplitude;
+    if (!near) return false;
+    e.orbits[i] = *o;
+    e.orbits[i].separation = at.separation;
+    return true;
+  });
   orbits_ += solves.load();
-  if (errors.failed() || failed.load()) return walk(values);
+  if (!all) return walk(values);
   if (!chord) {
     // where `from` jumped (its branch ended between the points i − 1 and i), the branch must still end there: the
     // orbit at i − 1 followed to l_i must not arrive (else the jump moved past a point: the whole sweep decides)

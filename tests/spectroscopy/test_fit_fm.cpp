@@ -53,6 +53,21 @@ TEST(FitFm, ForwardModelHasTheSmallAmplitudeLimit) {
   }
 }
 
+TEST(FitFm, RetractOfAConservativeLawRetracesTheApproach) {
+  // DMT + vdW at A = 5 nm has no fold along this curve and dissipates nothing: the retract (down to the smallest
+  // distance, then back up through the points) meets the approach's orbits
+  const std::vector<double> z = distances(12);
+  FitOptions o = truth();
+  const FmPrediction approach = predict_fm_curve(z, settings(), o);
+  o.direction = CurveDirection::retract;
+  const FmPrediction retract = predict_fm_curve(z, settings(), o);
+  for (std::size_t i = 0; i < z.size(); ++i) {
+    EXPECT_NEAR(retract.frequency_shift[i], approach.frequency_shift[i], 1e-6 * std::abs(approach.frequency_shift[i]) + 1e-3)
+        << "distance " << z[i];
+    EXPECT_EQ(retract.contact[i], approach.contact[i]);
+  }
+}
+
 TEST(FitFm, DmtEstimatesNearTheTruth) {
   const std::vector<double> z = distances(60);
   const FmPrediction p = predict_fm_curve(z, settings(), truth());

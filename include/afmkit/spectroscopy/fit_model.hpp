@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "afmkit/core/parallel.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
 #include "afmkit/tapping/fm.hpp"
 #include "afmkit/tapping/sweep.hpp"
@@ -25,6 +26,22 @@ double calibration_value(const FitOptions& options, const std::string& name);
 /// p(u) and dp/du of the parameter's transformation (fit.hpp: Transform).
 double to_parameter(const FitParameterInfo& p, double u);
 double parameter_derivative(const FitParameterInfo& p, double u);
+
+/// Runs point(i) for every i < n (OpenMP threads when `parallel`) until one returns false or throws; true when every
+/// point succeeded (a warm-started evaluation: each point from the previous curve's orbit there).
+template <class Point>
+bool each_point(std::size_t n, bool parallel, Point&& point) {
+  std::atomic<bool> failed{false};
+  ExceptionCollector errors;
+#pragma omp parallel for schedule(dynamic) if (parallel)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (failed.load()) continue;
+    errors.run([&] {
+      if (!point(i)) failed = true;
+    });
+  }
+  return !errors.failed() && !failed.load();
+}
 
 /// Every value the model needs (declared below).
 struct ModelValues;
