@@ -3,9 +3,14 @@
 // residuals over a forward model (cached evaluations, warm starts from the best one, Huber's loss, the Jacobian by
 // forward differences), Eigen's Levenberg–Marquardt over it, and the statistics at the estimates. What differs
 // between the fits — the forward model and the residuals of the data — comes in as the Model type and a function.
+#include <algorithm>
+#include <cmath>
 #include <functional>
+#include <limits>
+#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>

@@ -130,7 +130,7 @@ TEST(FitFm, DissipationChannelAndFrequencyShiftOffset) {
   o.law_values = {{"tip_radius", kRadius}, {"effective_modulus", kModulus}, {"hamaker", 0.8e-19},
                   {"departure_hamaker", 1.2e-19}};
   o.parameters = {"hamaker", "departure_hamaker", "frequency_shift_offset"};
-  o.initial = {{"distance_offset", kOffset}};
+  o.initial = {{"distance_offset", kOffset}, {"frequency_shift_offset", 2.0}};
   o.frequency_shift_noise = 1.0;
   o.dissipation_noise = 2e-21;
   o.allow_energy_gain = false;
