@@ -189,6 +189,11 @@ std::string estimates_of(const spectroscopy::FitResult& r, nlohmann::json& resul
   return summary;
 }
 
+/// --plot: data vs fit, drawn by Matplotlib from the table just written (the process becomes the interpreter).
+void draw_plot(const io::ParamSet& p) {
+  if (!p.text("plot").empty()) exec_python_module("_fit_plot", {"--plot", p.text("output"), p.text("plot")});
+}
+
 std::string closing_lines(const spectroscopy::FitResult& r) {
   std::string summary = fmt::format("\n  {} iterations, {} curve evaluations, {} orbit evaluations, {}", r.iterations,
                                     r.curve_evaluations, r.orbit_evaluations, io::quantity(r.seconds, "s", 3));
@@ -261,8 +266,7 @@ void run_fm_fit(const io::ParamSet& p, Captured* capture, const spectroscopy::Fm
                               : std::string());
   summary += closing_lines(r);
   out.finish(results, summary);
-  if (!p.text("plot").empty())  // data vs fit, drawn by Matplotlib from the table just written
-    exec_python_module("spectroscopy_fit", {"--plot", p.text("output"), p.text("plot")});
+  draw_plot(p);
 }
 
 void run_fit(const io::ParamSet& p, Captured* capture) {
@@ -341,8 +345,7 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
                                : std::string());
   summary += closing_lines(r);
   out.finish(results, summary);
-  if (!p.text("plot").empty())  // data vs fit, drawn by Matplotlib from the table just written
-    exec_python_module("spectroscopy_fit", {"--plot", p.text("output"), p.text("plot")});
+  draw_plot(p);
 }
 
 }  // namespace

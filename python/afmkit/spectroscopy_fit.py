@@ -9,7 +9,7 @@ amplitude=...)`` is the same for an FM-AFM curve (Hz, J per cycle). ``predict`` 
 models alone (synthetic data), ``plot`` draws data vs fit (Matplotlib), and ``run`` is the command ``afmkit
 spectroscopy fit`` on a file (keyword arguments are its TOML keys, in the command's units).
 
-Command line: ``python3 -m afmkit.spectroscopy_fit --plot TABLE.csv OUT.png`` draws the plot of a table written by
+Command line: ``python3 -m afmkit._fit_plot --plot TABLE.csv OUT.png`` draws the plot of a table written by
 ``afmkit spectroscopy fit`` (what its ``--plot`` does).
 """
 from __future__ import annotations
@@ -318,7 +318,7 @@ def plot_table(table: str, path: str) -> str:
 
 def _main(argv) -> int:
     if len(argv) != 3 or argv[0] != "--plot":
-        print("usage: python3 -m afmkit.spectroscopy_fit --plot TABLE.csv OUT.png", file=sys.stderr)
+        print("usage: python3 -m afmkit._fit_plot --plot TABLE.csv OUT.png", file=sys.stderr)
         return 2
     try:
         plot_table(argv[1], argv[2])
