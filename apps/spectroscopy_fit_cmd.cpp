@@ -1,6 +1,7 @@
 // afmkit spectroscopy fit: a registered force law (and the calibration: distance offset, amplitude scale, phase
-// offset) fitted to a measured AM-AFM amplitude/phase-versus-distance curve by weighted nonlinear least squares over
-// afmkit's periodic orbits (docs/fitting.md). The plot (--plot) is drawn by the Python package (Matplotlib).
+// offset; FM: distance offset, frequency shift offset) fitted to a measured AM-AFM amplitude/phase-versus-distance
+// curve, or to an FM-AFM frequency-shift (/dissipation) curve — chosen by the file's columns — by weighted nonlinear
+// least squares over afmkit's periodic orbits (docs/fitting.md). The plot (--plot) is drawn by the Python package.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -29,6 +30,24 @@ namespace afmkit::cli {
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kElectronvolt = 1.602176634e-19;  // J
+constexpr const char* kFmParameters = "hamaker,effective_modulus,distance_offset";  // FM default of `parameters`
+
+/// The keys of one mode that the other does not read (refused when given).
+const std::vector<std::string> kAmOnly = {"free_amplitude", "drive_frequency", "amplitude_scale", "phase_offset",
+                                          "amplitude_noise", "phase_noise"};
+const std::vector<std::string> kFmOnly = {"amplitude", "frequency_shift_offset", "frequency_shift_noise",
+                                          "dissipation_noise"};
+
+void refuse_other_mode(const io::ParamSet& p, spectroscopy::FitMode mode) {
+  const bool fm = mode == spectroscopy::FitMode::fm;
+  for (const std::string& key : fm ? kAmOnly : kFmOnly)
+    if (p.was_set(key))
+      throw InvalidParameter(key, fmt::format("{} does not apply to {} curve: file '{}' holds {} (the {} keys are {})",
+                                              key, fm ? "an FM" : "an AM", p.text("file"),
+                                              fm ? "a frequency shift column (FM-AFM)" : "an amplitude column (AM-AFM)",
+                                              fm ? "FM" : "AM", fmt::join(fm ? kFmOnly : kAmOnly, ", ")));
+}
 
 /// The fitted names of `parameters` (comma-separated, blanks ignored).
 std::vector<std::string> parameter_list(const std::string& text) {
@@ -58,14 +77,15 @@ double required(const io::ParamSet& p, const std::string& key, const std::string
 }
 
 /// Every parameter of the run in the options of the library (SI).
-spectroscopy::FitOptions fit_options(const io::ParamSet& p) {
+spectroscopy::FitOptions fit_options(const io::ParamSet& p, spectroscopy::FitMode mode) {
+  const bool fm = mode == spectroscopy::FitMode::fm;
   const impact::LawRegistry registry = impact::LawRegistry::builtin();
   spectroscopy::FitOptions o;
   o.law = p.text("law");
   const impact::LawSpec& spec = registry.find(o.law);
   o.force_curve = p.text("force_curve");
   o.allow_energy_gain = p.flag("allow_energy_gain");
-  o.parameters = parameter_list(p.text("parameters"));
+  o.parameters = parameter_list(fm && !p.was_set("parameters") ? std::string(kFmParameters) : p.text("parameters"));
   for (const auto& k : registry.keys()) {
     const bool reads = std::find(spec.keys.begin(), spec.keys.end(), k.key) != spec.keys.end();
     if (p.was_set(k.key) && !reads)
@@ -76,8 +96,14 @@ spectroscopy::FitOptions fit_options(const io::ParamSet& p) {
       o.law_values[k.key] = p.real(k.key) * spectroscopy::law_unit_to_si(k.unit);
   }
   o.initial["distance_offset"] = p.real("distance_offset") * 1e-9;
-  o.initial["amplitude_scale"] = p.real("amplitude_scale");
-  o.initial["phase_offset"] = p.real("phase_offset") * kDeg;
+  if (fm) {
+    o.initial["frequency_shift_offset"] = p.real("frequency_shift_offset");
+    o.frequency_shift_noise = p.real("frequency_shift_noise");
+    o.dissipation_noise = p.real("dissipation_noise") * kElectronvolt;
+  } else {
+    o.initial["amplitude_scale"] = p.real("amplitude_scale");
+    o.initial["phase_offset"] = p.real("phase_offset") * kDeg;
+  }
   o.direction = p.text("direction") == "retract" ? spectroscopy::CurveDirection::retract
                                                  : spectroscopy::CurveDirection::approach;
   o.amplitude_noise = p.real("amplitude_noise");
@@ -107,14 +133,155 @@ Shown shown(const std::string& si_unit) {
   return {1.0, si_unit};
 }
 
+/// The summary's and the sidecar's account of the estimates, shared by the modes; returns the summary's lines.
+std::string estimates_of(const spectroscopy::FitResult& r, nlohmann::json& results, nlohmann::json& units) {
+  nlohmann::json estimates = nlohmann::json::object();
+  std::vector<std::string> names;
+  std::string summary;
+  for (std::size_t j = 0; j < r.parameters.size(); ++j) {
+    const auto& info = r.parameters[j];
+    const Shown sh = shown(info.unit);
+    names.push_back(info.name);
+    estimates[info.name] = {{"value", r.estimates[j] * sh.factor},
+                            {"standard_error", r.standard_errors[j] * sh.factor},
+                            {"initial", info.initial * sh.factor},
+                            {"identifiable", r.identifiable[j]},
+                            {"transform", spectroscopy::transform_name(info.transform)}};
+    units[info.name] = sh.unit;
+    summary += fmt::format("\n  {} = {} ± {}", info.name, io::quantity(r.estimates[j] * sh.factor, sh.unit),
+                           io::quantity(r.standard_errors[j] * sh.factor, sh.unit));
+  }
+  results["mode"] = spectroscopy::fit_mode_name(r.mode);
+  results["status"] = spectroscopy::fit_status_name(r.status);
+  results["note"] = r.status == spectroscopy::FitStatus::ok
+                        ? std::string()
+                        : fmt::format("the fit did not converge: {} (estimates at the best point found)",
+                                      r.solver_status);
+  results["solver_status"] = r.solver_status;
+  results["estimates"] = estimates;
+  results["parameters"] = names;
+  results["correlation"] = r.correlation;
+  results["warnings"] = r.warnings;
+  results["condition_number"] = r.condition_number;
+  results["reduced_chi2"] = r.reduced_chi2;
+  results["iterations"] = r.iterations;
+  results["curve_evaluations"] = r.curve_evaluations;
+  results["orbit_evaluations"] = r.orbit_evaluations;
+  results["failed_evaluations"] = r.failed_evaluations;
+  results["seconds"] = r.seconds;
+  nlohmann::json law = nlohmann::json::object(), law_units = nlohmann::json::object();
+  for (const auto& [k, v] : r.law_values) law[k] = v;  // SI
+  {
+    const impact::LawRegistry registry = impact::LawRegistry::builtin();
+    for (const auto& k : registry.keys())
+      if (law.contains(k.key)) law_units[k.key] = spectroscopy::law_si_unit(k.unit);
+  }
+  results["law_values"] = law;
+  units["law_values"] = law_units;
+  units["correlation"] = "dimensionless";
+  units["condition_number"] = "dimensionless";
+  units["reduced_chi2"] = "dimensionless";
+  units["seconds"] = "s";
+  units["curve_evaluations"] = "count";
+  units["orbit_evaluations"] = "count";
+  units["failed_evaluations"] = "count";
+  units["iterations"] = "count";
+  return summary;
+}
+
+/// --plot: data vs fit, drawn by Matplotlib from the table just written (the process becomes the interpreter).
+void draw_plot(const io::ParamSet& p) {
+  if (!p.text("plot").empty()) exec_python_module("_fit_plot", {"--plot", p.text("output"), p.text("plot")});
+}
+
+std::string closing_lines(const spectroscopy::FitResult& r) {
+  std::string summary = fmt::format("\n  {} iterations, {} curve evaluations, {} orbit evaluations, {}", r.iterations,
+                                    r.curve_evaluations, r.orbit_evaluations, io::quantity(r.seconds, "s", 3));
+  for (const std::string& w : r.warnings) summary += "\n  warning: " + w;
+  return summary;
+}
+
+/// The FM fit: settings, table and summary of a frequency-shift curve.
+void run_fm_fit(const io::ParamSet& p, Captured* capture, const spectroscopy::FmFitCurve& curve) {
+  spectroscopy::FmFitSettings s;
+  s.spring_constant = required(p, "spring_constant", "N/m");
+  s.resonance_frequency = required(p, "resonance_frequency", "kHz") * 1e3;
+  s.quality_factor = required(p, "quality_factor", "dimensionless");
+  s.amplitude = required(p, "amplitude", "nm, the oscillation amplitude held by the amplitude loop") * 1e-9;
+  s.validate();
+  spectroscopy::FitOptions options = fit_options(p, spectroscopy::FitMode::fm);
+  spectroscopy::fit_parameter_info(options, spectroscopy::FitMode::fm);
+  curve.validate();
+  options.cancellation = cancellation_of(capture);
+  const spectroscopy::FitResult r = spectroscopy::fit_fm_curve(curve, s, options);
+
+  CommandOutput out(p, capture, "spectroscopy fit");
+  const bool diss = !r.dissipation.empty();
+  std::vector<io::Column> columns = {
+      {"distance", "nm", "measured distance (piezo separation; model separation = distance + distance_offset)"},
+      {"frequency_shift", "Hz", "measured frequency shift Δf"},
+      {"fitted_frequency_shift", "Hz", "model frequency shift at the estimates + frequency_shift_offset"},
+      {"frequency_shift_residual", "Hz", "measured − fitted frequency shift"}};
+  if (diss) {
+    columns.push_back({"dissipation", "eV", "measured energy dissipated per cycle"});
+    columns.push_back({"fitted_dissipation", "eV", "model energy taken by the tip–sample force per cycle"});
+    columns.push_back({"dissipation_residual", "eV", "measured − fitted dissipation"});
+  }
+  columns.push_back({"contact", "boolean (0/1)", "the orbit reaches the law's contact gap"});
+  columns.push_back({"jumped", "boolean (0/1)", "the FM orbit was reached past a fold of the branch"});
+  out.open(columns);
+  for (std::size_t i = 0; i < r.distance.size(); ++i) {
+    const double rf = r.frequency_shift[i] - r.fitted_frequency_shift[i];
+    if (diss) {
+      out.row(r.distance[i] * 1e9, r.frequency_shift[i], r.fitted_frequency_shift[i], rf,
+              r.dissipation[i] / kElectronvolt, r.fitted_dissipation[i] / kElectronvolt,
+              (r.dissipation[i] - r.fitted_dissipation[i]) / kElectronvolt, r.contact[i], r.jumped[i]);
+    } else {
+      out.row(r.distance[i] * 1e9, r.frequency_shift[i], r.fitted_frequency_shift[i], rf, r.contact[i], r.jumped[i]);
+    }
+  }
+  nlohmann::json results = nlohmann::json::object(), units = nlohmann::json::object();
+  std::string summary = fmt::format("fit of law {} to {} points (FM-AFM frequency shift{}, {}): status {} ({})",
+                                    options.law, r.distance.size(), diss ? " and dissipation" : "",
+                                    p.text("direction"), spectroscopy::fit_status_name(r.status), r.solver_status);
+  summary += estimates_of(r, results, units);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  results["rms_frequency_shift"] = r.rms_frequency_shift;
+  results["rms_dissipation"] = diss ? r.rms_dissipation / kElectronvolt : nan;
+  results["frequency_shift_noise"] = r.frequency_shift_noise;
+  results["dissipation_noise"] = diss ? r.dissipation_noise / kElectronvolt : nan;
+  results["noise_estimated"] = {{"frequency_shift", r.noise_estimated_frequency_shift},
+                                {"dissipation", r.noise_estimated_dissipation}};
+  units["rms_frequency_shift"] = "Hz";
+  units["rms_dissipation"] = "eV";
+  units["frequency_shift_noise"] = "Hz";
+  units["dissipation_noise"] = "eV";
+  results["units"] = units;
+  summary += fmt::format("\n  residual RMS: {}{}; noise σ: {}{}{}", io::quantity(r.rms_frequency_shift, "Hz"),
+                         diss ? ", " + io::quantity(r.rms_dissipation / kElectronvolt, "eV") : std::string(),
+                         io::quantity(r.frequency_shift_noise, "Hz"),
+                         r.noise_estimated_frequency_shift ? " (estimated)" : "",
+                         diss ? fmt::format(", {}{}", io::quantity(r.dissipation_noise / kElectronvolt, "eV"),
+                                            r.noise_estimated_dissipation ? " (estimated)" : "")
+                              : std::string());
+  summary += closing_lines(r);
+  out.finish(results, summary);
+  draw_plot(p);
+}
+
 void run_fit(const io::ParamSet& p, Captured* capture) {
   if (p.text("file").empty())
-    throw InvalidParameter("file", "file is required: the measured curve file (distance, amplitude, phase with "
-                                    "units in the header; docs/fitting.md#input)");
+    throw InvalidParameter("file", "file is required: the measured curve file (AM: distance, amplitude, phase; FM: "
+                                    "distance, frequency shift, dissipation; units in the header; "
+                                    "docs/fitting.md#input)");
   if (!p.text("plot").empty() && p.text("output").empty())
     throw InvalidParameter("plot", "plot needs output: the plot is drawn from the fitted curve's CSV file");
   if (!p.text("plot").empty() && capture)
     throw InvalidParameter("plot", "plot is drawn by the command line; in Python call afmkit.spectroscopy_fit.plot");
+  // the file's columns choose the mode: a frequency shift column is an FM curve, an amplitude column an AM curve
+  const spectroscopy::FitCurveFile file = spectroscopy::read_fit_curve(p.text("file"));
+  refuse_other_mode(p, file.mode);
+  if (file.mode == spectroscopy::FitMode::fm) return run_fm_fit(p, capture, file.fm);
   spectroscopy::FitSettings s;
   s.spring_constant = required(p, "spring_constant", "N/m");
   s.resonance_frequency = required(p, "resonance_frequency", "kHz") * 1e3;
@@ -122,9 +289,9 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
   s.free_amplitude = required(p, "free_amplitude", "nm") * 1e-9;
   s.drive_frequency = p.real("drive_frequency") * 1e3;
   s.validate();
-  const spectroscopy::FitOptions options = fit_options(p);
-  spectroscopy::fit_parameter_info(options);  // refuses unknown names before the file is read
-  const spectroscopy::FitCurve curve = spectroscopy::read_am_curve(p.text("file"));
+  const spectroscopy::FitOptions options = fit_options(p, spectroscopy::FitMode::am);
+  spectroscopy::fit_parameter_info(options);  // refuses unknown names before the fit
+  const spectroscopy::FitCurve& curve = file.am;
   curve.validate();
   spectroscopy::FitOptions run = options;
   run.cancellation = cancellation_of(capture);
@@ -156,67 +323,19 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
     }
   }
 
-  nlohmann::json results = nlohmann::json::object();
-  nlohmann::json estimates = nlohmann::json::object(), units = nlohmann::json::object();
-  std::vector<std::string> names;
+  nlohmann::json results = nlohmann::json::object(), units = nlohmann::json::object();
   std::string summary = fmt::format("fit of law {} to {} points ({}): status {} ({})", options.law, r.distance.size(),
                                     p.text("direction"), spectroscopy::fit_status_name(r.status), r.solver_status);
-  for (std::size_t j = 0; j < r.parameters.size(); ++j) {
-    const auto& info = r.parameters[j];
-    const Shown sh = shown(info.unit);
-    names.push_back(info.name);
-    estimates[info.name] = {{"value", r.estimates[j] * sh.factor},
-                            {"standard_error", r.standard_errors[j] * sh.factor},
-                            {"initial", info.initial * sh.factor},
-                            {"identifiable", r.identifiable[j]},
-                            {"transform", spectroscopy::transform_name(info.transform)}};
-    units[info.name] = sh.unit;
-    summary += fmt::format("\n  {} = {} ± {}", info.name, io::quantity(r.estimates[j] * sh.factor, sh.unit),
-                           io::quantity(r.standard_errors[j] * sh.factor, sh.unit));
-  }
-  results["status"] = spectroscopy::fit_status_name(r.status);
-  results["note"] = r.status == spectroscopy::FitStatus::ok
-                        ? std::string()
-                        : fmt::format("the fit did not converge: {} (estimates at the best point found)",
-                                      r.solver_status);
-  results["solver_status"] = r.solver_status;
-  results["estimates"] = estimates;
-  results["parameters"] = names;
-  results["correlation"] = r.correlation;
-  results["warnings"] = r.warnings;
-  results["condition_number"] = r.condition_number;
+  summary += estimates_of(r, results, units);
   results["rms_amplitude"] = r.rms_amplitude;
   results["rms_phase"] = phase ? r.rms_phase / kDeg : std::numeric_limits<double>::quiet_NaN();
   results["amplitude_noise"] = r.amplitude_noise;
   results["phase_noise"] = phase ? r.phase_noise / kDeg : std::numeric_limits<double>::quiet_NaN();
   results["noise_estimated"] = {{"amplitude", r.noise_estimated_amplitude}, {"phase", r.noise_estimated_phase}};
-  results["reduced_chi2"] = r.reduced_chi2;
-  results["iterations"] = r.iterations;
-  results["curve_evaluations"] = r.curve_evaluations;
-  results["orbit_evaluations"] = r.orbit_evaluations;
-  results["failed_evaluations"] = r.failed_evaluations;
-  results["seconds"] = r.seconds;
-  nlohmann::json law = nlohmann::json::object(), law_units = nlohmann::json::object();
-  for (const auto& [k, v] : r.law_values) law[k] = v;  // SI
-  {
-    const impact::LawRegistry registry = impact::LawRegistry::builtin();
-    for (const auto& k : registry.keys())
-      if (law.contains(k.key)) law_units[k.key] = spectroscopy::law_si_unit(k.unit);
-  }
-  results["law_values"] = law;
-  units["law_values"] = law_units;
   units["rms_amplitude"] = "dimensionless (A/A0)";
   units["rms_phase"] = "deg";
   units["amplitude_noise"] = "dimensionless (A/A0)";
   units["phase_noise"] = "deg";
-  units["correlation"] = "dimensionless";
-  units["condition_number"] = "dimensionless";
-  units["reduced_chi2"] = "dimensionless";
-  units["seconds"] = "s";
-  units["curve_evaluations"] = "count";
-  units["orbit_evaluations"] = "count";
-  units["failed_evaluations"] = "count";
-  units["iterations"] = "count";
   results["units"] = units;
   summary += fmt::format("\n  residual RMS: {:.4g} (A/A0){}; noise σ: {:.3g} (A/A0{}){}", r.rms_amplitude,
                          phase ? fmt::format(", {:.4g} deg", r.rms_phase / kDeg) : std::string(), r.amplitude_noise,
@@ -224,12 +343,9 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
                          phase ? fmt::format(", {:.3g} deg{}", r.phase_noise / kDeg,
                                              r.noise_estimated_phase ? " (estimated)" : "")
                                : std::string());
-  summary += fmt::format("\n  {} iterations, {} curve evaluations, {} orbit evaluations, {}", r.iterations,
-                         r.curve_evaluations, r.orbit_evaluations, io::quantity(r.seconds, "s", 3));
-  for (const std::string& w : r.warnings) summary += "\n  warning: " + w;
+  summary += closing_lines(r);
   out.finish(results, summary);
-  if (!p.text("plot").empty())  // data vs fit, drawn by Matplotlib from the table just written
-    exec_python_module("spectroscopy_fit", {"--plot", p.text("output"), p.text("plot")});
+  draw_plot(p);
 }
 
 }  // namespace
@@ -237,12 +353,14 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
 void register_spectroscopy_fit(CLI::App& spectroscopy) {
   add_command(
       spectroscopy, "fit",
-      "fit a force law (and the calibration: distance offset, amplitude scale, phase offset) to a measured AM-AFM "
-      "amplitude/phase-versus-distance curve by weighted least squares over afmkit's periodic orbits",
+      "fit a force law (and the calibration: distance offset, amplitude scale, phase offset; FM: distance offset, "
+      "frequency shift offset) to a measured AM-AFM amplitude/phase-versus-distance curve or an FM-AFM frequency-shift "
+      "curve (the file's columns decide) by weighted least squares over afmkit's periodic orbits",
       [](io::ParamSet& p) {
         p.group("Measured curve");
-        p.file("file", "", "measured curve: CSV of distance, amplitude and (optionally) phase with units in the "
-                            "header (docs/fitting.md#input)")
+        p.file("file", "", "measured curve: CSV of distance, amplitude and (optionally) phase (AM), or distance, "
+                            "frequency shift and (optionally) dissipation (FM), with units in the header "
+                            "(docs/fitting.md#input)")
             .positional()
             .default_text("required")
             .real("spring_constant", 0.0, "cantilever spring constant k (required)", io::Range::non_negative())
@@ -254,11 +372,15 @@ void register_spectroscopy_fit(CLI::App& spectroscopy) {
             .real("quality_factor", 0.0, "quality factor Q (required)", io::Range::non_negative())
             .unit("dimensionless")
             .default_text("required")
-            .real("free_amplitude", 0.0, "free amplitude A0 at the drive frequency (required)",
+            .real("free_amplitude", 0.0, "AM: free amplitude A0 at the drive frequency (required)",
                   io::Range::non_negative())
             .unit("nm")
             .default_text("required")
-            .real("drive_frequency", 0.0, "drive frequency", io::Range::non_negative())
+            .real("amplitude", 0.0, "FM: oscillation amplitude A held by the amplitude loop (required)",
+                  io::Range::non_negative())
+            .unit("nm")
+            .default_text("required")
+            .real("drive_frequency", 0.0, "AM: drive frequency", io::Range::non_negative())
             .unit("kHz")
             .follows("resonance_frequency")
             .text("direction", "approach", "the branch the curve is: approach (from the largest distance down) or "
@@ -267,10 +389,20 @@ void register_spectroscopy_fit(CLI::App& spectroscopy) {
         p.group("Fit")
             .text("parameters", "hamaker,effective_modulus,distance_offset,phase_offset",
                   "fitted parameters, comma-separated: keys of the law and/or distance_offset, amplitude_scale, "
-                  "phase_offset (the others stay at their given values)")
+                  "phase_offset (AM) or distance_offset, frequency_shift_offset (FM; default there "
+                  "hamaker,effective_modulus,distance_offset); the others stay at their given values")
             .real("distance_offset", 0.0, "d0: model separation = distance + d0 (initial or fixed value)",
                   io::Range::closed(-1e6, 1e6))
             .unit("nm")
+            .real("frequency_shift_offset", 0.0, "FM: Δf0, measured Δf = model Δf + Δf0 (initial or fixed)",
+                  io::Range::closed(-1e9, 1e9))
+            .unit("Hz")
+            .real("frequency_shift_noise", 0.0, "FM: σ of the measured Δf (0: estimated from the data's scatter)",
+                  io::Range::non_negative())
+            .unit("Hz")
+            .real("dissipation_noise", 0.0, "FM: σ of the measured dissipation (0: estimated from the data's scatter)",
+                  io::Range::non_negative())
+            .unit("eV")
             .real("amplitude_scale", 1.0, "s: true amplitude = s × measured (an InvOLS error; initial or fixed)",
                   io::Range::positive())
             .unit("dimensionless")

@@ -14,8 +14,9 @@ Keyword options are the command's keys (``afmkit spectroscopy prepare --help``),
 
 Also here: ``reconstruct_fm(distance, frequency_shift, ...)`` and ``reconstruct_am(distance, amplitude, phase, ...)``
 (the force from FM-AFM and AM-AFM curves, with the round trip: docs/reconstruction.md; ``reconstruct`` is the
-command on a file), and ``fit(distance, amplitude, phase, ...)`` (a law's parameters fitted over afmkit's exact
-orbits: docs/fitting.md; ``fit_file`` is the command on a file, ``plot_fit`` draws data vs fit).
+command on a file), ``fit(distance, amplitude, phase, ...)`` and ``fit_fm(distance, frequency_shift, ...)`` (a
+law's parameters fitted to an AM or FM curve over afmkit's exact orbits: docs/fitting.md; ``fit_file`` is the
+command on a file, ``plot_fit`` draws data vs fit).
 """
 from __future__ import annotations
 
@@ -254,9 +255,9 @@ def plot_main(argv) -> int:
 
 
 from .spectroscopy_reconstruct import Reconstruction, reconstruct, reconstruct_am, reconstruct_fm  # noqa: E402
-from .spectroscopy_fit import FitResult, fit, predict  # noqa: E402
+from .spectroscopy_fit import FitResult, fit, fit_fm, predict, predict_fm  # noqa: E402
 from .spectroscopy_fit import plot as plot_fit  # noqa: E402
 from .spectroscopy_fit import run as fit_file  # noqa: E402
 
 __all__ = ["prepare", "prepare_file", "PreparedCurve", "plot", "reconstruct_fm", "reconstruct_am", "reconstruct",
-           "Reconstruction", "fit", "fit_file", "predict", "plot_fit", "FitResult"]
+           "Reconstruction", "fit", "fit_fm", "fit_file", "predict", "predict_fm", "plot_fit", "FitResult"]

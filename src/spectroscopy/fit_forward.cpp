@@ -45,10 +45,6 @@ Point settle_at(const TappingModel& m, tapping::TipState start, const tapping::S
   return p;
 }
 
-double state_distance(tapping::TipState a, tapping::TipState b, double omega) {
-  return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
-}
-
 /// Where the tip lands when the followed branch ends just before m.separation. The transient from the last stable
 /// orbit decides (as in the sweep), unless Newton from the harmonic-balance solutions at m.separation finds exactly
 /// one stable orbit: then no other attractor of period 1 exists there and the transient would end on it (it may
@@ -114,6 +110,10 @@ Point step(const TappingModel& base, const Point& prev, double l_to, const tappi
 
 }  // namespace
 
+double state_distance(tapping::TipState a, tapping::TipState b, double omega) {
+  return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
+}
+
 AmForwardModel::AmForwardModel(const FitSettings& settings, const FitOptions& options, std::vector<double> distances)
     : settings_(settings), options_(options), distances_(std::move(distances)) {
   sweep_.harmonic_balance = false;
@@ -122,22 +122,26 @@ AmForwardModel::AmForwardModel(const FitSettings& settings, const FitOptions& op
   sweep_.shooting.tolerance = options.shooting_tolerance;
 }
 
-TappingModel AmForwardModel::model(const ModelValues& values) const {
+impact::ForceLaw build_law(const FitOptions& options, const ModelValues& values) {
   const impact::LawRegistry registry = impact::LawRegistry::builtin();
   impact::LawArguments args;
-  args.force_curve = options_.force_curve;
-  args.allow_energy_gain = options_.allow_energy_gain;
+  args.force_curve = options.force_curve;
+  args.allow_energy_gain = options.allow_energy_gain;
   for (const auto& [key, value] : values.law) {
     double f = 1.0;
     for (const auto& k : registry.keys())
       if (k.key == key) f = law_unit_to_si(k.unit);
     args.values[key] = value / f;  // registry units (nm, GPa, nN, J, ...)
   }
+  return registry.build(options.law, args);
+}
+
+TappingModel AmForwardModel::model(const ModelValues& values) const {
   const double drive = settings_.drive_frequency > 0.0 ? settings_.drive_frequency : settings_.resonance_frequency;
   const tapping::PhysicalCantilever pc(settings_.spring_constant, settings_.resonance_frequency * 1e-3,
                                        settings_.quality_factor, settings_.free_amplitude * values.amplitude_scale * 1e9,
                                        drive / settings_.resonance_frequency);
-  return TappingModel(pc.cantilever(), pc.drive(), pc.normalised_law(registry.build(options_.law, args)), 0.0);
+  return TappingModel(pc.cantilever(), pc.drive(), pc.normalised_law(build_law(options_, values)), 0.0);
 }
 
 double AmForwardModel::separation(const ModelValues& values, std::size_t i) const {
@@ -236,50 +240,42 @@ CurveEvaluation AmForwardModel::warm(const ModelValues& values, const CurveEvalu
   plain.sensitivity = false;
   const double omega = m.drive.frequency;
   const double amplitude = m.free_amplitude();
-  std::atomic<bool> failed{false};
   std::atomic<long> solves{0};
-  ExceptionCollector errors;
-#pragma omp parallel for schedule(dynamic) if (options_.parallel)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (failed.load()) continue;
-    errors.run([&] {
-      const PeriodicOrbit& old = from.orbits[i];
-      const TappingModel at = m.with_separation(separation(values, i));
-      ++solves;
-      std::optional<PeriodicOrbit> o;
-      if (chord) {
-        // one chord-Newton step with the monodromy of `old`: z' = z − (M − I)⁻¹ (P'(z) − z), off the perturbed
-        // orbit by O(|z' − z|²), the order of the forward difference's own error (docs/fitting.md#jacobian)
-        const int k = old.period_multiple;
-        const tapping::SimulationResult r = tapping::simulate(at, 0.0, old.initial, k * at.period(), plain);
-        const Eigen::Vector2d res(r.state.position - old.initial.position, r.state.velocity - old.initial.velocity);
-        const Eigen::Vector2d dz = (old.monodromy - Eigen::Matrix2d::Identity()).fullPivLu().solve(-res);
-        if (dz.allFinite() && std::hypot(dz.x(), dz.y() / omega) <= 0.01 * amplitude) {
-          o = old;
-          o->initial = {old.initial.position + dz.x(), old.initial.velocity + dz.y()};
-        }
+  const bool all = each_point(n, options_.parallel, [&](std::size_t i) {
+    const PeriodicOrbit& old = from.orbits[i];
+    const TappingModel at = m.with_separation(separation(values, i));
+    ++solves;
+    std::optional<PeriodicOrbit> o;
+    if (chord) {
+      // one chord-Newton step with the monodromy of `old`: z' = z − (M − I)⁻¹ (P'(z) − z), off the perturbed
+      // orbit by O(|z' − z|²), the order of the forward difference's own error (docs/fitting.md#jacobian)
+      const int k = old.period_multiple;
+      const tapping::SimulationResult r = tapping::simulate(at, 0.0, old.initial, k * at.period(), plain);
+      const Eigen::Vector2d res(r.state.position - old.initial.position, r.state.velocity - old.initial.velocity);
+      const Eigen::Vector2d dz = (old.monodromy - Eigen::Matrix2d::Identity()).fullPivLu().solve(-res);
+      if (dz.allFinite() && std::hypot(dz.x(), dz.y() / omega) <= 0.01 * amplitude) {
+        o = old;
+        o->initial = {old.initial.position + dz.x(), old.initial.velocity + dz.y()};
       }
-      if (!o) {
-        try {
-          o = tapping::try_shoot(at, old.initial, old.period_multiple, quick);
-        } catch (const NumericalFailure&) {
-          o.reset();
-        }
+    }
+    if (!o) {
+      try {
+        o = tapping::try_shoot(at, old.initial, old.period_multiple, quick);
+      } catch (const NumericalFailure&) {
+        o.reset();
       }
-      // the same branch: stable, of the same period, and near the previous orbit (a small change of the values
-      // moves the orbit a little; another branch is a finite distance away)
-      const bool near = o && o->stable && o->period_multiple == old.period_multiple &&
-                        state_distance(o->initial, old.initial, omega) <= 0.05 * amplitude;
-      if (!near) {
-        failed = true;
-        return;
-      }
-      e.orbits[i] = *o;
-      e.orbits[i].separation = at.separation;
-    });
-  }
+    }
+    // the same branch: stable, of the same period, and near the previous orbit (a small change of the values
+    // moves the orbit a little; another branch is a finite distance away)
+    const bool near = o && o->stable && o->period_multiple == old.period_multiple &&
+                      state_distance(o->initial, old.initial, omega) <= 0.05 * amplitude;
+    if (!near) return false;
+    e.orbits[i] = *o;
+    e.orbits[i].separation = at.separation;
+    return true;
+  });
   orbits_ += solves.load();
-  if (errors.failed() || failed.load()) return walk(values);
+  if (!all) return walk(values);
   if (!chord) {
     // where `from` jumped (its branch ended between the points i − 1 and i), the branch must still end there: the
     // orbit at i − 1 followed to l_i must not arrive (else the jump moved past a point: the whole sweep decides)

@@ -1,4 +1,5 @@
-// Reader of the measured AM-AFM curve file of `spectroscopy fit` (format: fit_input.hpp, docs/fitting.md#input).
+// Reader of the measured curve file of `spectroscopy fit`: AM-AFM amplitude/phase or FM-AFM frequency shift
+// (/dissipation) versus distance (format: fit_input.hpp, docs/fitting.md#input).
 #include "afmkit/spectroscopy/fit_input.hpp"
 
 #include <algorithm>
@@ -68,12 +69,16 @@ std::vector<Cell> split(std::string_view line, char sep) {
   return cells;
 }
 
-enum class Role { distance, amplitude, phase };
+enum class Role { distance, amplitude, phase, frequency_shift, dissipation };
+constexpr int kRoles = 5;
 
 struct Column {
   Role role;
-  double factor;  // to SI (m, rad)
+  double factor;  // to SI (m, rad, Hz, J)
 };
+
+constexpr const char* kColumns =
+    "AM: distance (nm), amplitude (nm), phase (deg); FM: distance (nm), frequency shift (Hz), dissipation (eV)";
 
 std::optional<double> length_unit(const std::string& u) {
   static const std::map<std::string, double> units = {{"m", 1.0},    {"mm", 1e-3},  {"um", 1e-6},  {"µm", 1e-6},
@@ -99,7 +104,8 @@ Column parse_column(std::string_view text, const std::string& origin, long line,
   } else {
     fail(origin, line, column,
          fmt::format("column '{}' has no unit: write it as 'name (unit)', 'name [unit]' or 'name_unit' (distance "
-                     "and amplitude: m, nm, pm, um, A; phase: rad or deg)",
+                     "and amplitude: m, nm, pm, um, A; phase: rad or deg; frequency shift: Hz, mHz, kHz; dissipation: "
+                     "J, aJ, zJ, eV, meV)",
                      t));
   }
   const std::string n = lower(name), u = lower(unit);
@@ -110,13 +116,31 @@ Column parse_column(std::string_view text, const std::string& origin, long line,
     role = Role::amplitude;
   else if (n == "phase" || n == "phi")
     role = Role::phase;
+  else if (n == "frequency shift" || n == "frequency_shift" || n == "df" || n == "delta f" || n == "delta_f" ||
+           n == "Δf")
+    role = Role::frequency_shift;
+  else if (n == "dissipation" || n == "energy" || n == "dissipated energy" || n == "dissipated_energy")
+    role = Role::dissipation;
   else
-    fail(origin, line, column,
-         fmt::format("unknown column '{}': the columns are distance, amplitude and (optionally) phase", name));
+    fail(origin, line, column, fmt::format("unknown column '{}': the columns are {} (phase and dissipation optional)",
+                                           name, kColumns));
   if (role == Role::phase) {
     if (u == "rad") return {role, 1.0};
     if (u == "deg" || u == "°" || u == "degree" || u == "degrees") return {role, kPi / 180.0};
     fail(origin, line, column, fmt::format("column '{}': unknown phase unit '{}' (rad or deg)", t, unit));
+  }
+  if (role == Role::frequency_shift) {
+    static const std::map<std::string, double> hz = {{"hz", 1.0}, {"mhz", 1e-3}, {"khz", 1e3}};
+    // "mHz" (milli) and "MHz" (mega) differ only in case: the unit is read as written for those two
+    if (unit == "MHz") return {role, 1e6};
+    if (const auto it = hz.find(u); it != hz.end()) return {role, it->second};
+    fail(origin, line, column, fmt::format("column '{}': unknown frequency unit '{}' (Hz, mHz, kHz)", t, unit));
+  }
+  if (role == Role::dissipation) {
+    static const std::map<std::string, double> joule = {
+        {"j", 1.0}, {"aj", 1e-18}, {"zj", 1e-21}, {"ev", 1.602176634e-19}, {"mev", 1.602176634e-22}};
+    if (const auto it = joule.find(u); it != joule.end()) return {role, it->second};
+    fail(origin, line, column, fmt::format("column '{}': unknown energy unit '{}' (J, aJ, zJ, eV, meV)", t, unit));
   }
   const auto f = length_unit(u);
   if (!f)
@@ -138,9 +162,11 @@ double parse_number(const Cell& cell, const std::string& column, const std::stri
 
 }  // namespace
 
-FitCurve parse_am_curve(std::string_view text, const std::string& origin) {
+FitCurveFile parse_fit_curve(std::string_view text, const std::string& origin) {
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
-  FitCurve c;
+  FitCurveFile file;
+  FitCurve& c = file.am;
+  FmFitCurve& f = file.fm;
   std::vector<Column> columns;
   std::vector<std::string> names;
   char sep = ',';
@@ -179,17 +205,35 @@ FitCurve parse_am_curve(std::string_view text, const std::string& origin) {
       } else {
         for (const Cell& cell : split(line, sep)) cells.emplace_back(std::string(cell.text), cell.column);
       }
-      bool has[3] = {false, false, false};
+      bool has[kRoles] = {};
+      std::vector<long> at(kRoles, 1);
       for (const auto& [cell, column] : cells) {
         const Column col = parse_column(cell, origin, line_no, column);
         const int r = static_cast<int>(col.role);
         if (has[r]) fail(origin, line_no, column, fmt::format("column '{}' repeats a column", cell));
         has[r] = true;
+        at[r] = column;
         columns.push_back(col);
         names.push_back(cell);
       }
-      if (!has[0]) fail(origin, line_no, 1, "no distance column (distance (nm), amplitude (nm), phase (deg))");
-      if (!has[1]) fail(origin, line_no, 1, "no amplitude column (distance (nm), amplitude (nm), phase (deg))");
+      auto has_role = [&](Role r) { return has[static_cast<int>(r)]; };
+      auto column_of = [&](Role r) { return at[static_cast<int>(r)]; };
+      if (!has_role(Role::distance)) fail(origin, line_no, 1, fmt::format("no distance column ({})", kColumns));
+      if (has_role(Role::amplitude) && has_role(Role::frequency_shift))
+        fail(origin, line_no, column_of(Role::frequency_shift),
+             fmt::format("both an amplitude and a frequency shift column: a curve is either AM or FM ({})", kColumns));
+      if (!has_role(Role::amplitude) && !has_role(Role::frequency_shift))
+        fail(origin, line_no, 1, fmt::format("no amplitude column (AM) and no frequency shift column (FM): {}",
+                                             kColumns));
+      file.mode = has_role(Role::frequency_shift) ? FitMode::fm : FitMode::am;
+      if (file.mode == FitMode::fm && has_role(Role::phase))
+        fail(origin, line_no, column_of(Role::phase),
+             "a phase column in an FM curve (frequency shift): the FM columns are distance, frequency shift and "
+             "(optionally) dissipation");
+      if (file.mode == FitMode::am && has_role(Role::dissipation))
+        fail(origin, line_no, column_of(Role::dissipation),
+             "a dissipation column in an AM curve (amplitude): the AM columns are distance, amplitude and "
+             "(optionally) phase");
       continue;
     }
     const std::vector<Cell> cells = split(line, sep);
@@ -207,7 +251,13 @@ FitCurve parse_am_curve(std::string_view text, const std::string& origin) {
                              "repeated rows first)",
                              cells[k].text, names[k], it->second));
           seen[v] = line_no;
-          c.distance.push_back(v);
+          (file.mode == FitMode::fm ? f.distance : c.distance).push_back(v);
+          break;
+        case Role::frequency_shift:
+          f.frequency_shift.push_back(v);
+          break;
+        case Role::dissipation:
+          f.dissipation.push_back(v);
           break;
         case Role::amplitude:
           if (!(v > 0.0))
@@ -221,18 +271,36 @@ FitCurve parse_am_curve(std::string_view text, const std::string& origin) {
       }
     }
   }
-  if (columns.empty()) fail(origin, line_no, 1, "no header line (distance (nm), amplitude (nm), phase (deg))");
-  if (c.distance.size() < 3)
-    fail(origin, header_line, 1, fmt::format("{} data row(s): at least 3 are needed", c.distance.size()));
-  return c;
+  if (columns.empty()) fail(origin, line_no, 1, fmt::format("no header line ({})", kColumns));
+  const std::size_t rows = file.mode == FitMode::fm ? f.distance.size() : c.distance.size();
+  if (rows < 3) fail(origin, header_line, 1, fmt::format("{} data row(s): at least 3 are needed", rows));
+  return file;
 }
 
-FitCurve read_am_curve(const std::string& path) {
+FitCurve parse_am_curve(std::string_view text, const std::string& origin) {
+  FitCurveFile file = parse_fit_curve(text, origin);
+  if (file.mode != FitMode::am)
+    throw InputError(fmt::format("{}:1:1: an FM curve (frequency shift column) where an AM curve (amplitude, phase) "
+                                 "is read",
+                                 origin));
+  return std::move(file.am);
+}
+
+FitCurveFile read_fit_curve(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("cannot open file '{}'", path));
   std::ostringstream ss;
   ss << in.rdbuf();
-  return parse_am_curve(ss.str(), path);
+  return parse_fit_curve(ss.str(), path);
+}
+
+FitCurve read_am_curve(const std::string& path) {
+  FitCurveFile file = read_fit_curve(path);
+  if (file.mode != FitMode::am)
+    throw InputError(fmt::format("{}:1:1: an FM curve (frequency shift column) where an AM curve (amplitude, phase) "
+                                 "is read",
+                                 path));
+  return std::move(file.am);
 }
 
 }  // namespace afmkit::spectroscopy

@@ -18,6 +18,18 @@ namespace afmkit::spectroscopy {
 
 namespace {
 constexpr double inf = std::numeric_limits<double>::infinity();
+
+/// InvalidParameter("distance", …) naming two equal distances.
+void require_distinct(const std::vector<double>& distance) {
+  std::vector<std::pair<double, std::size_t>> sorted;
+  for (std::size_t i = 0; i < distance.size(); ++i) sorted.emplace_back(distance[i], i);
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t k = 1; k < sorted.size(); ++k)
+    if (sorted[k].first == sorted[k - 1].first)
+      throw InvalidParameter("distance", fmt::format("distance[{}] = distance[{}] = {} m: every distance must be "
+                                                     "distinct (average repeated rows first)",
+                                                     sorted[k - 1].second, sorted[k].second, sorted[k].first));
+}
 }  // namespace
 
 double law_unit_to_si(const std::string& unit) {
@@ -42,6 +54,8 @@ const char* transform_name(Transform t) {
   }
   return "?";
 }
+
+const char* fit_mode_name(FitMode m) { return m == FitMode::fm ? "fm" : "am"; }
 
 const char* fit_status_name(FitStatus s) {
   switch (s) {
@@ -71,14 +85,38 @@ void FitCurve::validate() const {
     if (!phase.empty() && !std::isfinite(phase[i]))
       throw InvalidParameter("phase", fmt::format("phase[{}] = {} rad is not a finite number", i, phase[i]));
   }
-  std::vector<std::pair<double, std::size_t>> sorted;
-  for (std::size_t i = 0; i < n; ++i) sorted.emplace_back(distance[i], i);
-  std::sort(sorted.begin(), sorted.end());
-  for (std::size_t k = 1; k < n; ++k)
-    if (sorted[k].first == sorted[k - 1].first)
-      throw InvalidParameter("distance", fmt::format("distance[{}] = distance[{}] = {} m: every distance must be "
-                                                     "distinct (average repeated rows first)",
-                                                     sorted[k - 1].second, sorted[k].second, sorted[k].first));
+  require_distinct(distance);
+}
+
+void FmFitCurve::validate() const {
+  const std::size_t n = distance.size();
+  if (n < 3) throw InvalidParameter("distance", fmt::format("the curve has {} point(s): at least 3 are needed", n));
+  if (frequency_shift.size() != n)
+    throw InvalidParameter("frequency_shift", fmt::format("frequency_shift has {} values, distance {}: they must be "
+                                                          "equal",
+                                                          frequency_shift.size(), n));
+  if (!dissipation.empty() && dissipation.size() != n)
+    throw InvalidParameter("dissipation", fmt::format("dissipation has {} values, distance {}: they must be equal "
+                                                      "(or dissipation empty: frequency shift only)",
+                                                      dissipation.size(), n));
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(distance[i]))
+      throw InvalidParameter("distance", fmt::format("distance[{}] = {} m is not a finite number", i, distance[i]));
+    if (!std::isfinite(frequency_shift[i]))
+      throw InvalidParameter("frequency_shift", fmt::format("frequency_shift[{}] = {} Hz is not a finite number", i,
+                                                            frequency_shift[i]));
+    if (!dissipation.empty() && !std::isfinite(dissipation[i]))
+      throw InvalidParameter("dissipation",
+                             fmt::format("dissipation[{}] = {} J is not a finite number", i, dissipation[i]));
+  }
+  require_distinct(distance);
+}
+
+void FmFitSettings::validate() const {
+  validate::positive("spring_constant", spring_constant);
+  validate::positive("resonance_frequency", resonance_frequency);
+  validate::positive("quality_factor", quality_factor);
+  validate::positive("amplitude", amplitude);
 }
 
 void FitSettings::validate() const {
@@ -92,6 +130,8 @@ void FitSettings::validate() const {
 void FitOptions::validate() const {
   validate::non_negative("amplitude_noise", amplitude_noise);
   validate::non_negative("phase_noise", phase_noise);
+  validate::non_negative("frequency_shift_noise", frequency_shift_noise);
+  validate::non_negative("dissipation_noise", dissipation_noise);
   validate::non_negative("huber", huber);
   validate::require(fd_step >= 1e-8 && fd_step <= 0.1, "fd_step", fd_step, "in [1e-8, 0.1]");
   validate::require(max_evaluations >= 2 && max_evaluations <= 1000000, "max_evaluations", max_evaluations,
@@ -107,9 +147,23 @@ void FitOptions::validate() const {
   validate::require(condition_limit > 1.0, "condition_limit", condition_limit, "> 1");
 }
 
-bool is_calibration(const std::string& name) {
-  return name == "distance_offset" || name == "amplitude_scale" || name == "phase_offset";
+bool is_calibration(const std::string& name, FitMode mode) {
+  if (name == "distance_offset") return true;
+  return mode == FitMode::am ? name == "amplitude_scale" || name == "phase_offset" : name == "frequency_shift_offset";
 }
+
+bool is_calibration(const std::string& name) {
+  return is_calibration(name, FitMode::am) || is_calibration(name, FitMode::fm);
+}
+
+bool residual_only(const std::string& name) { return name == "phase_offset" || name == "frequency_shift_offset"; }
+
+namespace {
+const char* calibration_names(FitMode mode) {
+  return mode == FitMode::am ? "distance_offset, amplitude_scale, phase_offset"
+                             : "distance_offset, frequency_shift_offset";
+}
+}  // namespace
 
 double calibration_default(const std::string& name) { return name == "amplitude_scale" ? 1.0 : 0.0; }
 
@@ -118,18 +172,41 @@ double calibration_value(const FitOptions& options, const std::string& name) {
   return it != options.initial.end() ? it->second : calibration_default(name);
 }
 
-std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options) {
+ModelValues ModelValues::of(const FitOptions& options) {
+  ModelValues v;
+  v.law = options.law_values;
+  v.distance_offset = calibration_value(options, "distance_offset");
+  v.amplitude_scale = calibration_value(options, "amplitude_scale");
+  v.phase_offset = calibration_value(options, "phase_offset");
+  v.frequency_shift_offset = calibration_value(options, "frequency_shift_offset");
+  return v;
+}
+
+void ModelValues::set(const std::string& name, double p) {
+  if (name == "distance_offset") distance_offset = p;
+  else if (name == "amplitude_scale") amplitude_scale = p;
+  else if (name == "phase_offset") phase_offset = p;
+  else if (name == "frequency_shift_offset") frequency_shift_offset = p;
+  else law[name] = p;
+}
+
+std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options, FitMode mode) {
   const impact::LawRegistry registry = impact::LawRegistry::builtin();
   const impact::LawSpec& spec = registry.find(options.law);
   if (options.parameters.empty())
-    throw InvalidParameter("parameters", "no parameter to fit: name at least one (a key of the law, distance_offset, "
-                                         "amplitude_scale or phase_offset)");
-  for (const auto& [key, value] : options.initial)
+    throw InvalidParameter("parameters", fmt::format("no parameter to fit: name at least one (a key of the law, or "
+                                                     "of the calibration: {})",
+                                                     calibration_names(mode)));
+  for (const auto& [key, value] : options.initial) {
+    if (is_calibration(key) && !is_calibration(key, mode))
+      throw InvalidParameter(key, fmt::format("{} does not apply to an {} curve: its calibration parameters are {}",
+                                              key, mode == FitMode::fm ? "FM" : "AM", calibration_names(mode)));
     if (!is_calibration(key) &&
         std::find(options.parameters.begin(), options.parameters.end(), key) == options.parameters.end())
       throw InvalidParameter(key, fmt::format("an initial value is given for {}, which is not fitted: give fixed law "
                                               "values as law parameters, or add {} to the fitted parameters",
                                               key, key));
+  }
   std::set<std::string> seen;
   std::vector<FitParameterInfo> out;
   for (const std::string& name : options.parameters) {
@@ -137,12 +214,19 @@ std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options) {
       throw InvalidParameter("parameters", fmt::format("parameter '{}' is named twice", name));
     FitParameterInfo p;
     p.name = name;
+    if (is_calibration(name) && !is_calibration(name, mode))
+      throw InvalidParameter("parameters", fmt::format("'{}' is not a calibration parameter of an {} curve: they are "
+                                                       "{}",
+                                                       name, mode == FitMode::fm ? "FM" : "AM",
+                                                       calibration_names(mode)));
     if (is_calibration(name)) {
       p.initial = calibration_value(options, name);
-      if (name == "distance_offset") {
-        p.unit = "m", p.lower = -inf, p.upper = inf, p.transform = Transform::identity, p.scale = 1e-9;
-      } else if (name == "phase_offset") {
-        p.unit = "rad", p.lower = -inf, p.upper = inf, p.transform = Transform::identity, p.scale = 1.0;
+      // the offsets: unbounded, u = 1 is 1 nm, 1 rad or 1 Hz
+      const bool offset = name != "amplitude_scale";
+      if (offset) {
+        p.lower = -inf, p.upper = inf, p.transform = Transform::identity;
+        p.unit = name == "distance_offset" ? "m" : name == "phase_offset" ? "rad" : "Hz";
+        p.scale = name == "distance_offset" ? 1e-9 : 1.0;
       } else {
         p.unit = "dimensionless", p.lower = 0.0, p.upper = inf, p.transform = Transform::log;
       }
@@ -152,8 +236,8 @@ std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options) {
         throw InvalidParameter(
             "parameters",
             users.empty() ? fmt::format("'{}' is not a parameter that can be fitted: law = {} reads {}; the "
-                                        "calibration parameters are distance_offset, amplitude_scale, phase_offset",
-                                        name, options.law, fmt::join(spec.keys, ", "))
+                                        "calibration parameters are {}",
+                                        name, options.law, fmt::join(spec.keys, ", "), calibration_names(mode))
                           : fmt::format("'{}' is not a parameter of law = {} (it is one of law {}); law = {} reads {}",
                                         name, options.law, fmt::join(users, ", "), options.law,
                                         fmt::join(spec.keys, ", ")));

@@ -1,5 +1,6 @@
 #pragma once
-// Fitting a force law to a measured AM-AFM amplitude/phase-versus-distance curve (docs/fitting.md).
+// Fitting a force law to a measured AM-AFM amplitude/phase-versus-distance curve, or to an FM-AFM frequency-shift
+// (and dissipation) curve (docs/fitting.md; the FM fit: fit_fm_curve below and docs/fitting.md#fm-afm).
 //
 // Forward model: afmkit's exact periodic orbits of the tapping cantilever (seed-1 eq. 8) at the measured settings
 // (k, f0, Q, A0, drive frequency), the force law built by impact::LawRegistry from the parameter values, the
@@ -51,6 +52,32 @@ struct FitSettings {
   void validate() const;             // InvalidParameter naming the setting
 };
 
+/// A measured FM-AFM curve, SI units: the frequency shift Δf = f − f0 at constant amplitude A versus distance, and
+/// optionally the energy the tip–sample force takes per cycle (from the drive signal). Rows in any order.
+struct FmFitCurve {
+  std::vector<double> distance;         // [m] piezo separation (model separation = distance + distance_offset)
+  std::vector<double> frequency_shift;  // [Hz] Δf
+  std::vector<double> dissipation;      // [J] per cycle; empty: Δf only
+  /// Validates (InvalidParameter naming the array and the index): ≥ 3 rows, equal lengths, finite values, distinct
+  /// distances.
+  void validate() const;
+};
+
+/// The measured FM settings, SI units.
+struct FmFitSettings {
+  double spring_constant = 0.0;      // k [N/m] > 0
+  double resonance_frequency = 0.0;  // f0 [Hz] > 0, the free resonance
+  double quality_factor = 0.0;       // Q > 0
+  double amplitude = 0.0;            // A [m] > 0, the oscillation amplitude the amplitude loop holds
+  void validate() const;             // InvalidParameter naming the setting
+};
+
+/// Which measurement a fit is of: AM-AFM amplitude/phase (fit_am_curve) or FM-AFM frequency shift (fit_fm_curve).
+/// It decides the calibration parameters (AM: distance_offset, amplitude_scale, phase_offset; FM: distance_offset,
+/// frequency_shift_offset).
+enum class FitMode { am, fm };
+const char* fit_mode_name(FitMode m);  // "am", "fm"
+
 /// Which branch of the instrument sweep the data are: approach (distance decreasing) or retract (after the approach
 /// down to the smallest distance).
 enum class CurveDirection { approach, retract };
@@ -62,16 +89,20 @@ struct FitOptions {
   std::map<std::string, double> law_values;
   std::string force_curve;        // law = table: the force-curve file
   bool allow_energy_gain = false;
-  /// The fitted parameters: law keys and/or distance_offset, amplitude_scale, phase_offset.
+  /// The fitted parameters: law keys and/or the calibration (AM: distance_offset, amplitude_scale, phase_offset;
+  /// FM: distance_offset, frequency_shift_offset).
   std::vector<std::string> parameters;
   /// Initial (or fixed) values of the calibration parameters: distance_offset [m] (0), amplitude_scale (1),
-  /// phase_offset [rad] (0); initial values of fitted law keys may be given here too (SI).
+  /// phase_offset [rad] (0), frequency_shift_offset [Hz] (0); initial values of fitted law keys may be given here
+  /// too (SI).
   std::map<std::string, double> initial;
   CurveDirection direction = CurveDirection::approach;
   double amplitude_noise = 0.0;  // σ_A in A/A0 (0: estimated from the data)
   /// Huber's loss beyond this many σ (docs/fitting.md#weights; 0: plain least squares).
   double huber = 5.0;
   double phase_noise = 0.0;      // σ_φ [rad] (0: estimated)
+  double frequency_shift_noise = 0.0;  // FM: σ_Δf [Hz] (0: estimated)
+  double dissipation_noise = 0.0;      // FM: σ_E [J] per cycle (0: estimated)
   double fd_step = 1e-3;         // forward-difference step in the transformed coordinates u
   int max_evaluations = 100;     // forward-model evaluations (curves, the Jacobian's columns included)
   double tolerance = 1e-4;       // relative reduction of the cost and relative step (LM ftol and xtol)
@@ -110,6 +141,7 @@ enum class FitStatus { ok, not_converged, failed };
 const char* fit_status_name(FitStatus s);  // "ok", "not_converged", "failed"
 
 struct FitResult {
+  FitMode mode = FitMode::am;
   FitStatus status = FitStatus::failed;
   std::string solver_status;  // Eigen's LevenbergMarquardtSpace::Status in words
   std::vector<FitParameterInfo> parameters;
@@ -122,12 +154,19 @@ struct FitResult {
   // the data (sorted by the sweep's order) and the fit
   std::vector<double> distance, amplitude, phase;             // measured, SI (phase empty when not given)
   std::vector<double> fitted_amplitude, fitted_phase;         // model at the estimates, as measured (÷s, +φ0)
+  // FM (mode fm; the AM arrays above are then empty): measured and fitted (model + frequency_shift_offset)
+  std::vector<double> frequency_shift, fitted_frequency_shift;  // [Hz]
+  std::vector<double> dissipation, fitted_dissipation;          // [J] per cycle (empty when not measured)
   std::vector<bool> contact;                                  // orbit reaches the law's contact gap
   std::vector<bool> jumped;                                   // the response jumped onto another branch there
   double amplitude_noise = 0.0, phase_noise = 0.0;            // σ used (A/A0, rad)
   bool noise_estimated_amplitude = false, noise_estimated_phase = false;
   double rms_amplitude = 0.0;   // RMS of (A_meas − A_fit)/A0
   double rms_phase = 0.0;       // RMS of the phase residual [rad]
+  double frequency_shift_noise = 0.0, dissipation_noise = 0.0;  // FM: σ used [Hz], [J]
+  bool noise_estimated_frequency_shift = false, noise_estimated_dissipation = false;
+  double rms_frequency_shift = 0.0;  // FM: RMS of Δf_meas − Δf_fit [Hz]
+  double rms_dissipation = 0.0;      // FM: RMS of E_meas − E_fit [J] (NaN without dissipation)
   double cost = 0.0;            // Σ r² (weighted) at the estimates
   double reduced_chi2 = 0.0;    // Σ r² / (N − P)
   long curve_evaluations = 0;   // forward-model evaluations (whole curves, Jacobian columns included)
@@ -142,7 +181,8 @@ struct FitResult {
 /// The information of every parameter name the fit knows for `options.law` (transform, range, SI unit, initial).
 /// InvalidParameter("parameters", …) for an unknown name or one the law does not read; ("initial"/law key) for an
 /// initial value outside the range or 0 on a log scale.
-std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options);
+/// `mode` decides the calibration parameters.
+std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options, FitMode mode = FitMode::am);
 
 /// Weighted nonlinear least squares (see above). Bad input -> InvalidParameter; the model failing at the initial
 /// values -> NumericalFailure; a fit that stops on its budget -> status not_converged (the result still holds
@@ -157,6 +197,24 @@ struct AmPrediction {
   std::vector<bool> contact, jumped;
 };
 AmPrediction predict_am_curve(const std::vector<double>& distance, const FitSettings& settings,
+                              const FitOptions& options);
+
+/// The FM fit (docs/fitting.md#fm-afm). Forward model: the exact FM orbits of `tapping fm` (tapping/fm.hpp: the
+/// self-excited cantilever at constant amplitude A with an ideal phase-locked loop) at model separation
+/// l = distance + distance_offset, continued along the curve as the approach (or retract) sweeps it; a new trial
+/// point starts each orbit by Newton from the orbit at the same point of the best evaluation so far. Residuals (n,
+/// or 2n with dissipation): (Δf_meas − Δf_model − Δf_off)/σ_Δf and (E_meas − E_model)/σ_E, through Huber's loss;
+/// σ given or estimated from the data's scatter as in the AM fit. Solver, transforms, statistics and status: as
+/// fit_am_curve.
+FitResult fit_fm_curve(const FmFitCurve& curve, const FmFitSettings& settings, const FitOptions& options);
+
+/// The FM forward model alone: frequency shift [Hz] (+ frequency_shift_offset of `options.initial`) and dissipation
+/// [J per cycle] at each distance (in the order given). NumericalFailure where no FM orbit is found.
+struct FmPrediction {
+  std::vector<double> frequency_shift, dissipation;
+  std::vector<bool> contact, jumped;
+};
+FmPrediction predict_fm_curve(const std::vector<double>& distance, const FmFitSettings& settings,
                               const FitOptions& options);
 
 /// Factor converting a registry law unit to SI ("nm" -> 1e-9, "GPa" -> 1e9, "nN" -> 1e-9, others 1) and the SI

@@ -1,22 +1,54 @@
 #pragma once
-// The forward model of `spectroscopy fit` (fit.hpp): amplitude and phase along a measured curve from afmkit's
-// periodic orbits, and the parameter transformations. Internal to the fit (its tests use it too).
+// The forward models of `spectroscopy fit` (fit.hpp): amplitude and phase (AM) or frequency shift and dissipation
+// (FM) along a measured curve from afmkit's periodic orbits, and the parameter transformations. Internal to the fit
+// (its tests use it too).
 #include <atomic>
 #include <map>
 #include <string>
 #include <vector>
 
+#include "afmkit/core/parallel.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
+#include "afmkit/tapping/fm.hpp"
 #include "afmkit/tapping/sweep.hpp"
 
 namespace afmkit::spectroscopy {
 
-bool is_calibration(const std::string& name);  // distance_offset, amplitude_scale, phase_offset
-/// The value of a calibration parameter in `options.initial`, else its default (0, 1, 0).
+/// AM: distance_offset, amplitude_scale, phase_offset; FM: distance_offset, frequency_shift_offset.
+bool is_calibration(const std::string& name, FitMode mode);
+/// Any mode's calibration parameter.
+bool is_calibration(const std::string& name);
+/// A parameter that enters the residuals only (phase_offset, frequency_shift_offset): its Jacobian column needs no
+/// orbit.
+bool residual_only(const std::string& name);
+/// The value of a calibration parameter in `options.initial`, else its default (0, 1, 0, 0).
 double calibration_value(const FitOptions& options, const std::string& name);
 /// p(u) and dp/du of the parameter's transformation (fit.hpp: Transform).
 double to_parameter(const FitParameterInfo& p, double u);
 double parameter_derivative(const FitParameterInfo& p, double u);
+
+/// Runs point(i) for every i < n (OpenMP threads when `parallel`) until one returns false or throws; true when every
+/// point succeeded (a warm-started evaluation: each point from the previous curve's orbit there).
+template <class Point>
+bool each_point(std::size_t n, bool parallel, Point&& point) {
+  std::atomic<bool> failed{false};
+  ExceptionCollector errors;
+#pragma omp parallel for schedule(dynamic) if (parallel)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (failed.load()) continue;
+    errors.run([&] {
+      if (!point(i)) failed = true;
+    });
+  }
+  return !errors.failed() && !failed.load();
+}
+
+/// Every value the model needs (declared below).
+struct ModelValues;
+/// The law of `options.law` with the values of `values.law` (SI), in the registry's physical units (nm, nN).
+impact::ForceLaw build_law(const FitOptions& options, const ModelValues& values);
+/// Distance in the phase plane of two states: |Δx| and |Δẋ|/ω (model units).
+double state_distance(tapping::TipState a, tapping::TipState b, double omega);
 
 /// Every value the model needs: law values (registry keys, SI) and the calibration.
 struct ModelValues {
@@ -24,6 +56,11 @@ struct ModelValues {
   double distance_offset = 0.0;  // m
   double amplitude_scale = 1.0;
   double phase_offset = 0.0;     // rad
+  double frequency_shift_offset = 0.0;  // Hz
+  /// The calibration of `options.initial` (or the defaults) and the law values of `options.law_values`.
+  static ModelValues of(const FitOptions& options);
+  /// Sets the parameter `name` (a law key or a calibration name) to p.
+  void set(const std::string& name, double p);
 };
 
 /// One evaluation along the curve, in the sweep's order of the points.
@@ -40,6 +77,7 @@ struct CurveEvaluation {
 /// a retract curve, approach down to the smallest then retract).
 class AmForwardModel {
  public:
+  using Evaluation = CurveEvaluation;
   /// `distances` [m] in the sweep's order (approach: decreasing; retract: increasing).
   AmForwardModel(const FitSettings& settings, const FitOptions& options, std::vector<double> distances);
 
@@ -65,6 +103,45 @@ class AmForwardModel {
   tapping::TappingModel model(const ModelValues& values) const;
   double separation(const ModelValues& values, std::size_t i) const;  // model units (nm)
   void finish(const tapping::TappingModel& m, const ModelValues& values, CurveEvaluation& e) const;
+};
+
+/// One FM evaluation along the curve, in the sweep's order of the points.
+struct FmCurveEvaluation {
+  bool ok = false;
+  std::string error;
+  std::vector<tapping::FmOrbit> orbits;
+  std::vector<tapping::FmJacobian> jacobians;  // per point, kept for the next Newton solve there (Broyden-updated)
+  std::vector<double> frequency_shift, dissipation;  // model Δf [Hz] (without the offset), E [J per cycle]
+  std::vector<bool> contact, jumped;
+};
+
+/// The FM orbits (tapping/fm.hpp) along the measured distances as the instrument sweeps them (approach from the
+/// largest distance; retract: approach down to the smallest, then back up through the points).
+class FmForwardModel {
+ public:
+  using Evaluation = FmCurveEvaluation;
+  /// `distances` [m] in the sweep's order (approach: decreasing; retract: increasing).
+  FmForwardModel(const FmFitSettings& settings, const FitOptions& options, std::vector<double> distances);
+
+  /// Continuation along the curve from the free FM orbit (tapping::sweep_fm, through folds).
+  FmCurveEvaluation walk(const ModelValues& values) const;
+  /// Each point by Newton from the orbit of `from` at the same point (its Jacobian kept); falls back to walk() when
+  /// a point does not converge near the previous orbit, or `from` jumped anywhere. `chord` (the Jacobian's columns)
+  /// is accepted for the interface of the AM model: Newton to the tolerance from the kept Jacobian is about as cheap.
+  FmCurveEvaluation warm(const ModelValues& values, const FmCurveEvaluation& from, bool chord = false) const;
+
+  long curves() const { return curves_.load(); }
+  long orbits() const { return orbits_.load(); }
+
+ private:
+  FmFitSettings settings_;
+  FitOptions options_;
+  std::vector<double> distances_;
+  tapping::FmOptions fm_;
+  mutable std::atomic<long> curves_{0}, orbits_{0};
+  tapping::FmSetting setting(const ModelValues& values) const;
+  double separation(const ModelValues& values, std::size_t i) const;  // model units (nm)
+  void finish(FmCurveEvaluation& e) const;
 };
 
 }  // namespace afmkit::spectroscopy
