@@ -120,6 +120,8 @@ void fm_exact_round_trip(FmReconstruction& r, const std::vector<double>& z, cons
   }
   r.residual_rms = count ? std::sqrt(sum2 / static_cast<double>(count)) : std::numeric_limits<double>::quiet_NaN();
   r.residual_max = count ? mx : std::numeric_limits<double>::quiet_NaN();
+  r.round_trip_orbits = static_cast<int>(count);
+  r.round_trip_simulations = sweep.evaluations;
   r.round_trip_model = fmt::format("exact FM orbits of the table law (tapping fm: self-excited cantilever, ideal "
                                    "loops, Q = {:g}) at {} of the {} measured distances",
                                    options.quality_factor, count, n);
