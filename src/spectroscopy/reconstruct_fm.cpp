@@ -61,8 +61,7 @@ std::vector<std::vector<double>> invert(const std::vector<double>& z, const std:
   std::vector<std::vector<double>> out;
   if (method == FmMethod::sader_jarvis) {
     const std::vector<double> amp(n, s.amplitude);
-    for (const auto& om : omegas) out.push_back(sader_jarvis_force(z, om, amp, s.spring_constant, {}, tail));
-    return out;
+    return sader_jarvis_forces(z, omegas, amp, s.spring_constant, {}, tail);
   }
   // matrix: the grid continued over the tail (2A + 10λ beyond the last point, at most 500 more nodes)
   std::vector<double> grid = z;

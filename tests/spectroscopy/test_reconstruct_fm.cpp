@@ -10,6 +10,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/spectroscopy/reconstruct_fm.hpp"
+#include "afmkit/spectroscopy/reconstruct_kernels.hpp"
 #include "afmkit/spectroscopy/reconstruct_law.hpp"
 
 namespace sp = afmkit::spectroscopy;
@@ -165,6 +166,35 @@ TEST(ReconstructFm, NoiseIsEstimatedAndPropagatedWithAFixedSeed) {
                 5.0 * r1.force_uncertainty[i] + 0.02 * F0)
           << sp::to_string(method) << " z = " << r1.distance[i];
   }
+}
+
+TEST(ReconstructFm, SeveralCurvesOnOneGridGiveWhatEachGivesAlone) {
+  // the noise realisations are inverted together (the intervals' geometry shared): each exactly as alone, with
+  // and without a tail, for both term choices, on an uneven grid with a varying amplitude
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.5, 1.5);
+  std::vector<double> t, amp;
+  double z = 0.05e-9;
+  for (int i = 0; i < 60; ++i, z += 0.02e-9 * u(rng)) {
+    t.push_back(z);
+    amp.push_back(1e-9 * u(rng));
+  }
+  std::vector<std::vector<double>> omegas(3, std::vector<double>(t.size()));
+  for (auto& om : omegas)
+    for (std::size_t i = 0; i < t.size(); ++i) om[i] = -1e-4 * std::exp(-t[i] / lambda) * u(rng);
+  sp::ExponentialTail tail;
+  tail.active = true;
+  tail.value = omegas[0].back();
+  tail.decay_length = lambda;
+  for (const auto& with_tail : {sp::ExponentialTail{}, tail})
+    for (bool inside : {false, true}) {
+      sp::SaderJarvisTerms terms;
+      terms.amplitude_inside_derivative = inside;
+      const auto all = sp::sader_jarvis_forces(t, omegas, amp, k, terms, with_tail);
+      ASSERT_EQ(all.size(), omegas.size());
+      for (std::size_t m = 0; m < omegas.size(); ++m)
+        EXPECT_EQ(all[m], sp::sader_jarvis_force(t, omegas[m], amp, k, terms, with_tail)) << m;
+    }
 }
 
 TEST(ReconstructFm, BadInputNamesTheParameterAndIndex) {
