@@ -8,8 +8,8 @@
 //       default) and 100 separations.
 // Counters: orbits (of the round trip), simulations (FM: one-period simulations of the orbits' Newton solves), the
 // round-trip residual. table_period: one period of the FM round trip's table law (1000 knots) with and without
-// sensitivities, and the ratio of their steps (the cost of the round trip's Newton iterations: 18 before the
-// sensitivities of a C¹ table were held relative to their floor, 4 after; docs/reconstruction.md#speed).
+// sensitivities and orbit integrals, and the ratio of the steps (the cost of the round trip's Newton iterations:
+// 27 before the sensitivities of a C¹ table were held relative to their floor, 8.8 after; docs/reconstruction.md#speed).
 #include <cmath>
 #include <vector>
 
