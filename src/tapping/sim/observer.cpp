@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
+#include <type_traits>
 
 #include <boost/math/quadrature/gauss.hpp>
 
