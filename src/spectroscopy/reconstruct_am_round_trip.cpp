@@ -95,6 +95,7 @@ void am_round_trip(AmReconstruction& r, const AmSettings& s, bool dissipative, i
   }
   r.rms_amplitude_ratio = count ? std::sqrt(sa / static_cast<double>(count)) : std::numeric_limits<double>::quiet_NaN();
   r.rms_phase = count ? std::sqrt(sp / static_cast<double>(count)) : std::numeric_limits<double>::quiet_NaN();
+  r.round_trip_orbits = static_cast<int>(count);
   r.round_trip_model = fmt::format("exact periodic orbits of the table law (tapping sweep, approach) at {} of the {} "
                                    "measured separations; branches chosen by the sign of the velocity (run the law with "
                                    "--hysteresis velocity to reproduce it)",

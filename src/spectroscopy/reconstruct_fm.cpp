@@ -61,8 +61,7 @@ std::vector<std::vector<double>> invert(const std::vector<double>& z, const std:
   std::vector<std::vector<double>> out;
   if (method == FmMethod::sader_jarvis) {
     const std::vector<double> amp(n, s.amplitude);
-    for (const auto& om : omegas) out.push_back(sader_jarvis_force(z, om, amp, s.spring_constant, {}, tail));
-    return out;
+    return sader_jarvis_forces(z, omegas, amp, s.spring_constant, {}, tail);
   }
   // matrix: the grid continued over the tail (2A + 10λ beyond the last point, at most 500 more nodes)
   std::vector<double> grid = z;
@@ -120,6 +119,8 @@ void fm_exact_round_trip(FmReconstruction& r, const std::vector<double>& z, cons
   }
   r.residual_rms = count ? std::sqrt(sum2 / static_cast<double>(count)) : std::numeric_limits<double>::quiet_NaN();
   r.residual_max = count ? mx : std::numeric_limits<double>::quiet_NaN();
+  r.round_trip_orbits = static_cast<int>(count);
+  r.round_trip_simulations = sweep.evaluations;
   r.round_trip_model = fmt::format("exact FM orbits of the table law (tapping fm: self-excited cantilever, ideal "
                                    "loops, Q = {:g}) at {} of the {} measured distances",
                                    options.quality_factor, count, n);

@@ -69,6 +69,7 @@ struct AmReconstruction {
   std::vector<double> round_trip_amplitude_ratio, round_trip_phase;
   std::vector<double> residual_amplitude_ratio, residual_phase;  ///< round trip − measured (A/A0; rad)
   double rms_amplitude_ratio = 0.0, rms_phase = 0.0;              ///< (NaN without a round trip)
+  int round_trip_orbits = 0;  ///< periodic orbits the round trip found (one per separation it reached)
   std::string round_trip_model;
   std::vector<std::string> notes;
 };

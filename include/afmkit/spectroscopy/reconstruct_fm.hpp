@@ -70,6 +70,8 @@ struct FmReconstruction {
   ExponentialTail tail;                  ///< the tail used (of Ω = Δf/f0)
   double tail_sensitivity = 0.0;         ///< max |F(exponential tail) − F(zero tail)| [N] (NaN: no tail fit)
   impact::ForceCurve law;                ///< the table law (nm, nN), both branches F
+  int round_trip_orbits = 0;         ///< exact round trip: FM orbits found (0: first-order round trip)
+  long round_trip_simulations = 0;   ///< exact round trip: one-period simulations of their Newton solves
   std::string round_trip_model;
   std::vector<std::string> notes;        ///< ill-posedness and what was assumed
 };

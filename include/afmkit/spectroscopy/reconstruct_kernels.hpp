@@ -36,6 +36,12 @@ struct SaderJarvisTerms {
 std::vector<double> sader_jarvis_force(const std::vector<double>& t, const std::vector<double>& omega,
                                        const std::vector<double>& amplitude, double spring_constant,
                                        SaderJarvisTerms terms, const ExponentialTail& tail);
+/// The same for several Ω on one grid (the noise realisations): the intervals' geometry (square roots, divisions)
+/// computed once for all; each result is what sader_jarvis_force gives for that Ω.
+std::vector<std::vector<double>> sader_jarvis_forces(const std::vector<double>& t,
+                                                     const std::vector<std::vector<double>>& omegas,
+                                                     const std::vector<double>& amplitude, double spring_constant,
+                                                     SaderJarvisTerms terms, const ExponentialTail& tail);
 
 /// Matrix method (Giessibl, APL 78, 123 (2001)): solves the discretised first-order frequency-shift integral
 ///   Ω(z_i) = −(1/(π k A)) ∫_{−1}^{1} F(z_i + A(1 + u)) u/√(1 − u²) du

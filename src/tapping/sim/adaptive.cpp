@@ -96,21 +96,45 @@ class DenseSegment final : public Segment {
   mutable std::array<double, N> buffer_{};
 };
 
+/// Error control of Dopri5 as Dop853's: |err_i| ≤ atol + rtol · max(|y_i| + h|ẏ_i|, floor_i) (Boost.Odeint's default
+/// with the magnitude floor): the sensitivities are controlled relative to the identity they start from, not to
+/// their own (possibly tiny) entries. For a law only C¹ at its knots the variational equations' right-hand side
+/// (the law's slope) is only C⁰ there, and an entry near 0 held to atol alone took short steps at every knot
+/// crossed (3 to 4 times the steps per period of a 1000-point table; the FM round trip of a reconstruction).
+template <std::size_t N>
+struct FloorErrorChecker {
+  using State = std::array<double, N>;
+  double atol = 0.0, rtol = 0.0;
+  State floor{};
+  template <class Algebra, class Deriv, class Err>
+  double error(Algebra& /*algebra*/, const State& x_old, const Deriv& dxdt_old, Err& x_err, double dt) const {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < N; ++i) {
+      const double magnitude = std::max(std::abs(x_old[i]) + std::abs(dt * dxdt_old[i]), floor[i]);
+      worst = std::max(worst, std::abs(x_err[i]) / (atol + rtol * magnitude));
+    }
+    return worst;
+  }
+};
+
 /// Dormand–Prince 5(4) with dense output (Boost.Odeint runge_kutta_dopri5) behind the interface of Dop853, for
 /// laws that are only C¹ between switching gaps: there the 8th order buys nothing and costs rejected steps.
 template <class Field, std::size_t N>
 class Dopri5 {
  public:
   using State = std::array<double, N>;
-  Dopri5(double absolute_tolerance, double relative_tolerance, double max_step, const State& /*floor*/ = {})
-      : dense_(odeint::make_dense_output(absolute_tolerance, relative_tolerance, max_step,
-                                         odeint::runge_kutta_dopri5<State>())) {}
+  Dopri5(double absolute_tolerance, double relative_tolerance, double max_step, const State& floor = {})
+      : dense_(Controlled(FloorErrorChecker<N>{absolute_tolerance, relative_tolerance, floor},
+                          odeint::default_step_adjuster<double, double>(max_step))) {}
   void initialize(const Field& field, const State& y, double t, double dt) {
     field_ = field;
     dense_.initialize(y, t, dt);
   }
   /// One accepted step; a step ending beyond t_limit is reported as ending there (the run stops at t_limit).
   std::pair<double, double> do_step(double t_limit) {
+    // the drive's clock from the step's start (as Dop853 does): else every evaluation more than 0.35 rad of the
+    // drive after the mode's start fell back to std::cos
+    field_.begin_step(dense_.current_time());
     auto [t_old, t_new] = dense_.do_step(field_);
     if (t_new > t_limit) {
       t_new = t_limit;
@@ -126,7 +150,8 @@ class Dopri5 {
   const State& current_state() const { return y_; }
 
  private:
-  using Dense = decltype(odeint::make_dense_output(1.0, 1.0, 1.0, odeint::runge_kutta_dopri5<State>()));
+  using Controlled = odeint::controlled_runge_kutta<odeint::runge_kutta_dopri5<State>, FloorErrorChecker<N>>;
+  using Dense = odeint::dense_output_runge_kutta<Controlled>;
   Dense dense_;
   Field field_{};
   State y_{};
