@@ -5,9 +5,9 @@
 // written, run back through the forward model and compared with the measured Δf.
 //
 // SI units: z [m] = the closest tip–sample distance of the oscillation, Δf [Hz], A [m], k [N/m], f0 [Hz], F [N]
-// (positive repulsive, docs/conventions.md), U [J]. The forward model of the round trip is the first-order
-// large-amplitude formula Δf(z) = −(f0/(π k A)) ∫_{−1}^{1} F(z + A(1 + u)) u/√(1 − u²) du by quadrature — not an
-// exact orbit (the exact-orbit FM model will replace it).
+// (positive repulsive, docs/conventions.md), U [J]. The forward model of the round trip (FmOptions: exact_round_trip) is
+// either afmkit's exact FM orbits of the reconstructed table law (tapping/fm.hpp: the default) or the first-order
+// large-amplitude formula Δf(z) = −(f0/(π k A)) ∫_{−1}^{1} F(z + A(1 + u)) u/√(1 − u²) du by quadrature.
 #include <cstdint>
 #include <string>
 #include <vector>
