@@ -52,6 +52,19 @@ SaderJarvisTerms terms_of(AmMethod m) {
     default: return {true, true};                    // amplitude inside the derivative: d(A^{3/2} Ω)/dt
   }
 }
+/// The equivalent Ω each method inverts (docs/reconstruction.md#am). payam and hoelscher: the first-order Ω_eq,
+/// linear in the virial, which the Sader–Jarvis/Abel integrals invert. katan: the frequency of the equivalent FM
+/// oscillator, Ω = √(1 + (A0/(Q A)) cos φ) − 1 at r = 1 (Katan, van Es & Oosterkamp 2009), i.e. √(1 + 2 Ω_eq) − 1;
+/// it differs from Ω_eq at second order (−Ω_eq²/2).
+double method_frequency_shift(double a, double phase, const AmSettings& s, AmMethod m) {
+  const double omega = equivalent_frequency_shift(a, phase, s);
+  if (m != AmMethod::katan) return omega;
+  // 1 + 2 Ω_eq = (ω_eq/ω0)² of the equivalent oscillator: ≤ 0 means no real frequency (refused as a numerical
+  // failure by the caller's check of finite values)
+  const double x = 2.0 * omega;
+  return x / (std::sqrt(1.0 + x) + 1.0);  // √(1 + x) − 1 without cancellation
+}
+
 /// The points whose lower turning point D = l − A increases with l (from the free end inwards), at least 1/2000
 /// of the range of D apart; l ascending.
 std::vector<std::size_t> used_points(const std::vector<double>& l, const std::vector<double>& a) {
@@ -105,6 +118,14 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
                                                   "docs/conventions.md; π/2 for the free cantilever at resonance)",
                                                   i, curve.phase[i], curve.phase[i] * 180.0 / std::numbers::pi));
   }
+  if (options.method == AmMethod::katan)
+    for (std::size_t i = 0; i < n; ++i)
+      if (!(1.0 + 2.0 * equivalent_frequency_shift(curve.amplitude[i], curve.phase[i], s) > 0.0))
+        throw InvalidParameter("phase", fmt::format("phase[{}] = {}° with amplitude[{}] = {} m has no equivalent "
+                                                    "oscillator for method katan: 1 + (A0/(Q A)) cos φ must be > 0 "
+                                                    "(the amplitude is below A0/Q; use payam or hoelscher)",
+                                                    i, curve.phase[i] * 180.0 / std::numbers::pi, i,
+                                                    curve.amplitude[i]));
   if (options.round_trip_points < 0 || options.round_trip_points == 1 || options.round_trip_points > 100000)
     throw InvalidParameter("round_trip_points", fmt::format("round_trip_points = {} is out of range: 0 (all) or an "
                                                             "integer in [2, 100000]",
@@ -135,7 +156,7 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
     for (std::size_t i : kept) {
       r.gap.push_back(r.separation[i] - r.amplitude[i]);
       amp.push_back(r.amplitude[i]);
-      r.omega.push_back(equivalent_frequency_shift(r.amplitude[i], r.phase[i], s));
+      r.omega.push_back(method_frequency_shift(r.amplitude[i], r.phase[i], s, options.method));
       r.gap_dissipation.push_back(r.dissipation[i]);
     }
     ExponentialTail tail;
@@ -249,7 +270,7 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
         for (std::size_t i : kept2) {
           g2.push_back(r.separation[i] - a2[i]);
           amp2.push_back(a2[i]);
-          o2.push_back(equivalent_frequency_shift(a2[i], p2[i], s));
+          o2.push_back(method_frequency_shift(a2[i], p2[i], s, options.method));
         }
         const auto f2 = sader_jarvis_force(g2, o2, amp2, s.spring_constant, terms_of(options.method), tail);
         for (std::size_t i = 0; i < r.gap.size(); ++i) {

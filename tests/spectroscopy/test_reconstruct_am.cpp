@@ -178,3 +178,43 @@ TEST(ReconstructAm, BadInputNamesTheParameter) {
   EXPECT_THROW(sp::reconstruct_am(bad, set), afmkit::InvalidParameter);
   EXPECT_THROW(sp::AmSettings(k, f0, Q, -1e-9), afmkit::InvalidParameter);
 }
+
+TEST(ReconstructAm, KatanInvertsTheFrequencyOfTheEquivalentOscillator) {
+  // Katan, van Es & Oosterkamp (2009): the AM curve is the FM curve of the oscillator whose frequency balances the
+  // in-phase force, (ω/ω0)² = 1 + (A0/(Q A)) cos φ at the resonance drive: Ω = √(1 + (A0/(Q A)) cos φ) − 1, not
+  // its first-order part (A0/(2 Q A)) cos φ (the two differ by (A0 cos φ/(Q A))²/8). Low Q makes it visible.
+  const double q = 5.0;
+  sp::AmCurve c;
+  for (int i = 0; i < 20; ++i) {
+    c.separation.push_back((4.0 + 0.5 * i) * 1e-9);
+    c.amplitude.push_back((6.0 + 0.2 * i) * 1e-9);
+    c.phase.push_back(std::numbers::pi / 2 + 0.6 * std::exp(-0.3 * i));  // attractive: lag above 90°
+  }
+  const sp::AmSettings set(k, f0, q, A0);
+  sp::AmOptions o;
+  o.method = sp::AmMethod::katan;
+  o.round_trip = false;
+  const auto r = sp::reconstruct_am(c, set, o);
+  ASSERT_EQ(r.omega.size(), c.separation.size());
+  for (std::size_t i = 0; i < r.omega.size(); ++i) {
+    const double x = A0 * std::cos(c.phase[i]) / (q * c.amplitude[i]);
+    EXPECT_NEAR(r.omega[i], std::sqrt(1.0 + x) - 1.0, 1e-15) << i;
+  }
+  // payam and hoelscher invert the first-order Ω (linear in the virial)
+  o.method = sp::AmMethod::payam;
+  const auto p = sp::reconstruct_am(c, set, o);
+  for (std::size_t i = 0; i < p.omega.size(); ++i)
+    EXPECT_NEAR(p.omega[i], A0 * std::cos(c.phase[i]) / (2.0 * q * c.amplitude[i]), 1e-15) << i;
+  // no equivalent oscillator: 1 + (A0/(Q A)) cos φ ≤ 0 is refused, naming the phase and the index
+  auto bad = c;
+  bad.amplitude[3] = 0.1e-9;
+  bad.phase[3] = 3.0;
+  o.method = sp::AmMethod::katan;
+  try {
+    sp::reconstruct_am(bad, set, o);
+    FAIL();
+  } catch (const afmkit::InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "phase");
+    EXPECT_NE(std::string(e.what()).find("phase[3]"), std::string::npos);
+  }
+}

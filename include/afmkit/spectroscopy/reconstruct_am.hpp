@@ -56,7 +56,7 @@ struct AmReconstruction {
   std::vector<double> dissipation;  ///< E_dis [J] per point (Cleveland et al. 1998, exact first harmonic)
   // the points used (D strictly increasing with l), ascending in D
   std::vector<double> gap;             ///< D = l − A [m]
-  std::vector<double> omega;           ///< the equivalent Ω = Δf/f0 of the in-phase balance
+  std::vector<double> omega;           ///< the equivalent Ω = Δf/f0 the method inverts (katan: √(1 + 2 Ω_eq) − 1)
   std::vector<double> force;           ///< conservative F(D) [N]
   std::vector<double> force_uncertainty;  ///< 1σ of F from the noise estimated in Ω_eq (8 realisations) [N]
   std::vector<double> gap_dissipation; ///< E_dis at those points [J] (monotone fit, 0 above the contact part)
