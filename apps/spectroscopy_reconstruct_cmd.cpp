@@ -134,6 +134,13 @@ void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurv
                                    p.real("free_amplitude") * 1e-9, p.real("drive_frequency") * 1e3);
   spectroscopy::AmOptions o;
   o.method = spectroscopy::am_method_from(method);
+  if (o.method == spectroscopy::AmMethod::katan)  // Katan's equivalent oscillator needs 1 + 2 Ω_eq > 0
+    for (std::size_t i = 0; i < m.phase.size(); ++i)
+      if (!(1.0 + 2.0 * spectroscopy::equivalent_frequency_shift(m.amplitude[i], m.phase[i], s) > 0.0))
+        throw InputError(fmt::format("{}:{}: column phase: {}° with amplitude {} nm has no equivalent oscillator for "
+                                     "method katan: 1 + (A0/(Q A)) cos φ must be > 0 (use payam or hoelscher; "
+                                     "docs/reconstruction.md#am-sources)",
+                                     file, m.lines[i], m.phase[i] * 180.0 / std::numbers::pi, m.amplitude[i] * 1e9));
   o.tail = spectroscopy::tail_model_from(p.text("tail"));
   o.round_trip_points = static_cast<int>(p.integer("round_trip_points"));
   const auto r = spectroscopy::reconstruct_am({m.distance, m.amplitude, m.phase}, s, o);

@@ -138,11 +138,7 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
   r.amplitude = detail::permuted(curve.amplitude, order);
   r.phase = detail::permuted(curve.phase, order);
   return computed("force reconstruction (AM)", [&] {
-    std::size_t negative = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      r.dissipation.push_back(dissipated_energy(r.amplitude[i], r.phase[i], s));
-      if (r.dissipation[i] < 0.0) ++negative;
-    }
+    for (std::size_t i = 0; i < n; ++i) r.dissipation.push_back(dissipated_energy(r.amplitude[i], r.phase[i], s));
     // the points whose lower turning point D = l − A increases with l (from the free end inwards), at least
     // 1/2000 of the range of D apart: nearly coincident D (the repulsive regime, dense sampling) would turn the
     // orbits' or the instrument's noise into huge derivatives
@@ -176,6 +172,11 @@ AmReconstruction reconstruct_am(const AmCurve& curve, const AmSettings& s, const
     const double drive_work = std::numbers::pi * s.spring_constant * s.free_amplitude * s.free_amplitude / s.quality_factor;
     const double threshold = std::max({3.0 * estimate_noise(r.gap_dissipation), 1e-3 * e_max, 2e-4 * drive_work});
     std::vector<double> delta = branch_difference(r.gap, r.gap_dissipation, threshold, r.contact_gap);
+    // E_dis < 0 beyond the same threshold: a conservative curve gives E_dis = 0 up to the rounding of
+    // A0 sin φ − A (a difference of nearly equal numbers), which is no sign of a wrong setting
+    std::size_t negative = 0;
+    for (double e : r.dissipation)
+      if (e < -threshold) ++negative;
     // the same difference at the three deepest points: both branches then have the same end slope, and their
     // straight continuations below the table stay parallel (the law dissipates there too, never creates energy)
     const double deep = (delta[0] + delta[1] + delta[2]) / 3.0;

@@ -35,12 +35,17 @@ def virial(force, gap, amplitude):
     return (2.0 / math.pi) * np.sum(WT * force(gap + a * (1.0 + np.cos(TH))) * np.cos(TH), axis=-1)
 
 
+def no_dissipation(gap, amplitude):
+    return 0.0 * np.asarray(amplitude, dtype=float)
+
+
 def first_order_curve(force, dissipation, gaps):
-    """l, A, φ (afmkit's lag convention) that balance the first harmonic at each D; the upper (free) branch."""
+    """l, A, φ (afmkit's lag convention) that balance the first harmonic at each D (dissipation(D, A): E_dis of
+    the orbit [J]); the upper (free) branch."""
     sep, amp, ph = [], [], []
     for d in gaps:
         def cos_sin(a):
-            return -virial(force, d, a) * Q / (K * A0), a / A0 + dissipation(d) * Q / (math.pi * K * a * A0)
+            return -virial(force, d, a) * Q / (K * A0), a / A0 + dissipation(d, a) * Q / (math.pi * K * a * A0)
 
         def g(a):
             c, s = cos_sin(a)
@@ -67,14 +72,17 @@ def test_the_quadrature_is_the_closed_form():
         assert float(virial(exponential, d, a)) == pytest.approx(exact, rel=1e-12)
 
 
-@pytest.mark.parametrize("method,bound", [("payam", 0.03), ("hoelscher", 0.03), ("katan", 0.06)])
+# bounds (of the largest attraction probed): measured 1.4 % (payam), 4.9 % (hoelscher: the large-amplitude limit
+# at A/λ ≈ 9.3, about 5 % of the local force), 11.7 % (katan: the amplitude outside the derivative, at the deepest
+# point where A falls 1.5 times faster than D; below 0.5 % from the next λ on); all of it at the deepest points
+@pytest.mark.parametrize("method,bound", [("payam", 0.025), ("hoelscher", 0.07), ("katan", 0.15)])
 def test_conservative_force_is_recovered_by_each_method(method, bound):
-    sep, amp, ph = first_order_curve(exponential, lambda d: 0.0, GAPS)
+    sep, amp, ph = first_order_curve(exponential, no_dissipation, GAPS)
     assert amp.min() < 0.95 * A0  # the curve probes the force: the amplitude falls by more than 5 %
     r = sr.reconstruct_am(sep, amp, ph, spring_constant=K, resonance_frequency=F0_HZ, quality_factor=Q,
                           free_amplitude=A0, method=method, round_trip=False)
     gap, force = np.asarray(r.gap), np.asarray(r.force)
-    assert np.allclose(gap, sep[-len(gap):] - amp[-len(gap):]) or gap.size == sep.size
+    assert gap.size == sep.size and np.allclose(gap, sep - amp, rtol=0.0, atol=1e-18)  # every point used, D = l − A
     truth = exponential(gap)
     inner = gap < gap[-1] - 3.0 * LAM  # the zero tail biases the last few λ (the law is cut at the last point)
     err = np.max(np.abs(force[inner] - truth[inner]))
@@ -82,9 +90,11 @@ def test_conservative_force_is_recovered_by_each_method(method, bound):
     # no dissipation in a conservative law: E_dis is 0 to rounding, and the branches do not differ
     assert np.max(np.abs(r.dissipation)) < 1e-9 * math.pi * K * A0 * A0 / Q
     assert math.isnan(r.contact_gap)
+    # and no note of negative dissipation: E_dis = 0 up to rounding is no sign of a wrong setting
+    assert not any("dissipate less" in note for note in r.notes), r.notes
 
 
-C_DIS, MU = 1.0e-9, 0.8e-9  # branch difference F_a − F_r = C e^{−d/μ} [N, m]
+C_DIS, MU = 5.0e-9, 1.2e-9  # branch difference F_a − F_r = C e^{−d/μ} [N, m]
 
 
 def hysteresis_mean(d):
@@ -96,24 +106,27 @@ def dissipation_closed_form(d):
 
 
 def dissipation_quadrature(gap, amplitude):
-    """E_dis = ∮ F dd over one cycle with branches chosen by the direction of motion, by Gauss–Legendre."""
-    approach = lambda d: hysteresis_mean(d) + 0.5 * C_DIS * np.exp(-d / MU)
-    departure = lambda d: hysteresis_mean(d) - 0.5 * C_DIS * np.exp(-d / MU)
-    d = gap + amplitude * (1.0 + np.cos(TH))
-    dd = -amplitude * np.sin(TH)  # dd/dθ on the approach half (θ ∈ [0, π]); the departure half mirrors it
-    return float(np.sum(WT * (approach(d) - departure(d)) * (-dd)))
+    """E_dis = −∮ F dd over one cycle with branches chosen by the direction of motion (approach F_a, departure
+    F_r), by Gauss–Legendre in θ: ∫_0^π (F_a − F_r)(d(θ)) A sin θ dθ, d(θ) = D + A (1 + cos θ); amplitude a
+    number or an array. The orbit reaches D + 2A only: E_dis = C μ (e^{−D/μ} − e^{−(D + 2A)/μ})."""
+    a = np.asarray(amplitude, dtype=float)[..., None]
+    d = gap + a * (1.0 + np.cos(TH))
+    return np.sum(WT * C_DIS * np.exp(-d / MU) * a * np.sin(TH), axis=-1)
 
 
 def test_dissipation_and_the_departure_branch():
     # the closed form and the quadrature agree (the independent path for E_dis)
     for d, a in [(2e-9, 8e-9), (4e-9, 9e-9)]:
-        assert dissipation_quadrature(d, a) == pytest.approx(dissipation_closed_form(d), rel=1e-9)
-    sep, amp, ph = first_order_curve(hysteresis_mean, dissipation_closed_form, GAPS)
+        exact = C_DIS * MU * (math.exp(-d / MU) - math.exp(-(d + 2 * a) / MU))
+        assert float(dissipation_quadrature(d, a)) == pytest.approx(exact, rel=1e-12)
+    sep, amp, ph = first_order_curve(hysteresis_mean, dissipation_quadrature, GAPS)
     r = sr.reconstruct_am(sep, amp, ph, spring_constant=K, resonance_frequency=F0_HZ, quality_factor=Q,
                           free_amplitude=A0, method="payam", round_trip=False)
     # E_dis per point (Cleveland et al. / Anczykowski et al.) to rounding
-    e_true = np.array([dissipation_quadrature(d, a) for d, a in zip(sep - amp, amp)])
+    e_true = np.array([float(dissipation_quadrature(d, a)) for d, a in zip(sep - amp, amp)])
     assert np.max(np.abs(np.asarray(r.dissipation) - e_true)) < 1e-9 * e_true.max()
+    # ... which is the area between the branches below the orbit's reach (closed form), within e^{−2A/μ}
+    assert np.max(np.abs(e_true - [dissipation_closed_form(d) for d in sep - amp])) < 1e-6 * e_true.max()
     # the branch difference −dE_dis/dD over the contact part, against C e^{−D/μ}
     gap = np.asarray(r.gap)
     delta = np.asarray(r.approach_force) - np.asarray(r.retract_force)
@@ -121,7 +134,7 @@ def test_dissipation_and_the_departure_branch():
     near = gap < r.contact_gap - 2.0 * (gap[1] - gap[0])
     assert near.sum() > 10
     err = np.max(np.abs(delta[near][3:] - truth[near][3:]))
-    assert err < 0.03 * truth[0], err / truth[0]
+    assert err < 0.005 * truth[0], err / truth[0]  # measured 0.06 %
     # the conservative force is unaffected by the dissipation
     inner = gap < gap[-1] - 3.0 * LAM
     assert np.max(np.abs(np.asarray(r.force)[inner] - exponential(gap[inner]))) < 0.03 * abs(exponential(gap[0]))
@@ -139,11 +152,15 @@ def test_phase_convention_of_the_free_cantilever():
         assert np.max(np.abs(r.force)) < 1e-12 * K * A0
         assert np.max(np.abs(r.dissipation)) < 1e-9 * math.pi * K * A0 * A0 / Q
     # attraction delays the response (φ > π/2): the force comes out attractive; the mirrored convention would not
-    sep, amp, ph = first_order_curve(exponential, lambda d: 0.0, GAPS)
+    sep, amp, ph = first_order_curve(exponential, no_dissipation, GAPS)
     assert np.all(ph > 0.5 * math.pi)
     r = sr.reconstruct_am(sep, amp, ph, spring_constant=K, resonance_frequency=F0_HZ, quality_factor=Q,
                           free_amplitude=A0, round_trip=False)
     assert r.force[0] < 0.0
+    # a phase offset of 1° makes the attractive points dissipate less than the free cantilever: said
+    r = sr.reconstruct_am(sep, amp, ph + math.radians(1.0), spring_constant=K, resonance_frequency=F0_HZ,
+                          quality_factor=Q, free_amplitude=A0, round_trip=False)
+    assert any("dissipate less" in note for note in r.notes), r.notes
 
 
 def test_first_harmonic_balance_from_the_equation_of_motion():
