@@ -14,6 +14,7 @@ import math
 import numpy as np
 import pytest
 
+import afmkit
 from afmkit import spectroscopy_reconstruct as sr
 
 K, F0_HZ, Q, A0 = 40.0, 300e3, 400.0, 10e-9
@@ -69,7 +70,7 @@ def first_order_curve(force, dissipation, gaps):
             c, s = cos_sin(a)
             return c * c + s * s - 1.0
 
-        grid = np.linspace(A0, 0.5 * A0, 200)
+        grid = np.linspace(A0, 0.5 * A0, 60)
         vals = g(grid)
         j = next(i for i in range(1, len(grid)) if vals[i] < 0.0 <= vals[i - 1])
         a = bisect(lambda v: float(g(v)), grid[j], grid[j - 1])
@@ -177,6 +178,14 @@ def test_dissipation_and_the_departure_branch():
 def test_phase_convention_of_the_free_cantilever():
     # docs/conventions.md: x ≈ A cos(ωt − φ) for the drive cos ωt, φ the lag: π/2 at resonance for the free
     # cantilever; off resonance φ = atan2(r/Q, 1 − r²). A free curve gives no force and no dissipation.
+    # afmkit's own exact orbit of the free cantilever driven below resonance: the lag atan2(r/Q, 1 − r²) (51.3°
+    # at r = 0.999, Q = 400; a lead would read −51.3° or 128.7°), at the free amplitude A0 given for the drive
+    orbit = afmkit.tapping.orbit(units="physical", law="dmt", spring_constant=K, resonance_frequency=F0_HZ * 1e-3,
+                                 quality_factor=Q, free_amplitude=A0 * 1e9, separation=200.0, frequency_ratio=0.999,
+                                 output="")
+    assert orbit.units["phase"] == "rad" and orbit.units["amplitude"] == "nm"
+    assert orbit.table["phase"][0] == pytest.approx(math.atan2(0.999 / Q, 1.0 - 0.999 ** 2), abs=1e-5)
+    assert orbit.table["amplitude"][0] == pytest.approx(A0 * 1e9, rel=1e-5)
     for r_drive in (1.0, 0.999, 1.001):
         f_drive = r_drive * F0_HZ
         phi = math.atan2(r_drive / Q, 1.0 - r_drive ** 2)
