@@ -75,7 +75,8 @@ struct AmReconstruction {
 };
 
 /// E_dis = π k A (A0 |1 − r² + i r/Q| sin φ − A r/Q), r = f/f0 (the first-harmonic energy balance; at r = 1 the
-/// formula of Cleveland et al., APL 72, 2613 (1998): (π k A²/Q)((A0/A) sin φ − 1)).
+/// formula of Cleveland et al., APL 72, 2613 (1998): (π k A²/Q)((A0/A) sin φ − 1)); off resonance Anczykowski's
+/// (π k A²/Q)((A0'/A) sin φ − r) with A0' = Q A0 |1 − r² + i r/Q|, the free amplitude at resonance.
 double dissipated_energy(double amplitude, double phase, const AmSettings& s);
 /// Ω_eq = −(1 − r²)/2 + (A0/(2A)) |1 − r² + i r/Q| cos φ (at r = 1: A0 cos φ/(2 Q A)).
 double equivalent_frequency_shift(double amplitude, double phase, const AmSettings& s);
