@@ -16,6 +16,7 @@ parameters are checked by the afmkit command that uses them, with ``afmkit.Inval
 """
 from __future__ import annotations
 
+import functools
 import math
 import os
 import pathlib
@@ -37,11 +38,17 @@ class ReportEntry:
 
 
 def figure(figure_id: str):
-    """Marks a figure function with the id of the figure it draws (selectable before it runs)."""
+    """Marks a figure function with the id of the figure it draws (selectable before it runs); ``out`` is checked
+    before anything is computed."""
 
     def mark(fn):
-        fn.figure_id = figure_id
-        return fn
+        @functools.wraps(fn)
+        def checked(out=None, **keywords):
+            check_out(out)
+            return fn(out, **keywords)
+
+        checked.figure_id = figure_id
+        return checked
 
     return mark
 
