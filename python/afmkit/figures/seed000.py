@@ -534,6 +534,11 @@ def fig_hb_vs_orbits(out=None, *, cases=tuple(ORBIT_CASES), points: int = 3000):
 # ---------------------------------------------------------------------------------------------------------------
 # beyond the paper: impacts and restitution (seed-1 eqs. 1-6, ext. E0)
 
+def _masses(body: dict) -> str:
+    m1, m2 = _fmt(body["mass1"]), _fmt(body["mass2"])
+    return f"m1 = m2 = {m1} kg" if m1 == m2 else f"m1 = {m1} kg, m2 = {m2} kg"
+
+
 @figure("beyond-impact")
 def fig_impact(out=None, *, approach_stiffness: float = IMPACT_KA, departure_ratios=tuple(IMPACT_RATIOS),
                bodies=tuple(IMPACT_BODIES), loop_ratio: float = IMPACT_LOOP_RATIO, loop_points: int = 400):
@@ -620,14 +625,14 @@ def fig_impact(out=None, *, approach_stiffness: float = IMPACT_KA, departure_rat
          "impact energy_balance_residual / kinetic_energy_before"),
     ]
     caption = (f"Two-body impact with the linear hysteresis law (seed-1 eqs. 1–6, `afmkit impact`, adaptive "
-               f"integrator), K_a = {_fmt(ka)} N/m. (a) Force–gap loop of one impact (m1 = "
-               f"{_fmt(body_list[0]['mass1'])} kg, m2 = {_fmt(body_list[0]['mass2'])} kg, approach speed "
+               f"integrator), K_a = {_fmt(ka)} N/m. (a) Force–gap loop of one impact ("
+               f"{_masses(body_list[0])}, approach speed "
                f"{_fmt(body_list[0]['velocity'])} nm/s, K_b = {_fmt(loop_r)} K_a): the bodies approach on the K_a branch "
                f"and leave on the K_b branch; the area between them is the energy lost, "
                f"{loop.results['energy_loss_area']:.4g} {u['energy']} against the kinetic-energy loss "
                f"{loop.results['kinetic_energy_loss']:.4g} {u['energy']}. (b) The simulated coefficient of restitution "
-               f"for K_b/K_a from {_fmt(min(ratios))} to {_fmt(max(ratios))} and {len(body_list)} mass/speed "
-               f"pair(s) "
+               f"for K_b/K_a from {_fmt(min(ratios))} to {_fmt(max(ratios))} and "
+               f"{['one', 'two', 'three', 'four'][len(body_list) - 1]} mass/speed pair{'s' if len(body_list) > 1 else ''} "
                f"agrees with e = √(K_b/K_a) to {worst_e:.1e}, independent of masses and speed.")
     return finish(fig, out, "beyond-impact",
                   title="Beyond the papers: impact restitution and energy loss (seed-1 eqs. 1–6)",
