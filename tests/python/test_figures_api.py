@@ -63,6 +63,13 @@ def test_fig3_with_other_parameters_draws_them_and_writes_nothing(tmp_path, monk
     assert len(marked) == 2 and all(ln.get_ydata()[0] == pytest.approx(5.0, rel=1e-6) for ln in marked)
 
 
+def test_numpy_arrays_and_scalars_are_accepted():
+    fig = seed000.fig4(stiffness_ratios=np.array([1, 10]), free_amplitude=np.float32(15.0), points=np.int64(80))
+    labels = [ln.get_label() for ln in _labelled_lines(fig.axes[0])]
+    assert labels[:2] == ["K_a/ω_n² = 1", "K_a/ω_n² = 10"]
+    assert fig.axes[0].get_ylim() == pytest.approx((0.0, 22.5))  # 1.5 A_free
+
+
 def test_out_writes_the_png_into_a_folder_or_to_a_file_name(tmp_path):
     fig = seed000.fig3(tmp_path / "a", stiffness_ratios=[10.0], points=60)
     assert sorted(os.listdir(tmp_path / "a")) == ["seed000-fig3.png"]

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import functools
 import math
+import numbers as _numbers
 import os
 import pathlib
 from dataclasses import dataclass, field
@@ -80,7 +81,7 @@ def finish(fig, out, figure_id: str, **entry):
 # checks of the keyword parameters (ValueError naming the keyword and the allowed range)
 
 def _finite(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+    return isinstance(x, _numbers.Real) and not isinstance(x, bool) and math.isfinite(x)  # NumPy scalars too
 
 
 def number(name: str, value, *, low=None, high=None, positive=False) -> float:
@@ -95,7 +96,7 @@ def number(name: str, value, *, low=None, high=None, positive=False) -> float:
 
 def integer(name: str, value, *, low: int, high: int) -> int:
     """An integer in [low, high]."""
-    if not isinstance(value, int) or isinstance(value, bool) or not low <= value <= high:
+    if not isinstance(value, _numbers.Integral) or isinstance(value, bool) or not low <= value <= high:
         raise ValueError(f"{name} = {value!r} is out of range: must be an integer in [{low}, {high}]")
     return int(value)
 
