@@ -283,10 +283,10 @@ def fig3(out=None, *, plant_rate: float = GAMMA, gain=None, a: float = 0.5, b: f
     above = [d for d in delays if d >= tc]
     outcome = []
     if below:
-        outcome.append(f"With τ = {', '.join(f'{d:g}' for d in below)} T (below the delay margin) the output "
-                       "converges to 0 (the first harmonic is removed)")
+        outcome.append(f"With τ = {', '.join(f'{d:g}T' for d in below)} the output converges to 0 (the first "
+                       "harmonic is removed)")
     if above:
-        outcome.append(f"with τ = {', '.join(f'{d:g}' for d in above)} T, beyond the delay margin")
+        outcome.append(f"with τ = {', '.join(f'{d:g}T' for d in above)}, beyond the delay margin")
     return finish(
         fig, out, "seed003-fig3",
         title="Seed 2, Fig. 3: plant + one oscillator converges for a short delay and diverges for a longer one",
@@ -583,10 +583,11 @@ def fig7(out=None, *, plant_rate: float = GAMMA, gain=None, harmonics: int = 10,
                 ", ".join(f"{s['real']:.3g}{s['imag']:+.3g}i (×{s['multiplicity']})" for s in structural) or "none",
                 "control roots --controller infinite")]
     g_text, couplings, tau = _bank_text(L)
+    couplings_ab, k_text = couplings.rsplit(", ", 1)
     return finish(
         fig, out, "seed003-fig7",
         title="Seed 2, Fig. 7: truncated bank versus the neutral N = ∞ controller on a long run",
-        caption=(f"Same loop as Fig. 5 (first-order plant {g_text}, {couplings}, {tau}, "
+        caption=(f"Same loop as Fig. 5 (first-order plant {g_text}, {k_text}, {couplings_ab}, {tau}, "
                  f"multi-harmonic f), AB3 with {steps} steps per period, {periods} periods: the truncated bank "
                  f"N = {L['harmonics']} against afmkit's realisation of the neutral N = ∞ controller (four integrators and two "
                  "one-period delay lines). (a) the controls agree closely in the transient; (b) later the "
