@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import afmkit
-from afmkit.figures import Figure, seed000
+from afmkit.figures import ReportEntry, seed000
 
 
 def _hb_physical(ka, **kw):
@@ -125,8 +125,8 @@ def test_helpers():
 
 
 def test_fig3_draws(tmp_path):
-    f = seed000.fig3(tmp_path)
-    assert isinstance(f, Figure) and f.id == "seed000-fig3"
+    f = seed000.fig3(tmp_path).report
+    assert isinstance(f, ReportEntry) and f.id == "seed000-fig3"
     png = tmp_path / f.filename
     assert png.exists() and png.stat().st_size > 10000
     import matplotlib.image as mpimg

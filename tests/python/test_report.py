@@ -40,6 +40,10 @@ def test_a_selection_writes_a_page_with_just_those_figures(tmp_path):
         assert f'id="{fid}"' in page
         assert (tmp_path / "rep" / "figures" / f"{fid}.png").stat().st_size > 1000
     assert "restitution" in page  # the impact figure's key number
+    # the figures first, the key numbers after them; no citation of a file outside the repository
+    assert page.rindex("<figure>") < page.index('<h2 id="numbers">')
+    for outside in ("MATH.md", "shared/", "/work/", "seeds/"):
+        assert outside not in page
     assert leftovers(tmp_path / "rep") == []
 
 

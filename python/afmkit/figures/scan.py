@@ -18,9 +18,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import afmkit  # noqa: E402
-from afmkit.figures import Figure, figure  # noqa: E402
+from afmkit.figures import figure, finish  # noqa: E402
 
-DPI = 110
+#: the scan of the report (keywords of afmkit.scan; docs/scan.md)
+SCAN = dict(sample="grating", sample_resolution=512, tilt_angle=0.05, end_radius=4e-3, radial_speed=400e-6,
+            sample_rate=50e3, spindle_frequency=50.0, delay=1e-3, detector_range=2e-6, harmonics=10, alpha=0.1,
+            beta=-0.1, image_resolution=192)
 
 
 def read_gsf(path) -> tuple[np.ndarray, dict]:
@@ -59,11 +62,25 @@ def _level(z: np.ndarray) -> np.ndarray:
 
 
 @figure("beyond-scan-images")
-def scan_images(out_dir: pathlib.Path) -> Figure:
-    """Deflection image without and with the controller, reconstructed topography, residual tilt vs radius."""
-    params = dict(sample="grating", sample_resolution=512, tilt_angle=0.05, end_radius=4e-3, radial_speed=400e-6,
-                  sample_rate=50e3, spindle_frequency=50.0, delay=1e-3, detector_range=2e-6, harmonics=10,
-                  alpha=0.1, beta=-0.1, image_resolution=192)
+def scan_images(out=None, *, sample: str = SCAN["sample"], sample_resolution: int = SCAN["sample_resolution"],
+                tilt_angle: float = SCAN["tilt_angle"], end_radius: float = SCAN["end_radius"],
+                radial_speed: float = SCAN["radial_speed"], sample_rate: float = SCAN["sample_rate"],
+                spindle_frequency: float = SCAN["spindle_frequency"], delay: float = SCAN["delay"],
+                detector_range: float = SCAN["detector_range"], harmonics: int = SCAN["harmonics"],
+                alpha: float = SCAN["alpha"], beta: float = SCAN["beta"],
+                image_resolution: int = SCAN["image_resolution"]):
+    """Beyond the papers: the virtual rotational scan (``afmkit.scan``) of a tilted sample without and with the
+    controller: deflection images, reconstructed topography, residual tilt against radius, scan-area gain.
+
+    The keywords are those of ``afmkit.scan`` (SI units, docs/scan.md; checked there, ValueError naming the key):
+    tilt_angle (degrees), end_radius (m), radial_speed (m/s), sample_rate and spindle_frequency (Hz), delay (s),
+    detector_range (m), harmonics, alpha and beta (Ω), sample_resolution and image_resolution (pixels); the
+    defaults are :data:`SCAN`. Returns the Matplotlib Figure (``fig.report``: caption, key numbers); writes the
+    PNG if ``out``."""
+    params = dict(sample=sample, sample_resolution=sample_resolution, tilt_angle=tilt_angle, end_radius=end_radius,
+                  radial_speed=radial_speed, sample_rate=sample_rate, spindle_frequency=spindle_frequency,
+                  delay=delay, detector_range=detector_range, harmonics=harmonics, alpha=alpha, beta=beta,
+                  image_resolution=image_resolution)
     with tempfile.TemporaryDirectory(prefix="afmkit-scan-") as tmp:
         off_prefix, on_prefix = f"{tmp}/off", f"{tmp}/on"
         r_off = afmkit.scan(control="off", image_output=off_prefix, **params)
@@ -134,10 +151,6 @@ def scan_images(out_dir: pathlib.Path) -> Figure:
     a.set_xlabel("x [mm]")
     a.set_ylabel("y [mm]")
     a.legend(fontsize=8, loc="lower right")
-    name = "beyond-scan-images.png"
-    fig.savefig(pathlib.Path(out_dir) / name, dpi=DPI)
-    plt.close(fig)
-
     def g(v, d=3):
         return f"{v:.{d}g}" if isinstance(v, (int, float)) and math.isfinite(v) else str(v)
 
@@ -155,20 +168,24 @@ def scan_images(out_dir: pathlib.Path) -> Figure:
                 f"{g(float(r_on['deflection_first_harmonic'][-1]) * 1e9)} nm", "afmkit scan: per-turn table"),
                ("loop spectral abscissa at the nominal delay", f"{g(res['loop_spectral_abscissa'], 4)} 1/s",
                 "afmkit scan: loop_spectral_abscissa")]
-    return Figure(
-        id="beyond-scan-images",
+    return finish(
+        fig, out, "beyond-scan-images",
         title="Beyond the paper: virtual rotational scan of a tilted grating without and with the controller",
-        caption=("A grating (period 800 µm, lines 50 nm, 512² sample map) tilted by 0.05° spins at 50 Hz under a tip moving "
-                 "outwards at 400 µm/s to r = 4 mm (50 kHz sampling, plant rate γ = 2π·1 kHz, actuator delay 1 ms "
-                 "= 0.05 T, detector range ±2 µm); controller: bank of N = 10 oscillators, α = 0.1Ω, β = −0.1Ω, "
+        caption=(f"A {sample} ({'period 800 µm, lines 50 nm, ' if sample == 'grating' else ''}"
+                 f"{sample_resolution}² sample map) tilted by {tilt_angle:g}° spins at {spindle_frequency:g} Hz under a "
+                 f"tip moving outwards at {radial_speed * 1e6:g} µm/s to r = {end_radius * 1e3:g} mm "
+                 f"({sample_rate / 1e3:g} kHz sampling, plant rate γ = 2π·1 kHz, actuator delay {delay * 1e3:g} ms "
+                 f"= {delay * spindle_frequency:g} T, detector range ±{detector_range * 1e6:g} µm); controller: bank "
+                 f"of N = {harmonics} oscillators, α = {alpha:g}Ω, β = {beta:g}Ω, ".replace("-", "−") +
                  "K = γ. Without control the tilt's first harmonic grows as r·tan ψ and saturates the detector at "
                  f"r = {r_no * 1e3:.2f} mm; with control the deflection keeps only the grating lines and the whole "
                  f"disc is imaged (scan-area gain {lb}{gain:.2f}). The controller also removes the grating's own "
                  "first harmonic on each circle (the rings in the controlled deflection); the reconstruction "
                  "d + z_a restores it and matches the truth after levelling, up to the plant's low-pass (lag "
                  "atan(Ω/γ) ≈ 2.9°, rounded edges). Without control the valid area is the band |x| < r_off "
-                 "(tilt along x). Images 192 × 192 pixels, read back from the GSF files afmkit writes."),
-        filename=name, numbers=numbers)
+                 f"(tilt along x). Images {image_resolution} × {image_resolution} pixels, read back from the GSF "
+                 "files afmkit writes."),
+        numbers=numbers)
 
 
 FIGURES = [scan_images]

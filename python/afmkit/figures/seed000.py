@@ -8,8 +8,6 @@ K_a/omega_n^2 in {1, 10, 100, 1000}, K_b = 0.64 K_a. The repulsive-attractive fi
 """
 from __future__ import annotations
 
-import pathlib
-
 import matplotlib
 
 matplotlib.use("Agg")
@@ -17,9 +15,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import afmkit  # noqa: E402
-from afmkit.figures import Figure, figure  # noqa: E402
+from afmkit.figures import figure, finish, integer, interval, number, number_list  # noqa: E402
 
-DPI = 110
 COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e"]
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -60,9 +57,14 @@ IMPACT_LOOP_RATIO = 0.64
 # ---------------------------------------------------------------------------------------------------------------
 # helpers
 
-def _physical_case(ka_ratio: float) -> dict:
-    k = PHYSICAL["spring_constant"]
-    return dict(PHYSICAL, sample_stiffness_approach=ka_ratio * k, sample_stiffness_departure=RATIO_B * ka_ratio * k)
+def _physical_case(ka_ratio: float, model: dict = PHYSICAL, departure_ratio: float = RATIO_B) -> dict:
+    k = model["spring_constant"]
+    return dict(model, sample_stiffness_approach=ka_ratio * k,
+                sample_stiffness_departure=departure_ratio * ka_ratio * k)
+
+
+def _color(i: int) -> str:
+    return COLORS[i % len(COLORS)]
 
 
 def _fmt(x: float, digits: int = 4) -> str:
@@ -101,15 +103,6 @@ def _runs(flag):
     return out
 
 
-def _save(fig, out_dir: pathlib.Path, name: str) -> str:
-    out_dir = pathlib.Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    fname = f"{name}.png"
-    fig.savefig(out_dir / fname, dpi=DPI)
-    plt.close(fig)
-    return fname
-
-
 def _hb_vs_exact(cont, hb_fold_max):
     """Largest relative difference |B_orbit - B_HB| / B_HB over the continuation points with l at or below the
     largest HB fold (beyond it HB has no contact solution to compare with); B_HB = nearest HB amplitude at l."""
@@ -127,68 +120,110 @@ def _hb_vs_exact(cont, hb_fold_max):
 # ---------------------------------------------------------------------------------------------------------------
 # Figures 3 and 4 of the paper
 
-def _fig34_runs(q_min: float, q_max: float, points: int):
-    return [(ka, afmkit.tapping.hb(**_physical_case(ka), q_min=q_min, q_max=q_max, points=points,
-                                   separation=PROBE_SEPARATION)) for ka in STIFFNESS_RATIOS]
+def _fig34_setup(spring_constant, resonance_frequency, quality_factor, free_amplitude, stiffness_ratios,
+                 departure_ratio, probe_separation, q_range, points):
+    """The checked parameters of Figs. 3-4: (model, stiffness ratios, departure ratio, probe separation, q range)."""
+    model = dict(PHYSICAL, spring_constant=number("spring_constant", spring_constant, positive=True),
+                 resonance_frequency=number("resonance_frequency", resonance_frequency, positive=True),
+                 quality_factor=number("quality_factor", quality_factor, positive=True),
+                 free_amplitude=number("free_amplitude", free_amplitude, positive=True))
+    ratios = number_list("stiffness_ratios", stiffness_ratios, positive=True, longest=12)
+    kb = number("departure_ratio", departure_ratio, positive=True, high=1.0)
+    probe = number("probe_separation", probe_separation)
+    q = interval("q_range", q_range)
+    integer("points", points, low=10, high=100000)
+    return model, ratios, kb, probe, q
 
 
-def _fig34_caption_params(r) -> str:
-    p = PHYSICAL
+def _fig34_runs(model, ratios, departure_ratio, probe, q_range, points):
+    return [(ka, afmkit.tapping.hb(**_physical_case(ka, model, departure_ratio), q_min=q_range[0], q_max=q_range[1],
+                                   points=points, separation=probe)) for ka in ratios]
+
+
+def _fig34_caption_params(r, p, ratios, departure_ratio) -> str:
     return (f"f0 = {_fmt(p['resonance_frequency'])} kHz, Q = {_fmt(p['quality_factor'])}, k = "
             f"{_fmt(p['spring_constant'])} N/m, ω = ω_n, free amplitude {_fmt(r.results['free_amplitude'])} "
             f"{r.units['separation']}, linear hysteresis law (seed-1 eq. 11) with K_a/ω_n² = "
-            f"{', '.join(_fmt(k) for k in STIFFNESS_RATIOS)} (sample stiffness "
-            f"{', '.join(_fmt(k * p['spring_constant']) for k in STIFFNESS_RATIOS)} N/m) and K_b = "
-            f"{_fmt(RATIO_B)} K_a (restitution e = √(K_b/K_a) = {_fmt(np.sqrt(RATIO_B))})")
+            f"{', '.join(_fmt(k) for k in ratios)} (sample stiffness "
+            f"{', '.join(_fmt(k * p['spring_constant']) for k in ratios)} N/m) and K_b = "
+            f"{_fmt(departure_ratio)} K_a (restitution e = √(K_b/K_a) = {_fmt(np.sqrt(departure_ratio))})")
 
 
 @figure("seed000-fig3")
-def fig3(out_dir: pathlib.Path) -> Figure:
-    runs = _fig34_runs(0.2, 1.1, 2000)
+def fig3(out=None, *, spring_constant: float = PHYSICAL["spring_constant"],
+         resonance_frequency: float = PHYSICAL["resonance_frequency"],
+         quality_factor: float = PHYSICAL["quality_factor"], free_amplitude: float = PHYSICAL["free_amplitude"],
+         stiffness_ratios=tuple(STIFFNESS_RATIOS), departure_ratio: float = RATIO_B,
+         probe_separation: float = PROBE_SEPARATION, q_range=(0.2, 1.1), points: int = 2000):
+    """Seed 1, Fig. 3: harmonic-balance separation l(q) for several sample stiffnesses (physical units).
+
+    spring_constant (N/m), resonance_frequency (kHz), quality_factor, free_amplitude (nm): the cantilever;
+    stiffness_ratios: K_a/ω_n² (sample stiffness in units of k), one curve each; departure_ratio: K_b/K_a;
+    probe_separation (nm): where the solutions are marked; q_range, points: the q samples of `tapping hb` (also the
+    x range). Returns the Matplotlib Figure (``fig.report``: caption, key numbers); writes the PNG if ``out``."""
+    p, ratios, kb, probe, q_range = _fig34_setup(spring_constant, resonance_frequency, quality_factor,
+                                                 free_amplitude, stiffness_ratios, departure_ratio,
+                                                 probe_separation, q_range, points)
+    runs = _fig34_runs(p, ratios, kb, probe, q_range, points)
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
     numbers = []
-    for (ka, r), c in zip(runs, COLORS):
+    for i, (ka, r) in enumerate(runs):
+        c = _color(i)
         q, l, _ = _contact_curve(r)
         ax.plot(q, l, color=c, lw=1.6, label=f"K_a/ω_n² = {_fmt(ka)}")
         sol = [s for s in r.results["solutions_at_separation"] if s["branch"] != "free"]
         for s in sol:
             ax.plot(s["q"], s["separation"], "o", color=c, ms=4)
-            numbers.append((f"q at l = {_fmt(PROBE_SEPARATION)} {r.units['separation']}, K_a/ω_n² = {_fmt(ka)}",
+            numbers.append((f"q at l = {_fmt(probe)} {r.units['separation']}, K_a/ω_n² = {_fmt(ka)}",
                             f"{s['q']:.6f}", f"tapping hb solutions_at_separation ({s['branch']} branch)"))
     unit = runs[0][1].units["separation"]
-    ax.axhline(PROBE_SEPARATION, color="0.6", lw=0.7, ls=":")
+    free = runs[0][1].results["free_amplitude"]
+    ax.axhline(probe, color="0.6", lw=0.7, ls=":")
     ax.axvline(1.0, color="0.6", lw=0.7, ls="--")
-    ax.set_xlim(0.2, 1.1)
-    ax.set_ylim(-5, 30)
+    ax.set_xlim(*q_range)
+    ax.set_ylim(-0.25 * free, 1.5 * free)
     ax.set_xlabel("penetration parameter q = (A + l)/B (dimensionless)")
     ax.set_ylabel(f"separation l ({unit})")
     ax.set_title("Separation l versus q for increasing sample stiffness")
     ax.legend(loc="upper left", fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fname = _save(fig, out_dir, "seed000-fig3")
     q_stiff = numbers[-1][1] if numbers else "n/a"
-    caption = (f"Harmonic-balance separation l(q) (seed-1 eq. 18, `tapping hb`) for {_fig34_caption_params(runs[0][1])}. "
+    caption = (f"Harmonic-balance separation l(q) (seed-1 eq. 18, `tapping hb`) for "
+               f"{_fig34_caption_params(runs[0][1], p, ratios, kb)}. "
                f"As K_a grows the contact part (q < 1) collapses onto the vertical line q = 1, as in the paper: the "
-               f"dots mark the solution at l = {_fmt(PROBE_SEPARATION)} {unit}, at q = {q_stiff} for the stiffest "
+               f"dots mark the solution at l = {_fmt(probe)} {unit}, at q = {q_stiff} for the stiffest "
                f"sample. For q > 1 (no contact) l = q·A_free. l(q) is increasing (ω = ω_n), so every separation has "
                f"one solution.")
-    return Figure(id="seed000-fig3", title="Seed 1, Fig. 3: separation l versus q for increasing sample stiffness",
-                  caption=caption, filename=fname, numbers=numbers)
+    return finish(fig, out, "seed000-fig3",
+                  title="Seed 1, Fig. 3: separation l versus q for increasing sample stiffness",
+                  caption=caption, numbers=numbers)
 
 
 @figure("seed000-fig4")
-def fig4(out_dir: pathlib.Path) -> Figure:
-    runs = _fig34_runs(-20.0, 1.5, 3000)
+def fig4(out=None, *, spring_constant: float = PHYSICAL["spring_constant"],
+         resonance_frequency: float = PHYSICAL["resonance_frequency"],
+         quality_factor: float = PHYSICAL["quality_factor"], free_amplitude: float = PHYSICAL["free_amplitude"],
+         stiffness_ratios=tuple(STIFFNESS_RATIOS), departure_ratio: float = RATIO_B,
+         probe_separation: float = PROBE_SEPARATION, q_range=(-20.0, 1.5), points: int = 3000):
+    """Seed 1, Fig. 4: harmonic-balance amplitude B against separation l for several sample stiffnesses.
+
+    The keywords are those of :func:`fig3` (q_range here reaches into permanent contact, q < −1, drawn dotted).
+    Returns the Matplotlib Figure (``fig.report``: caption, key numbers); writes the PNG if ``out``."""
+    p, ratios, kb, probe, q_range = _fig34_setup(spring_constant, resonance_frequency, quality_factor,
+                                                 free_amplitude, stiffness_ratios, departure_ratio,
+                                                 probe_separation, q_range, points)
+    runs = _fig34_runs(p, ratios, kb, probe, q_range, points)
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
     numbers = []
-    for (ka, r), c in zip(runs, COLORS):
+    for i, (ka, r) in enumerate(runs):
+        c = _color(i)
         q, l, b = _contact_curve(r)
         phys = q >= -1.0
         ax.plot(l[phys], b[phys], color=c, lw=1.6, label=f"K_a/ω_n² = {_fmt(ka)}")
         ax.plot(l[q <= -1.0], b[q <= -1.0], color=c, lw=1.0, ls=":")
         for s in r.results["solutions_at_separation"]:
-            numbers.append((f"B at l = {_fmt(PROBE_SEPARATION)} {r.units['amplitude']}, K_a/ω_n² = {_fmt(ka)}",
+            numbers.append((f"B at l = {_fmt(probe)} {r.units['amplitude']}, K_a/ω_n² = {_fmt(ka)}",
                             f"{s['amplitude']:.4f} {r.units['amplitude']}",
                             f"tapping hb solutions_at_separation ({s['branch']} branch, q = {s['q']:.5f})"))
         lim = r.results.get("minimum_separation_limit")
@@ -199,52 +234,91 @@ def fig4(out_dir: pathlib.Path) -> Figure:
     unit = r0.units["separation"]
     free = r0.results["free_amplitude"]
     ax.plot([0, free], [0, free], color="0.5", lw=0.8, ls="--", label="B = l (stiff limit, eq. 22)")
-    ax.set_xlim(-5, 30)
-    ax.set_ylim(0, 30)
+    ax.set_xlim(-0.25 * free, 1.5 * free)
+    ax.set_ylim(0, 1.5 * free)
     ax.set_xlabel(f"separation l ({unit})")
     ax.set_ylabel(f"amplitude B ({r0.units['amplitude']})")
     ax.set_title("Separation–amplitude curves with increasing force slope")
     ax.legend(loc="lower right", fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fname = _save(fig, out_dir, "seed000-fig4")
     caption = (f"Harmonic-balance amplitude B versus separation l (seed-1 eq. 19, `tapping hb`) for "
-               f"{_fig34_caption_params(r0)}. Solid: |q| ≤ 1 and free oscillation; dotted: the permanent-contact "
-               f"range q < −1 (physically meaningless, down to q = −20). For l ≥ {_fmt(free)} {unit} the tip does not "
+               f"{_fig34_caption_params(r0, p, ratios, kb)}. Solid: |q| ≤ 1 and free oscillation; dotted: the "
+               f"permanent-contact range q < −1 (physically meaningless, down to q = {_fmt(q_range[0]).replace('-', '−')}). For "
+               f"l ≥ {_fmt(free)} {unit} the tip does not "
                f"touch and B = A_free; below, the amplitude follows the separation more and more closely as the "
                f"sample stiffens (B ≈ l, eq. 22, dashed) — the amplitude-modulation imaging principle.")
-    return Figure(id="seed000-fig4", title="Seed 1, Fig. 4: separation–amplitude curves for increasing force slope",
-                  caption=caption, filename=fname, numbers=numbers)
+    return finish(fig, out, "seed000-fig4",
+                  title="Seed 1, Fig. 4: separation–amplitude curves for increasing force slope",
+                  caption=caption, numbers=numbers)
 
 
 # ---------------------------------------------------------------------------------------------------------------
 # repulsive-attractive hysteresis (after the extraction of the paper)
 
-def _attractive_case_text() -> str:
-    a = ATTRACTIVE
+def _attractive_case_text(a: dict = ATTRACTIVE) -> str:
     return (f"Q = {_fmt(a['quality_factor'])}, Γ = {_fmt(a['drive_amplitude'])} L·ω_n², K_a = "
             f"{_fmt(a['approach_stiffness'])} ω_n², K_b = {_fmt(a['departure_stiffness'])} ω_n², F_a = "
             f"{_fmt(a['approach_adhesion'])} L·ω_n², F_b = {_fmt(a['departure_adhesion'])} L·ω_n²")
 
 
+def _attractive_model(quality_factor, drive_amplitude, approach_stiffness, departure_stiffness, approach_adhesion,
+                      departure_adhesion) -> dict:
+    return dict(law="attractive", quality_factor=number("quality_factor", quality_factor, positive=True),
+                drive_amplitude=number("drive_amplitude", drive_amplitude, positive=True),
+                approach_stiffness=number("approach_stiffness", approach_stiffness, positive=True),
+                departure_stiffness=number("departure_stiffness", departure_stiffness, positive=True),
+                approach_adhesion=number("approach_adhesion", approach_adhesion, low=0.0),
+                departure_adhesion=number("departure_adhesion", departure_adhesion, low=0.0))
+
+
 @figure("seed000-attractive")
-def fig_attractive(out_dir: pathlib.Path) -> Figure:
-    curves = [(w, afmkit.tapping.hb(**ATTRACTIVE, frequency_ratio=w, q_min=-1.0, q_max=2.5, points=4000))
-              for w in FREQUENCY_RATIOS]
-    lo, hi = SWEEP_RANGE
+def fig_attractive(out=None, *, quality_factor: float = ATTRACTIVE["quality_factor"],
+                   drive_amplitude: float = ATTRACTIVE["drive_amplitude"],
+                   approach_stiffness: float = ATTRACTIVE["approach_stiffness"],
+                   departure_stiffness: float = ATTRACTIVE["departure_stiffness"],
+                   approach_adhesion: float = ATTRACTIVE["approach_adhesion"],
+                   departure_adhesion: float = ATTRACTIVE["departure_adhesion"],
+                   frequency_ratios=tuple(FREQUENCY_RATIOS), q_range=(-1.0, 2.5), points: int = 4000,
+                   sweep_ratio: float = SWEEP_RATIO, sweep_range=SWEEP_RANGE, sweep_points: int = SWEEP_POINTS,
+                   sweep_step: float = SWEEP_FINE, axis_limit: float = 22.0):
+    """Seed 1, after eq. 33: HB curves with attraction (eq. 26, normalised units), folds, and an approach/retract
+    sweep of exact orbits with its jumps.
+
+    quality_factor, drive_amplitude (Γ), approach_stiffness/departure_stiffness (K_a, K_b),
+    approach_adhesion/departure_adhesion (F_a, F_b): the model; frequency_ratios: ω/ω_n, one HB curve each;
+    q_range, points: the q samples of `tapping hb`; sweep_ratio (one of frequency_ratios), sweep_range,
+    sweep_points: the instrument sweep of panel (b), refined with step sweep_step around the HB grazing and fold;
+    axis_limit: the separation and amplitude extent of panel (a). Returns the Matplotlib Figure (``fig.report``:
+    caption, key numbers); writes the PNG if ``out``."""
+    model = _attractive_model(quality_factor, drive_amplitude, approach_stiffness, departure_stiffness,
+                              approach_adhesion, departure_adhesion)
+    ratios = number_list("frequency_ratios", frequency_ratios, positive=True, longest=12)
+    q_min, q_max = interval("q_range", q_range)
+    integer("points", points, low=10, high=100000)
+    if number("sweep_ratio", sweep_ratio, positive=True) not in ratios:
+        raise ValueError(f"sweep_ratio = {sweep_ratio!r} is not allowed: must be one of frequency_ratios "
+                         f"({', '.join(_fmt(w) for w in ratios)})")
+    lo, hi = interval("sweep_range", sweep_range)
+    integer("sweep_points", sweep_points, low=2, high=10000)
+    number("sweep_step", sweep_step, positive=True)
+    number("axis_limit", axis_limit, positive=True)
+    curves = [(w, afmkit.tapping.hb(**model, frequency_ratio=w, q_min=q_min, q_max=q_max, points=points))
+              for w in ratios]
     # instrument sweep: a uniform grid, refined (step SWEEP_FINE) around the HB grazing and the HB fold where the
     # jumps are expected, so the jump separations are resolved to SWEEP_FINE
-    h99 = dict(curves)[SWEEP_RATIO].results
-    seps = list(np.linspace(lo, hi, SWEEP_POINTS))
+    h99 = dict(curves)[sweep_ratio].results
+    seps = list(np.linspace(lo, hi, sweep_points))
     for centre in [h99["free_amplitude"]] + [f["separation"] for f in h99["folds"] if lo < f["separation"] < hi]:
-        seps += list(centre + SWEEP_FINE * np.arange(-25, 26))
+        seps += list(centre + sweep_step * np.arange(-25, 26))
     seps = sorted({round(float(x), 6) for x in seps if lo <= x <= hi})
-    sweep = afmkit.tapping.sweep(**ATTRACTIVE, frequency_ratio=SWEEP_RATIO, mode="instrument", separations=seps)
+    sweep = afmkit.tapping.sweep(**model, frequency_ratio=sweep_ratio, mode="instrument", separations=seps)
     unit = curves[0][1].units["separation"]
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(12.4, 4.8))
     ins = ax.inset_axes([0.62, 0.08, 0.35, 0.35])
     numbers = []
-    for (w, r), c in zip(curves, COLORS):
+    for i, (w, r) in enumerate(curves):
+        c = _color(i)
         first = True
         for branch, ls in (("plus", "-"), ("free", "-"), ("minus", ":")):
             for _, l, b in _branch_lines(r, branch):
@@ -261,8 +335,8 @@ def fig_attractive(out_dir: pathlib.Path) -> Figure:
                         "tapping hb free_amplitude"))
     ax.plot([], [], "D", mfc="none", mec="k", label="fold (dl/dq = 0)")
     ax.plot([], [], "k:", label="'−' root of ext. E1")
-    ax.set_xlim(0, 22)
-    ax.set_ylim(0, 22)
+    ax.set_xlim(0, axis_limit)
+    ax.set_ylim(0, axis_limit)
     ax.set_xlabel(f"separation l ({unit})")
     ax.set_ylabel(f"amplitude B ({unit})")
     ax.set_title("(a) harmonic balance, all branches")
@@ -274,8 +348,8 @@ def fig_attractive(out_dir: pathlib.Path) -> Figure:
     ins.tick_params(labelsize=6)
 
     # (b) the omega = 0.99 omega_n curve and the instrument sweep
-    r99 = dict(curves)[SWEEP_RATIO]
-    c99 = COLORS[FREQUENCY_RATIOS.index(SWEEP_RATIO)]
+    r99 = dict(curves)[sweep_ratio]
+    c99 = _color(ratios.index(sweep_ratio))
     for branch in ("plus", "free"):
         for _, l, b in _branch_lines(r99, branch):
             bx.plot(l, b, color=c99, lw=1.2, alpha=0.7, label="harmonic balance" if branch == "plus" else None)
@@ -298,48 +372,91 @@ def fig_attractive(out_dir: pathlib.Path) -> Figure:
                             textcoords="offset points", fontsize=8, color=col)
     for d in ("approach", "retract"):
         for lj in sweep.results[f"{d}_jumps"]:
-            numbers.append((f"sweep jump on {d}, ω/ω_n = {_fmt(SWEEP_RATIO)}", f"l = {lj:.4f} {unit}",
-                            f"tapping sweep {d}_jumps (grid step {SWEEP_FINE:g} {unit} near the jump)"))
+            numbers.append((f"sweep jump on {d}, ω/ω_n = {_fmt(sweep_ratio)}", f"l = {lj:.4f} {unit}",
+                            f"tapping sweep {d}_jumps (grid step {sweep_step:g} {unit} near the jump)"))
     bx.set_xlim(lo, hi)
     free99 = r99.results["free_amplitude"]
     amp = sweep["amplitude"]
     bx.set_ylim(np.nanmin(amp) - 0.3, np.nanmax(amp) + 0.4)
     bx.set_xlabel(f"separation l ({unit})")
     bx.set_ylabel(f"amplitude B ({unit})")
-    bx.set_title(f"(b) ω = {_fmt(SWEEP_RATIO)} ω_n: approach/retract sweep, jumps and hysteresis")
+    bx.set_title(f"(b) ω = {_fmt(sweep_ratio)} ω_n: approach/retract sweep, jumps and hysteresis")
     bx.legend(loc="lower right", fontsize=8)
     bx.grid(alpha=0.3)
     fig.tight_layout()
-    fname = _save(fig, out_dir, "seed000-attractive")
     big = [f for f in r99.results["folds"] if f["kind"] == "maximum" and f["separation"] > lo]
     fold_txt = f"{big[0]['separation']:.4f} {unit}" if big else "none"
     caption = (f"Repulsive–attractive hysteresis (seed-1 eq. 26) in normalised units (ω_n = 1, L = length unit): "
-               f"{_attractive_case_text()}, ω/ω_n = {', '.join(_fmt(w) for w in FREQUENCY_RATIOS)}. "
+               f"{_attractive_case_text(model)}, ω/ω_n = {', '.join(_fmt(w) for w in ratios)}. "
                f"(a) Harmonic balance with both roots of ext. E1 (`tapping hb`): the contact branch bends above the "
                f"free amplitude and folds back (diamonds: dl/dq = 0), so several amplitudes coexist at one "
                f"separation; the inset shows the small-amplitude solutions of a tip trapped at the surface. "
                f"(b) An approach/retract sweep of exact periodic orbits ({len(seps)} separations per direction, "
-               f"step {SWEEP_FINE:g} {unit} near the HB grazing and fold, `tapping sweep`) jumps into contact on approach at l = "
+               f"step {sweep_step:g} {unit} near the HB grazing and fold, `tapping sweep`) jumps into contact on approach at l = "
                f"{', '.join(f'{x:.4f}' for x in sweep.results['approach_jumps'])} {unit} (HB grazing "
                f"{free99:.4f}) and off contact on retract at l = "
                f"{', '.join(f'{x:.4f}' for x in sweep.results['retract_jumps'])} {unit} (HB fold {fold_txt}): "
                f"hysteresis.")
-    return Figure(id="seed000-attractive",
+    return finish(fig, out, "seed000-attractive",
                   title="Seed 1, after eq. 33: separation–amplitude curves with attraction — folds, jumps, hysteresis",
-                  caption=caption, filename=fname, numbers=numbers)
+                  caption=caption, numbers=numbers)
 
 
 # ---------------------------------------------------------------------------------------------------------------
 # beyond the paper: harmonic balance against exact periodic orbits
 
+def _orbit_cases(cases) -> list:
+    """The checked cases of :func:`fig_hb_vs_orbits`."""
+    try:
+        items = list(cases)
+    except TypeError:
+        items = []
+    if not 1 <= len(items) <= 4:
+        raise ValueError(f"cases = {cases!r} is not allowed: must be a list of 1 to 4 dicts with keys model (dict of "
+                         f"afmkit.tapping keywords), window (separation range) and probes (separations)")
+    out = []
+    for i, case in enumerate(items):
+        if not isinstance(case, dict) or not isinstance(case.get("model"), dict):
+            raise ValueError(f"cases[{i}] = {case!r} is not allowed: must be a dict with a dict 'model' of "
+                             f"afmkit.tapping keywords, a 'window' (low, high) and a list 'probes'")
+        unknown = set(case) - {"model", "window", "probes", "title"}
+        if unknown:
+            raise ValueError(f"cases[{i}] has unknown keys {sorted(unknown)}: allowed are model, window, probes, "
+                             f"title")
+        window = interval(f"cases[{i}].window", case.get("window"))
+        probes = number_list(f"cases[{i}].probes", case.get("probes", ()), longest=12) if case.get("probes") else []
+        title = case.get("title") or f"({'abcd'[i]}) " + ", ".join(f"{k} = {v}" for k, v in case["model"].items())
+        out.append(dict(model=case["model"], window=window, probes=probes, title=str(title)))
+    return out
+
+
+def _shared_model_text(cases) -> str:
+    """ "Normalised units, Q = …, Γ = … L·ω_n². " when every case has the same Q and Γ (the caption's common part)."""
+    q = {c["model"].get("quality_factor", 100.0) for c in cases}
+    g = {c["model"].get("drive_amplitude") for c in cases}
+    if len(q) == 1 and len(g) == 1 and None not in g and all(c["model"].get("units", "normalized") != "physical"
+                                                            for c in cases):
+        return f"Normalised units, Q = {_fmt(q.pop())}, Γ = {_fmt(g.pop())} L·ω_n². "
+    return ""
+
+
 @figure("beyond-hb-vs-orbits")
-def fig_hb_vs_orbits(out_dir: pathlib.Path) -> Figure:
-    fig, axes = plt.subplots(1, len(ORBIT_CASES), figsize=(12.4, 4.8))
-    numbers, cap_parts = [], []
-    for ax, case, tag in zip(axes, ORBIT_CASES, "ab"):
+def fig_hb_vs_orbits(out=None, *, cases=tuple(ORBIT_CASES), points: int = 3000):
+    """Beyond the papers: harmonic balance against the exact periodic orbits (stable and unstable branches, folds).
+
+    cases: one panel each, a dict with ``model`` (keywords of afmkit.tapping.hb/sweep/orbit), ``window`` (the
+    separation range of the continuation and of the panel), ``probes`` (separations where `tapping orbit` finds
+    every orbit) and ``title`` (its first four characters, "(a) ", are dropped in the caption); points: q samples
+    of `tapping hb`. Returns the Matplotlib Figure (``fig.report``: caption, key numbers); writes the PNG if
+    ``out``."""
+    cases = _orbit_cases(cases)
+    integer("points", points, low=10, high=100000)
+    fig, axes = plt.subplots(1, len(cases), figsize=(6.2 * len(cases), 4.8), squeeze=False)
+    numbers_, cap_parts = [], []
+    for ax, case, tag in zip(axes[0], cases, "abcd"):
         lo, hi = case["window"]
         model = case["model"]
-        hb = afmkit.tapping.hb(**model, q_min=-1.0, q_max=2.5, points=3000)
+        hb = afmkit.tapping.hb(**model, q_min=-1.0, q_max=2.5, points=points)
         cont = afmkit.tapping.sweep(**model, mode="continuation", separation_min=lo, separation_max=hi)
         unit = hb.units["separation"]
         for branch in ("plus", "free", "minus"):
@@ -360,7 +477,7 @@ def fig_hb_vs_orbits(out_dir: pathlib.Path) -> Figure:
         for k, lf in enumerate(f["separation"] for f in cont.results["folds"]):
             ax.axvline(lf, color="#d62728", lw=0.8, ls=":", label="exact fold (continuation)" if k == 0 else None)
         for lg in cont.results["grazing"]:
-            numbers.append((f"({tag}) grazing of the free oscillation (exact)", f"l = {lg:.5f} {unit}",
+            numbers_.append((f"({tag}) grazing of the free oscillation (exact)", f"l = {lg:.5f} {unit}",
                             "tapping sweep continuation grazing"))
         # tapping orbit: every periodic orbit at a few separations
         n_orbits, multi = 0, []
@@ -378,12 +495,12 @@ def fig_hb_vs_orbits(out_dir: pathlib.Path) -> Figure:
         big_exact = max((f["separation"] for f in cont.results["folds"]), default=None)
         big_hb = max((f for f in hb_folds if f["kind"] == "maximum"), key=lambda f: f["separation"], default=None)
         if big_exact is not None and big_hb is not None:
-            numbers.append((f"({tag}) fold (largest l): exact orbit vs HB",
+            numbers_.append((f"({tag}) fold (largest l): exact orbit vs HB",
                             f"{big_exact:.4f} vs {big_hb['separation']:.4f} {unit} "
                             f"({100 * (big_exact - big_hb['separation']) / big_hb['separation']:+.2f} %)",
                             "tapping sweep continuation folds; tapping hb folds"))
         for name, (rel, at, n) in diff.items():
-            numbers.append((f"({tag}) max |B_orbit − B_HB|/B_HB, {name} branch",
+            numbers_.append((f"({tag}) max |B_orbit − B_HB|/B_HB, {name} branch",
                             f"{100 * rel:.2f} % (at l = {at:.3f} {unit})",
                             f"tapping sweep continuation, {n} points with l ≤ largest HB fold"))
         cap_parts.append(
@@ -402,28 +519,51 @@ def fig_hb_vs_orbits(out_dir: pathlib.Path) -> Figure:
         ax.legend(loc="lower right", fontsize=7.5)
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    fname = _save(fig, out_dir, "beyond-hb-vs-orbits")
     caption = ("Harmonic balance (grey, `tapping hb`) against the exact periodic orbits of eq. 8 (shooting with "
                "Floquet multipliers: `tapping sweep` in continuation mode through the folds, blue stable / red dashed "
                "unstable; circles: every orbit `tapping orbit` finds at a few separations, filled = stable). "
-               "Normalised units, Q = 100, Γ = 0.2 L·ω_n². The unstable middle branch joins the fold to the grazing "
+               + _shared_model_text(cases) + "The unstable middle branch joins the fold to the grazing "
                "of the free oscillation, so between them several orbits coexist. " + "; ".join(cap_parts)
                + " (difference measured at the nearest HB amplitude, over the points with l below the largest HB "
                "fold).")
-    return Figure(id="beyond-hb-vs-orbits",
+    return finish(fig, out, "beyond-hb-vs-orbits",
                   title="Beyond the papers: harmonic balance against exact periodic orbits (stability, folds)",
-                  caption=caption, filename=fname, numbers=numbers)
+                  caption=caption, numbers=numbers_)
 
 
 # ---------------------------------------------------------------------------------------------------------------
 # beyond the paper: impacts and restitution (seed-1 eqs. 1-6, ext. E0)
 
+def _masses(body: dict) -> str:
+    m1, m2 = _fmt(body["mass1"]), _fmt(body["mass2"])
+    return f"m1 = m2 = {m1} kg" if m1 == m2 else f"m1 = {m1} kg, m2 = {m2} kg"
+
+
 @figure("beyond-impact")
-def fig_impact(out_dir: pathlib.Path) -> Figure:
+def fig_impact(out=None, *, approach_stiffness: float = IMPACT_KA, departure_ratios=tuple(IMPACT_RATIOS),
+               bodies=tuple(IMPACT_BODIES), loop_ratio: float = IMPACT_LOOP_RATIO, loop_points: int = 400):
+    """Beyond the papers: two-body impacts with the hysteresis law (seed-1 eqs. 1-6): one force-gap loop and the
+    coefficient of restitution against √(K_b/K_a).
+
+    approach_stiffness (K_a, N/m); departure_ratios: the K_b/K_a of panel (b); bodies: dicts of mass1, mass2 (kg)
+    and velocity (approach speed), one marker series each, the first also drawn in panel (a); loop_ratio: K_b/K_a
+    of panel (a); loop_points: samples of its loop. Returns the Matplotlib Figure (``fig.report``: caption, key
+    numbers); writes the PNG if ``out``."""
+    ka = number("approach_stiffness", approach_stiffness, positive=True)
+    ratios = number_list("departure_ratios", departure_ratios, positive=True, high=1.0)
+    loop_r = number("loop_ratio", loop_ratio, positive=True, high=1.0)
+    integer("loop_points", loop_points, low=2, high=100000)
+    try:
+        body_list = [dict(b) for b in bodies]
+    except (TypeError, ValueError):
+        body_list = []
+    if not 1 <= len(body_list) <= 4 or any(set(b) != {"mass1", "mass2", "velocity"} for b in body_list):
+        raise ValueError(f"bodies = {bodies!r} is not allowed: must be a list of 1 to 4 dicts with keys mass1, "
+                         f"mass2 (kg) and velocity")
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11.0, 4.4))
-    loop = afmkit.impact(law="hysteresis", approach_stiffness=IMPACT_KA,
-                         departure_stiffness=IMPACT_LOOP_RATIO * IMPACT_KA, method="integrator", points=400,
-                         **IMPACT_BODIES[0])
+    loop = afmkit.impact(law="hysteresis", approach_stiffness=ka,
+                         departure_stiffness=loop_r * ka, method="integrator", points=loop_points,
+                         **body_list[0])
     gap, force, rate = loop["gap"], loop["force"], loop["gap_rate"]
     inside = gap <= loop.results["contact_gap"]
     for sel, col, lab in ((inside & (rate < 0), "#1f77b4", "approach (K_a)"),
@@ -438,16 +578,17 @@ def fig_impact(out_dir: pathlib.Path) -> Figure:
                     label=f"lost energy (eq. 6) = {loop.results['energy_loss_area']:.4g} {loop.results['units']['energy']}")
     ax.set_xlabel(f"gap d ({loop.units['gap']})")
     ax.set_ylabel(f"contact force H ({loop.units['force']})")
-    ax.set_title(f"(a) one impact, K_a = {_fmt(IMPACT_KA)} N/m, K_b = {_fmt(IMPACT_LOOP_RATIO * IMPACT_KA)} N/m",
+    ax.set_title(f"(a) one impact, K_a = {_fmt(ka)} N/m, K_b = {_fmt(loop_r * ka)} N/m",
                  fontsize=10)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
 
     worst_e, worst_de, worst_res = 0.0, 0.0, 0.0
-    for bodies, mk, col in zip(IMPACT_BODIES, ("o", "x"), ("#1f77b4", "#d62728")):
+    for k, bodies in enumerate(body_list):
+        mk, col = "ox+^"[k], COLORS[k]
         e_sim, e_formula = [], []
-        for ratio in IMPACT_RATIOS:
-            r = afmkit.impact(law="hysteresis", approach_stiffness=IMPACT_KA, departure_stiffness=ratio * IMPACT_KA,
+        for ratio in ratios:
+            r = afmkit.impact(law="hysteresis", approach_stiffness=ka, departure_stiffness=ratio * ka,
                               method="integrator", points=2, **bodies)
             res = r.results
             e_sim.append(res["restitution"])
@@ -458,7 +599,7 @@ def fig_impact(out_dir: pathlib.Path) -> Figure:
             worst_res = max(worst_res, abs(res["energy_balance_residual"]) / res["kinetic_energy_before"])
         e_sim, e_formula = np.array(e_sim), np.array(e_formula)
         worst_e = max(worst_e, float(np.max(np.abs(e_sim - e_formula))))
-        bx.plot(IMPACT_RATIOS, e_sim, mk, color=col, ms=7, mfc="none",
+        bx.plot(ratios, e_sim, mk, color=col, ms=7, mfc="none",
                 label=f"simulated, m1 = {_fmt(bodies['mass1'])} kg, m2 = {_fmt(bodies['mass2'])} kg, "
                       f"v = {_fmt(bodies['velocity'])} nm/s")
     kk = np.linspace(0, 1, 200)
@@ -469,15 +610,14 @@ def fig_impact(out_dir: pathlib.Path) -> Figure:
     bx.legend(fontsize=7.5, loc="lower right")
     bx.grid(alpha=0.3)
     fig.tight_layout()
-    fname = _save(fig, out_dir, "beyond-impact")
     u = loop.results["units"]
     numbers = [
-        (f"restitution, K_b/K_a = {_fmt(IMPACT_LOOP_RATIO)}: formula vs simulation",
+        (f"restitution, K_b/K_a = {_fmt(loop_r)}: formula vs simulation",
          f"{loop.results['restitution_impulsive_limit']:.6f} vs {loop.results['restitution']:.10f}",
          "impact restitution_impulsive_limit, restitution (integrator)"),
         ("max |e_sim − √(K_b/K_a)| over all runs", f"{worst_e:.2e}",
-         f"impact, {len(IMPACT_RATIOS) * len(IMPACT_BODIES)} runs (integrator)"),
-        (f"energy loss, K_b/K_a = {_fmt(IMPACT_LOOP_RATIO)}: kinetic (eq. 3) vs area (eq. 6)",
+         f"impact, {len(ratios) * len(body_list)} runs (integrator)"),
+        (f"energy loss, K_b/K_a = {_fmt(loop_r)}: kinetic (eq. 3) vs area (eq. 6)",
          f"{loop.results['kinetic_energy_loss']:.6g} vs {loop.results['energy_loss_area']:.6g} {u['energy']}",
          "impact kinetic_energy_loss, energy_loss_area"),
         ("max relative |ΔE_kin − (1 − e²)μḋ²/2| (eq. 3)", f"{worst_de:.2e}", "impact, all runs"),
@@ -485,15 +625,18 @@ def fig_impact(out_dir: pathlib.Path) -> Figure:
          "impact energy_balance_residual / kinetic_energy_before"),
     ]
     caption = (f"Two-body impact with the linear hysteresis law (seed-1 eqs. 1–6, `afmkit impact`, adaptive "
-               f"integrator), K_a = {_fmt(IMPACT_KA)} N/m. (a) Force–gap loop of one impact (m1 = m2 = 1 kg, "
-               f"approach speed 1 nm/s, K_b = {_fmt(IMPACT_LOOP_RATIO)} K_a): the bodies approach on the K_a branch "
+               f"integrator), K_a = {_fmt(ka)} N/m. (a) Force–gap loop of one impact ("
+               f"{_masses(body_list[0])}, approach speed "
+               f"{_fmt(body_list[0]['velocity'])} nm/s, K_b = {_fmt(loop_r)} K_a): the bodies approach on the K_a branch "
                f"and leave on the K_b branch; the area between them is the energy lost, "
                f"{loop.results['energy_loss_area']:.4g} {u['energy']} against the kinetic-energy loss "
                f"{loop.results['kinetic_energy_loss']:.4g} {u['energy']}. (b) The simulated coefficient of restitution "
-               f"for K_b/K_a from {_fmt(IMPACT_RATIOS[0])} to {_fmt(IMPACT_RATIOS[-1])} and two mass/speed pairs "
+               f"for K_b/K_a from {_fmt(min(ratios))} to {_fmt(max(ratios))} and "
+               f"{['one', 'two', 'three', 'four'][len(body_list) - 1]} mass/speed pair{'s' if len(body_list) > 1 else ''} "
                f"agrees with e = √(K_b/K_a) to {worst_e:.1e}, independent of masses and speed.")
-    return Figure(id="beyond-impact", title="Beyond the papers: impact restitution and energy loss (seed-1 eqs. 1–6)",
-                  caption=caption, filename=fname, numbers=numbers)
+    return finish(fig, out, "beyond-impact",
+                  title="Beyond the papers: impact restitution and energy loss (seed-1 eqs. 1–6)",
+                  caption=caption, numbers=numbers)
 
 
 FIGURES = [fig3, fig4, fig_attractive, fig_hb_vs_orbits, fig_impact]

@@ -88,15 +88,20 @@ def _select(tasks, figures: str):
 
 
 def _run_figure(module: str, name: str, staging: str):
-    """In a worker process: one figure function, timed."""
+    """In a worker process: one figure function with its defaults, timed; writes the PNG into `staging` and returns
+    the figure's report entry (caption, key numbers, file name)."""
     import matplotlib
 
     matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     fn = getattr(importlib.import_module(f"afmkit.figures.{module}"), name)
     start = time.perf_counter()
     fig = fn(Path(staging))
-    fig.seconds = time.perf_counter() - start
-    return fig
+    entry = fig.report
+    plt.close(fig)
+    entry.seconds = time.perf_counter() - start
+    return entry
 
 
 def _worker_init(threads: int, parent: int) -> None:

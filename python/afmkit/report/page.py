@@ -36,7 +36,14 @@ def render(figures, speed, *, version: str, seconds: float, jobs: int) -> str:
         "<nav><h2>Contents</h2><ol>",
     ]
     parts += [f'<li><a href="#{_e(f.id)}">{_e(f.title)}</a></li>' for f in figures]
-    parts += ['<li><a href="#numbers">Key numbers</a></li>', "</ol></nav>", '<h2 id="numbers">Key numbers</h2>',
+    parts += ['<li><a href="#numbers">Key numbers</a></li>', "</ol></nav>"]
+    # the figures first, then the key numbers (each row links back to its figure)
+    for f in figures:
+        parts += [f'<h2 id="{_e(f.id)}">{_e(f.title)}</h2>', "<figure>",
+                  f'<img src="{_e(f.filename)}" alt="{_e(f.title)}">',
+                  f'<figcaption>{_e(f.caption)} <span class="muted">({f.seconds:.1f} s)</span></figcaption>',
+                  "</figure>"]
+    parts += ['<h2 id="numbers">Key numbers</h2>',
               "<table><tr><th>quantity</th><th>value</th><th>how it was obtained</th><th>figure</th></tr>"]
     for fig, q, v, src in numbers:
         parts.append(f'<tr><td>{_e(q)}</td><td>{_e(v)}</td><td>{_e(src)}</td>'
@@ -44,10 +51,5 @@ def render(figures, speed, *, version: str, seconds: float, jobs: int) -> str:
     for q, v, src in speed:
         parts.append(f"<tr><td>{_e(q)}</td><td>{_e(v)}</td><td>{_e(src)}</td><td>speed</td></tr>")
     parts.append("</table>")
-    for f in figures:
-        parts += [f'<h2 id="{_e(f.id)}">{_e(f.title)}</h2>', "<figure>",
-                  f'<img src="{_e(f.filename)}" alt="{_e(f.title)}">',
-                  f'<figcaption>{_e(f.caption)} <span class="muted">({f.seconds:.1f} s)</span></figcaption>',
-                  "</figure>"]
     parts.append("</body></html>\n")
     return "\n".join(parts)
