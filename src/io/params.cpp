@@ -145,6 +145,8 @@ ParamSet::Entry ParamSet::make_entry(Value value, const std::string& help, Range
 
 void ParamSet::declare(const std::string& key, Entry e) {
   e.group = group_;
+  if (const auto c = group_conditions_.find(group_); c != group_conditions_.end())
+    e.applies.push_back({c->second.first, {c->second.second}});
   if (!entries_.count(key)) order_.push_back(key);
   entries_[key] = std::move(e);
   last_ = key;
@@ -205,6 +207,15 @@ ParamSet& ParamSet::only_if_given(std::vector<std::string> instead_of) {
   Entry& e = entries_[last_];
   e.only_if_given = true;
   e.instead_of = std::move(instead_of);
+  return *this;
+}
+ParamSet& ParamSet::applies_when(const std::string& param, const std::string& key, std::vector<std::string> values) {
+  const auto it = entries_.find(param);
+  const auto on = entries_.find(key);
+  if (it == entries_.end() || on == entries_.end() || !std::holds_alternative<std::string>(on->second.value))
+    throw std::logic_error(fmt::format("ParamSet::applies_when: '{}' or the text parameter '{}' is not declared",
+                                       param, key));
+  it->second.applies.push_back({key, std::move(values)});
   return *this;
 }
 void ParamSet::record_used(const std::string& key, Value value) {
@@ -527,6 +538,9 @@ const ParamSet::Entry& ParamSet::current(const std::string& key) const {
 bool ParamSet::recorded(const std::string& key) const {
   const Entry& e = entry(key);
   if (e.only_if_given && !e.set) return false;
+  for (const auto& [on, values] : e.applies)  // a key of another unit system or law than the run's
+    if (std::find(values.begin(), values.end(), std::get<std::string>(current(on).value)) == values.end())
+      return false;
   for (const auto& [other, o] : entries_)
     if (o.only_if_given && o.set && std::find(o.instead_of.begin(), o.instead_of.end(), key) != o.instead_of.end())
       return false;
