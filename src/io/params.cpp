@@ -447,14 +447,59 @@ void ParamSet::set_default(const std::string& key, const std::string& text) {
   entries_.at(key).set = false;
 }
 
-void ParamSet::load_toml_text(const std::string& text, const std::string& origin) {
-  check_toml_nesting(text, origin);
-  toml::table tbl;
+namespace {
+/// The `parameters` of a JSON sidecar (io::make_sidecar) as a TOML table: the record of a run given as --config
+/// replays it. InputError naming the file when it is not a sidecar.
+toml::table sidecar_parameters(const std::string& text, const std::string& origin) {
+  nlohmann::json doc;
   try {
-    tbl = toml::parse(text, origin);
-  } catch (const toml::parse_error& err) {
-    const auto& b = err.source().begin;
-    throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, b.line, b.column, err.description()));
+    doc = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(fmt::format("{}: malformed JSON (a JSON config file must be the sidecar of a run): {}", origin,
+                                 e.what()));
+  }
+  const auto params = doc.is_object() ? doc.find("parameters") : doc.end();
+  if (params == doc.end() || !params->is_object())
+    throw InputError(fmt::format("{}: a JSON config file must be the sidecar of a run (an object with a "
+                                 "\"parameters\" object); give parameters as TOML otherwise",
+                                 origin));
+  toml::table tbl;
+  for (const auto& [key, v] : params->items()) {
+    const auto no_value = [&] {
+      throw InvalidParameter(key, fmt::format("{}: key '{}' = {} is not a parameter value", origin, key, v.dump()));
+    };
+    if (v.is_boolean()) tbl.insert(key, v.get<bool>());
+    else if (v.is_number_integer()) tbl.insert(key, v.get<std::int64_t>());
+    else if (v.is_number()) tbl.insert(key, v.get<double>());
+    else if (v.is_string()) tbl.insert(key, v.get<std::string>());
+    else if (v.is_array()) {
+      toml::array a;
+      for (const auto& x : v) {
+        if (!x.is_number()) no_value();
+        a.push_back(x.get<double>());
+      }
+      tbl.insert(key, std::move(a));
+    } else {
+      no_value();
+    }
+  }
+  return tbl;
+}
+}  // namespace
+
+void ParamSet::load_toml_text(const std::string& text, const std::string& origin) {
+  toml::table tbl;
+  const auto first = text.find_first_not_of(" \t\r\n");
+  if (first != std::string::npos && text[first] == '{') {  // a sidecar (a TOML document cannot start with '{')
+    tbl = sidecar_parameters(text, origin);
+  } else {
+    check_toml_nesting(text, origin);
+    try {
+      tbl = toml::parse(text, origin);
+    } catch (const toml::parse_error& err) {
+      const auto& b = err.source().begin;
+      throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, b.line, b.column, err.description()));
+    }
   }
   for (auto&& item : tbl) {  // (no structured binding: clang 14 cannot capture one in the lambda below)
     const std::string key(item.first.str());

@@ -108,7 +108,9 @@ class ParamSet {
   void add_options(CLI::App& app);
   /// Call after parsing: loads --config (if any), applies flags, validates. Throws on bad input.
   void resolve();
-  /// Load values from TOML text (used by resolve() and by tests). `origin` names the source in messages.
+  /// Load values from TOML text (used by resolve() and by tests). `origin` names the source in messages. A JSON
+  /// sidecar of a run (text starting with '{': its "parameters" object) is read as the same keys, so that
+  /// `--config out.csv.json` replays the run it records.
   void load_toml_text(const std::string& text, const std::string& origin);
   /// Change the default of a registered parameter (textual form, validated); it still counts as "not set".
   void set_default(const std::string& key, const std::string& text);
