@@ -218,6 +218,13 @@ ParamSet& ParamSet::applies_when(const std::string& param, const std::string& ke
   it->second.applies.push_back({key, std::move(values)});
   return *this;
 }
+ParamSet& ParamSet::recorded_only_if_given(const std::string& param) {
+  const auto it = entries_.find(param);
+  if (it == entries_.end())
+    throw std::logic_error(fmt::format("ParamSet::recorded_only_if_given: '{}' is not declared", param));
+  it->second.only_if_given = true;
+  return *this;
+}
 void ParamSet::record_used(const std::string& key, Value value) {
   auto it = entries_.find(key);
   if (it == entries_.end()) throw std::logic_error("ParamSet::record_used: no parameter named '" + key + "'");

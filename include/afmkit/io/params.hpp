@@ -75,6 +75,9 @@ class ParamSet {
   /// departure_stiffness): not given, it is left out of the records; given, it stands for the keys `instead_of`,
   /// which are then left out of the records (a replay gives the alternative, as the run did).
   ParamSet& only_if_given(std::vector<std::string> instead_of = {});
+  /// Parameter `param` (declared before) counts only when given, as only_if_given(): for a shared key that a
+  /// command refuses when given (it does not apply there), so that its records never list it.
+  ParamSet& recorded_only_if_given(const std::string& param);
   /// Parameter `param` (declared before) applies only when the text parameter `key` has one of `values` (a key of
   /// one unit system, of some force laws): otherwise the run did not use it and it is left out of the records
   /// (to_json: sidecars, Python r.params; units_json), so that a record lists exactly the parameters that applied
