@@ -222,6 +222,7 @@ void register_control_simulate(CLI::App& control) {
                    "F_1, F_2, ... of f (eq. 14); default: the Fig. 5 example F1 = 1, F_k = 0.3/k (k = 2..8)",
                    io::Range::non_negative())
             .unit("signal")
+            .default_text("F1 = 1, F_k = 0.3/k (k = 2..8)")  // computed: 0.3/3 is not 0.1 (recorded as used)
             .reals("disturbance_phases", {}, "phi_1, phi_2, ...")
             .unit("rad")
             .default_text("random from disturbance_seed, phi_1 = 0")
