@@ -148,3 +148,14 @@ def test_the_command_line_replays_from_its_sidecar(path, tmp_path):
         assert a.read_bytes() == b.read_bytes(), f"{path}: {b.name} differs from the recorded run's"
     replayed = json.loads((pairs[0][1].parent / (pairs[0][1].name + ".json")).read_text())["parameters"]
     assert set(replayed) == set(recorded)
+
+
+def test_an_explicit_list_of_separations_is_recorded_instead_of_the_grid(tmp_path):
+    for path in ("tapping sweep", "tapping fm"):
+        f = make_command(path)
+        r = f(separations=[9.0, 8.0, 7.5], quiet=True)
+        assert r.params["separations"] == [9.0, 8.0, 7.5]
+        assert not {"separation_min", "separation_max", "points", "separations_file"} & set(r.params), path
+        again = f(**r.params)
+        same_table(r, again)
+        assert sorted(set(r["separation"])) == [7.5, 8.0, 9.0]  # the list, not the declared grid
