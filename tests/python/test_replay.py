@@ -159,3 +159,22 @@ def test_an_explicit_list_of_separations_is_recorded_instead_of_the_grid(tmp_pat
         again = f(**r.params)
         same_table(r, again)
         assert sorted(set(r["separation"])) == [7.5, 8.0, 9.0]  # the list, not the declared grid
+
+
+def test_a_recorded_scan_records_no_key_of_the_simulated_instrument_and_replays(tmp_path):
+    recorded = os.path.join(SOURCE, "examples", "recorded", "spiral.csv")
+    f = make_command("scan")
+    r = f(recorded=recorded, image_resolution=100, image_output="")
+    assert r.params["recorded"] == recorded
+    # refused when given with recorded (simulation_only_keys): so never in its record
+    assert not {"sample", "sample_file", "spindle_frequency", "bandwidth", "gain", "delay", "control"} & set(r.params)
+    same_table(r, f(**r.params))
+    if CLI:
+        out = tmp_path / "turns.csv"
+        run = subprocess.run([CLI, "scan", "--recorded", recorded, "--image-resolution", "100", "--image-output", "",
+                              "--output", str(out)], capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr
+        again = subprocess.run([CLI, "scan", "--config", str(out) + ".json", "--output", str(tmp_path / "again.csv")],
+                               capture_output=True, text=True)
+        assert again.returncode == 0, again.stderr
+        assert (tmp_path / "again.csv").read_bytes() == out.read_bytes()
