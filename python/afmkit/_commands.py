@@ -41,7 +41,7 @@ def _summary(value):
 _GRIDS = {"control chart": ("delay", "y", "x"), "control tune": ("y", "x")}
 _AXIS_NAMES = {"x": "x", "y": "y"}  # the summary keys naming the x and y axes of a chart
 # Tables along one independent variable: its column is the dimension (when its values are distinct).
-_INDEX = {"control tf": "frequency", "control simulate": "t", "impact": "t"}
+_INDEX = {"control tf": "frequency", "control simulate": "t", "impact": "t", "tapping fm": "separation"}
 
 
 def _needs(module: str, method: str):
@@ -155,7 +155,8 @@ class Result(dict):
     def to_xarray(self):
         """The table as an xarray Dataset: on the grid's dimensions when the rows are a grid (``control chart``:
         delay x beta x alpha, or the chart's own axes; ``control tune``: its coarse grid), else along the
-        independent variable (``control tf``: frequency; ``simulate``, ``impact``: t) or one dimension ``row``.
+        independent variable (``control tf``: frequency; ``simulate``, ``impact``: t; ``tapping fm``: separation) or
+        one dimension ``row``.
         Every variable and coordinate has ``units`` and ``long_name`` attributes; the Dataset's attributes hold the
         command, the summary results (as JSON text) and the parameters (as JSON text)."""
         xr = _needs("xarray", "to_xarray")
