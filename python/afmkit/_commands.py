@@ -263,8 +263,9 @@ def _docstring(spec: dict) -> str:
             facts.append(p["allowed"])
         lines.append(f"  {p['key']} ({'; '.join(facts)})")
         lines.extend(textwrap.wrap(p["help"], 100, initial_indent="      ", subsequent_indent="      "))
-    lines += ["", "config: a TOML file read first (as --config); keyword arguments override it.",
-              "Returns an afmkit.Result (table columns as NumPy arrays, units, summary results)."]
+    lines += ["", "config: a TOML file, or a run's JSON sidecar, read first (as --config); keyword arguments override it.",
+              "Returns an afmkit.Result: a read-only mapping of the table's columns (NumPy arrays; flags bool) with units,",
+              "the summary results (r.results), the parameters as run (r.params), to_pandas() and to_xarray()."]
     return "\n".join(lines)
 
 
