@@ -126,13 +126,14 @@ class Result(dict):
     def _repr_html_(self, max_rows: int = 10) -> str:
         from html import escape
         n = len(self)
-        shown = list(range(n)) if n <= max_rows else list(range(max_rows // 2)) + [-1] + list(range(n - max_rows // 2, n))
+        half = max_rows // 2
+        shown = list(range(n)) if n <= max_rows else [*range(half), -1, *range(n - half, n)]
         head = "".join(f'<th title="{escape(self.meaning[c])}">{escape(c)}<br><small>{escape(self.units[c])}</small>'
                        f"</th>" for c in self.columns)
         body = []
         for i in shown:
             if i < 0:
-                body.append(f'<tr><td colspan="{len(self.columns)}">… {n - 2 * (max_rows // 2)} more rows …</td></tr>')
+                body.append(f'<tr><td colspan="{len(self.columns)}">… {n - 2 * half} more rows …</td></tr>')
                 continue
             cells = "".join(f"<td>{escape(_cell(self[c][i]))}</td>" for c in self.columns)
             body.append(f"<tr>{cells}</tr>")
@@ -263,9 +264,10 @@ def _docstring(spec: dict) -> str:
             facts.append(p["allowed"])
         lines.append(f"  {p['key']} ({'; '.join(facts)})")
         lines.extend(textwrap.wrap(p["help"], 100, initial_indent="      ", subsequent_indent="      "))
-    lines += ["", "config: a TOML file, or a run's JSON sidecar, read first (as --config); keyword arguments override it.",
-              "Returns an afmkit.Result: a read-only mapping of the table's columns (NumPy arrays; flags bool) with units,",
-              "the summary results (r.results), the parameters as run (r.params), to_pandas() and to_xarray()."]
+    lines += ["", "config: a TOML file, or a run's JSON sidecar, read first (as --config); keyword arguments",
+              "override it.",
+              "Returns an afmkit.Result: a read-only mapping of the table's columns (NumPy arrays; flags bool) with",
+              "units, the summary results (r.results), the parameters as run (r.params), to_pandas(), to_xarray()."]
     return "\n".join(lines)
 
 
