@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -476,7 +477,8 @@ toml::table sidecar_parameters(const std::string& text, const std::string& origi
       throw InvalidParameter(key, fmt::format("{}: key '{}' = {} is not a parameter value", origin, key, v.dump()));
     };
     if (v.is_boolean()) tbl.insert(key, v.get<bool>());
-    else if (v.is_number_integer()) tbl.insert(key, v.get<std::int64_t>());
+    else if (v.is_number_integer() && !(v.is_number_unsigned() && v.get<std::uint64_t>() > INT64_MAX))
+      tbl.insert(key, v.get<std::int64_t>());
     else if (v.is_number()) tbl.insert(key, v.get<double>());
     else if (v.is_string()) tbl.insert(key, v.get<std::string>());
     else if (v.is_array()) {

@@ -221,6 +221,37 @@ TEST(ParamSetRecords, OnlyTheKeysOfTheUnitSystemAndLawInUseAreRecorded) {
   EXPECT_THROW(p.applies_when("hamaker", "separation", {"1"}), std::logic_error);
 }
 
+TEST(ParamSetRecords, ARunsJsonSidecarLoadsAsItsParameters) {
+  ParamSet p = law_like();
+  p.load_toml_text(R"({"program": "afmkit", "parameters": {"hamaker": 1e-19, "stiffness": 3}, "results": {}})",
+                   "run.csv.json");
+  EXPECT_EQ(p.real("hamaker"), 1e-19);
+  EXPECT_EQ(p.real("stiffness"), 3.0);  // an integer for a real, as in TOML
+  EXPECT_TRUE(p.was_set("hamaker"));
+  EXPECT_EQ(p.real("departure_hamaker"), 1e-19);  // not given: follows, as in the run
+  // the record of one set, given to another, gives the same record
+  ParamSet q = law_like();
+  q.load_toml_text(nlohmann::json{{"parameters", p.to_json()}}.dump(2), "again.json");
+  EXPECT_EQ(q.to_json(), p.to_json());
+  // not a sidecar, malformed, a wrong type, an unknown key: named with the file
+  EXPECT_THROW(law_like().load_toml_text(R"({"hamaker": 1})", "x.json"), InputError);
+  EXPECT_THROW(law_like().load_toml_text(R"({"parameters": {"hamaker": 1e-19)", "x.json"), InputError);
+  EXPECT_THROW(law_like().load_toml_text(R"({"parameters": {"hamaker": "x"}})", "x.json"), InvalidParameter);
+  EXPECT_THROW(law_like().load_toml_text(R"({"parameters": {"hamaker": null}})", "x.json"), InvalidParameter);
+  EXPECT_THROW(law_like().load_toml_text(R"({"parameters": {"nothing": 1}})", "x.json"), InputError);
+  // an integer beyond the 64-bit range is refused, never wrapped into range
+  ParamSet n;
+  n.integer("seed", 1, "seed", 0, 100);
+  try {
+    n.load_toml_text(R"({"parameters": {"seed": 18446744073709551615}})", "x.json");
+    FAIL() << "accepted";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "seed");
+    EXPECT_EQ(std::string(e.what()).find("-1"), std::string::npos) << e.what();  // not read as 2^64 - 1 -> -1
+  }
+  EXPECT_EQ(n.integer("seed"), 1);
+}
+
 TEST(ParamSetRecords, RecordUsedReplacesTheDefaultInTheRecordWithoutCountingAsGiven) {
   ParamSet p = law_like();
   p.record_used("stiffness", 3.25);
