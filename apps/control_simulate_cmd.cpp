@@ -55,6 +55,15 @@ control::Disturbance disturbance_from(const io::ParamSet& p) {
   return control::Disturbance(p.real("disturbance_offset"), std::move(h));
 }
 
+/// The amplitudes the run used (one per entry of disturbance_amplitudes): the paper example's F_k = 0.3/k differ
+/// from the declared decimals in the last bit (0.3/3 != 0.1), so the record gives the values used.
+std::vector<double> amplitudes_used(const io::ParamSet& p, const control::Disturbance& f) {
+  std::vector<double> amplitudes(p.reals("disturbance_amplitudes").size(), 0.0);
+  for (const auto& h : f.harmonics)
+    if (h.order >= 1 && static_cast<std::size_t>(h.order) <= amplitudes.size()) amplitudes[h.order - 1] = h.amplitude;
+  return amplitudes;
+}
+
 /// The phases the run drew (one per entry of disturbance_amplitudes; 0 where F_k = 0), for the record.
 std::vector<double> phases_used(const io::ParamSet& p, const control::Disturbance& f) {
   std::vector<double> phases(p.reals("disturbance_amplitudes").size(), 0.0);
@@ -143,6 +152,8 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
                                                     o.report_max_order, nyquist_order, o.steps_per_period));
   io::ParamSet as_run = params_as_run(p, c, {{"max_order", o.report_max_order}});
   if (!p.was_set("disturbance_phases")) as_run.record_used("disturbance_phases", phases_used(p, disturbance));
+  if (!p.was_set("disturbance_amplitudes"))
+    as_run.record_used("disturbance_amplitudes", amplitudes_used(p, disturbance));
   CommandOutput out(as_run, capture, "control simulate");
   const bool keep_rows = p.flag("json") && !out.writes_file();
   o.record_every = out.writes_file() || keep_rows ? static_cast<int>(p.integer("record_every")) : 0;
@@ -211,6 +222,7 @@ void register_control_simulate(CLI::App& control) {
                    "F_1, F_2, ... of f (eq. 14); default: the Fig. 5 example F1 = 1, F_k = 0.3/k (k = 2..8)",
                    io::Range::non_negative())
             .unit("signal")
+            .default_text("F1 = 1, F_k = 0.3/k (k = 2..8)")  // computed: 0.3/3 is not 0.1 (recorded as used)
             .reals("disturbance_phases", {}, "phi_1, phi_2, ...")
             .unit("rad")
             .default_text("random from disturbance_seed, phi_1 = 0")

@@ -27,11 +27,22 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
       .flag("allow_energy_gain", false,
             "accept a law that creates energy (retract branch above the approach branch somewhere: K_b > K_a, "
             "restitution > 1, departure_modulus > effective_modulus, ...)");
+  // the records list only the keys of the law in use (ParamSet::applies_when)
+  std::vector<std::string> with_curve;
+  for (const auto& name : registry.names())
+    if (registry.find(name).needs_force_curve) with_curve.push_back(name);
+  p.applies_when("force_curve", "law", with_curve);
+  for (const auto& [command_key, registry_key] : aliases)
+    p.applies_when(command_key, "law", registry.laws_using(registry_key));
   for (const auto& k : registry.keys()) {
-    if (std::find(skip.begin(), skip.end(), k.key) != skip.end()) continue;
+    if (std::find(skip.begin(), skip.end(), k.key) != skip.end()) {  // declared by the command (same meaning)
+      p.applies_when(k.key, "law", registry.laws_using(k.key));
+      continue;
+    }
     const std::string laws = fmt::format("[{}] ", fmt::join(registry.laws_using(k.key), ", "));
     io::Range range{k.lower, std::min(k.upper, 1e308), k.lower_open, false};
     p.real(k.key, k.default_value, laws + k.help, range).unit(k.unit.empty() ? "dimensionless" : k.unit);
+    p.applies_when(k.key, "law", registry.laws_using(k.key));
     if (!k.follows.empty()) p.follows(k.follows);  // recorded with the value it takes (params.hpp)
     if (k.only_if_given) {  // an alternative: recorded only when given, then instead of the key it replaces
       std::vector<std::string> replaced{k.replaces};

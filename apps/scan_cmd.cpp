@@ -185,6 +185,7 @@ void register_scan(CLI::App& app) {
         p.group("Recorded data")
             .file("recorded", "", "recorded spiral CSV (time, radius, deflection, angle or index) to filter offline "
                                   "instead of simulating (docs/scan.md#recorded-data)");
+        record_only_what_applies(p);
         p.group("Images and files")
             .integer("image_resolution", 512, "pixels per side of the images (square, covering the scanned disc)", 2,
                      16384)

@@ -279,6 +279,18 @@ const std::vector<std::string>& simulation_only_keys() {
   return keys;
 }
 
+void record_only_what_applies(io::ParamSet& p) {
+  for (const std::string& key : simulation_only_keys()) p.applies_when(key, "recorded", {""});
+  p.applies_when("sample_file", "sample", {"file"})
+      .applies_when("sample_z_scale", "sample", {"file"})
+      .applies_when("sample_resolution", "sample", {"grating", "steps", "particles", "rough", "flat"})
+      .applies_when("sample_seed", "sample", {"particles", "rough"});
+  for (const char* key : {"grating_period", "grating_height", "grating_duty"}) p.applies_when(key, "sample", {"grating"});
+  for (const char* key : {"steps_width", "steps_height"}) p.applies_when(key, "sample", {"steps"});
+  for (const char* key : {"particles_count", "particles_radius"}) p.applies_when(key, "sample", {"particles"});
+  for (const char* key : {"rough_rms", "rough_correlation_length"}) p.applies_when(key, "sample", {"rough"});
+}
+
 scan::InstrumentSpec instrument_from(const io::ParamSet& p) {
   scan::InstrumentSpec s;
   s.spiral.spindle_frequency = p.real("spindle_frequency");

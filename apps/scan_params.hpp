@@ -24,5 +24,9 @@ scan::Surface surface_from(const io::ParamSet& p);
 void require_scan_memory(const io::ParamSet& p, bool recorded);
 /// Keys that describe the simulated instrument or sample (refused together with `recorded`).
 const std::vector<std::string>& simulation_only_keys();
+/// Declares which keys apply when (ParamSet::applies_when), so that a run's record lists only those: the
+/// simulation's keys without `recorded`, sample_file and sample_z_scale for sample = file, each generator's own
+/// keys for that generator. Call after `recorded` is declared.
+void record_only_what_applies(io::ParamSet& p);
 
 }  // namespace afmkit::cli

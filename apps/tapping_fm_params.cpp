@@ -12,7 +12,23 @@
 
 namespace afmkit::cli {
 
+namespace {
+/// The shared keys that do not apply to the self-excited cantilever, and why.
+const std::vector<std::pair<const char*, const char*>>& keys_not_for_fm() {
+  static const std::vector<std::pair<const char*, const char*>> keys{
+      {"drive_amplitude", "the drive is set by the amplitude controller: give amplitude"},
+      {"free_amplitude", "the drive is set by the amplitude controller: give amplitude"},
+      {"frequency_ratio", "the oscillation frequency is set by the phase-locked loop"},
+      {"separation", "give separation_min and separation_max, or separations"},
+      {"max_period_multiple", "FM orbits have the period of the oscillation"},
+      {"max_transient_periods", "FM orbits are found by Newton, without transients"}};
+  return keys;
+}
+}  // namespace
+
 void add_tapping_fm_params(io::ParamSet& p) {
+  // refused when given (reject_keys_not_for_fm): never in the records
+  for (const auto& [key, why] : keys_not_for_fm()) p.recorded_only_if_given(key);
   p.group("FM-AFM")
       .real("amplitude", 5.0, "oscillation amplitude A held by the amplitude controller (first harmonic of the "
                               "deflection)",
@@ -29,8 +45,10 @@ void add_tapping_fm_params(io::ParamSet& p) {
              io::Range::closed(-1e6, 1e6))
       .unit(kLengthUnit)
       .default_text("none: points on [separation_min, separation_max]")
+      .only_if_given(uniform_grid_keys())  // the record of a run gives the list or the grid it used
       .file("separations_file", "",
             "file with the separations instead (numbers separated by commas, spaces or lines; # comments)")
+      .only_if_given(uniform_grid_keys())
       .text("axis", "separation",
             "what separation_min, separation_max and separations set: separation (the rest position l, stepped as an "
             "instrument's piezo) or min_gap (the tip-sample distance at the lower turning point; l is solved for)",
@@ -43,16 +61,8 @@ void add_tapping_fm_params(io::ParamSet& p) {
 }
 
 void reject_keys_not_for_fm(const io::ParamSet& p) {
-  static const char* const keys[][2] = {
-      {"drive_amplitude", "the drive is set by the amplitude controller: give amplitude"},
-      {"free_amplitude", "the drive is set by the amplitude controller: give amplitude"},
-      {"frequency_ratio", "the oscillation frequency is set by the phase-locked loop"},
-      {"separation", "give separation_min and separation_max, or separations"},
-      {"max_period_multiple", "FM orbits have the period of the oscillation"},
-      {"max_transient_periods", "FM orbits are found by Newton, without transients"}};
-  for (const auto& k : keys)
-    if (p.was_set(k[0]))
-      throw InvalidParameter(k[0], fmt::format("{} does not apply to tapping fm: {}", k[0], k[1]));
+  for (const auto& [key, why] : keys_not_for_fm())
+    if (p.was_set(key)) throw InvalidParameter(key, fmt::format("{} does not apply to tapping fm: {}", key, why));
 }
 
 std::vector<double> fm_separations(const io::ParamSet& p, double length_scale) {

@@ -1,6 +1,9 @@
 #pragma once
 // Model parameters shared by `afmkit tapping orbit | hb | sweep` (and the demo), in normalised or physical
 // units (docs/units.md). Keys of the other unit system are rejected when given explicitly.
+#include <string>
+#include <vector>
+
 #include "afmkit/io/params.hpp"
 #include "afmkit/tapping/model.hpp"
 #include "afmkit/tapping/units.hpp"
@@ -9,6 +12,9 @@ namespace afmkit::cli {
 
 /// Unit of a length parameter of the tapping commands: nm in physical runs, the model length L in normalised runs.
 inline constexpr const char* kLengthUnit = "nm (physical) or L (normalised)";
+/// The keys of the uniform grid of separations, which an explicit list (separations, separations_file) replaces:
+/// a run given a list records the list, not the grid it did not use.
+inline std::vector<std::string> uniform_grid_keys() { return {"separation_min", "separation_max", "points"}; }
 
 /// units, cantilever, drive, force law, separation.
 void add_tapping_model_params(io::ParamSet& p);

@@ -253,8 +253,10 @@ void register_tapping_sweep(CLI::App& tapping) {
                    io::Range::closed(-1e6, 1e6))
             .unit(kLengthUnit)
             .default_text("none: points on [separation_min, separation_max]")
+            .only_if_given(uniform_grid_keys())  // the record of a run gives the list or the grid it used
             .file("separations_file", "",
                   "file with the separations instead (numbers separated by commas, spaces or lines; # comments)")
+            .only_if_given(uniform_grid_keys())
             .text("mode", "instrument",
                   "instrument (approach then retract, jumps and hysteresis), continuation (pseudo-arclength through "
                   "folds, unstable branches) or both",

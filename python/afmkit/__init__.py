@@ -4,7 +4,7 @@ Every command of the ``afmkit`` program is a function whose keyword arguments ar
 
     import afmkit
     r = afmkit.tapping.hb(units="physical", quality_factor=100, separation_min=-5, separation_max=30)
-    r["amplitude"], r.units["amplitude"], r.results["folds"]
+    r["amplitude"], r.amplitude, r.units["amplitude"], r.results.folds, r.to_pandas(), r.to_xarray()
 
     afmkit.impact(...), afmkit.tapping.orbit | hb | sweep | fm(...), afmkit.control.tf | roots | margin | chart |
     tune | simulate | export(...), afmkit.scan(...), afmkit.demo(...)

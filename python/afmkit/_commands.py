@@ -13,38 +13,223 @@ import numpy as np
 from . import _afmkit
 
 
-class Result:
-    """What one command computed: its table as NumPy arrays, the columns' units and meanings, the summary results.
+class _Summary(dict):
+    """The summary results of a run (the command's ``--json`` document without the table): a dict, whose keys are
+    also attributes (``r.results.folds``; nested documents likewise: ``r.results.box.real_min``)."""
 
-    ``r["amplitude"]`` is a column (float64, or str for label columns); ``r.units["amplitude"]`` its unit;
-    ``r.results`` the summary document (the command's ``--json`` output without the table); ``r.params`` the
-    parameters as run.
+    def __getattr__(self, name):
+        try:
+            return _summary(self[name])
+        except KeyError:
+            raise AttributeError(f"no summary result '{name}' (results: {', '.join(self)})") from None
+
+    def __dir__(self):
+        return list(super().__dir__()) + [k for k in self if k.isidentifier()]
+
+
+def _summary(value):
+    if isinstance(value, dict) and not isinstance(value, _Summary):
+        return _Summary(value)
+    if isinstance(value, list):
+        return [_summary(v) for v in value]
+    return value
+
+
+# Gridded results: the columns that span the grid (slowest first) of a table whose rows are every point of a
+# Cartesian grid; to_xarray() gives the other columns on these dimensions. Renamed: a dimension named after the
+# axis the summary gives ("x" -> results["x"]: alpha, a, ...).
+_GRIDS = {"control chart": ("delay", "y", "x"), "control tune": ("y", "x")}
+_AXIS_NAMES = {"x": "x", "y": "y"}  # the summary keys naming the x and y axes of a chart
+# Tables along one independent variable: its column is the dimension (when its values are distinct).
+_INDEX = {"control tf": "frequency", "control simulate": "t", "impact": "t", "tapping fm": "separation"}
+
+
+def _needs(module: str, method: str):
+    try:
+        return __import__(module)
+    except ImportError:
+        raise ImportError(f"afmkit.Result.{method}() needs {module} (Debian: apt install python3-{module}; or pip "
+                          f"install {module})") from None
+
+
+class Result(dict):
+    """What one command computed: a read-only mapping of its table's columns (name -> NumPy array), with the
+    columns' units and meanings and the summary results.
+
+    ``r["amplitude"]`` or ``r.amplitude`` is a column (float64; bool for flags such as ``stable``; str for labels);
+    ``dict(r)``, ``pd.DataFrame(r)`` and ``for name in r`` work as for a dict of columns; ``len(r)`` is the number
+    of rows (as a DataFrame's), ``r.columns`` the column names in order. ``r.units["amplitude"]`` is a column's
+    unit, ``r.meaning["amplitude"]`` what it holds; ``r.results`` the summary document (the command's ``--json``
+    output without the table; keys also as attributes: ``r.results.folds``); ``r.params`` the parameters as run
+    (``f(**r.params)`` repeats the run). ``r.to_pandas()`` and ``r.to_xarray()`` give the table with its units.
     """
 
     def __init__(self, command: str, raw: dict):
+        super().__init__(raw["table"])
         self.command = command
-        self.results: dict = raw["results"]
+        self.results: _Summary = _summary(raw["results"])
         self.params: dict = raw["params"]
         self.columns: list[str] = [c[0] for c in raw["columns"]]
         self.units: dict[str, str] = {c[0]: c[1] for c in raw["columns"]}
         self.meaning: dict[str, str] = {c[0]: c[2] for c in raw["columns"]}
-        self.table: dict[str, np.ndarray] = raw["table"]
+        self._raw_columns = [tuple(c) for c in raw["columns"]]
+
+    # ---- the mapping (read-only)
+    @property
+    def table(self) -> dict:
+        """The columns as a plain dict (name -> array)."""
+        return dict(self)
 
     def __getitem__(self, column: str) -> np.ndarray:
         try:
-            return self.table[column]
+            return super().__getitem__(column)
         except KeyError:
             raise KeyError(f"{self.command}: no column '{column}' (columns: {', '.join(self.columns)})") from None
 
-    def __contains__(self, column: str) -> bool:
-        return column in self.table
+    def get(self, column, default=None):
+        return super().get(column, default)
 
     def __len__(self) -> int:
-        return len(next(iter(self.table.values()))) if self.table else 0
+        """The number of rows."""
+        return len(next(iter(self.values()))) if super().__len__() else 0
 
+    def _read_only(self, *args, **kwargs):
+        raise TypeError(f"afmkit.Result is read-only: copy it first (dict(r), r.to_pandas())")
+
+    __setitem__ = __delitem__ = __ior__ = _read_only
+    clear = pop = popitem = setdefault = update = _read_only
+
+    def __reduce__(self):  # copy, pickle (Dask, multiprocessing)
+        raw = {"results": self.results, "params": self.params, "columns": self._raw_columns, "table": dict(self)}
+        return (Result, (self.command, raw))
+
+    def __getattr__(self, name: str):
+        # called only when normal lookup fails: columns whose names are not attributes of the object
+        if not name.startswith("_") and name in self.keys():
+            return self[name]
+        raise AttributeError(f"afmkit.Result of {self.__dict__.get('command', '?')} has no attribute or column "
+                             f"'{name}' (columns: {', '.join(self.__dict__.get('columns', []))})")
+
+    def __dir__(self):
+        return list(super().__dir__()) + [c for c in self.keys() if c.isidentifier()]
+
+    def __eq__(self, other):
+        return self is other
+
+    __hash__ = object.__hash__
+
+    # ---- views
     def __repr__(self) -> str:
         cols = ", ".join(f"{c} [{self.units[c]}]" for c in self.columns)
         return f"<afmkit.Result of {self.command}: {len(self)} rows; columns: {cols or 'none'}>"
+
+    def _repr_html_(self, max_rows: int = 10) -> str:
+        from html import escape
+        n = len(self)
+        half = max_rows // 2
+        shown = list(range(n)) if n <= max_rows else [*range(half), -1, *range(n - half, n)]
+        head = "".join(f'<th title="{escape(self.meaning[c])}">{escape(c)}<br><small>{escape(self.units[c])}</small>'
+                       f"</th>" for c in self.columns)
+        body = []
+        for i in shown:
+            if i < 0:
+                body.append(f'<tr><td colspan="{len(self.columns)}">… {n - 2 * half} more rows …</td></tr>')
+                continue
+            cells = "".join(f"<td>{escape(_cell(self[c][i]))}</td>" for c in self.columns)
+            body.append(f"<tr>{cells}</tr>")
+        summary = "".join(f"<tr><th>{escape(str(k))}</th><td>{escape(_short(v))}</td></tr>"
+                          for k, v in self.results.items())
+        return (f"<div><b>afmkit.Result</b> of <code>{escape(self.command)}</code>: {n} rows, "
+                f"{len(self.columns)} columns<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody>"
+                f"</table><details><summary>summary results</summary><table>{summary}</table></details></div>")
+
+    # ---- other libraries
+    def to_pandas(self):
+        """The table as a pandas DataFrame; ``df.attrs``: ``units`` and ``meaning`` (column -> text), ``command``,
+        ``results`` (the summary) and ``params``."""
+        pd = _needs("pandas", "to_pandas")
+        df = pd.DataFrame({c: self[c] for c in self.columns})
+        df.attrs.update(command=self.command, units=dict(self.units), meaning=dict(self.meaning),
+                        results=self.results, params=dict(self.params))
+        return df
+
+    def to_xarray(self):
+        """The table as an xarray Dataset: on the grid's dimensions when the rows are a grid (``control chart``:
+        delay x beta x alpha, or the chart's own axes; ``control tune``: its coarse grid), else along the
+        independent variable (``control tf``: frequency; ``simulate``, ``impact``: t; ``tapping fm``: separation) or
+        one dimension ``row``.
+        Every variable and coordinate has ``units`` and ``long_name`` attributes; the Dataset's attributes hold the
+        command, the summary results (as JSON text) and the parameters (as JSON text)."""
+        xr = _needs("xarray", "to_xarray")
+        import json
+
+        def attrs(c):
+            return {"units": self.units[c], "long_name": self.meaning[c]}
+
+        grid = self._grid()
+        if grid is not None:
+            axes, coords, where, dims = grid
+            shape = tuple(len(v) for v in coords)
+            data_vars = {}
+            for c in self.columns:
+                if c in axes:
+                    continue
+                col = self[c]
+                if col.dtype.kind == "f":
+                    full = np.full(shape, np.nan)
+                elif col.dtype.kind == "b":
+                    full = np.zeros(shape, bool)
+                else:
+                    full = np.empty(shape, col.dtype)
+                full[where] = col
+                data_vars[c] = (dims, full, attrs(c))
+            coord_vars = {d: (d, v, attrs(a)) for d, a, v in zip(dims, axes, coords)}
+        else:
+            dim = _INDEX.get(self.command)
+            if dim not in self.keys() or len(np.unique(self[dim])) != len(self):
+                dim = "row"
+            data_vars = {c: (dim, self[c], attrs(c)) for c in self.columns if c != dim}
+            coord_vars = {dim: (dim, self[dim], attrs(dim))} if dim != "row" else {"row": ("row", np.arange(len(self)))}
+        ds = xr.Dataset(data_vars, coords=coord_vars)
+        ds.attrs.update(command=self.command, results=json.dumps(self.results, default=str),
+                        params=json.dumps(self.params, default=str))
+        return ds
+
+    def _grid(self):
+        """(axis columns, sorted values per axis, index tuple of each row, dimension names) when the rows are every
+        point of a grid exactly once, else None."""
+        axes = [a for a in _GRIDS.get(self.command, ()) if a in self.keys()]
+        if not axes or len(self) == 0:
+            return None
+        coords, index = [], []
+        for a in axes:
+            col = self[a]
+            if col.dtype.kind != "f" or not np.all(np.isfinite(col)):
+                return None
+            values, inverse = np.unique(col, return_inverse=True)
+            coords.append(values)
+            index.append(inverse)
+        shape = tuple(len(v) for v in coords)
+        flat = np.ravel_multi_index(index, shape)
+        if int(np.prod(shape)) != len(self) or len(np.unique(flat)) != len(self):
+            return None
+        dims = []
+        for a in axes:
+            name = self.results.get(_AXIS_NAMES[a]) if a in _AXIS_NAMES else None
+            ok = isinstance(name, str) and name.isidentifier() and name not in self.keys()
+            dims.append(name if ok else a)
+        return axes, coords, tuple(index), dims
+
+
+def _cell(x) -> str:
+    if isinstance(x, (float, np.floating)):
+        return f"{x:.6g}"
+    return str(x)
+
+
+def _short(v) -> str:
+    text = str(v)
+    return text if len(text) <= 120 else text[:117] + "…"
 
 
 _KINDS = {"real": float, "integer": int, "text": str, "file": str, "flag": bool, "reals": list}
@@ -79,8 +264,10 @@ def _docstring(spec: dict) -> str:
             facts.append(p["allowed"])
         lines.append(f"  {p['key']} ({'; '.join(facts)})")
         lines.extend(textwrap.wrap(p["help"], 100, initial_indent="      ", subsequent_indent="      "))
-    lines += ["", "config: a TOML file read first (as --config); keyword arguments override it.",
-              "Returns an afmkit.Result (table columns as NumPy arrays, units, summary results)."]
+    lines += ["", "config: a TOML file, or a run's JSON sidecar, read first (as --config); keyword arguments",
+              "override it.",
+              "Returns an afmkit.Result: a read-only mapping of the table's columns (NumPy arrays; flags bool) with",
+              "units, the summary results (r.results), the parameters as run (r.params), to_pandas(), to_xarray()."]
     return "\n".join(lines)
 
 

@@ -54,8 +54,25 @@ py::object json_to_python(const nlohmann::json& j) {
   }
 }
 
-/// Column `c` of the rows: float64 when every cell is a number, a boolean or null (NaN), else an array of str.
-py::object column_array(const nlohmann::json& rows, std::size_t c) {
+/// Whether column `c` is a flag (unit "boolean", "boolean (0/1)") holding only booleans or 0/1 (no NaN).
+bool flag_column(const io::Column& column, const nlohmann::json& rows, std::size_t c) {
+  if (column.unit.rfind("boolean", 0) != 0) return false;
+  for (const auto& r : rows)
+    if (!(r[c].is_boolean() || (r[c].is_number() && (r[c].get<double>() == 0.0 || r[c].get<double>() == 1.0))))
+      return false;
+  return true;
+}
+
+/// Column `c` of the rows: bool for a flag column (flag_column), float64 when every cell is a number, a boolean or
+/// null (NaN), else an array of str.
+py::object column_array(const io::Column& column, const nlohmann::json& rows, std::size_t c) {
+  if (flag_column(column, rows, c)) {
+    py::array_t<bool> a(static_cast<py::ssize_t>(rows.size()));
+    auto w = a.mutable_unchecked<1>();
+    py::ssize_t i = 0;
+    for (const auto& r : rows) w(i++) = r[c].is_boolean() ? r[c].get<bool>() : r[c].get<double>() == 1.0;
+    return a;
+  }
   bool numeric = true;
   for (const auto& r : rows)
     if (!(r[c].is_number() || r[c].is_boolean() || r[c].is_null())) numeric = false;
@@ -112,7 +129,7 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   for (std::size_t c = 0; c < captured.columns.size(); ++c) {
     const io::Column& col = captured.columns[c];
     columns.append(py::make_tuple(col.name, col.unit, col.description));
-    table[py::str(col.name)] = column_array(captured.rows, c);
+    table[py::str(col.name)] = column_array(col, captured.rows, c);
   }
   out["columns"] = columns;
   out["table"] = table;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -145,6 +146,8 @@ ParamSet::Entry ParamSet::make_entry(Value value, const std::string& help, Range
 
 void ParamSet::declare(const std::string& key, Entry e) {
   e.group = group_;
+  if (const auto c = group_conditions_.find(group_); c != group_conditions_.end())
+    e.applies.push_back({c->second.first, {c->second.second}});
   if (!entries_.count(key)) order_.push_back(key);
   entries_[key] = std::move(e);
   last_ = key;
@@ -205,6 +208,22 @@ ParamSet& ParamSet::only_if_given(std::vector<std::string> instead_of) {
   Entry& e = entries_[last_];
   e.only_if_given = true;
   e.instead_of = std::move(instead_of);
+  return *this;
+}
+ParamSet& ParamSet::applies_when(const std::string& param, const std::string& key, std::vector<std::string> values) {
+  const auto it = entries_.find(param);
+  const auto on = entries_.find(key);
+  if (it == entries_.end() || on == entries_.end() || !std::holds_alternative<std::string>(on->second.value))
+    throw std::logic_error(fmt::format("ParamSet::applies_when: '{}' or the text parameter '{}' is not declared",
+                                       param, key));
+  it->second.applies.push_back({key, std::move(values)});
+  return *this;
+}
+ParamSet& ParamSet::recorded_only_if_given(const std::string& param) {
+  const auto it = entries_.find(param);
+  if (it == entries_.end())
+    throw std::logic_error(fmt::format("ParamSet::recorded_only_if_given: '{}' is not declared", param));
+  it->second.only_if_given = true;
   return *this;
 }
 void ParamSet::record_used(const std::string& key, Value value) {
@@ -436,14 +455,60 @@ void ParamSet::set_default(const std::string& key, const std::string& text) {
   entries_.at(key).set = false;
 }
 
-void ParamSet::load_toml_text(const std::string& text, const std::string& origin) {
-  check_toml_nesting(text, origin);
-  toml::table tbl;
+namespace {
+/// The `parameters` of a JSON sidecar (io::make_sidecar) as a TOML table: the record of a run given as --config
+/// replays it. InputError naming the file when it is not a sidecar.
+toml::table sidecar_parameters(const std::string& text, const std::string& origin) {
+  nlohmann::json doc;
   try {
-    tbl = toml::parse(text, origin);
-  } catch (const toml::parse_error& err) {
-    const auto& b = err.source().begin;
-    throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, b.line, b.column, err.description()));
+    doc = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(fmt::format("{}: malformed JSON (a JSON config file must be the sidecar of a run): {}", origin,
+                                 e.what()));
+  }
+  const auto params = doc.is_object() ? doc.find("parameters") : doc.end();
+  if (params == doc.end() || !params->is_object())
+    throw InputError(fmt::format("{}: a JSON config file must be the sidecar of a run (an object with a "
+                                 "\"parameters\" object); give parameters as TOML otherwise",
+                                 origin));
+  toml::table tbl;
+  for (const auto& [key, v] : params->items()) {
+    const auto no_value = [&] {
+      throw InvalidParameter(key, fmt::format("{}: key '{}' = {} is not a parameter value", origin, key, v.dump()));
+    };
+    if (v.is_boolean()) tbl.insert(key, v.get<bool>());
+    else if (v.is_number_integer() && !(v.is_number_unsigned() && v.get<std::uint64_t>() > INT64_MAX))
+      tbl.insert(key, v.get<std::int64_t>());
+    else if (v.is_number()) tbl.insert(key, v.get<double>());
+    else if (v.is_string()) tbl.insert(key, v.get<std::string>());
+    else if (v.is_array()) {
+      toml::array a;
+      for (const auto& x : v) {
+        if (!x.is_number()) no_value();
+        a.push_back(x.get<double>());
+      }
+      tbl.insert(key, std::move(a));
+    } else {
+      no_value();
+    }
+  }
+  return tbl;
+}
+}  // namespace
+
+void ParamSet::load_toml_text(const std::string& text, const std::string& origin) {
+  toml::table tbl;
+  const auto first = text.find_first_not_of(" \t\r\n");
+  if (first != std::string::npos && text[first] == '{') {  // a sidecar (a TOML document cannot start with '{')
+    tbl = sidecar_parameters(text, origin);
+  } else {
+    check_toml_nesting(text, origin);
+    try {
+      tbl = toml::parse(text, origin);
+    } catch (const toml::parse_error& err) {
+      const auto& b = err.source().begin;
+      throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", origin, b.line, b.column, err.description()));
+    }
   }
   for (auto&& item : tbl) {  // (no structured binding: clang 14 cannot capture one in the lambda below)
     const std::string key(item.first.str());
@@ -527,6 +592,9 @@ const ParamSet::Entry& ParamSet::current(const std::string& key) const {
 bool ParamSet::recorded(const std::string& key) const {
   const Entry& e = entry(key);
   if (e.only_if_given && !e.set) return false;
+  for (const auto& [on, values] : e.applies)  // a key of another unit system or law than the run's
+    if (std::find(values.begin(), values.end(), std::get<std::string>(current(on).value)) == values.end())
+      return false;
   for (const auto& [other, o] : entries_)
     if (o.only_if_given && o.set && std::find(o.instead_of.begin(), o.instead_of.end(), key) != o.instead_of.end())
       return false;

@@ -181,6 +181,77 @@ TEST(ParamSetRecords, AnAlternativeIsRecordedOnlyWhenGivenAndThenReplacesItsKey)
   EXPECT_FALSE(p.units_json().contains("stiffness"));
 }
 
+TEST(ParamSetRecords, OnlyTheKeysOfTheUnitSystemAndLawInUseAreRecorded) {
+  ParamSet p;
+  p.text("units", "normalised", "unit system", {"normalised", "physical"})
+      .text("law", "hysteresis", "force law", {"hysteresis", "dmt", "hertz"})
+      .real("separation", 10.0, "l")
+      .unit("L")
+      .group("Model in normalised units", "units", "normalised")
+      .real("natural_frequency", 1.0, "ω_n", Range::positive())
+      .unit("rad/t")
+      .group("Model in physical units", "units", "physical")
+      .real("spring_constant", 40.0, "k", Range::positive())
+      .unit("N/m")
+      .group("Law")
+      .real("hamaker", 6.4e-20, "A_H", Range::non_negative())
+      .unit("J")
+      .real("tip_radius", 10.0, "R", Range::positive())
+      .unit("nm");
+  p.applies_when("hamaker", "law", {"dmt"}).applies_when("tip_radius", "law", {"dmt", "hertz"});
+  p.resolve();
+  nlohmann::json j = p.to_json();
+  EXPECT_TRUE(j.contains("separation") && j.contains("natural_frequency") && j.contains("law"));
+  EXPECT_FALSE(j.contains("spring_constant"));  // the other unit system
+  EXPECT_FALSE(j.contains("hamaker"));          // laws the run did not use
+  EXPECT_FALSE(j.contains("tip_radius"));
+  EXPECT_FALSE(p.units_json().contains("hamaker"));
+  p.set_from_string("units", "physical");
+  p.set_from_string("law", "hertz");
+  j = p.to_json();
+  EXPECT_FALSE(j.contains("natural_frequency"));
+  EXPECT_EQ(j["spring_constant"].get<double>(), 40.0);
+  EXPECT_EQ(j["tip_radius"].get<double>(), 10.0);
+  EXPECT_FALSE(j.contains("hamaker"));
+  EXPECT_EQ(p.units_json()["tip_radius"], "nm");
+  // still readable (a command decides whether a foreign key given is an error); a condition on an undeclared key
+  // or on a number is a programming error
+  EXPECT_EQ(p.real("natural_frequency"), 1.0);
+  EXPECT_THROW(p.applies_when("nothing", "law", {"dmt"}), std::logic_error);
+  EXPECT_THROW(p.applies_when("hamaker", "separation", {"1"}), std::logic_error);
+}
+
+TEST(ParamSetRecords, ARunsJsonSidecarLoadsAsItsParameters) {
+  ParamSet p = law_like();
+  p.load_toml_text(R"({"program": "afmkit", "parameters": {"hamaker": 1e-19, "stiffness": 3}, "results": {}})",
+                   "run.csv.json");
+  EXPECT_EQ(p.real("hamaker"), 1e-19);
+  EXPECT_EQ(p.real("stiffness"), 3.0);  // an integer for a real, as in TOML
+  EXPECT_TRUE(p.was_set("hamaker"));
+  EXPECT_EQ(p.real("departure_hamaker"), 1e-19);  // not given: follows, as in the run
+  // the record of one set, given to another, gives the same record
+  ParamSet q = law_like();
+  q.load_toml_text(nlohmann::json{{"parameters", p.to_json()}}.dump(2), "again.json");
+  EXPECT_EQ(q.to_json(), p.to_json());
+  // not a sidecar, malformed, a wrong type, an unknown key: named with the file
+  EXPECT_THROW(law_like().load_toml_text(R"({"hamaker": 1})", "x.json"), InputError);
+  EXPECT_THROW(law_like().load_toml_text(R"({"parameters": {"hamaker": 1e-19)", "x.json"), InputError);
+  EXPECT_THROW(law_like().load_toml_text(R"({"parameters": {"hamaker": "x"}})", "x.json"), InvalidParameter);
+  EXPECT_THROW(law_like().load_toml_text(R"({"parameters": {"hamaker": null}})", "x.json"), InvalidParameter);
+  EXPECT_THROW(law_like().load_toml_text(R"({"parameters": {"nothing": 1}})", "x.json"), InputError);
+  // an integer beyond the 64-bit range is refused, never wrapped into range
+  ParamSet n;
+  n.integer("seed", 1, "seed", 0, 100);
+  try {
+    n.load_toml_text(R"({"parameters": {"seed": 18446744073709551615}})", "x.json");
+    FAIL() << "accepted";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "seed");
+    EXPECT_EQ(std::string(e.what()).find("-1"), std::string::npos) << e.what();  // not read as 2^64 - 1 -> -1
+  }
+  EXPECT_EQ(n.integer("seed"), 1);
+}
+
 TEST(ParamSetRecords, RecordUsedReplacesTheDefaultInTheRecordWithoutCountingAsGiven) {
   ParamSet p = law_like();
   p.record_used("stiffness", 3.25);

@@ -73,6 +73,9 @@ def test_result_equals_the_command_lines_table_bit_for_bit(command, args):
         if r[col].dtype.kind == "f":
             want = np.array([math.nan if c is None else float(c) for c in cells])
             np.testing.assert_array_equal(r[col], want, err_msg=col)
+        elif r[col].dtype.kind == "b":  # a flag: true/false (or 0/1) in the document
+            assert r.units[col].startswith("boolean") and all(c in (0, 1) for c in cells), col
+            assert list(r[col]) == [c == 1 for c in cells], col
         else:
             assert list(r[col]) == [str(c) for c in cells], col
         assert r.units[col] == doc["columns"][i]["unit"] and r.meaning[col] == doc["columns"][i]["description"]

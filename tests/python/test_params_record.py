@@ -53,24 +53,6 @@ NEW_VALUE = {"hamaker": 1e-19, "effective_modulus": 3.0, "plant_rate": 7.0, "del
              "resonance_frequency": 310.0}
 
 
-def replayable(command, params):
-    """The record without the keys at their declared defaults (the run used those anyway) and without the keys of
-    another law or unit system than the run's (their --help text starts with "[law, ...]" or "[normalised]" /
-    "[physical]"): keys of other laws are recorded too but refused when given — a separate issue."""
-    spec = next(s for s in _afmkit.commands() if s["path"] == command)
-    law, units = params.get("law"), params.get("units")
-    out = {}
-    for p in spec["params"]:
-        k = p["key"]
-        if k not in params or params[k] == p["default"]:
-            continue
-        tag = p["help"][1:p["help"].index("]")].split(", ") if p["help"].startswith("[") else None
-        if tag and tag != [units] and law not in tag:
-            continue
-        out[k] = params[k]
-    return out
-
-
 def followers():
     """(command, key, followed key) for every parameter whose --help default reads "= <other key>"."""
     out = []
@@ -107,9 +89,8 @@ def test_a_followed_default_is_recorded_as_the_value_used(command, key, source, 
     used = NEW_VALUE[source]
     expected = [used] if isinstance(r.params[key], list) else used  # delays = [delay]
     assert r.params[key] == expected, f"{command}: {key} recorded {r.params[key]}"
-    # the record replays and records the same (the keys of other laws are recorded too, and refused when given:
-    # a separate issue; the replay leaves them out)
-    again = FUNCTIONS[command](**replayable(command, r.params))
+    # the record replays as it is (it lists only the keys of the unit system and law in use) and records the same
+    again = FUNCTIONS[command](**r.params)
     assert again.params == r.params
 
 
@@ -117,7 +98,7 @@ def test_dmt_record_gives_the_same_law_and_replays():
     r = afmkit.impact(law="dmt", hamaker=1e-19, mass1=1e-11, mass2=1.0, velocity=1e6, gap=2.0)
     assert r.params["departure_hamaker"] == 1e-19
     assert "restitution" not in r.params
-    again = afmkit.impact(**replayable("impact", r.params))  # was: "departure_hamaker = 6.4e-20 must be >= hamaker"
+    again = afmkit.impact(**r.params)  # was: "departure_hamaker = 6.4e-20 must be >= hamaker"
     assert again.results["restitution"] == r.results["restitution"]
     # independently of the record: the run with both A_H given explicitly is the same impact
     explicit = afmkit.impact(law="dmt", hamaker=1e-19, departure_hamaker=1e-19, mass1=1e-11, mass2=1.0,
@@ -129,11 +110,11 @@ def test_dmt_record_gives_the_same_law_and_replays():
 def test_an_alternative_is_recorded_only_when_used():
     r = afmkit.impact(restitution=0.5)
     assert r.params["restitution"] == 0.5 and "departure_stiffness" not in r.params
-    assert afmkit.impact(**replayable("impact", r.params)).results["restitution"] == pytest.approx(
+    assert afmkit.impact(**r.params).results["restitution"] == pytest.approx(
         r.results["restitution"], rel=1e-12)
     r = afmkit.impact(v1=1.0, v2=-2.0)
     assert "velocity" not in r.params and r.params["v1"] == 1.0
-    assert afmkit.impact(**replayable("impact", r.params)).results["restitution"] == r.results["restitution"]
+    assert afmkit.impact(**r.params).results["restitution"] == r.results["restitution"]
 
 
 def test_computed_defaults_are_recorded_as_computed():

@@ -75,6 +75,15 @@ class ParamSet {
   /// departure_stiffness): not given, it is left out of the records; given, it stands for the keys `instead_of`,
   /// which are then left out of the records (a replay gives the alternative, as the run did).
   ParamSet& only_if_given(std::vector<std::string> instead_of = {});
+  /// Parameter `param` (declared before) counts only when given, as only_if_given(): for a shared key that a
+  /// command refuses when given (it does not apply there), so that its records never list it.
+  ParamSet& recorded_only_if_given(const std::string& param);
+  /// Parameter `param` (declared before) applies only when the text parameter `key` has one of `values` (a key of
+  /// one unit system, of some force laws): otherwise the run did not use it and it is left out of the records
+  /// (to_json: sidecars, Python r.params; units_json), so that a record lists exactly the parameters that applied
+  /// and replays as given. Conditions add up (all must hold). A parameter declared in a group with a condition
+  /// (group(name, when_key, when_value)) has that condition.
+  ParamSet& applies_when(const std::string& param, const std::string& key, std::vector<std::string> values);
   /// Records the value a run used for a parameter whose value the command computes or chooses itself
   /// ("automatic", "proven bound", a default that depends on other values): value() and the records give it from
   /// now on; it does not count as given (was_set). Validated as a given value is (InvalidParameter naming the key).
@@ -102,7 +111,9 @@ class ParamSet {
   void add_options(CLI::App& app);
   /// Call after parsing: loads --config (if any), applies flags, validates. Throws on bad input.
   void resolve();
-  /// Load values from TOML text (used by resolve() and by tests). `origin` names the source in messages.
+  /// Load values from TOML text (used by resolve() and by tests). `origin` names the source in messages. A JSON
+  /// sidecar of a run (text starting with '{': its "parameters" object) is read as the same keys, so that
+  /// `--config out.csv.json` replays the run it records.
   void load_toml_text(const std::string& text, const std::string& origin);
   /// Change the default of a registered parameter (textual form, validated); it still counts as "not set".
   void set_default(const std::string& key, const std::string& text);
@@ -170,6 +181,7 @@ class ParamSet {
     bool only_if_given = false;           // not given: not recorded
     std::vector<std::string> instead_of;  // given: these parameters are not recorded
     bool used = false;                    // value recorded by record_used
+    std::vector<std::pair<std::string, std::vector<std::string>>> applies;  // (text key, values): applies_when
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;

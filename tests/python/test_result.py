@@ -1,0 +1,140 @@
+"""afmkit.Result as people already use tables (docs/python.md#the-result-object): a read-only mapping of columns,
+attribute access, bool flags, pandas and xarray with units, an HTML view. Small runs (well under a second each)."""
+import copy
+import pickle
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import afmkit
+from afmkit import _afmkit
+
+
+@pytest.fixture(scope="module")
+def sweep():
+    return afmkit.tapping.sweep(separation_min=7.0, separation_max=9.0, points=4, mode="instrument", quiet=True)
+
+
+@pytest.fixture(scope="module")
+def chart():
+    # delays not in increasing order, a non-square grid: the re-gridding must not rely on either
+    return afmkit.control.chart(harmonics=2, x_points=5, y_points=4, delays=[0.3, 0.1, 0.2], boundaries_output="",
+                                progress=False)
+
+
+def test_the_mapping_protocol_gives_the_columns(sweep):
+    d = dict(sweep)
+    assert list(d) == sweep.columns == list(sweep) == list(sweep.keys())
+    for c in sweep.columns:
+        assert d[c] is sweep[c] and getattr(sweep, c) is sweep[c]
+    assert len(sweep) == 8 == len(sweep["amplitude"])  # rows, as before (and as a DataFrame's)
+    assert len(sweep.keys()) == len(sweep.columns)
+    assert "amplitude" in sweep and "nothing" not in sweep
+    assert [k for k, _ in sweep.items()] == sweep.columns
+    assert sweep.get("nothing") is None
+    with pytest.raises(KeyError, match="no column 'nothing'"):
+        sweep["nothing"]
+    with pytest.raises(AttributeError, match="nothing"):
+        sweep.nothing
+    for change in (lambda: sweep.__setitem__("amplitude", 1), lambda: sweep.pop("amplitude"),
+                   lambda: sweep.update(x=1), lambda: sweep.__delitem__("amplitude"), sweep.clear):
+        with pytest.raises(TypeError, match="read-only"):
+            change()
+    assert sweep.columns[0] == "separation"  # unchanged by the attempts
+
+
+def test_old_uses_keep_working(sweep):
+    assert sweep.table["amplitude"] is sweep["amplitude"] and set(sweep.table) == set(sweep.columns)
+    assert sweep.units["amplitude"] == "L" and sweep.meaning["amplitude"]
+    assert sweep.results["rows"] == len(sweep) and sweep.results.rows == len(sweep)
+    assert "afmkit.Result of tapping sweep: 8 rows" in repr(sweep)
+
+
+def test_the_summary_reads_as_attributes():
+    r = afmkit.control.roots(harmonics=3)
+    assert r.results.box.real_min == r.results["box"]["real_min"]
+    assert isinstance(r.results, dict)
+    with pytest.raises(AttributeError, match="no summary result 'nothing'"):
+        r.results.nothing
+
+
+def test_flags_are_booleans_equal_to_the_command_lines_0_1(sweep):
+    assert sweep.stable.dtype == bool and sweep.jumped.dtype == bool and sweep.periodic.dtype == bool
+    # independently: stable means every Floquet multiplier inside the unit circle (the column's definition)
+    ok = np.isfinite(sweep.floquet_max)
+    assert np.array_equal(sweep.stable[ok], sweep.floquet_max[ok] < 1)
+    assert sweep.amplitude[sweep.stable].size == np.count_nonzero(sweep.stable)  # usable as a mask
+    flags = [c for c in sweep.columns if sweep.units[c].startswith("boolean")]
+    assert set(flags) == {"stable", "periodic", "jumped", "trapped"}
+    assert all(sweep[c].dtype == bool for c in flags)
+    assert all(sweep[c].dtype != bool for c in sweep.columns if c not in flags)
+
+
+def test_pandas_dataframe_and_to_pandas(sweep):
+    pd = pytest.importorskip("pandas")
+    df = pd.DataFrame(sweep)
+    assert list(df.columns) == sweep.columns and len(df) == len(sweep)
+    assert df["stable"].dtype == bool
+    np.testing.assert_array_equal(df["amplitude"].to_numpy(), sweep.amplitude)
+    df = sweep.to_pandas()
+    assert df.attrs["units"] == sweep.units and df.attrs["meaning"] == sweep.meaning
+    assert df.attrs["command"] == "tapping sweep" and df.attrs["params"] == sweep.params
+    assert df.attrs["results"]["rows"] == len(sweep)
+
+
+def test_to_xarray_of_a_chart_is_the_long_table_regridded(chart):
+    ds = chart.to_xarray()
+    assert chart.results["x"] == "alpha" and chart.results["y"] == "beta"
+    assert ds.spectral_abscissa.dims == ("delay", "beta", "alpha")
+    assert ds.sizes == {"delay": 3, "beta": 4, "alpha": 5}
+    # independently of to_xarray: each row's value at its (delay, y, x) coordinates
+    for i in range(len(chart)):
+        at = dict(delay=chart.delay[i], beta=chart.y[i], alpha=chart.x[i])
+        for c in ("spectral_abscissa", "unstable_roots", "region"):
+            v = ds[c].sel(at).item()
+            assert v == chart[c][i] or (np.isnan(v) and np.isnan(chart[c][i])), (c, i)
+    np.testing.assert_array_equal(ds.delay.values, [0.1, 0.2, 0.3])
+    np.testing.assert_array_equal(ds.alpha.values, np.unique(chart.x))
+    assert ds.alpha.attrs["units"] == "Omega" and "alpha" in ds.alpha.attrs["long_name"]
+    assert ds.delay.attrs["units"] == "T"
+    assert ds.spectral_abscissa.attrs == {"units": chart.units["spectral_abscissa"],
+                                          "long_name": chart.meaning["spectral_abscissa"]}
+    assert ds.attrs["command"] == "control chart"
+
+
+def test_to_xarray_of_a_margin_map_and_of_tables():
+    m = afmkit.control.chart(controller="single", harmonics=2, x_points=3, y_points=2, quantity="margin",
+                             boundaries_output="", progress=False).to_xarray()
+    assert m.critical_delay.dims == ("b", "a")
+    tf = afmkit.control.tf(harmonics=3, points=7).to_xarray()
+    assert tf.magnitude.dims == ("frequency",) and tf.frequency.attrs["units"] == "Omega"
+    hb = afmkit.tapping.hb(points=30)
+    ds = hb.to_xarray()
+    assert ds.amplitude.dims == ("row",) and ds.sizes["row"] == len(hb)
+    assert list(ds.branch.values) == list(hb.branch)
+
+
+def test_html_shows_names_units_and_the_summary(sweep):
+    html = sweep._repr_html_()
+    assert html.startswith("<div>") and html.count("<th title=") == len(sweep.columns)
+    assert "<small>L</small>" in html and "tapping sweep" in html and "rows" in html
+    long = afmkit.tapping.hb(points=100)._repr_html_()
+    assert "more rows" in long and long.count("<tr><td>") == 10  # head and tail rows only
+
+
+def test_a_result_copies_and_pickles(sweep):
+    for other in (pickle.loads(pickle.dumps(sweep)), copy.copy(sweep), copy.deepcopy(sweep)):
+        assert other.columns == sweep.columns and other.params == sweep.params and other.units == sweep.units
+        assert all(np.array_equal(other[c], sweep[c]) for c in sweep.columns)
+        assert other.results.rows == sweep.results.rows
+
+
+def test_the_module_imports_without_pandas_and_xarray_and_says_what_is_missing():
+    code = ("import sys; sys.modules['pandas'] = None; sys.modules['xarray'] = None\n"
+            "import afmkit\nr = afmkit.control.tf(harmonics=2, points=3)\n"
+            "for f in (r.to_pandas, r.to_xarray):\n"
+            "    try:\n        f()\n    except ImportError as e:\n        print(e)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert "to_pandas() needs pandas" in out and "to_xarray() needs xarray" in out
