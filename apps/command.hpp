@@ -94,6 +94,9 @@ class CommandOutput {
   /// `capture`: nullptr on the command line; else the results, columns and rows go there instead of being printed.
   CommandOutput(const io::ParamSet& params, Captured* capture, std::string command,
                 const std::string& output_key = "output");
+  /// It keeps a reference to `params` (the record it writes at finish()): a temporary would dangle.
+  CommandOutput(io::ParamSet&& params, Captured* capture, std::string command,
+                const std::string& output_key = "output") = delete;
 
   /// Opens the table (file or memory) with its columns; call once before adding rows.
   void open(std::vector<io::Column> columns);

@@ -49,6 +49,15 @@ void refuse_other_mode(const io::ParamSet& p, spectroscopy::FitMode mode) {
                                               fm ? "FM" : "AM", fmt::join(fm ? kFmOnly : kAmOnly, ", ")));
 }
 
+/// The record of a run (sidecar, Python r.params): without the other mode's keys, which the run did not read (a
+/// replay would give them, and be refused).
+io::ParamSet record_of(const io::ParamSet& p, spectroscopy::FitMode mode) {
+  io::ParamSet as_run = p;
+  for (const std::string& key : mode == spectroscopy::FitMode::fm ? kAmOnly : kFmOnly)
+    as_run.recorded_only_if_given(key);
+  return as_run;
+}
+
 /// The fitted names of `parameters` (comma-separated, blanks ignored).
 std::vector<std::string> parameter_list(const std::string& text) {
   std::vector<std::string> out;
@@ -215,7 +224,9 @@ void run_fm_fit(const io::ParamSet& p, Captured* capture, const spectroscopy::Fm
   options.cancellation = cancellation_of(capture);
   const spectroscopy::FitResult r = spectroscopy::fit_fm_curve(curve, s, options);
 
-  CommandOutput out(p, capture, "spectroscopy fit");
+  io::ParamSet as_run = record_of(p, spectroscopy::FitMode::fm);  // the FM default of `parameters`: the list fitted
+  if (!p.was_set("parameters")) as_run.record_used("parameters", std::string(kFmParameters));
+  CommandOutput out(as_run, capture, "spectroscopy fit");
   const bool diss = !r.dissipation.empty();
   std::vector<io::Column> columns = {
       {"distance", "nm", "measured distance (piezo separation; model separation = distance + distance_offset)"},
@@ -297,7 +308,8 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
   run.cancellation = cancellation_of(capture);
   const spectroscopy::FitResult r = spectroscopy::fit_am_curve(curve, s, run);
 
-  CommandOutput out(p, capture, "spectroscopy fit");
+  const io::ParamSet as_run = record_of(p, spectroscopy::FitMode::am);  // CommandOutput keeps a reference
+  CommandOutput out(as_run, capture, "spectroscopy fit");
   const bool phase = !r.phase.empty();
   std::vector<io::Column> columns = {
       {"distance", "nm", "measured distance (piezo separation; model separation = distance + distance_offset)"},

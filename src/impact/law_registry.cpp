@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/impact/laws/contact_laws.hpp"
 #include "afmkit/impact/laws/table_law.hpp"
@@ -14,17 +15,17 @@
 namespace afmkit::impact {
 
 namespace {
-constexpr double inf = std::numeric_limits<double>::infinity();
+using afmkit::numbers::infinity;
 
 LawKey positive(std::string key, std::string unit, double def, std::string help, std::string follows = {}) {
-  return {std::move(key), std::move(unit), def, std::move(help), 0.0, inf, true, std::move(follows), false, ""};
+  return {std::move(key), std::move(unit), def, std::move(help), 0.0, infinity, true, std::move(follows), false, ""};
 }
 LawKey non_negative(std::string key, std::string unit, double def, std::string help, std::string follows = {}) {
-  return {std::move(key), std::move(unit), def, std::move(help), 0.0, inf, false, std::move(follows), false, ""};
+  return {std::move(key), std::move(unit), def, std::move(help), 0.0, infinity, false, std::move(follows), false, ""};
 }
 
 std::string range_text(const LawKey& k) {
-  if (k.upper == inf) return fmt::format("{} {}", k.lower_open ? ">" : ">=", k.lower);
+  if (k.upper == infinity) return fmt::format("{} {}", k.lower_open ? ">" : ">=", k.lower);
   return fmt::format("in {}{}, {}]", k.lower_open ? "(" : "[", k.lower, k.upper);
 }
 
@@ -35,7 +36,7 @@ std::vector<LawKey> builtin_keys() {
       LawKey{"restitution", "", 1.0,
              "if given: K_b = e^2 K_a for the restitution e in (0, 1] of an impulsive impact (e > 1 needs "
              "allow_energy_gain); instead of departure_stiffness",
-             0.0, inf, true, "", true, "departure_stiffness"},
+             0.0, infinity, true, "", true, "departure_stiffness"},
       non_negative("approach_adhesion", "nN", 0.0, "F_a, attraction at the contact edge while approaching"),
       non_negative("departure_adhesion", "nN", 0.0, "F_b >= F_a, attraction at the contact edge while departing"),
       positive("effective_modulus", "GPa", 1.0, "effective modulus E* (while approaching)"),

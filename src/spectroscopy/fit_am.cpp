@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
 #include "afmkit/spectroscopy/fit_model.hpp"
 #include "fit_engine.hpp"
@@ -16,7 +17,7 @@ namespace afmkit::spectroscopy {
 
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using afmkit::numbers::nan;
 
 /// The data in the sweep's order.
 FitCurve sorted_curve(const FitCurve& c, const std::vector<std::size_t>& order) {

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
 #include "afmkit/spectroscopy/fit_model.hpp"
 #include "fit_engine.hpp"
@@ -15,7 +16,7 @@ namespace afmkit::spectroscopy {
 
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using afmkit::numbers::nan;
 
 double rms(const std::vector<double>& a, const std::vector<double>& b) {
   double s = 0.0;

@@ -9,6 +9,7 @@
 #include <fmt/ranges.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/core/validate.hpp"
 #include "afmkit/impact/law_registry.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
@@ -17,7 +18,7 @@
 namespace afmkit::spectroscopy {
 
 namespace {
-constexpr double inf = std::numeric_limits<double>::infinity();
+using afmkit::numbers::infinity;
 
 /// InvalidParameter("distance", …) naming two equal distances.
 void require_distinct(const std::vector<double>& distance) {
@@ -224,11 +225,11 @@ std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options, FitM
       // the offsets: unbounded, u = 1 is 1 nm, 1 rad or 1 Hz
       const bool offset = name != "amplitude_scale";
       if (offset) {
-        p.lower = -inf, p.upper = inf, p.transform = Transform::identity;
+        p.lower = -infinity, p.upper = infinity, p.transform = Transform::identity;
         p.unit = name == "distance_offset" ? "m" : name == "phase_offset" ? "rad" : "Hz";
         p.scale = name == "distance_offset" ? 1e-9 : 1.0;
       } else {
-        p.unit = "dimensionless", p.lower = 0.0, p.upper = inf, p.transform = Transform::log;
+        p.unit = "dimensionless", p.lower = 0.0, p.upper = infinity, p.transform = Transform::log;
       }
     } else {
       if (std::find(spec.keys.begin(), spec.keys.end(), name) == spec.keys.end()) {

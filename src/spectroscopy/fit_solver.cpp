@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/core/numbers.hpp"
 #include "afmkit/impact/law_registry.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
 #include "afmkit/spectroscopy/fit_model.hpp"
@@ -24,8 +25,8 @@ namespace afmkit::spectroscopy::engine {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double inf = std::numeric_limits<double>::infinity();
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+using afmkit::numbers::infinity;
+using afmkit::numbers::nan;
 
 }  // namespace
 
@@ -94,14 +95,14 @@ void statistics(const Eigen::MatrixXd& jac, double s2, const Eigen::VectorXd& u,
   }
   const long q = static_cast<long>(live.size());
   Eigen::MatrixXd cov_u = Eigen::MatrixXd::Constant(p, p, nan);
-  r.condition_number = inf;
+  r.condition_number = infinity;
   if (q > 0) {
     Eigen::MatrixXd scaled(q, q);  // unit diagonal: D⁻¹ H D⁻¹
     for (long a = 0; a < q; ++a)
       for (long b = 0; b < q; ++b) scaled(a, b) = h(live[a], live[b]) / (d[live[a]] * d[live[b]]);
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(scaled);
     const Eigen::VectorXd lam = es.eigenvalues();  // ascending
-    r.condition_number = lam[0] > 0.0 ? lam[q - 1] / lam[0] : inf;
+    r.condition_number = lam[0] > 0.0 ? lam[q - 1] / lam[0] : infinity;
     if (!(r.condition_number <= options.condition_limit)) {
       const Eigen::VectorXd v = es.eigenvectors().col(0);
       std::string names;
@@ -125,10 +126,10 @@ void statistics(const Eigen::MatrixXd& jac, double s2, const Eigen::VectorXd& u,
       for (long k = 0; k < q; ++k)
         if (!(lam[k] > 1e-14 * lam[q - 1]))
           for (long a = 0; a < q; ++a)
-            if (std::abs(es.eigenvectors()(a, k)) > 1e-6) cov_u(live[a], live[a]) = inf;
+            if (std::abs(es.eigenvectors()(a, k)) > 1e-6) cov_u(live[a], live[a]) = infinity;
     }
   }
-  r.standard_errors.assign(static_cast<std::size_t>(p), inf);
+  r.standard_errors.assign(static_cast<std::size_t>(p), infinity);
   r.correlation.assign(static_cast<std::size_t>(p), std::vector<double>(static_cast<std::size_t>(p), nan));
   for (long a = 0; a < p; ++a) {
     const auto sa = static_cast<std::size_t>(a);

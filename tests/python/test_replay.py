@@ -81,6 +81,15 @@ def test_python_replays_from_its_record(path, tmp_path):
     assert len(r) > 0 or path in ("control export", "demo")  # these write files only
 
 
+def test_an_fm_fit_records_the_parameters_it_fitted(tmp_path):
+    # the FM default of `parameters` differs from the declared (AM) default: the record names what was fitted
+    fit = make_command("spectroscopy fit")
+    r = fit(file=os.path.join(CONFIGS, "fm_fit_curve_dmt.csv"), spring_constant=40.0, resonance_frequency=300.0,
+            quality_factor=400.0, amplitude=5.0, max_evaluations=2)
+    assert r.params["parameters"] == "hamaker,effective_modulus,distance_offset"
+    same_table(r, fit(**r.params))
+
+
 def test_the_record_holds_only_the_unit_system_and_law_in_use(tmp_path):
     orbit = make_command("tapping orbit")(**CASES["tapping orbit"](tmp_path)).params
     assert {"spring_constant", "resonance_frequency", "hamaker", "departure_hamaker", "tip_radius"} <= set(orbit)

@@ -1,4 +1,5 @@
 #include "afmkit/tapping/system.hpp"
+#include "afmkit/core/numbers.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +8,7 @@
 namespace afmkit::tapping {
 
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using afmkit::numbers::infinity;
 }
 
 TappingSystem::TappingSystem(TappingModel model)
@@ -35,9 +36,9 @@ int TappingSystem::region_of(double gap) const {
   return static_cast<int>(std::upper_bound(switching().begin(), switching().end(), gap) - switching().begin());
 }
 
-double TappingSystem::region_lo(int region) const { return region == 0 ? -kInf : switching()[region - 1]; }
+double TappingSystem::region_lo(int region) const { return region == 0 ? -infinity : switching()[region - 1]; }
 double TappingSystem::region_hi(int region) const {
-  return region >= static_cast<int>(switching().size()) ? kInf : switching()[region];
+  return region >= static_cast<int>(switching().size()) ? infinity : switching()[region];
 }
 
 double TappingSystem::drive(double t) const { return gamma_ * std::cos(omega_ * t); }
@@ -52,7 +53,7 @@ double TappingSystem::interaction(ContactBranch branch, double x, double velocit
 double TappingSystem::clamp_gap(double d, int region) const {
   double dc = std::max(d, region_lo(region));
   const double hi = region_hi(region);
-  if (dc >= hi) dc = std::nextafter(hi, -kInf);
+  if (dc >= hi) dc = std::nextafter(hi, -infinity);
   return dc;
 }
 
