@@ -16,7 +16,7 @@ for a keyword of the wrong Python type; a solver that does not converge raises `
 from . import _afmkit
 from ._afmkit import InputError, InvalidParameter, NumericalFailure
 from ._commands import Result, make_command
-from . import control, spectroscopy, tapping
+from . import control, laws, spectroscopy, tapping
 
 __version__ = _afmkit.__version__
 
@@ -24,5 +24,5 @@ impact = make_command("impact")
 scan = make_command("scan")
 demo = make_command("demo")
 
-__all__ = ["impact", "tapping", "control", "spectroscopy", "scan", "demo", "Result", "InvalidParameter", "InputError",
-           "NumericalFailure"]
+__all__ = ["impact", "tapping", "control", "spectroscopy", "laws", "scan", "demo", "Result", "InvalidParameter",
+           "InputError", "NumericalFailure"]

@@ -281,8 +281,12 @@ def _signature_default(p: dict):
 def make_command(path: str):
     """The Python function of command ``path`` ("tapping orbit")."""
     spec = next(s for s in _afmkit.commands() if s["path"] == path)
+    keys = {p["key"] for p in spec["params"]}
 
     def command(**kwargs) -> Result:
+        if "law" in keys:  # law= an afmkit.laws object: the keywords it stands for
+            from . import laws
+            kwargs = laws.expand(path, kwargs, keys)
         # None: not given (the default, which for some keys is another key's value or computed: _signature_default)
         return Result(path, _afmkit.run(path, {k: v for k, v in kwargs.items() if v is not None}))
 

@@ -54,6 +54,14 @@ class Reconstruction:
     def keys(self):
         return self._data.keys()
 
+    @property
+    def table(self):
+        """The reconstructed law as an :class:`afmkit.laws.Table`, which the commands take as ``law=``
+        (``afmkit.tapping.sweep(law=r.table, ...)``)."""
+        from .laws import Table
+        law = self._data["law"]
+        return Table(law["distance"], law["approach_force"], law["retract_force"])
+
     def write_law(self, path: str) -> str:
         """Write the table-law file (distance (nm), approach force (nN), retract force (nN)) that
         ``--law table --force-curve`` and ``afmkit.tapping.*(law="table", force_curve=path)`` read."""

@@ -11,5 +11,6 @@ void bind_study(pybind11::module_& m);            // study_batch.cpp: one chunk 
 void bind_spectroscopy_prepare(pybind11::module_& m);  // spectroscopy_prepare.cpp: prepare() on NumPy arrays
 void bind_spectroscopy_fit(pybind11::module_& m); // spectroscopy_fit.cpp: the law fit on NumPy arrays
 void bind_spectroscopy_reconstruct(pybind11::module_& m);  // spectroscopy_reconstruct.cpp: force reconstruction
+void bind_laws(pybind11::module_& m);              // laws.cpp: the force-law registry (afmkit.laws)
 
 }  // namespace afmkit::python

@@ -14,4 +14,5 @@ PYBIND11_MODULE(_afmkit, m) {
   afmkit::python::bind_spectroscopy_prepare(m);
   afmkit::python::bind_spectroscopy_fit(m);
   afmkit::python::bind_spectroscopy_reconstruct(m);
+  afmkit::python::bind_laws(m);
 }

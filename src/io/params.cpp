@@ -472,7 +472,9 @@ toml::table sidecar_parameters(const std::string& text, const std::string& origi
                                  "\"parameters\" object); give parameters as TOML otherwise",
                                  origin));
   toml::table tbl;
-  for (const auto& [key, v] : params->items()) {
+  for (const auto& item : params->items()) {
+    const std::string key = item.key();  // not a structured binding: clang 14 cannot capture those in a lambda
+    const nlohmann::json& v = item.value();
     const auto no_value = [&] {
       throw InvalidParameter(key, fmt::format("{}: key '{}' = {} is not a parameter value", origin, key, v.dump()));
     };
