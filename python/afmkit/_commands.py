@@ -144,6 +144,23 @@ class Result(dict):
                 f"</table><details><summary>summary results</summary><table>{summary}</table></details></div>")
 
     # ---- other libraries
+    def plot(self, ax=None, **kwargs):
+        """The common view of this command's result, drawn with Matplotlib; returns the Axes (an array of Axes for
+        a view with several panels).
+
+        ``tapping sweep``: amplitude and phase against separation per direction, unstable points as open circles,
+        jumps as dashed arrows; ``tapping fm``: frequency shift and drive against separation (``x="min_gap"``);
+        ``tapping hb``: amplitude and phase per branch, folds as diamonds; ``control chart``: the spectral
+        abscissa (its zero contour: the stability boundary) or delay margin on the grid, one panel per delay
+        (``delay=``: one of them; ``quantity=``); ``control tf``: Bode plot; ``control simulate``, ``impact``:
+        signals against time; ``scan``: an image (``channel="topography"|"deflection"|"truth"``).
+        ``ax``: an Axes, or a sequence of Axes (one per panel, in that order; fewer Axes: the first panels);
+        None: a new figure. ``phase="lag"|"lead"`` (None: as the command reports it: lag for tapping, the
+        response's argument, a lead, for tf) and ``degrees`` choose how a phase is drawn. Axis labels carry the
+        columns' units. Other commands raise NotImplementedError naming the commands with a view."""
+        from . import _plots
+        return _plots.plot(self, ax, **kwargs)
+
     def to_pandas(self):
         """The table as a pandas DataFrame; ``df.attrs``: ``units`` and ``meaning`` (column -> text), ``command``,
         ``results`` (the summary) and ``params``."""
