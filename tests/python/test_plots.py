@@ -1,0 +1,191 @@
+"""Result.plot() (docs/python.md#plots): each view draws the result's own columns (read back from the Matplotlib
+artists and compared with the table), into the Axes it is given; commands without a view raise
+NotImplementedError. Small runs, Agg backend: about a second in all."""
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from matplotlib.collections import QuadMesh  # noqa: E402
+
+import afmkit  # noqa: E402
+
+# the repulsive-attractive case of the demo (bistable at omega = 0.99 omega_n: jumps, an unstable branch, folds)
+ATTRACTIVE = dict(law="attractive", approach_adhesion=0.5, departure_adhesion=1.0, frequency_ratio=0.99)
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    yield
+    plt.close("all")
+
+
+@pytest.fixture(scope="module")
+def instrument():
+    return afmkit.tapping.sweep(**ATTRACTIVE, separation_min=8, separation_max=11, points=13, mode="instrument",
+                                quiet=True)
+
+
+@pytest.fixture(scope="module")
+def continuation():
+    return afmkit.tapping.sweep(**ATTRACTIVE, separation_min=8, separation_max=11, points=13, mode="continuation",
+                                quiet=True)
+
+
+@pytest.fixture(scope="module")
+def hb():
+    return afmkit.tapping.hb(**ATTRACTIVE, points=200)
+
+
+def _line(ax, label):
+    lines = [ln for ln in ax.get_lines() if ln.get_label() == label]
+    assert len(lines) == 1, f"{label}: {[ln.get_label() for ln in ax.get_lines()]}"
+    return np.asarray(lines[0].get_xdata(), float), np.asarray(lines[0].get_ydata(), float)
+
+
+def _finite(x):
+    return x[np.isfinite(x)]
+
+
+def test_sweep_draws_each_direction_broken_and_arrowed_at_its_jumps(instrument):
+    r = instrument
+    assert r.jumped.any(), "the case must jump (else the test shows nothing)"
+    axes = r.plot()
+    assert len(axes) == 2
+    for d in ("approach", "retract"):
+        m = r.direction == d
+        x, y = _line(axes[0], d)
+        np.testing.assert_array_equal(_finite(x), r.separation[m])
+        np.testing.assert_array_equal(_finite(y), r.amplitude[m])
+        # one break (NaN) per jumped row of that direction, none elsewhere
+        assert np.isnan(x).sum() == r.jumped[m][1:].sum()
+        _, p = _line(axes[1], d)
+        np.testing.assert_array_equal(_finite(p), r.phase[m])  # default: as reported (a lag)
+    arrows = [t for t in axes[0].texts if getattr(t, "arrow_patch", None) is not None]
+    assert len(arrows) == sum(r.jumped[r.direction == d][1:].sum() for d in ("approach", "retract"))
+    assert axes[0].get_ylabel() == f"amplitude [{r.units['amplitude']}]"
+    assert axes[1].get_xlabel() == f"separation [{r.units['separation']}]"
+
+
+def test_sweep_marks_unstable_points_and_folds_and_the_phase_convention_is_selectable(continuation):
+    r = continuation
+    assert (~r.stable).any() and len(r.results.folds) >= 1
+    axes = r.plot(phase="lead", degrees=True)
+    x, y = _line(axes[0], "unstable")
+    np.testing.assert_array_equal(x, r.separation[~r.stable])
+    np.testing.assert_array_equal(y, r.amplitude[~r.stable])
+    _, p = _line(axes[1], "continuation")
+    np.testing.assert_allclose(_finite(p), -r.phase * 180 / np.pi, rtol=1e-15)
+    assert axes[1].get_ylabel() == "phase [deg]"
+    fx, fy = _line(axes[0], "fold")
+    np.testing.assert_array_equal(fx, [f["separation"] for f in r.results.folds])
+    np.testing.assert_array_equal(fy, [f["amplitude"] for f in r.results.folds])
+    with pytest.raises(ValueError, match="phase = 'behind' is not allowed.*'lag', 'lead'"):
+        r.plot(phase="behind")
+
+
+def test_hb_draws_every_branch_and_its_folds(hb):
+    r = hb
+    axes = r.plot()
+    for branch in set(r.branch):
+        m = r.branch == branch
+        pts = set()
+        for ln in axes[0].get_lines():
+            if ln.get_label() in (f"{branch} branch", f"_{branch}"):
+                pts |= set(zip(ln.get_xdata(), ln.get_ydata()))
+        assert pts == set(zip(r.separation[m], r.amplitude[m])), branch
+    fx, fy = _line(axes[0], "fold (dl/dq = 0)")
+    np.testing.assert_array_equal(fx, [f["separation"] for f in r.results.folds])
+    np.testing.assert_array_equal(fy, [f["amplitude"] for f in r.results.folds])
+    _, fp = _line(axes[1], "fold (dl/dq = 0)")
+    np.testing.assert_array_equal(fp, [f["phase"] for f in r.results.folds])
+
+
+def test_chart_draws_one_panel_per_delay_on_the_grid():
+    r = afmkit.control.chart(harmonics=2, x_points=5, y_points=4, delays=[0.3, 0.1], boundaries_output="",
+                             progress=False)
+    axes = r.plot()
+    assert len(axes) == 2
+    xs, ys = np.unique(r.x), np.unique(r.y)
+    for a, d in zip(axes, sorted(set(r.delay))):
+        # the long table re-gridded by hand (independent of to_xarray)
+        z = np.full((len(ys), len(xs)), np.nan)
+        m = r.delay == d
+        z[np.searchsorted(ys, r.y[m]), np.searchsorted(xs, r.x[m])] = r.spectral_abscissa[m]
+        mesh = [c for c in a.collections if isinstance(c, QuadMesh)]
+        assert len(mesh) == 1
+        np.testing.assert_array_equal(np.ma.filled(mesh[0].get_array(), np.nan).ravel(), z.ravel())
+        assert f"{d:g}" in a.get_title()
+        assert a.get_xlabel() == f"{r.results.x} [Omega]"
+    fig, ax = plt.subplots()
+    assert r.plot(ax=ax, delay=0.3) is ax
+    with pytest.raises(ValueError, match="delay = 0.5 is not allowed: must be one of the chart's delays"):
+        r.plot(delay=0.5)
+
+
+def test_tf_is_a_bode_plot():
+    r = afmkit.control.tf(points=30, system="loop")
+    axes = r.plot()
+    (mag,), (ph,) = axes[0].get_lines(), axes[1].get_lines()
+    np.testing.assert_array_equal(mag.get_xdata(), r.frequency)
+    np.testing.assert_array_equal(mag.get_ydata(), r.magnitude)
+    np.testing.assert_allclose(ph.get_ydata(), np.degrees(r.phase), rtol=1e-15)
+    assert axes[0].get_xscale() == "log" and axes[0].get_yscale() == "log"
+    assert axes[1].get_xlabel() == "frequency [Omega]"
+    (ph,) = r.plot(phase="lag", degrees=False)[1].get_lines()
+    np.testing.assert_array_equal(ph.get_ydata(), -r.phase)
+
+
+@pytest.mark.parametrize("command, panels", [
+    ("control simulate", [("y", "target", "m"), ("u",)]),
+    ("impact", [("gap",), ("force",)]),
+])
+def test_signals_against_time(command, panels):
+    r = (afmkit.control.simulate(periods=3, steps_per_period=100) if command == "control simulate"
+         else afmkit.impact(points=50))
+    axes = r.plot()
+    for a, columns in zip(axes, panels):
+        lines = a.get_lines()
+        assert [ln.get_label() for ln in lines] == list(columns)
+        for ln, c in zip(lines, columns):
+            np.testing.assert_array_equal(ln.get_xdata(), r.t)
+            np.testing.assert_array_equal(ln.get_ydata(), r[c])
+        assert r.units[columns[0]] in a.get_ylabel()
+    assert axes[-1].get_xlabel() == f"time t [{r.units['t']}]"
+
+
+def test_scan_draws_its_image_and_says_what_it_needs_without_one(tmp_path):
+    r = afmkit.scan(sample_resolution=64, end_radius=5e-4, radial_speed=1e-3, sample_rate=5000, image_resolution=16,
+                    image_output=str(tmp_path / "s"), output="")
+    ax = r.plot(channel="truth")
+    (im,) = ax.get_images()
+    z = im.get_array()
+    assert z.shape == (16, 16)
+    assert np.isfinite(np.ma.filled(z, np.nan)).sum() == r.results.valid_pixels
+    # the extent is the disc scanned: 2 end_radius across, centred
+    np.testing.assert_allclose(im.get_extent(), [-5e-4, 5e-4, 5e-4, -5e-4], rtol=1e-6)
+    none = afmkit.scan(sample_resolution=64, end_radius=5e-4, radial_speed=1e-3, sample_rate=5000,
+                       image_resolution=16, image_output="", output="")
+    with pytest.raises(NotImplementedError, match="holds no image.*topography, deflection, truth"):
+        none.plot()
+
+
+def test_draws_into_the_axes_given(instrument):
+    fig, ax = plt.subplots()
+    assert instrument.plot(ax=ax) is ax
+    assert len(fig.axes) == 1  # no new figure, no second panel
+    x, _ = _line(ax, "approach")
+    np.testing.assert_array_equal(_finite(x), instrument.separation[instrument.direction == "approach"])
+    fig, two = plt.subplots(1, 2)
+    out = instrument.plot(ax=two)
+    assert list(out) == list(two)
+    assert two[1].get_ylabel().startswith("phase lag")
+    with pytest.raises(ValueError, match="3 Axes given, this view has at most 2 panels"):
+        instrument.plot(ax=plt.subplots(3)[1])
+
+
+def test_a_command_without_a_view_says_which_have_one():
+    r = afmkit.control.margin()
+    with pytest.raises(NotImplementedError, match="control margin: no plot view.*tapping sweep.*control chart"):
+        r.plot()
