@@ -61,7 +61,8 @@ class Result(dict):
     of rows (as a DataFrame's), ``r.columns`` the column names in order. ``r.units["amplitude"]`` is a column's
     unit, ``r.meaning["amplitude"]`` what it holds; ``r.results`` the summary document (the command's ``--json``
     output without the table; keys also as attributes: ``r.results.folds``); ``r.params`` the parameters as run
-    (``f(**r.params)`` repeats the run). ``r.to_pandas()`` and ``r.to_xarray()`` give the table with its units.
+    (``f(**r.params)`` repeats the run). ``r.to_pandas()`` and ``r.to_xarray()`` give the table with its units;
+    ``r.plot()`` draws the common view of the result (Matplotlib).
     """
 
     def __init__(self, command: str, raw: dict):
@@ -284,7 +285,8 @@ def _docstring(spec: dict) -> str:
     lines += ["", "config: a TOML file, or a run's JSON sidecar, read first (as --config); keyword arguments",
               "override it.",
               "Returns an afmkit.Result: a read-only mapping of the table's columns (NumPy arrays; flags bool) with",
-              "units, the summary results (r.results), the parameters as run (r.params), to_pandas(), to_xarray()."]
+              "units, the summary results (r.results), the parameters as run (r.params), to_pandas(), to_xarray(),",
+              "plot() (the common view of the command's result: docs/python.md#plots)."]
     return "\n".join(lines)
 
 

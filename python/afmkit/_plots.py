@@ -206,12 +206,15 @@ def _chart(r, ax=None, *, delay=None, quantity=None, colorbar=True):
         z = (var.sel(delay=d) if d is not None else var).transpose(ydim, xdim).values
         if quantity == "spectral_abscissa":
             finite = z[np.isfinite(z)]
-            lim = float(np.max(np.abs(finite))) if finite.size else 1.0
-            lim = lim if lim > 0 else 1.0
+            # each side of 0 its own full colour range (blue: stable, red: unstable), whatever the extremes
+            scale = float(np.max(np.abs(finite))) if finite.size else 1.0
+            tiny = 1e-9 * scale if scale > 0 else 1e-9
+            low = min(float(finite.min()), -tiny) if finite.size else -1.0
+            high = max(float(finite.max()), tiny) if finite.size else 1.0
             mesh = a.pcolormesh(xs, ys, np.ma.masked_invalid(z), cmap="RdBu_r", shading="nearest",
-                                norm=TwoSlopeNorm(vmin=-lim, vcenter=0.0, vmax=lim))
+                                norm=TwoSlopeNorm(vmin=low, vcenter=0.0, vmax=high))
             if finite.size and finite.min() < 0 < finite.max() and len(xs) > 1 and len(ys) > 1:
-                a.contour(xs, ys, z, levels=[0.0], colors="k", linewidths=1.2)
+                a.contour(xs, ys, np.ma.masked_invalid(z), levels=[0.0], colors="k", linewidths=1.2)
             title = "stable where < 0 (black: boundary)"
         else:
             mesh = a.pcolormesh(xs, ys, np.ma.masked_invalid(z), cmap="viridis", shading="nearest")
