@@ -329,4 +329,12 @@ def plot(r, ax=None, **kwargs):
         raise NotImplementedError(f"{r.command}: no plot view; Result.plot() draws the results of "
                                   f"{', '.join(_VIEWS)} (other results: r.to_pandas().plot(...) or Matplotlib on the "
                                   f"columns)")
+    import inspect
+    allowed = [k for k, p in inspect.signature(view).parameters.items() if p.kind is p.KEYWORD_ONLY]
+    unknown = [k for k in kwargs if k not in allowed]
+    if unknown:
+        raise TypeError(f"{r.command}: plot() got the keyword {unknown[0]!r}, which this view does not take "
+                        f"(keywords: {', '.join(['ax'] + allowed)})")
+    if len(r) == 0 and r.command != "scan":
+        raise ValueError(f"{r.command}: the result has no rows: nothing to plot")
     return view(r, ax, **kwargs)

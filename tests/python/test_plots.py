@@ -189,3 +189,17 @@ def test_a_command_without_a_view_says_which_have_one():
     r = afmkit.control.margin()
     with pytest.raises(NotImplementedError, match="control margin: no plot view.*tapping sweep.*control chart"):
         r.plot()
+
+
+def test_a_keyword_the_view_does_not_take_is_named_with_the_allowed_ones(instrument):
+    with pytest.raises(TypeError, match="tapping sweep: plot\\(\\) got the keyword 'channel'.*keywords: ax, phase, "
+                                        "degrees"):
+        instrument.plot(channel="truth")
+
+
+def test_an_empty_result_is_refused_not_drawn_blank(instrument):
+    raw = {"table": {c: instrument[c][:0] for c in instrument.columns}, "results": {}, "params": {},
+           "columns": [(c, instrument.units[c], instrument.meaning[c]) for c in instrument.columns]}
+    empty = afmkit.Result("tapping sweep", raw)
+    with pytest.raises(ValueError, match="tapping sweep: the result has no rows: nothing to plot"):
+        empty.plot()
