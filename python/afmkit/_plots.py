@@ -301,9 +301,13 @@ def _scan(r, ax=None, *, channel="topography", colorbar=True):
             "scan: this result holds no image (image_output was empty, or a recorded spiral without images); the "
             f"scan view draws an image channel ({', '.join(_CHANNELS)}) of a run with image_output=PREFIX; the "
             "per-turn table is r.radius, r.deflection_first_harmonic, ...")
-    z, h = _read_gsf(image)
-    if mask is not None:
-        m, _ = _read_gsf(mask)
+    try:
+        z, h = _read_gsf(image)
+        m = _read_gsf(mask)[0] if mask is not None else None
+    except OSError as e:
+        raise FileNotFoundError(f"scan: the image this run wrote cannot be read ({e.filename or image}: "
+                                f"{e.strerror or e}); run the scan again with image_output=PREFIX") from None
+    if m is not None:
         z = np.where(m > 0.5, z, np.nan)
     x0, y0 = float(h.get("XOffset", 0)), float(h.get("YOffset", 0))
     xr, yr = float(h.get("XReal", z.shape[1])), float(h.get("YReal", z.shape[0]))

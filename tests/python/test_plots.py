@@ -169,6 +169,9 @@ def test_scan_draws_its_image_and_says_what_it_needs_without_one(tmp_path):
                        image_resolution=16, image_output="", output="")
     with pytest.raises(NotImplementedError, match="holds no image.*topography, deflection, truth"):
         none.plot()
+    (tmp_path / "s_deflection.gsf").unlink()
+    with pytest.raises(FileNotFoundError, match="scan: the image this run wrote cannot be read.*s_deflection.gsf"):
+        r.plot(channel="deflection")
 
 
 def test_draws_into_the_axes_given(instrument):
