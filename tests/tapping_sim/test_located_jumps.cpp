@@ -7,6 +7,7 @@
 // previous one, its Floquet multipliers computed, until the orbit is no longer stable.
 #include <cmath>
 #include <complex>
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -67,23 +68,25 @@ std::optional<double> brute_force_end(const TappingModel& base, PeriodicOrbit fr
   return std::nullopt;
 }
 
-class LocatedJumps : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    for (int points : {25, 60, 241}) sweeps_.push_back(sweep_instrument(dmt_case(12.0), 0.0, 12.0, points, options()));
-  }
-  static std::vector<SweepResult> sweeps_;
-};
-std::vector<SweepResult> LocatedJumps::sweeps_;
+// The instrument sweeps of the three grids, each computed once per process and only when a test asks for it (each
+// test runs in its own process under ctest: the brute-force tests need only the 25- and 60-point sweeps).
+const SweepResult& grid_sweep(int points) {
+  static std::map<int, SweepResult> sweeps;
+  auto it = sweeps.find(points);
+  if (it == sweeps.end())
+    it = sweeps.emplace(points, sweep_instrument(dmt_case(12.0), 0.0, 12.0, points, options())).first;
+  return it->second;
+}
+constexpr int kGrids[] = {25, 60, 241};
 
-TEST_F(LocatedJumps, TheSameJumpsOnEveryGrid) {
+TEST(LocatedJumps, TheSameJumpsOnEveryGrid) {
   const double tol = options().jump_tolerance * dmt_case(12.0).free_amplitude();  // 1e-4 nm
   for (SweepDirection d : {SweepDirection::approach, SweepDirection::retract}) {
-    const auto reference = deterministic_jumps(sweeps_.back(), d);  // 241 points
+    const auto reference = deterministic_jumps(grid_sweep(241), d);
     ASSERT_FALSE(reference.empty()) << direction_name(d);
-    for (std::size_t g = 0; g + 1 < sweeps_.size(); ++g) {
-      const auto jumps = deterministic_jumps(sweeps_[g], d);
-      ASSERT_EQ(jumps.size(), reference.size()) << direction_name(d) << ", grid " << g;
+    for (int points : {25, 60}) {
+      const auto jumps = deterministic_jumps(grid_sweep(points), d);
+      ASSERT_EQ(jumps.size(), reference.size()) << direction_name(d) << ", grid of " << points << " points";
       for (std::size_t i = 0; i < jumps.size(); ++i) {
         EXPECT_TRUE(jumps[i].located);
         EXPECT_LE(jumps[i].tolerance, tol);
@@ -93,7 +96,8 @@ TEST_F(LocatedJumps, TheSameJumpsOnEveryGrid) {
     }
   }
   // every jump is listed per direction, and each grid row after a jump is marked
-  for (const SweepResult& r : sweeps_) {
+  for (int points : kGrids) {
+    const SweepResult& r = grid_sweep(points);
     std::size_t approach = 0;
     for (const SweepJump& j : r.jumps) approach += j.direction == SweepDirection::approach;
     EXPECT_EQ(r.approach_jumps.size(), approach);
@@ -124,13 +128,13 @@ const SweepPoint& row_before(const std::vector<SweepPoint>& side, double l) {
   return *before;
 }
 
-TEST_F(LocatedJumps, ApproachJumpWhereTheFreeBranchLosesStabilityByBruteForce) {
+TEST(LocatedJumps, ApproachJumpWhereTheFreeBranchLosesStabilityByBruteForce) {
   const TappingModel base = dmt_case(12.0);
   const double tol = options().jump_tolerance * base.free_amplitude();
-  const SweepJump j = deterministic_jumps(sweeps_[0], SweepDirection::approach).front();  // 25 points
+  const SweepJump j = deterministic_jumps(grid_sweep(25), SweepDirection::approach).front();
   EXPECT_LT(j.separation, 0.5);
   // the free (non-touching) period-1 orbit of the grid point before, walked down in steps of 1e-4 nm
-  const SweepPoint& before = row_before(sweeps_[0].approach, j.separation);
+  const SweepPoint& before = row_before(grid_sweep(25).approach, j.separation);
   ASSERT_TRUE(before.orbit.stable);
   PeriodicOrbit last;
   const double step = 1e-4;
@@ -143,12 +147,12 @@ TEST_F(LocatedJumps, ApproachJumpWhereTheFreeBranchLosesStabilityByBruteForce) {
   EXPECT_LT(std::max(m[0].real(), m[1].real()), -0.9) << m[0] << " " << m[1];
 }
 
-TEST_F(LocatedJumps, FirstRetractJumpIsAPeriodDoublingByBruteForce) {
+TEST(LocatedJumps, FirstRetractJumpIsAPeriodDoublingByBruteForce) {
   const TappingModel base = dmt_case(12.0);
   const double tol = options().jump_tolerance * base.free_amplitude();
-  const SweepJump j = deterministic_jumps(sweeps_[1], SweepDirection::retract).front();  // 60 points
+  const SweepJump j = deterministic_jumps(grid_sweep(60), SweepDirection::retract).front();
   // the contact orbit of the grid point before, walked up in steps of 1e-4 nm
-  const SweepPoint& before = row_before(sweeps_[1].retract, j.separation);
+  const SweepPoint& before = row_before(grid_sweep(60).retract, j.separation);
   ASSERT_TRUE(before.orbit.stable);
   PeriodicOrbit last;
   const double step = 1e-4;
