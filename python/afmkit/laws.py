@@ -185,7 +185,7 @@ def expand(path: str, kwargs: dict, keys) -> dict:
     for key, value in law.kwargs().items():
         if key not in keys:
             raise ValueError(f"{path}: law {law!r} has {key}, which this command does not take")
-        if key in out and out[key] is not None and key != "law":
+        if out.get(key) is not None:
             raise ValueError(f"{path}: {key} is given both in law={law!r} and as a keyword: give it once")
         out[key] = value
     if "units" in keys and law.physical and out.get("units") is None:

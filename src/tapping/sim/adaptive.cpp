@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 
 #include <boost/numeric/odeint.hpp>
 #include <fmt/format.h>
@@ -12,6 +13,7 @@
 #include "afmkit/core/error.hpp"
 #include "dop853.hpp"
 #include "engine.hpp"
+#include "small_angle.hpp"
 
 namespace afmkit::tapping::detail {
 
@@ -33,19 +35,9 @@ class DriveClock {
   }
   double cos_at(double t) const {
     const double u = omega_ * (t - t0_);
-    if (!(std::abs(u) <= 0.35)) return std::cos(omega_ * t);
-    const double u2 = u * u;
-    // C(u) = Σ (−u²)^k/(2k)!, S(u) = u Σ (−u²)^k/(2k+1)!, k ≤ 8 (Horner)
-    double c = 1.0 / 20922789888000.0, s = 1.0 / 355687428096000.0;  // 1/16!, 1/17!
-    constexpr double even[8] = {1.0 / 87178291200.0, 1.0 / 479001600.0, 1.0 / 3628800.0, 1.0 / 40320.0,
-                                1.0 / 720.0,         1.0 / 24.0,        1.0 / 2.0,       1.0};
-    constexpr double odd[8] = {1.0 / 1307674368000.0, 1.0 / 6227020800.0, 1.0 / 39916800.0, 1.0 / 362880.0,
-                               1.0 / 5040.0,          1.0 / 120.0,        1.0 / 6.0,        1.0};
-    for (int k = 0; k < 8; ++k) {
-      c = even[k] - u2 * c;
-      s = odd[k] - u2 * s;
-    }
-    return c0_ * c - s0_ * (u * s);
+    if (!(std::abs(u) <= detail::small_angle_limit)) return std::cos(omega_ * t);
+    const std::complex<double> e = detail::small_angle_phasor(u);  // cos(ωt0 + u) = c0 cos u − s0 sin u
+    return c0_ * e.real() - s0_ * e.imag();
   }
 
  private:

@@ -10,6 +10,7 @@
 
 #include "afmkit/core/validate.hpp"
 #include "afmkit/tapping/system.hpp"
+#include "small_angle.hpp"
 
 namespace afmkit::tapping {
 
@@ -34,21 +35,10 @@ void SampleRecorder::on_segment(const TappingSystem&, const Segment& segment) {
 
 namespace {
 
-/// e^{iu}: by its Taylor series (degree 16/17, below 1e-19 for |u| ≤ 0.35, as the drive clock of the adaptive
-/// stepper) where u is small, else std::polar.
+/// e^{iu}: by its Taylor series (small_angle.hpp) where u is small, else std::polar.
 std::complex<double> small_phasor(double u) {
-  if (!(std::abs(u) <= 0.35)) return std::polar(1.0, u);
-  const double u2 = u * u;
-  double c = 1.0 / 20922789888000.0, s = 1.0 / 355687428096000.0;  // 1/16!, 1/17!
-  constexpr double even[8] = {1.0 / 87178291200.0, 1.0 / 479001600.0, 1.0 / 3628800.0, 1.0 / 40320.0,
-                              1.0 / 720.0,         1.0 / 24.0,        1.0 / 2.0,       1.0};
-  constexpr double odd[8] = {1.0 / 1307674368000.0, 1.0 / 6227020800.0, 1.0 / 39916800.0, 1.0 / 362880.0,
-                             1.0 / 5040.0,          1.0 / 120.0,        1.0 / 6.0,        1.0};
-  for (int k = 0; k < 8; ++k) {
-    c = even[k] - u2 * c;
-    s = odd[k] - u2 * s;
-  }
-  return {c, u * s};
+  if (!(std::abs(u) <= detail::small_angle_limit)) return std::polar(1.0, u);
+  return detail::small_angle_phasor(u);
 }
 
 }  // namespace
