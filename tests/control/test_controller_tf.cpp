@@ -15,7 +15,7 @@ using afmkit::control::testing::rel_err;
 using cplx = std::complex<double>;
 
 namespace {
-constexpr double kOmega = 1.3;
+constexpr double kOmegaTf = 1.3;
 OscillatorBank random_bank(std::mt19937& rng, int n, std::vector<int> rejected = {1}) {
   std::normal_distribution<double> nd;
   std::vector<double> a(n), b(n);
@@ -23,7 +23,7 @@ OscillatorBank random_bank(std::mt19937& rng, int n, std::vector<int> rejected =
     a[k] = nd(rng);
     b[k] = nd(rng);
   }
-  return OscillatorBank(kOmega, nd(rng), a, b, 0.3 + std::abs(nd(rng)), std::move(rejected));
+  return OscillatorBank(kOmegaTf, nd(rng), a, b, 0.3 + std::abs(nd(rng)), std::move(rejected));
 }
 // Reference C∞ near its removable points from the series definition (eq. 25 with N = ∞):
 // C∞ = K H1/(1 + α/s + Σ_{k≥2} H_k), summed in long double to M = 20000 plus an Euler–Maclaurin tail
@@ -59,15 +59,15 @@ TEST(ControllerTf, SingleOscillatorEq10MatchesStateSpace) {
     const double a = nd(rng), b = nd(rng), k = 0.2 + std::abs(nd(rng));
     // (5)–(6) directly: ẋ = −Ωz + a m, ż = Ωx + b m, w = K x (2 states, no x0)
     Eigen::MatrixXd am(2, 2), bm(2, 1), cm(1, 2), dm = Eigen::MatrixXd::Zero(1, 1);
-    am << 0, -kOmega, kOmega, 0;
+    am << 0, -kOmegaTf, kOmegaTf, 0;
     bm << a, b;
     cm << k, 0;
     const auto g = ss(am, bm, cm, dm);
-    const auto rational = single_oscillator_tf(kOmega, a, b, k);
-    const OscillatorBank single = OscillatorBank::single(kOmega, a, b, k);
+    const auto rational = single_oscillator_tf(kOmegaTf, a, b, k);
+    const OscillatorBank single = OscillatorBank::single(kOmegaTf, a, b, k);
     for (auto s : random_points(8, 12)) {
       const cplx ref = g(s);
-      worst = std::max(worst, rel_err(single_oscillator_tf(kOmega, a, b, k, s), ref));
+      worst = std::max(worst, rel_err(single_oscillator_tf(kOmegaTf, a, b, k, s), ref));
       worst = std::max(worst, rel_err(rational(s), ref));
       worst = std::max(worst, rel_err(controller_response(single, s), ref));
       worst = std::max(worst, rel_err(bank_tf(single, s), ref));
@@ -112,7 +112,7 @@ TEST(ControllerTf, ShermanMorrisonMatchesDirectInverse) {
         const int i = k + n;
         g(i) = k == 0 ? cplx(bank.a0()) : k > 0 ? 0.5 * cplx(bank.a(k), bank.b(k)) : 0.5 * cplx(bank.a(-k), -bank.b(-k));
         w(i) = (k != 0 && bank.is_rejected(std::abs(k))) ? 0.0 : 1.0;
-        m(i, i) = s - cplx(0.0, k * kOmega);
+        m(i, i) = s - cplx(0.0, k * kOmegaTf);
       }
       m += g * w.transpose();
       const Eigen::VectorXcd direct = m.partialPivLu().solve(g);
@@ -127,13 +127,13 @@ TEST(ControllerTf, CouplingsEq25AndQnEq28MatchEq18With20) {
   double worst25 = 0.0, worst28 = 0.0;
   for (int n : {1, 2, 5, 12, 40}) {
     for (auto [alpha, beta, k] : {std::tuple{0.3, 0.1, 2.0}, {1.5, -0.2, 20.0}, {0.05, 0.7, 1.0}}) {
-      const auto bank = OscillatorBank::with_couplings(kOmega, n, alpha, beta, k);
+      const auto bank = OscillatorBank::with_couplings(kOmegaTf, n, alpha, beta, k);
       const auto g = ss(bank);
       for (auto s : random_points(300 + n, 10)) {
         const cplx ref18 = bank_tf(bank, s);
-        if (n <= 12) worst25 = std::max(worst25, rel_err(couplings_tf(kOmega, n, alpha, beta, k, s), g(s)));
-        worst25 = std::max(worst25, rel_err(couplings_tf(kOmega, n, alpha, beta, k, s), ref18));
-        worst28 = std::max(worst28, rel_err(qn_tf(kOmega, n, alpha, beta, k, s), ref18));
+        if (n <= 12) worst25 = std::max(worst25, rel_err(couplings_tf(kOmegaTf, n, alpha, beta, k, s), g(s)));
+        worst25 = std::max(worst25, rel_err(couplings_tf(kOmegaTf, n, alpha, beta, k, s), ref18));
+        worst28 = std::max(worst28, rel_err(qn_tf(kOmegaTf, n, alpha, beta, k, s), ref18));
       }
     }
   }
@@ -143,7 +143,7 @@ TEST(ControllerTf, CouplingsEq25AndQnEq28MatchEq18With20) {
 
 TEST(ControllerTf, InfiniteForms29And31AgreeAndAreTheLimitOfCN) {
   const double alpha = 0.4, beta = 0.15, k = 3.0;
-  const InfiniteBank inf(kOmega, alpha, beta, k);
+  const InfiniteBank inf(kOmegaTf, alpha, beta, k);
   double worst = 0.0;
   for (auto s : random_points(400, 14)) {
     worst = std::max(worst, rel_err(infinite_tf_quasi(inf, s), infinite_tf(inf, s)));
@@ -151,12 +151,12 @@ TEST(ControllerTf, InfiniteForms29And31AgreeAndAreTheLimitOfCN) {
   }
   EXPECT_LT(worst, 1e-11);
   // |C_N − C∞| ≈ 1.14/N at the points of the independent reference check (docs/theory-control.md#infinite-bank)
-  const std::vector<cplx> pts{{0.0, 0.37 * kOmega}, {0.0, 1.5 * kOmega}, {0.0, 2.71 * kOmega}, {0.0, 5.5 * kOmega},
+  const std::vector<cplx> pts{{0.0, 0.37 * kOmegaTf}, {0.0, 1.5 * kOmegaTf}, {0.0, 2.71 * kOmegaTf}, {0.0, 5.5 * kOmegaTf},
                               {0.2, 3.3}, {1.0, 0.5}};
   double prev = 1e9;
   for (int n : {10, 50, 200, 800}) {
     double d = 0.0;
-    for (auto s : pts) d = std::max(d, std::abs(couplings_tf(kOmega, n, alpha, beta, k, s) - infinite_tf(inf, s)));
+    for (auto s : pts) d = std::max(d, std::abs(couplings_tf(kOmegaTf, n, alpha, beta, k, s) - infinite_tf(inf, s)));
     EXPECT_LT(d, prev);
     prev = d;
     if (n >= 200) {
@@ -167,24 +167,24 @@ TEST(ControllerTf, InfiniteForms29And31AgreeAndAreTheLimitOfCN) {
 
 TEST(ControllerTf, ZerosAndPolesAtTheHarmonics) {
   // eq. (18): zeros at s = 0 and ±ikΩ (k ≥ 2), pole at ±iΩ; every form returns the limit there
-  const auto bank = OscillatorBank::with_couplings(kOmega, 5, 0.4, 0.15, 3.0);
-  const InfiniteBank inf(kOmega, 0.4, 0.15, 3.0);
+  const auto bank = OscillatorBank::with_couplings(kOmegaTf, 5, 0.4, 0.15, 3.0);
+  const InfiniteBank inf(kOmegaTf, 0.4, 0.15, 3.0);
   for (int k : {0, 2, 3, 5}) {
-    const cplx s(0.0, k * kOmega);
+    const cplx s(0.0, k * kOmegaTf);
     EXPECT_EQ(std::abs(bank_tf(bank, s)), 0.0);
-    EXPECT_EQ(std::abs(couplings_tf(kOmega, 5, 0.4, 0.15, 3.0, s)), 0.0);
+    EXPECT_EQ(std::abs(couplings_tf(kOmegaTf, 5, 0.4, 0.15, 3.0, s)), 0.0);
     EXPECT_EQ(std::abs(complex_form_tf(bank, s)), 0.0);
-    EXPECT_EQ(std::abs(qn_tf(kOmega, 5, 0.4, 0.15, 3.0, s)), 0.0);
+    EXPECT_EQ(std::abs(qn_tf(kOmegaTf, 5, 0.4, 0.15, 3.0, s)), 0.0);
     EXPECT_LT(std::abs(infinite_tf(inf, s)), 1e-12);
     EXPECT_LT(std::abs(infinite_tf_quasi(inf, s)), 1e-12);
   }
-  EXPECT_TRUE(std::isinf(std::abs(bank_tf(bank, cplx(0.0, kOmega)))));
-  EXPECT_TRUE(std::isinf(std::abs(controller_response(inf, cplx(0.0, -kOmega)))));
-  EXPECT_TRUE(std::isinf(std::abs(infinite_tf_quasi(inf, cplx(0.0, kOmega)))));
+  EXPECT_TRUE(std::isinf(std::abs(bank_tf(bank, cplx(0.0, kOmegaTf)))));
+  EXPECT_TRUE(std::isinf(std::abs(controller_response(inf, cplx(0.0, -kOmegaTf)))));
+  EXPECT_TRUE(std::isinf(std::abs(infinite_tf_quasi(inf, cplx(0.0, kOmegaTf)))));
   // near the pole: |C| ~ residue/|δ|; the pole-free form and the state space agree to full relative accuracy
   const auto g = ss(bank);
   for (double delta : {1e-4, 1e-8, 1e-11}) {
-    const cplx s(0.0, kOmega * (1.0 + delta));
+    const cplx s(0.0, kOmegaTf * (1.0 + delta));
     EXPECT_LT(rel_err(controller_response(bank, s), bank_tf(bank, s)), 1e-9);
     EXPECT_LT(rel_err(controller_response(bank, s), g(s)), 1e-4);  // LU of a nearly singular matrix
   }
@@ -192,7 +192,7 @@ TEST(ControllerTf, ZerosAndPolesAtTheHarmonics) {
   // with the series definition (no cancellation there) and with the N = ∞ value of the literal form far away
   double worst = 0.0;
   for (double delta : {1e-1, 1e-3, 1e-6, 1e-9, 1e-12}) {
-    for (cplx s : {cplx(delta, kOmega), cplx(-delta, -kOmega + delta), cplx(delta, delta), cplx(0.0, delta)})
+    for (cplx s : {cplx(delta, kOmegaTf), cplx(-delta, -kOmegaTf + delta), cplx(delta, delta), cplx(0.0, delta)})
       worst = std::max(worst, rel_err(controller_response(inf, s), infinite_tf_series(inf, s)));
   }
   EXPECT_LT(worst, 1e-13);

@@ -12,6 +12,8 @@
 #include "afmkit/core/error.hpp"
 #include "test_helpers.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit::control;
 using afmkit::InvalidParameter;
 using afmkit::control::testing::random_points;
@@ -20,8 +22,8 @@ using cplx = std::complex<double>;
 using Structure = SmithPredictor::Structure;
 
 namespace {
-constexpr double kOmega = 1.0;
-constexpr double kT = 2.0 * std::numbers::pi;
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kT;
 
 OscillatorBank general_bank() {
   return OscillatorBank(kOmega, 0.3, {0.4, -0.2, 0.5, 0.1}, {0.2, 0.3, -0.4, 0.25}, 15.0, {1, 3});

@@ -8,12 +8,14 @@
 #include "afmkit/control/stability_tau0.hpp"
 #include "afmkit/core/error.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit::control;
 using cplx = std::complex<double>;
 
 namespace {
-constexpr double kOmega = 1.0;
-constexpr double kGamma = 20.0;
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kGamma;
 
 double abscissa(int n, double alpha, double beta) {
   return undelayed_spectral_abscissa(

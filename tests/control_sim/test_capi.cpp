@@ -11,9 +11,12 @@
 #include "afmkit/afmkit_c.h"
 #include "afmkit/control/realtime_filter.hpp"
 
+#include "../fig5_parameters.hpp"
+
 namespace {
-constexpr double kOmega = 1.0, kGamma = 20.0;
-const double kRate = 2000.0 / (2.0 * std::numbers::pi);
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kGamma;
+const double kCapiRate = 2000.0 / (2.0 * std::numbers::pi);
 
 std::vector<double> test_signal(int n) {
   std::vector<double> v(n);
@@ -24,10 +27,10 @@ std::vector<double> test_signal(int n) {
 
 TEST(CApi, CreateStepDestroyMatchesCppFilter) {
   char err[256] = "x";
-  afmkit_filter* h = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, err, sizeof err);
+  afmkit_filter* h = afmkit_filter_create(kCapiRate, kOmega, 10, 0.1, -0.1, kGamma, err, sizeof err);
   ASSERT_NE(h, nullptr);
   EXPECT_STREQ(err, "");
-  auto ref = afmkit::control::RealtimeFilter::with_couplings(kRate, kOmega, 10, 0.1, -0.1, kGamma);
+  auto ref = afmkit::control::RealtimeFilter::with_couplings(kCapiRate, kOmega, 10, 0.1, -0.1, kGamma);
   for (double m : test_signal(3000)) ASSERT_EQ(afmkit_filter_step(h, m), ref.step(m));
   afmkit_filter_destroy(h);
   afmkit_filter_destroy(nullptr);  // allowed
@@ -39,13 +42,13 @@ TEST(CApi, InvalidInputReturnsNullAndMessage) {
   EXPECT_EQ(afmkit_filter_create(3.0, kOmega, 10, 0.1, -0.1, kGamma, err, sizeof err), nullptr);
   EXPECT_NE(std::string(err).find("sample_rate"), std::string::npos) << err;
   EXPECT_NE(std::string(err).find("Nyquist"), std::string::npos) << err;
-  EXPECT_EQ(afmkit_filter_create(kRate, -1.0, 10, 0.1, -0.1, kGamma, err, sizeof err), nullptr);
+  EXPECT_EQ(afmkit_filter_create(kCapiRate, -1.0, 10, 0.1, -0.1, kGamma, err, sizeof err), nullptr);
   EXPECT_NE(std::string(err).find("rotation_frequency"), std::string::npos) << err;
-  EXPECT_EQ(afmkit_filter_create(kRate, kOmega, 0, 0.1, -0.1, kGamma, err, sizeof err), nullptr);
+  EXPECT_EQ(afmkit_filter_create(kCapiRate, kOmega, 0, 0.1, -0.1, kGamma, err, sizeof err), nullptr);
   EXPECT_NE(std::string(err).find("harmonics"), std::string::npos) << err;
-  EXPECT_EQ(afmkit_filter_create(kRate, kOmega, 10, std::nan(""), -0.1, kGamma, err, sizeof err), nullptr);
+  EXPECT_EQ(afmkit_filter_create(kCapiRate, kOmega, 10, std::nan(""), -0.1, kGamma, err, sizeof err), nullptr);
   EXPECT_NE(std::string(err).find("alpha"), std::string::npos) << err;
-  EXPECT_EQ(afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, 0.0, nullptr, 0), nullptr);  // no buffer: still safe
+  EXPECT_EQ(afmkit_filter_create(kCapiRate, kOmega, 10, 0.1, -0.1, 0.0, nullptr, 0), nullptr);  // no buffer: still safe
   char tiny[8];
   EXPECT_EQ(afmkit_filter_create(3.0, kOmega, 10, 0.1, -0.1, kGamma, tiny, sizeof tiny), nullptr);
   EXPECT_EQ(std::strlen(tiny), 7u);  // truncated, NUL-terminated
@@ -55,25 +58,25 @@ TEST(CApi, GeneralBankAndForms) {
   const double a[3] = {0.2, 0.2, 0.2}, b[3] = {0.2, 0.1, 0.0667};
   const int rej[2] = {1, 3};
   char err[256];
-  afmkit_filter* h = afmkit_filter_create_general(kRate, kOmega, 3, 0.1, a, b, kGamma, rej, 2,
+  afmkit_filter* h = afmkit_filter_create_general(kCapiRate, kOmega, 3, 0.1, a, b, kGamma, rej, 2,
                                                   AFMKIT_FORM_BLOCK_ZERO_ORDER_HOLD, err, sizeof err);
   ASSERT_NE(h, nullptr) << err;
   afmkit::control::RealtimeFilter ref(
-      afmkit::control::OscillatorBank(kOmega, 0.1, {0.2, 0.2, 0.2}, {0.2, 0.1, 0.0667}, kGamma, {1, 3}), kRate,
+      afmkit::control::OscillatorBank(kOmega, 0.1, {0.2, 0.2, 0.2}, {0.2, 0.1, 0.0667}, kGamma, {1, 3}), kCapiRate,
       afmkit::control::SampledForm::BlockZeroOrderHold);
   for (double m : test_signal(500)) ASSERT_EQ(afmkit_filter_step(h, m), ref.step(m));
   afmkit_filter_destroy(h);
-  EXPECT_EQ(afmkit_filter_create_general(kRate, kOmega, 3, 0.1, a, b, kGamma, rej, 2, 7, err, sizeof err), nullptr);
+  EXPECT_EQ(afmkit_filter_create_general(kCapiRate, kOmega, 3, 0.1, a, b, kGamma, rej, 2, 7, err, sizeof err), nullptr);
   EXPECT_NE(std::string(err).find("form"), std::string::npos);
-  EXPECT_EQ(afmkit_filter_create_general(kRate, kOmega, 3, 0.1, nullptr, b, kGamma, nullptr, 0, 0, err, sizeof err),
+  EXPECT_EQ(afmkit_filter_create_general(kCapiRate, kOmega, 3, 0.1, nullptr, b, kGamma, nullptr, 0, 0, err, sizeof err),
             nullptr);
   const int bad_rej[1] = {4};
-  EXPECT_EQ(afmkit_filter_create_general(kRate, kOmega, 3, 0.1, a, b, kGamma, bad_rej, 1, 0, err, sizeof err), nullptr);
+  EXPECT_EQ(afmkit_filter_create_general(kCapiRate, kOmega, 3, 0.1, a, b, kGamma, bad_rej, 1, 0, err, sizeof err), nullptr);
   EXPECT_NE(std::string(err).find("rejected"), std::string::npos) << err;
 }
 
 TEST(CApi, BlockResetSkipAndCounters) {
-  afmkit_filter* h = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
+  afmkit_filter* h = afmkit_filter_create(kCapiRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
   ASSERT_NE(h, nullptr);
   std::vector<double> in = test_signal(1000), out(1000);
   in[500] = std::numeric_limits<double>::quiet_NaN();
@@ -93,7 +96,7 @@ TEST(CApi, BlockResetSkipAndCounters) {
   EXPECT_TRUE(std::isnan(afmkit_filter_step(nullptr, 1.0)));
   EXPECT_EQ(afmkit_filter_step_block(nullptr, in.data(), out.data(), 1), AFMKIT_NULL_HANDLE);
   EXPECT_EQ(afmkit_filter_reset(nullptr), AFMKIT_NULL_HANDLE);
-  EXPECT_EQ(afmkit_filter_set_parameters(nullptr, kRate, kOmega, 10, 0.1, -0.1, kGamma), AFMKIT_NULL_HANDLE);
+  EXPECT_EQ(afmkit_filter_set_parameters(nullptr, kCapiRate, kOmega, 10, 0.1, -0.1, kGamma), AFMKIT_NULL_HANDLE);
   EXPECT_EQ(afmkit_filter_state_size(nullptr), 0u);
   EXPECT_EQ(afmkit_filter_save_state(nullptr, out.data(), out.size()), AFMKIT_NULL_HANDLE);
   EXPECT_EQ(afmkit_filter_restore_state(nullptr, out.data(), out.size()), AFMKIT_NULL_HANDLE);
@@ -102,14 +105,14 @@ TEST(CApi, BlockResetSkipAndCounters) {
 }
 
 TEST(CApi, BumplessSetParameters) {
-  afmkit_filter* h = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
-  afmkit_filter* r = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
+  afmkit_filter* h = afmkit_filter_create(kCapiRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
+  afmkit_filter* r = afmkit_filter_create(kCapiRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
   const auto sig = test_signal(5000);
   for (int i = 0; i < 4999; ++i) {
     afmkit_filter_step(h, sig[i]);
     afmkit_filter_step(r, sig[i]);
   }
-  ASSERT_EQ(afmkit_filter_set_parameters(h, 1.2 * kRate, kOmega, 8, 0.12, -0.08, 2.0 * kGamma), AFMKIT_OK);
+  ASSERT_EQ(afmkit_filter_set_parameters(h, 1.2 * kCapiRate, kOmega, 8, 0.12, -0.08, 2.0 * kGamma), AFMKIT_OK);
   const double u_ref = afmkit_filter_step(r, sig[4999]), u_new = afmkit_filter_step(h, sig[4999]);
   EXPECT_GT(std::abs(u_ref), 1e-3);
   EXPECT_NEAR(u_new, u_ref, 1e-9 * std::abs(u_ref));
@@ -125,7 +128,7 @@ TEST(CApi, BumplessSetParameters) {
 }
 
 TEST(CApi, SaveRestoreBitForBit) {
-  afmkit_filter* h = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
+  afmkit_filter* h = afmkit_filter_create(kCapiRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
   const auto sig = test_signal(2000);
   for (int i = 0; i < 1000; ++i) afmkit_filter_step(h, sig[i]);
   const size_t n = afmkit_filter_state_size(h);
@@ -136,7 +139,7 @@ TEST(CApi, SaveRestoreBitForBit) {
   ASSERT_EQ(afmkit_filter_save_state(h, buf.data(), n), AFMKIT_OK);
   std::vector<double> first;
   for (int i = 1000; i < 2000; ++i) first.push_back(afmkit_filter_step(h, sig[i]));
-  afmkit_filter* g = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
+  afmkit_filter* g = afmkit_filter_create(kCapiRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
   ASSERT_EQ(afmkit_filter_restore_state(g, buf.data(), n), AFMKIT_OK);
   for (int i = 1000; i < 2000; ++i) ASSERT_EQ(afmkit_filter_step(g, sig[i]), first[i - 1000]);
   buf[0] = 0.0;
@@ -150,7 +153,7 @@ TEST(CApi, SaveRestoreBitForBit) {
 // A buffer no filter saved is refused whole, the filter unchanged: the overflow-prone values (coordinates near
 // DBL_MAX, counters beyond 2^64 whose conversion to uint64 is undefined) as well as the structural ones.
 TEST(CApi, RestoreRefusesStatesNoFilterCouldHaveSaved) {
-  afmkit_filter* h = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
+  afmkit_filter* h = afmkit_filter_create(kCapiRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
   ASSERT_NE(h, nullptr);
   const auto sig = test_signal(2000);
   for (int i = 0; i < 1000; ++i) afmkit_filter_step(h, sig[i]);
@@ -193,7 +196,7 @@ TEST(CApi, RestoreRefusesStatesNoFilterCouldHaveSaved) {
 }
 
 TEST(CApi, InputLimitSkipsHugeSamples) {
-  afmkit_filter* h = afmkit_filter_create(kRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
+  afmkit_filter* h = afmkit_filter_create(kCapiRate, kOmega, 10, 0.1, -0.1, kGamma, nullptr, 0);
   ASSERT_NE(h, nullptr);
   EXPECT_EQ(afmkit_filter_input_limit(h), AFMKIT_DEFAULT_INPUT_LIMIT);
   std::vector<double> in = test_signal(20000), out(in.size());

@@ -13,12 +13,14 @@
 #include "afmkit/core/error.hpp"
 #include "sim_test_helpers.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit::control;
 
 namespace {
-constexpr double kOmega = 1.0;
-constexpr double kT = 2.0 * std::numbers::pi;
-constexpr double kGamma = 20.0;  // γ = 20 Ω (Fig. 3/5 parameters, docs/theory-control.md#simulation)
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kT;
+using afmkit_test::fig5::kGamma;
 
 OscillatorBank fig5_bank(double gain = kGamma) { return OscillatorBank::with_couplings(kOmega, 10, 0.1, -0.1, gain); }
 

@@ -16,10 +16,14 @@
 #include "afmkit/control/realtime_filter.hpp"
 #include "afmkit/core/error.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit::control;
 
 namespace {
-constexpr double kOmega = 1.0, kT = 2.0 * std::numbers::pi, kGamma = 20.0;
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kT;
+using afmkit_test::fig5::kGamma;
 
 std::vector<double> signal(int n) {
   std::vector<double> v(static_cast<std::size_t>(n));

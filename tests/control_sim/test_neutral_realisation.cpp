@@ -17,15 +17,19 @@
 #include "afmkit/control/closed_loop_simulation.hpp"
 #include "afmkit/control/harmonic_analysis.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit::control;
 
 namespace {
-constexpr double kOmega = 1.0, kT = 2.0 * std::numbers::pi, kGamma = 20.0;
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kT;
+using afmkit_test::fig5::kGamma;
 const Plant& fig5_static() {
   static const Plant p(PlantKind::Static, kGamma, kOmega, 0.1 * kT, Disturbance::paper_example());
   return p;
 }
-SimulationOptions opts(int periods, int steps, int record = 0) {
+SimulationOptions neutral_opts(int periods, int steps, int record = 0) {
   SimulationOptions o;
   o.periods = periods;
   o.steps_per_period = steps;
@@ -36,12 +40,12 @@ SimulationOptions opts(int periods, int steps, int record = 0) {
 
 TEST(NeutralRealisation, TruncatedBankConvergesToItAsOneOverN) {
   const InfiniteBank inf(kOmega, 0.1, -0.1, kGamma);
-  const auto un = simulate_closed_loop(fig5_static(), inf, opts(40, 2000, 1)).series.u;
+  const auto un = simulate_closed_loop(fig5_static(), inf, neutral_opts(40, 2000, 1)).series.u;
   double dev[2];
   int idx = 0;
   for (int n : {10, 40}) {
     const auto ut = simulate_closed_loop(fig5_static(), OscillatorBank::with_couplings(kOmega, n, 0.1, -0.1, kGamma),
-                                         opts(40, 2000, 1)).series.u;
+                                         neutral_opts(40, 2000, 1)).series.u;
     ASSERT_EQ(ut.size(), un.size());
     double d = 0.0;
     for (std::size_t i = 0; i < un.size(); ++i) d = std::max(d, std::abs(ut[i] - un[i]));
@@ -58,8 +62,8 @@ TEST(NeutralRealisation, LongRunErrorIsFirstOrderInStepTruncatedIsThirdOrder) {
   double neutral[3], truncated[3];
   int i = 0;
   for (int m : {500, 1000, 2000}) {
-    neutral[i] = simulate_closed_loop(fig5_static(), inf, opts(150, m)).report.residual_first_harmonic;
-    truncated[i] = simulate_closed_loop(fig5_static(), bank, opts(150, m)).report.residual_first_harmonic;
+    neutral[i] = simulate_closed_loop(fig5_static(), inf, neutral_opts(150, m)).report.residual_first_harmonic;
+    truncated[i] = simulate_closed_loop(fig5_static(), bank, neutral_opts(150, m)).report.residual_first_harmonic;
     ++i;
   }
   for (int j = 0; j < 2; ++j) {
@@ -98,7 +102,7 @@ TEST(NeutralRealisation, ClosedLoopHasRootsOnTheImaginaryAxis) {
 
 TEST(NeutralRealisation, RejectsFirstHarmonicWithFirstOrderPlant) {
   const Plant plant(PlantKind::FirstOrder, kGamma, kOmega, 0.1 * kT, Disturbance::paper_example());
-  const auto r = simulate_closed_loop(plant, InfiniteBank(kOmega, 0.1, -0.1, kGamma), opts(60, 2000)).report;
+  const auto r = simulate_closed_loop(plant, InfiniteBank(kOmega, 0.1, -0.1, kGamma), neutral_opts(60, 2000)).report;
   EXPECT_FALSE(r.diverged);
   EXPECT_LT(r.residual_first_harmonic, 2e-3);
   // harmonics 2..8 of f are kept (N = ∞ bank); 0 and 2..8 compared with γ f_k/(γ + ikΩ)

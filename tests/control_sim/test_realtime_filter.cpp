@@ -14,14 +14,18 @@
 #include "afmkit/core/error.hpp"
 #include "sim_test_helpers.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit::control;
 
 namespace {
-constexpr double kOmega = 1.0, kT = 2.0 * std::numbers::pi, kGamma = 20.0;
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kT;
+using afmkit_test::fig5::kGamma;
 constexpr int kSteps = 2000;  // samples per rotation period
-const double kRate = kSteps / kT;
+const double kFilterRate = kSteps / kT;
 
-OscillatorBank fig5_bank(int n = 10, double gain = kGamma) {
+OscillatorBank fig5_filter_bank(int n = 10, double gain = kGamma) {
   return OscillatorBank::with_couplings(kOmega, n, 0.1, -0.1, gain);
 }
 
@@ -31,7 +35,7 @@ struct Loop {
   std::vector<double> y_hist;
   int delay = 200;
   double measure(long n) const {
-    if (n - delay < 0) return f(kOmega * (n - delay) / kRate);
+    if (n - delay < 0) return f(kOmega * (n - delay) / kFilterRate);
     return y_hist[static_cast<std::size_t>(n - delay)];
   }
   /// run `count` samples; returns u per sample
@@ -43,7 +47,7 @@ struct Loop {
       if (skip_every > 0 && n % skip_every == skip_every - 1) m = std::numeric_limits<double>::quiet_NaN();
       const double un = filter.step(m);
       u[static_cast<std::size_t>(i)] = un;
-      y_hist.push_back(f(kOmega * n / kRate) + un / kGamma);
+      y_hist.push_back(f(kOmega * n / kFilterRate) + un / kGamma);
     }
     return u;
   }
@@ -56,7 +60,7 @@ struct Loop {
 
 TEST(RealtimeFilter, ModalFormEqualsDenseMatrixExponential) {
   for (int n : {1, 3, 10, 50}) {
-    const auto bank = fig5_bank(n);
+    const auto bank = fig5_filter_bank(n);
     const double fs = 40.0 * n / kT;
     RealtimeFilter f(bank, fs);
     EXPECT_TRUE(f.uses_modal_form()) << n;
@@ -104,7 +108,7 @@ TEST(RealtimeFilter, ZeroOrderHoldMatchesRungeKuttaWithHeldSample) {
 
 TEST(RealtimeFilter, BlockFormMatchesRungeKuttaOfEachOscillatorWithHeldError) {
   // ż = A0 z + b e with e = m − c_eᵀ z(t_n) held (no coupling inside the step)
-  const auto bank = fig5_bank(6);
+  const auto bank = fig5_filter_bank(6);
   const double fs = 50.0 / kT, h = 1.0 / fs, m = -0.4;
   RealtimeFilter f(bank, fs, SampledForm::BlockZeroOrderHold);
   EXPECT_FALSE(f.uses_modal_form());
@@ -126,8 +130,8 @@ TEST(RealtimeFilter, OutputEqualsClosedLoopSimulationWithSameDiscretisation) {
     o.steps_per_period = kSteps;
     o.stepping = stepping;
     o.record_every = 1;
-    const auto res = simulate_closed_loop(plant, fig5_bank(), o);
-    RealtimeFilter f(fig5_bank(), kRate, form);
+    const auto res = simulate_closed_loop(plant, fig5_filter_bank(), o);
+    RealtimeFilter f(fig5_filter_bank(), kFilterRate, form);
     double max_diff = 0.0, max_u = 0.0;
     for (std::size_t n = 0; n < res.series.m.size(); ++n) {
       max_diff = std::max(max_diff, std::abs(f.step(res.series.m[n]) - res.series.u[n]));
@@ -140,7 +144,7 @@ TEST(RealtimeFilter, OutputEqualsClosedLoopSimulationWithSameDiscretisation) {
 
 TEST(RealtimeFilter, ClosedLoopRejectsFirstHarmonicToRounding) {
   for (auto form : {SampledForm::ZeroOrderHold, SampledForm::BlockZeroOrderHold}) {
-    RealtimeFilter f(fig5_bank(), kRate, form);
+    RealtimeFilter f(fig5_filter_bank(), kFilterRate, form);
     Loop loop;
     loop.run(f, 60L * kSteps);
     EXPECT_LT(loop.first_harmonic_of_last_period(), 1e-10);
@@ -148,7 +152,7 @@ TEST(RealtimeFilter, ClosedLoopRejectsFirstHarmonicToRounding) {
 }
 
 TEST(RealtimeFilter, BumplessParameterChange) {
-  RealtimeFilter f(fig5_bank(), kRate);
+  RealtimeFilter f(fig5_filter_bank(), kFilterRate);
   Loop loop;
   loop.run(f, 20L * kSteps + kSteps / 4);  // a quarter period in: u ≈ −γ F1 sin(Ωt) is near its peak
   // reference: a copy continuing with the old parameters
@@ -156,12 +160,12 @@ TEST(RealtimeFilter, BumplessParameterChange) {
   Loop loop_ref = loop;
   const double next_old = loop_ref.run(ref, 1)[0];
   // change K (×1.6), α, β, N and the sample rate at once
-  f.reconfigure(OscillatorBank::with_couplings(kOmega, 12, 0.15, -0.05, 1.6 * kGamma), 1.1 * kRate);
+  f.reconfigure(OscillatorBank::with_couplings(kOmega, 12, 0.15, -0.05, 1.6 * kGamma), 1.1 * kFilterRate);
   const double next_new = loop.run(f, 1)[0];
   EXPECT_GT(std::abs(next_old), 1.0);
   EXPECT_NEAR(next_new, next_old, 1e-9 * std::abs(next_old));  // u = −K x1 continuous
   // gain only, then the loop keeps converging (K = γ/2 is still stable)
-  RealtimeFilter g(fig5_bank(), kRate);
+  RealtimeFilter g(fig5_filter_bank(), kFilterRate);
   Loop loop2;
   loop2.run(g, 15L * kSteps + kSteps / 4);
   RealtimeFilter g_ref = g;
@@ -176,17 +180,17 @@ TEST(RealtimeFilter, BumplessParameterChange) {
 }
 
 TEST(RealtimeFilter, InvalidReconfigurationLeavesFilterUnchanged) {
-  RealtimeFilter f(fig5_bank(), kRate);
+  RealtimeFilter f(fig5_filter_bank(), kFilterRate);
   Loop loop;
   loop.run(f, 3L * kSteps);
   const auto saved = f.save_state();
-  EXPECT_THROW(f.reconfigure(fig5_bank(), 2.0 / kT), afmkit::InvalidParameter);  // Nyquist
+  EXPECT_THROW(f.reconfigure(fig5_filter_bank(), 2.0 / kT), afmkit::InvalidParameter);  // Nyquist
   EXPECT_EQ(f.save_state(), saved);
-  EXPECT_EQ(f.sample_rate(), kRate);
+  EXPECT_EQ(f.sample_rate(), kFilterRate);
 }
 
 TEST(RealtimeFilter, NonFiniteSamplesAreSkipped) {
-  RealtimeFilter f(fig5_bank(), kRate);
+  RealtimeFilter f(fig5_filter_bank(), kFilterRate);
   Loop loop;
   loop.run(f, 1000);
   const double before = f.last_output();
@@ -197,7 +201,7 @@ TEST(RealtimeFilter, NonFiniteSamplesAreSkipped) {
   EXPECT_TRUE(f.controller_state().allFinite());
   // a loop with every 97th sample lost still converges (the oscillators keep their phase)
   for (auto form : {SampledForm::ZeroOrderHold, SampledForm::BlockZeroOrderHold}) {
-    RealtimeFilter g(fig5_bank(), kRate, form);
+    RealtimeFilter g(fig5_filter_bank(), kFilterRate, form);
     Loop l;
     l.run(g, 60L * kSteps, 97);
     EXPECT_EQ(g.skipped_samples(), static_cast<std::uint64_t>(60L * kSteps / 97));
@@ -208,7 +212,7 @@ TEST(RealtimeFilter, NonFiniteSamplesAreSkipped) {
 
 TEST(RealtimeFilter, SaveRestoreReproducesOutputsBitForBit) {
   for (auto form : {SampledForm::ZeroOrderHold, SampledForm::BlockZeroOrderHold}) {
-    RealtimeFilter f(fig5_bank(), kRate, form);
+    RealtimeFilter f(fig5_filter_bank(), kFilterRate, form);
     Loop loop;
     loop.run(f, 1234);
     f.step(std::numeric_limits<double>::quiet_NaN());
@@ -218,7 +222,7 @@ TEST(RealtimeFilter, SaveRestoreReproducesOutputsBitForBit) {
     for (int i = 0; i < 500; ++i) inputs.push_back(std::sin(0.01 * i) + 0.3 * std::cos(0.07 * i));
     std::vector<double> out1;
     for (double m : inputs) out1.push_back(f.step(m));
-    RealtimeFilter g(fig5_bank(), kRate, form);  // fresh filter, same configuration
+    RealtimeFilter g(fig5_filter_bank(), kFilterRate, form);  // fresh filter, same configuration
     g.restore_state(state);
     EXPECT_EQ(g.skipped_samples(), 1u);
     for (std::size_t i = 0; i < inputs.size(); ++i) ASSERT_EQ(g.step(inputs[i]), out1[i]) << i;
@@ -228,17 +232,17 @@ TEST(RealtimeFilter, SaveRestoreReproducesOutputsBitForBit) {
 }
 
 TEST(RealtimeFilter, RestoreIntoOtherConfigurationCarriesPhysicalState) {
-  RealtimeFilter f(fig5_bank(), kRate);
+  RealtimeFilter f(fig5_filter_bank(), kFilterRate);
   Loop loop;
   loop.run(f, 4321);
   const Eigen::VectorXd z = f.controller_state();
-  RealtimeFilter g(fig5_bank(10, 2.0 * kGamma), 0.5 * kRate, SampledForm::BlockZeroOrderHold);
+  RealtimeFilter g(fig5_filter_bank(10, 2.0 * kGamma), 0.5 * kFilterRate, SampledForm::BlockZeroOrderHold);
   g.restore_state(f.save_state());
   EXPECT_LT((g.controller_state() - z).norm(), 1e-12 * z.norm());
 }
 
 TEST(RealtimeFilter, MalformedStateIsRejected) {
-  RealtimeFilter f(fig5_bank(), kRate);
+  RealtimeFilter f(fig5_filter_bank(), kFilterRate);
   auto state = f.save_state();
   auto bad = state;
   bad[0] = 1.0;
@@ -254,7 +258,7 @@ TEST(RealtimeFilter, MalformedStateIsRejected) {
 }
 
 TEST(RealtimeFilter, ResetAndBlockProcessing) {
-  RealtimeFilter f(fig5_bank(), kRate), g(fig5_bank(), kRate);
+  RealtimeFilter f(fig5_filter_bank(), kFilterRate), g(fig5_filter_bank(), kFilterRate);
   std::vector<double> in(300), out(300);
   for (int i = 0; i < 300; ++i) in[i] = std::sin(0.02 * i);
   f.step_block(in, out);
@@ -270,14 +274,14 @@ TEST(RealtimeFilter, ResetAndBlockProcessing) {
 TEST(RealtimeFilter, SampleRateMustSatisfyNyquist) {
   // N Ω < π f_s: N = 10, Ω = 1 ⇒ f_s > 10/π = 3.18
   try {
-    RealtimeFilter f(fig5_bank(), 3.0);
+    RealtimeFilter f(fig5_filter_bank(), 3.0);
     ADD_FAILURE();
   } catch (const afmkit::InvalidParameter& e) {
     EXPECT_EQ(e.parameter(), "sample_rate");
     EXPECT_NE(std::string(e.what()).find("Nyquist"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("3.18"), std::string::npos);
   }
-  EXPECT_NO_THROW(RealtimeFilter(fig5_bank(), 3.2));
-  EXPECT_THROW(RealtimeFilter(fig5_bank(), std::nan("")), afmkit::InvalidParameter);
-  EXPECT_THROW(RealtimeFilter(fig5_bank(), -5.0), afmkit::InvalidParameter);
+  EXPECT_NO_THROW(RealtimeFilter(fig5_filter_bank(), 3.2));
+  EXPECT_THROW(RealtimeFilter(fig5_filter_bank(), std::nan("")), afmkit::InvalidParameter);
+  EXPECT_THROW(RealtimeFilter(fig5_filter_bank(), -5.0), afmkit::InvalidParameter);
 }

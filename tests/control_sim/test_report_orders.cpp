@@ -13,13 +13,13 @@
 using namespace afmkit::control;
 
 namespace {
-constexpr double kOmega = 2.0, kRate = 20.0 * kOmega;
+constexpr double kOmegaOrders = 2.0, kRateOrders = 20.0 * kOmegaOrders;
 // f = sin(Ωt) + 0.4 sin(4Ωt + 0.7): harmonic 4 above a bank of N = 2
 Plant plant_with_fourth_harmonic() {
-  return Plant(PlantKind::Static, kRate, kOmega, 0.1 * 2.0 * std::numbers::pi / kOmega,
+  return Plant(PlantKind::Static, kRateOrders, kOmegaOrders, 0.1 * 2.0 * std::numbers::pi / kOmegaOrders,
                Disturbance(0.0, {{1, 1.0, 0.0}, {4, 0.4, 0.7}}));
 }
-OscillatorBank bank() { return OscillatorBank::with_couplings(kOmega, 2, 0.1 * kOmega, -0.1 * kOmega, kRate); }
+OscillatorBank bank() { return OscillatorBank::with_couplings(kOmegaOrders, 2, 0.1 * kOmegaOrders, -0.1 * kOmegaOrders, kRateOrders); }
 }  // namespace
 
 TEST(ReportOrders, HarmonicAboveTheBankIsReportedAndMatchesDftAndFrequencyDomain) {
@@ -36,7 +36,7 @@ TEST(ReportOrders, HarmonicAboveTheBankIsReportedAndMatchesDftAndFrequencyDomain
   const auto& y = r.series.y;
   ASSERT_EQ(y.size(), static_cast<std::size_t>(o.periods * m));
   const std::complex<double> f4 = std::complex<double>(0.0, -0.4) * std::exp(std::complex<double>(0.0, 0.7));
-  const LoopSpec loop(bank(), PlantKind::Static, kRate, 0.1 * 2.0 * std::numbers::pi / kOmega);
+  const LoopSpec loop(bank(), PlantKind::Static, kRateOrders, 0.1 * 2.0 * std::numbers::pi / kOmegaOrders);
   double above = 0.0;
   for (const HarmonicComparison& h : r.report.harmonics) {
     std::complex<double> dft = 0.0;  // (2/M) Σ y_n e^{−2πikn/M} over the last period (k = 0: the mean)
@@ -48,7 +48,7 @@ TEST(ReportOrders, HarmonicAboveTheBankIsReportedAndMatchesDftAndFrequencyDomain
   }
   const HarmonicComparison& h4 = r.report.harmonics[3];  // orders 0, 2, 3, 4 (1 rejected)
   ASSERT_EQ(h4.order, 4);
-  const std::complex<double> expected = disturbance_response(loop, {0.0, 4.0 * kOmega}) * f4;
+  const std::complex<double> expected = disturbance_response(loop, {0.0, 4.0 * kOmegaOrders}) * f4;
   EXPECT_GT(std::abs(expected - f4), 1e-2);  // the controller changes what it does not model
   EXPECT_NEAR(std::abs(h4.value - expected), 0.0, 1e-4 * std::abs(f4));
   EXPECT_EQ(h4.target, f4);

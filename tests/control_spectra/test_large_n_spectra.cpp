@@ -10,11 +10,13 @@
 #include "afmkit/control/delay_margin.hpp"
 #include "afmkit/control/spectrum.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit::control;
 
 namespace {
-constexpr double kGamma = 20.0;
-const double kT = 2.0 * std::numbers::pi;
+using afmkit_test::fig5::kGamma;
+using afmkit_test::fig5::kT;
 
 LoopSpec bank_loop(int n, double tau) {
   return LoopSpec(OscillatorBank::with_couplings(1.0, n, 0.1, -0.1, kGamma), PlantKind::Static, kGamma, tau);

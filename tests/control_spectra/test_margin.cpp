@@ -13,12 +13,15 @@
 #include "afmkit/core/error.hpp"
 #include "reference.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit;
 using namespace afmkit::control;
 
 namespace {
-constexpr double kOmega = 1.0, kGamma = 20.0;
-const double kT = 2.0 * std::numbers::pi / kOmega;
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kGamma;
+using afmkit_test::fig5::kT;
 
 double reference_abscissa(const OscillatorBank& bank, PlantKind kind, double gamma, double tau) {
   double m = -INFINITY;

@@ -11,13 +11,16 @@
 #include "afmkit/core/error.hpp"
 #include "reference.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit;
 using namespace afmkit::control;
 using test::cplx;
 
 namespace {
-constexpr double kOmega = 1.0, kGamma = 20.0;
-const double kT = 2.0 * std::numbers::pi / kOmega;
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kGamma;
+using afmkit_test::fig5::kT;
 
 // Every root in the box matches a reference eigenvalue and every reference eigenvalue well inside the box is found.
 void expect_matches_reference(const Spectrum& sp, const std::vector<cplx>& ref, double tol) {

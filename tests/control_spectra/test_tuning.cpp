@@ -11,12 +11,15 @@
 #include "afmkit/control/tuning.hpp"
 #include "afmkit/core/error.hpp"
 
+#include "../fig5_parameters.hpp"
+
 using namespace afmkit;
 using namespace afmkit::control;
 
 namespace {
-constexpr double kOmega = 1.0, kGamma = 20.0;
-const double kT = 2.0 * std::numbers::pi / kOmega;
+using afmkit_test::fig5::kOmega;
+using afmkit_test::fig5::kGamma;
+using afmkit_test::fig5::kT;
 
 RobustTuningSpec spec(bool infinite) {
   RobustTuningSpec s;

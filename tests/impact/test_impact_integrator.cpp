@@ -11,7 +11,7 @@
 using namespace afmkit::impact;
 
 namespace {
-double momentum(const Body& a, const Body& b) { return a.mass * a.velocity + b.mass * b.velocity; }
+double total_momentum(const Body& a, const Body& b) { return a.mass * a.velocity + b.mass * b.velocity; }
 
 // DMT in the library's units; masses in kg, lengths in nm, forces in nN -> time in s (1 nN/kg = 1 nm/s²).
 const double tip_mass = 1e-11, sample_mass = 3e-10;
@@ -49,7 +49,7 @@ TEST(ImpactIntegrator, AgreesWithClosedForm) {
     EXPECT_NEAR(num.kinetic_energy_loss, exact.kinetic_energy_loss, tol * exact.kinetic_energy_before);
     EXPECT_NEAR(num.peak_force, exact.peak_force, tol * exact.peak_force);
     // momentum of eq. (1) integrated body by body (H1 = −H2)
-    EXPECT_NEAR(momentum(num.body1_after, num.body2_after), 0.0, 1e-12 * (c.m1 + c.m2) * c.speed);
+    EXPECT_NEAR(total_momentum(num.body1_after, num.body2_after), 0.0, 1e-12 * (c.m1 + c.m2) * c.speed);
   }
 }
 
@@ -96,7 +96,7 @@ TEST(ImpactIntegrator, DmtImpactLosesTheAreaBetweenBranches) {
   EXPECT_NEAR(r.energy_loss_restitution, r.kinetic_energy_loss, 1e-8 * r.kinetic_energy_before);
   EXPECT_GT(r.restitution, 0.0);
   EXPECT_LT(r.restitution, 1.0);
-  EXPECT_NEAR(momentum(r.body1_after, r.body2_after), 0.0, 1e-12 * tip_mass * speed);
+  EXPECT_NEAR(total_momentum(r.body1_after, r.body2_after), 0.0, 1e-12 * tip_mass * speed);
   // peak force: approach branch at the minimum gap (Hertz monotone)
   EXPECT_NEAR(r.peak_force, dmt_law.approach(r.minimum_gap), 1e-12 * r.peak_force);
   // independent RK4 reference on the relative coordinate with an SI-unit DMT
@@ -149,7 +149,7 @@ TEST(ImpactIntegrator, TimeDependentForcesMatchConstantClosedForm) {
   const auto p = simulate_impact(ImpactProblem(b1, b2, law, pulse));
   ASSERT_EQ(p.outcome, ImpactOutcome::separated);
   const double impulse = 3.0 / 7.0 * (1 - std::cos(7.0 * p.end_time));
-  EXPECT_NEAR(momentum(p.body1_after, p.body2_after) - momentum(b1, b2), impulse, 1e-9);
+  EXPECT_NEAR(total_momentum(p.body1_after, p.body2_after) - total_momentum(b1, b2), impulse, 1e-9);
 }
 
 TEST(ImpactIntegrator, BudgetsAndBadLawsAreNumericalFailures) {

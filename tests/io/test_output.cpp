@@ -31,7 +31,7 @@ fs::path fresh_dir(const std::string& name) {
   return dir;
 }
 
-std::string slurp(const fs::path& p) {
+std::string read_output(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream ss;
   ss << in.rdbuf();
@@ -91,7 +91,7 @@ TEST(TableWriter, DoublesRoundTripBitExactAndCellsHaveTheirText) {
   ASSERT_TRUE(std::getline(in, line));
   EXPECT_EQ(line, "nan,0,0,undefined");  // the one spelling of "undefined" (docs/conventions.md)
   EXPECT_FALSE(std::getline(in, line));
-  const auto meta = nlohmann::json::parse(slurp(dir / "sub/t.csv.json"));
+  const auto meta = nlohmann::json::parse(read_output(dir / "sub/t.csv.json"));
   EXPECT_EQ(meta["results"]["rows"], values.size() + 1);
   EXPECT_EQ(meta["command"], "test");
   EXPECT_FALSE(any_temporary(dir / "sub"));
@@ -116,7 +116,7 @@ TEST(TableWriter, AbandonedWriterLeavesNothingAndKeepsTheOldFile) {
     throw std::runtime_error("interrupted");  // e.g. a numerical failure half way
   } catch (const std::runtime_error&) {
   }
-  EXPECT_EQ(slurp(dir / "t.csv"), "old\n");
+  EXPECT_EQ(read_output(dir / "t.csv"), "old\n");
   EXPECT_FALSE(fs::exists(dir / "t.csv.json"));
   EXPECT_FALSE(any_temporary(dir));
   fs::remove_all(dir);
@@ -188,7 +188,7 @@ TEST(TableWriter, ANonRegularTargetIsRefusedAndASymbolicLinkIsFollowed) {
     out.commit(nlohmann::json::object());
   }
   EXPECT_TRUE(fs::is_symlink(dir / "link.csv"));
-  EXPECT_EQ(slurp(dir / "data" / "real.csv"), "a\n1.5\n");
+  EXPECT_EQ(read_output(dir / "data" / "real.csv"), "a\n1.5\n");
   EXPECT_TRUE(fs::exists(dir / "link.csv.json"));
   fs::remove_all(dir);
 }
@@ -200,7 +200,7 @@ TEST(TableWriter, TheSidecarDescribesEveryColumnAndAColumnNeedsAUnit) {
     out.row(1.0, 0.5);
     out.commit(afmkit::io::make_sidecar("test", nlohmann::json::object()));
   }
-  const auto meta = nlohmann::json::parse(slurp(dir / "t.csv.json"));
+  const auto meta = nlohmann::json::parse(read_output(dir / "t.csv.json"));
   ASSERT_EQ(meta["columns"].size(), 2u);
   EXPECT_EQ(meta["columns"][0], (nlohmann::json{{"name", "separation"}, {"unit", "nm"}, {"description", "separation l"}}));
   EXPECT_EQ(meta["columns"][1]["unit"], "rad");
@@ -233,7 +233,7 @@ TEST(TableWriter, TextCellsWithCommasOrQuotesAreQuotedAsRfc4180) {
     out.row("say \"hi\"", 3.0);
     out.commit(afmkit::io::make_sidecar("test", nlohmann::json::object()));
   }
-  EXPECT_EQ(slurp(dir / "t.csv"), "name,x\nplain,1\n\"bank N=10, rejected 1,3\",2\n\"say \"\"hi\"\"\",3\n");
+  EXPECT_EQ(read_output(dir / "t.csv"), "name,x\nplain,1\n\"bank N=10, rejected 1,3\",2\n\"say \"\"hi\"\"\",3\n");
   fs::remove_all(dir);
 }
 
@@ -250,6 +250,6 @@ TEST(TableWriter, EveryNaNIsWrittenNanAndInfinitiesInf) {
     out.row(negative_nan, computed, inf, -static_cast<double>(inf));
     out.commit(afmkit::io::make_sidecar("test", {{"x", 1}}));
   }
-  EXPECT_EQ(slurp(dir / "t.csv"), "a,b,c,d\nnan,nan,inf,-inf\n");
+  EXPECT_EQ(read_output(dir / "t.csv"), "a,b,c,d\nnan,nan,inf,-inf\n");
   fs::remove_all(dir);
 }

@@ -23,7 +23,7 @@ std::string slurp(const std::string& path) {
   return s.str();
 }
 
-std::string error_of(const std::string& bytes, ac::ReadOptions o = {}) {
+std::string jpk_error_of(const std::string& bytes, ac::ReadOptions o = {}) {
   try {
     ac::parse_curves(bytes, "x.jpk-force", ".jpk-force", o);
   } catch (const afmkit::InputError& e) {
@@ -71,7 +71,7 @@ TEST(CurvesJpk, TruncatedArchivesAreRefusedNamingTheFile) {
   CURVES_REAL_FILE(path, "jpk_spot3-0192.jpk-force");
   const std::string bytes = slurp(path);
   for (std::size_t cut : {std::size_t{0}, std::size_t{3}, std::size_t{100}, bytes.size() / 2, bytes.size() - 10}) {
-    const std::string msg = error_of(bytes.substr(0, cut));
+    const std::string msg = jpk_error_of(bytes.substr(0, cut));
     EXPECT_NE(msg.find("x.jpk-force"), std::string::npos) << cut << ": " << msg;
   }
 }
@@ -81,7 +81,7 @@ TEST(CurvesJpk, CorruptedEntryIsRefusedNamingTheEntry) {
   std::string bytes = slurp(path);
   // Flip bytes inside the first entry's data (after its local header): its CRC no longer matches.
   for (std::size_t i = 200; i < 260; ++i) bytes[i] = static_cast<char>(bytes[i] ^ 0x5a);
-  const std::string msg = error_of(bytes);
+  const std::string msg = jpk_error_of(bytes);
   EXPECT_NE(msg.find("x.jpk-force"), std::string::npos) << msg;
   EXPECT_NE(msg.find("entry"), std::string::npos) << msg;
 }
@@ -89,7 +89,7 @@ TEST(CurvesJpk, CorruptedEntryIsRefusedNamingTheEntry) {
 TEST(CurvesJpk, WrongMagicAsJpkIsRefused) {
   ac::ReadOptions o;
   o.format = "jpk-force";
-  const std::string msg = error_of("Height (nm)\tDefl (nm)\n1\t2\n", o);
+  const std::string msg = jpk_error_of("Height (nm)\tDefl (nm)\n1\t2\n", o);
   EXPECT_NE(msg.find("not a readable JPK"), std::string::npos) << msg;
 }
 
@@ -108,7 +108,7 @@ TEST(CurvesJpk, AnEntryDeclaringMoreThanItCanHoldIsRefusedBeforeAllocation) {
     if (bytes.compare(at, 4, std::string("PK\x01\x02", 4)) == 0) std::memcpy(&bytes[at + 24], &huge, 4), ++patched;
   }
   ASSERT_GE(patched, 4);
-  const std::string msg = error_of(bytes);
+  const std::string msg = jpk_error_of(bytes);
   EXPECT_NE(msg.find("x.jpk-force"), std::string::npos) << msg;
   EXPECT_NE(msg.find("declares 2147483647 bytes"), std::string::npos) << msg;
 }

@@ -21,7 +21,7 @@ ac::RawCurve parse(const std::string& text, const std::string& format) {
   return curves.at(0);
 }
 
-std::string error_of(const std::string& text, const std::string& format) {
+std::string preset_error_of(const std::string& text, const std::string& format) {
   try {
     parse(text, format);
   } catch (const afmkit::InputError& e) {
@@ -85,15 +85,15 @@ TEST(CurvesPresets, JpkTxt) {
 
 TEST(CurvesPresets, JpkTxtWithoutRetractIsRefused) {
   const std::string extend_only = kJpk.substr(0, kJpk.find("\n# segmentIndex: 1"));
-  const std::string msg = error_of(extend_only, "jpk-txt");
+  const std::string msg = preset_error_of(extend_only, "jpk-txt");
   EXPECT_NE(msg.find("export.txt: no retract part (the jpk-txt preset"), std::string::npos) << msg;
 }
 
 TEST(CurvesPresets, JpkTxtColumnsThatDisagreeAreRefused) {
   std::string bad = kJpk;
   bad.replace(bad.rfind("# units: m N m s"), 16, "# units: m N m");
-  EXPECT_NE(error_of(bad, "jpk-txt").find("line 17: '# units:' gives 3 units for 4 columns"), std::string::npos)
-      << error_of(bad, "jpk-txt");
+  EXPECT_NE(preset_error_of(bad, "jpk-txt").find("line 17: '# units:' gives 3 units for 4 columns"), std::string::npos)
+      << preset_error_of(bad, "jpk-txt");
 }
 
 TEST(CurvesPresets, NanoscopeTxtSideBySideWithUnitsInNames) {
@@ -129,10 +129,10 @@ TEST(CurvesPresets, NanoscopeTxtRetractSortedLikeTheExtendIsReversed) {
 }
 
 TEST(CurvesPresets, NanoscopeTxtWithoutRetractColumnsIsRefused) {
-  const std::string msg = error_of("Calc_Ramp_Ex_nm\tDefl_nm_Ex\n0\t0\n100\t5\n", "nanoscope-txt");
+  const std::string msg = preset_error_of("Calc_Ramp_Ex_nm\tDefl_nm_Ex\n0\t0\n100\t5\n", "nanoscope-txt");
   EXPECT_NE(msg.find("line 1: not the layout of the nanoscope-txt preset"), std::string::npos) << msg;
   const std::string empty_rt =
-      error_of("Calc_Ramp_Ex_nm\tCalc_Ramp_Rt_nm\tDefl_nm_Ex\tDefl_nm_Rt\n0\t\t0\t\n100\t\t5\t\n", "nanoscope-txt");
+      preset_error_of("Calc_Ramp_Ex_nm\tCalc_Ramp_Rt_nm\tDefl_nm_Ex\tDefl_nm_Rt\n0\t\t0\t\n100\t\t5\t\n", "nanoscope-txt");
   EXPECT_NE(empty_rt.find("no retract part"), std::string::npos) << empty_rt;
 }
 
@@ -155,7 +155,7 @@ TEST(CurvesPresets, AsylumTxt) {
 }
 
 TEST(CurvesPresets, AsylumTxtWithoutRetractIsRefused) {
-  const std::string msg = error_of("SiN0000Defl\tSiN0000ZSnsr\n0\t1e-6\n1e-9\t2e-6\n", "asylum-txt");
+  const std::string msg = preset_error_of("SiN0000Defl\tSiN0000ZSnsr\n0\t1e-6\n1e-9\t2e-6\n", "asylum-txt");
   EXPECT_NE(msg.find("no retract part"), std::string::npos) << msg;
 }
 
@@ -199,7 +199,7 @@ TEST(CurvesPresets, AutoFormatReadsEachRealFile) {
 TEST(CurvesPresets, AfmWorkshopWithoutRetractColumnsIsRefused) {
   const std::string text =
       "Force-Distance Curve\nFile Format:\t3\n\nExtend Z-Sense(nm),Extend Force(nN)\n100,1\n200,2\n300,3\n";
-  const std::string msg = error_of(text, "afmworkshop-csv");
+  const std::string msg = preset_error_of(text, "afmworkshop-csv");
   EXPECT_NE(msg.find("export.txt: no retract height column in the header (line 4: 1 'Extend Z-Sense(nm)', 2 "
                      "'Extend Force(nN)'): the afmworkshop-csv preset expects 'Retract Z-Sense(nm)'"),
             std::string::npos)

@@ -20,7 +20,7 @@ std::vector<ac::RawCurve> parse(const std::string& text, ac::ReadOptions options
 }
 
 // The InputError message of parsing `text`, or "" when it parses.
-std::string error_of(const std::string& text, ac::ReadOptions options = {}) {
+std::string text_error_of(const std::string& text, ac::ReadOptions options = {}) {
   try {
     parse(text, options);
   } catch (const afmkit::InputError& e) {
@@ -128,67 +128,67 @@ TEST(CurvesText, NanPaddingAtTheEndIsDroppedAndNoted) {
 
 // Refusals: every message names the file and the line / column.
 TEST(CurvesText, NanInTheMiddleIsRefused) {
-  const std::string msg = error_of("Height (nm)\tDefl (nm)\n30\t0\n20\tNaN\n10\t2\n20\t0\n");
+  const std::string msg = text_error_of("Height (nm)\tDefl (nm)\n30\t0\n20\tNaN\n10\t2\n20\t0\n");
   EXPECT_NE(msg.find("curve.txt: line 3, column 2: missing value"), std::string::npos) << msg;
 }
 
 TEST(CurvesText, ANonNumberCellIsRefusedWithLineAndColumn) {
-  const std::string msg = error_of("Height (nm)\tDefl (nm)\n30\t0\n20\t1\n10\tabc\n");
+  const std::string msg = text_error_of("Height (nm)\tDefl (nm)\n30\t0\n20\t1\n10\tabc\n");
   EXPECT_NE(msg.find("curve.txt: line 4, column 2: 'abc' is not a number"), std::string::npos) << msg;
-  const std::string inf = error_of("Height (nm)\tDefl (nm)\n30\t0\n20\t1\n10\tinf\n");
+  const std::string inf = text_error_of("Height (nm)\tDefl (nm)\n30\t0\n20\t1\n10\tinf\n");
   EXPECT_NE(inf.find("line 4, column 2: 'inf' is not a finite number"), std::string::npos) << inf;
-  const std::string wide = error_of("Height (nm)\tDefl (nm)\n30\t0\n20\t1\t7\n");
+  const std::string wide = text_error_of("Height (nm)\tDefl (nm)\n30\t0\n20\t1\t7\n");
   EXPECT_NE(wide.find("line 3: 3 columns"), std::string::npos) << wide;
 }
 
 TEST(CurvesText, AHeaderWithoutUnitsAndNoUnitOptionIsRefused) {
-  const std::string msg = error_of("Height\tDeflection\n30\t0\n10\t1\n20\t0\n");
+  const std::string msg = text_error_of("Height\tDeflection\n30\t0\n10\t1\n20\t0\n");
   EXPECT_NE(msg.find("curve.txt: the height column 1 ('Height', line 1) has no unit in its header"),
             std::string::npos)
       << msg;
-  const std::string bare = error_of("30\t0\n10\t1\n20\t0\n");
+  const std::string bare = text_error_of("30\t0\n10\t1\n20\t0\n");
   EXPECT_NE(bare.find("has no unit (no header row)"), std::string::npos) << bare;
-  const std::string unknown = error_of("Height (furlong)\tDefl (nm)\n30\t0\n10\t1\n");
+  const std::string unknown = text_error_of("Height (furlong)\tDefl (nm)\n30\t0\n10\t1\n");
   EXPECT_NE(unknown.find("unknown unit 'furlong'"), std::string::npos) << unknown;
-  const std::string wrong = error_of("Height (V)\tDefl (nm)\n30\t0\n10\t1\n");
+  const std::string wrong = text_error_of("Height (V)\tDefl (nm)\n30\t0\n10\t1\n");
   EXPECT_NE(wrong.find("the unit 'V' is a voltage, the height must be a length"), std::string::npos) << wrong;
 }
 
 TEST(CurvesText, ChoicesThatDoNotExistAreRefused) {
   ac::ReadOptions o;
   o.height.name = "Zpiezo";
-  const std::string msg = error_of("Height (nm)\tDefl (nm)\n30\t0\n10\t1\n", o);
+  const std::string msg = text_error_of("Height (nm)\tDefl (nm)\n30\t0\n10\t1\n", o);
   EXPECT_NE(msg.find("no column named 'Zpiezo' for the height (header, line 1: 1 'Height (nm)', 2 'Defl (nm)')"),
             std::string::npos)
       << msg;
   ac::ReadOptions p;
   p.deflection.position = 5;
-  EXPECT_NE(error_of("Height (nm)\tDefl (nm)\n30\t0\n10\t1\n", p).find("the deflection column is 5, but the file has 2"),
+  EXPECT_NE(text_error_of("Height (nm)\tDefl (nm)\n30\t0\n10\t1\n", p).find("the deflection column is 5, but the file has 2"),
             std::string::npos);
-  const std::string none = error_of("Height (nm)\tAmplitude (nm)\n30\t0\n10\t1\n");
+  const std::string none = text_error_of("Height (nm)\tAmplitude (nm)\n30\t0\n10\t1\n");
   EXPECT_NE(none.find("no deflection or force column"), std::string::npos) << none;
 }
 
 TEST(CurvesText, NoDataAndBinaryInputAreRefused) {
-  EXPECT_NE(error_of("").find("no rows of numbers"), std::string::npos);
-  EXPECT_NE(error_of("just words\nand more\n").find("no rows of numbers"), std::string::npos);
-  EXPECT_NE(error_of(std::string("PK\x03\x04\0\0", 6)).find("not a readable JPK"), std::string::npos);
-  EXPECT_NE(error_of(std::string("ab\0cd", 5)).find("byte 2: a NUL byte"), std::string::npos);
+  EXPECT_NE(text_error_of("").find("no rows of numbers"), std::string::npos);
+  EXPECT_NE(text_error_of("just words\nand more\n").find("no rows of numbers"), std::string::npos);
+  EXPECT_NE(text_error_of(std::string("PK\x03\x04\0\0", 6)).find("not a readable JPK"), std::string::npos);
+  EXPECT_NE(text_error_of(std::string("ab\0cd", 5)).find("byte 2: a NUL byte"), std::string::npos);
 }
 
 TEST(CurvesText, BadOptionsAreRefusedNamingTheOption) {
   ac::ReadOptions o;
   o.format = "bruker";
-  EXPECT_NE(error_of("1\t2\n", o).find("format 'bruker' is not one of"), std::string::npos);
+  EXPECT_NE(text_error_of("1\t2\n", o).find("format 'bruker' is not one of"), std::string::npos);
   ac::ReadOptions s;
   s.separator = "pipe";
-  EXPECT_NE(error_of("1\t2\n", s).find("separator 'pipe'"), std::string::npos);
+  EXPECT_NE(text_error_of("1\t2\n", s).find("separator 'pipe'"), std::string::npos);
   ac::ReadOptions k;
   k.spring_constant = -1;
-  EXPECT_NE(error_of("1\t2\n", k).find("spring constant = -1 N/m: must be a positive"), std::string::npos);
+  EXPECT_NE(text_error_of("1\t2\n", k).find("spring constant = -1 N/m: must be a positive"), std::string::npos);
   ac::ReadOptions d;
   d.height_direction = "up";
-  EXPECT_NE(error_of("H (nm)\tD (nm)\n1\t2\n2\t3\n", d).find("height direction 'up'"), std::string::npos);
+  EXPECT_NE(text_error_of("H (nm)\tD (nm)\n1\t2\n2\t3\n", d).find("height direction 'up'"), std::string::npos);
 }
 
 TEST(CurvesText, CalibrationOptionsOverrideTheFile) {
@@ -224,11 +224,11 @@ TEST(CurvesText, NonRegularFilesAreRefusedWithoutBlocking) {
 }
 
 TEST(CurvesText, NonPositiveCalibrationInTheFileIsRefusedWithItsLine) {
-  const std::string msg = error_of("# springConstant: -0.1\nHeight (nm)\tDefl (V)\n30\t0\n10\t1\n20\t0\n");
+  const std::string msg = text_error_of("# springConstant: -0.1\nHeight (nm)\tDefl (V)\n30\t0\n10\t1\n20\t0\n");
   EXPECT_NE(msg.find("curve.txt: line 1: 'springConstant: -0.1': the spring constant must be positive"),
             std::string::npos)
       << msg;
-  const std::string zero = error_of("# InvOLS: 0\nHeight (nm)\tDefl (V)\n30\t0\n10\t1\n20\t0\n");
+  const std::string zero = text_error_of("# InvOLS: 0\nHeight (nm)\tDefl (V)\n30\t0\n10\t1\n20\t0\n");
   EXPECT_NE(zero.find("line 1: 'InvOLS: 0': the InvOLS must be positive"), std::string::npos) << zero;
 }
 
@@ -243,7 +243,7 @@ TEST(CurvesText, TrailingSeparatorsAndAUnitsRowUnderTheNames) {
   EXPECT_DOUBLE_EQ(c.segments[0].height[0], 30e-9);
   EXPECT_DOUBLE_EQ(c.segments[0].deflection[0], 5e-12);
   // A last column with values is data, not a separator: the two-cell line is then no header.
-  const std::string msg = error_of("Height (nm)\tDefl (nm)\n30\t0\t1\n10\t2\t1\n20\t0\t1\n");
+  const std::string msg = text_error_of("Height (nm)\tDefl (nm)\n30\t0\t1\n10\t2\t1\n20\t0\t1\n");
   EXPECT_NE(msg.find("has no unit (no header row)"), std::string::npos) << msg;
 }
 
@@ -251,7 +251,7 @@ TEST(CurvesText, SegmentColumnWithPaddingRows) {
   const auto c = parse("Height (nm),Defl (nm),Segment\n30,0,0\n10,2,0\n10,2,1\n30,0,1\n,,\n")[0];
   ASSERT_EQ(c.segments.size(), 2u);
   EXPECT_EQ(c.segments[1].size(), 2u);
-  EXPECT_NE(error_of("Height (nm),Defl (nm),Segment\n30,0,0\n10,2,\n10,2,1\n").find("line 3, column 3: the segment "
+  EXPECT_NE(text_error_of("Height (nm),Defl (nm),Segment\n30,0,0\n10,2,\n10,2,1\n").find("line 3, column 3: the segment "
                                                                                      "column has no value"),
             std::string::npos);
 }

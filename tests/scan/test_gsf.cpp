@@ -35,7 +35,7 @@ std::string gsf(const std::string& header, const std::vector<float>& values) {
 }
 
 // The message of the InputError raised by parsing `bytes` as file `name` ("" when none is raised).
-std::string error_of(const std::string& bytes, const std::string& name = "bad.gsf") {
+std::string gsf_error_of(const std::string& bytes, const std::string& name = "bad.gsf") {
   try {
     afmkit::scan::parse_gsf(bytes, name);
   } catch (const InputError& e) {
@@ -45,7 +45,7 @@ std::string error_of(const std::string& bytes, const std::string& name = "bad.gs
 }
 
 void expect_error(const std::string& bytes, std::initializer_list<const char*> parts) {
-  const std::string message = error_of(bytes, "dir/bad.gsf");
+  const std::string message = gsf_error_of(bytes, "dir/bad.gsf");
   ASSERT_FALSE(message.empty()) << "accepted";
   EXPECT_NE(message.find("dir/bad.gsf"), std::string::npos) << message;
   for (const char* p : parts) EXPECT_NE(message.find(p), std::string::npos) << "'" << p << "' not in: " << message;

@@ -32,7 +32,7 @@ std::string gxyzf(const std::string& header, const std::vector<double>& values) 
   return out;
 }
 
-void expect_error(const std::string& bytes, std::initializer_list<const char*> parts) {
+void expect_gxyzf_error(const std::string& bytes, std::initializer_list<const char*> parts) {
   try {
     afmkit::scan::parse_gxyzf(bytes, "dir/bad.gxyzf");
     ADD_FAILURE() << "accepted";
@@ -103,22 +103,22 @@ TEST(Gxyzf, HandMadeFileWithACommonZUnitsAndGridHints) {
 
 TEST(Gxyzf, EveryBadInputNamesTheFileAndTheField) {
   const std::vector<double> one{0, 0, 1};
-  expect_error("Gwyddion XYZ Field 2.0\nNChannels = 1\n", {"Gwyddion XYZ Field 1.0"});
-  expect_error(gxyzf("NPoints = 1\n", one), {"missing", "NChannels"});
-  expect_error(gxyzf("NChannels = 1\n", one), {"missing", "NPoints"});
-  expect_error(gxyzf("NChannels = 0\nNPoints = 1\n", one), {":2:", "NChannels", "'0'"});
-  expect_error(gxyzf("NChannels = 1025\nNPoints = 1\n", one), {"NChannels", "1024"});
-  expect_error(gxyzf("NChannels = 1\nNPoints = 1e3\n", one), {":3:", "NPoints", "'1e3'"});
-  expect_error(gxyzf("NChannels = 1\nNPoints = 2\n", one), {"size mismatch", "NPoints · (NChannels + 2) = 2 · 3", "truncated"});
-  expect_error(gxyzf("NChannels = 1\nNPoints = 1\n", {0, 0, 1, 2}), {"size mismatch", "too long"});
-  expect_error(gxyzf("NChannels = 1\nNPoints = 1\n", {0, NAN, 1}), {"point 0", "y", "not finite"});
-  expect_error(gxyzf("NChannels = 2\nNPoints = 1\n", {0, 0, 1, INFINITY}), {"point 0", "z2", "not finite"});
-  expect_error(gxyzf("NChannels = 1\nNPoints = 1\nTitle1 = a\tb\n", one), {"Title1", "control character"});
-  expect_error(gxyzf("NChannels = 1\nNPoints = 1\nNPoints = 1\n", one), {"duplicate", "NPoints"});
-  expect_error("Gwyddion XYZ Field 1.0\nNChannels = 1\nNPoints = 1\n", {"bad padding", "no NUL"});
+  expect_gxyzf_error("Gwyddion XYZ Field 2.0\nNChannels = 1\n", {"Gwyddion XYZ Field 1.0"});
+  expect_gxyzf_error(gxyzf("NPoints = 1\n", one), {"missing", "NChannels"});
+  expect_gxyzf_error(gxyzf("NChannels = 1\n", one), {"missing", "NPoints"});
+  expect_gxyzf_error(gxyzf("NChannels = 0\nNPoints = 1\n", one), {":2:", "NChannels", "'0'"});
+  expect_gxyzf_error(gxyzf("NChannels = 1025\nNPoints = 1\n", one), {"NChannels", "1024"});
+  expect_gxyzf_error(gxyzf("NChannels = 1\nNPoints = 1e3\n", one), {":3:", "NPoints", "'1e3'"});
+  expect_gxyzf_error(gxyzf("NChannels = 1\nNPoints = 2\n", one), {"size mismatch", "NPoints · (NChannels + 2) = 2 · 3", "truncated"});
+  expect_gxyzf_error(gxyzf("NChannels = 1\nNPoints = 1\n", {0, 0, 1, 2}), {"size mismatch", "too long"});
+  expect_gxyzf_error(gxyzf("NChannels = 1\nNPoints = 1\n", {0, NAN, 1}), {"point 0", "y", "not finite"});
+  expect_gxyzf_error(gxyzf("NChannels = 2\nNPoints = 1\n", {0, 0, 1, INFINITY}), {"point 0", "z2", "not finite"});
+  expect_gxyzf_error(gxyzf("NChannels = 1\nNPoints = 1\nTitle1 = a\tb\n", one), {"Title1", "control character"});
+  expect_gxyzf_error(gxyzf("NChannels = 1\nNPoints = 1\nNPoints = 1\n", one), {"duplicate", "NPoints"});
+  expect_gxyzf_error("Gwyddion XYZ Field 1.0\nNChannels = 1\nNPoints = 1\n", {"bad padding", "no NUL"});
   std::string header = "Gwyddion XYZ Field 1.0\nNChannels = 1\nNPoints = 1\n";  // 23+14+12 = 49: 7 NULs needed
-  expect_error(header + std::string(3, '\0') + le64(0.1) + le64(0.2) + le64(0.3), {"bad padding", "byte 52"});
-  expect_error(header + std::string(15, '\0') + le64(0.1) + le64(0.2) + le64(0.3), {"bad padding", "15 NUL bytes"});
+  expect_gxyzf_error(header + std::string(3, '\0') + le64(0.1) + le64(0.2) + le64(0.3), {"bad padding", "byte 52"});
+  expect_gxyzf_error(header + std::string(15, '\0') + le64(0.1) + le64(0.2) + le64(0.3), {"bad padding", "15 NUL bytes"});
 }
 
 TEST(Gxyzf, ConstructorNamesTheBadField) {

@@ -32,7 +32,7 @@ std::string other_png(png_uint_32 format, int width = 3, int height = 2) {
   return out;
 }
 
-std::string error_of(const std::string& bytes) {
+std::string png_error_of(const std::string& bytes) {
   try {
     afmkit::scan::parse_png16(bytes, "dir/x.png");
   } catch (const InputError& e) {
@@ -102,24 +102,24 @@ TEST(Png16, ScalingOfTheFiniteRangeAndInvalidPixels) {
 }
 
 TEST(Png16, OtherPngsAndNonPngsAreRefusedWithWhatWasFound) {
-  std::string m = error_of(other_png(PNG_FORMAT_RGB));
+  std::string m = png_error_of(other_png(PNG_FORMAT_RGB));
   EXPECT_NE(m.find("dir/x.png: not a 16-bit greyscale PNG: bit depth 8, colour type 2 (RGB)"), std::string::npos) << m;
-  m = error_of(other_png(PNG_FORMAT_GRAY));
+  m = png_error_of(other_png(PNG_FORMAT_GRAY));
   EXPECT_NE(m.find("bit depth 8, colour type 0 (greyscale)"), std::string::npos) << m;
-  m = error_of(other_png(PNG_FORMAT_LINEAR_Y_ALPHA));
+  m = png_error_of(other_png(PNG_FORMAT_LINEAR_Y_ALPHA));
   EXPECT_NE(m.find("bit depth 16, colour type 4 (greyscale with alpha)"), std::string::npos) << m;
-  m = error_of("Gwyddion Simple Field 1.0\n");
+  m = png_error_of("Gwyddion Simple Field 1.0\n");
   EXPECT_NE(m.find("dir/x.png: not a PNG file"), std::string::npos) << m;
-  EXPECT_NE(error_of("").find("not a PNG"), std::string::npos);
+  EXPECT_NE(png_error_of("").find("not a PNG"), std::string::npos);
 
   Grey16 img{64, 64, std::vector<std::uint16_t>(64 * 64)};
   for (std::size_t k = 0; k < img.pixels.size(); ++k) img.pixels[k] = static_cast<std::uint16_t>(k * 2654435761u);
   const std::string good = afmkit::scan::format_png16(img);
-  m = error_of(good.substr(0, good.size() / 2));  // truncated
+  m = png_error_of(good.substr(0, good.size() / 2));  // truncated
   EXPECT_NE(m.find("dir/x.png: bad PNG"), std::string::npos) << m;
   std::string corrupt = good;
   corrupt[good.size() / 2] = static_cast<char>(corrupt[good.size() / 2] ^ 0x55);  // inside IDAT: CRC mismatch
-  m = error_of(corrupt);
+  m = png_error_of(corrupt);
   EXPECT_NE(m.find("dir/x.png: bad PNG"), std::string::npos) << m;
 }
 

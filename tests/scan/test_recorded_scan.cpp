@@ -19,7 +19,6 @@
 
 namespace {
 using namespace afmkit::scan;
-constexpr double kPi = std::numbers::pi;
 
 // 50 Hz spindle, 4 kHz sampling (80 samples per turn), 60 turns from 1 mm outwards at 0.2 µm per turn:
 // d = 1 µm·(r/1 mm) sin(θ + 0.3) (tilt) + 20 nm sin(2θ + 1) + 10 nm cos 3θ + 5 nm.
@@ -33,11 +32,11 @@ void write_recording(const std::string& path, bool index_pulse) {
   std::ofstream f(path);
   f << (index_pulse ? "time,radius,index,deflection\n" : "time,radius,angle,deflection\n");
   for (int n = 0; n <= kPerTurn * kTurns; ++n) {
-    const double t = n / 4000.0, theta = 2 * kPi * 50 * t, r = 1e-3 + 0.2e-6 * 50 * t;
+    const double t = n / 4000.0, theta = 2 * std::numbers::pi * 50 * t, r = 1e-3 + 0.2e-6 * 50 * t;
     if (index_pulse)
       f << fmt::format("{},{},{},{}\n", t, r, n % kPerTurn == 0 ? 1 : 0, signal(theta, r));
     else
-      f << fmt::format("{},{},{},{}\n", t, r, std::fmod(theta, 2 * kPi), signal(theta, r));
+      f << fmt::format("{},{},{},{}\n", t, r, std::fmod(theta, 2 * std::numbers::pi), signal(theta, r));
   }
 }
 
@@ -68,7 +67,7 @@ TEST(RecordedScan, RemovesTheFirstHarmonicKeepsTheOthers) {
   o.extra = &rec;
   o.on_turn = [&](const TurnRecord& r) { turns.push_back(r); };
   const RecordedScan scan = filter_recorded_scan(path, RecordedFilterSpec{}, 64, o);
-  EXPECT_NEAR(scan.survey.rotation_frequency, 2 * kPi * 50, 1e-9);
+  EXPECT_NEAR(scan.survey.rotation_frequency, 2 * std::numbers::pi * 50, 1e-9);
   EXPECT_NEAR(scan.survey.sample_rate, 4000, 1e-9);
   EXPECT_EQ(scan.survey.samples, kPerTurn * kTurns + 1);
   ASSERT_EQ(rec.samples.size(), static_cast<std::size_t>(kPerTurn * kTurns + 1));
@@ -111,8 +110,8 @@ TEST(RecordedScan, IsTheRealtimeFilterInTheVirtualLoop) {
   RecordedScanOptions o;
   o.extra = &rec;
   filter_recorded_scan(path, RecordedFilterSpec{7, 0.2, -0.05}, 64, o);
-  auto f = afmkit::control::RealtimeFilter::with_couplings(4000, 2 * kPi * 50, 7, 0.2 * 2 * kPi * 50,
-                                                           -0.05 * 2 * kPi * 50, 3.0);  // any K
+  auto f = afmkit::control::RealtimeFilter::with_couplings(4000, 2 * std::numbers::pi * 50, 7, 0.2 * 2 * std::numbers::pi * 50,
+                                                           -0.05 * 2 * std::numbers::pi * 50, 3.0);  // any K
   double previous = 0;
   double worst = 0;
   for (const ScanSample& s : rec.samples) {
@@ -141,7 +140,7 @@ TEST(RecordedScan, IndexPulseRecordingGivesTheSameSignal) {
   // later, so the tilt-free signals agree once both have converged
   for (std::size_t i = 0; i < b.samples.size(); i += 97) {
     const ScanSample& x = a.samples[i + kPerTurn];
-    EXPECT_NEAR(std::remainder(b.samples[i].angle - x.angle, 2 * kPi), 0.0, 1e-9);
+    EXPECT_NEAR(std::remainder(b.samples[i].angle - x.angle, 2 * std::numbers::pi), 0.0, 1e-9);
     EXPECT_EQ(b.samples[i].deflection, x.deflection);
     if (i > 40 * kPerTurn) {
       EXPECT_NEAR(b.samples[i].topography, x.topography, 1e-3 * 1e-6);
@@ -175,9 +174,9 @@ TEST(RecordedScan, EveryTurnsRadialSpreadIsSurveyedTheLastPartialOneToo) {
     std::ofstream f(dir.file(name));
     f << "time,radius,angle,deflection\n";
     for (int n = 0; n < samples; ++n) {
-      const double t = n / 4000.0, theta = 2 * kPi * 50 * t;
+      const double t = n / 4000.0, theta = 2 * std::numbers::pi * 50 * t;
       const double r = n == outlier ? 2e-3 : 1e-3 + 0.2e-6 * 50 * t;
-      f << fmt::format("{},{},{},{}\n", t, r, std::fmod(theta, 2 * kPi), 0.0);
+      f << fmt::format("{},{},{},{}\n", t, r, std::fmod(theta, 2 * std::numbers::pi), 0.0);
     }
     return dir.file(name);
   };

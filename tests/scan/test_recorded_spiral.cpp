@@ -79,7 +79,7 @@ std::vector<SpiralSample> read_all(RecordedSpiralReader& r) {
 }
 
 /// The message of the InputError raised while reading `text` to the end ("" when none).
-std::string error_of(const std::string& text) {
+std::string spiral_error_of(const std::string& text) {
   try {
     auto r = reader_of(text);
     read_all(r);
@@ -247,81 +247,81 @@ TEST(RecordedSpiral, CommentsBlankLinesCrLfBomAndHeaderCase) {
 }
 
 TEST(RecordedSpiral, HeaderErrorsNameLineAndColumn) {
-  EXPECT_EQ(error_of(""), "rec.csv: no header line: a recorded spiral starts with a line naming its columns "
+  EXPECT_EQ(spiral_error_of(""), "rec.csv: no header line: a recorded spiral starts with a line naming its columns "
                           "(time, radius, deflection and angle or index)");
-  EXPECT_EQ(error_of("# only a comment\n\n"), error_of(""));
-  EXPECT_NE(error_of("0,1,2,3\n").find("rec.csv:1: the first line holds numbers, not column names"),
+  EXPECT_EQ(spiral_error_of("# only a comment\n\n"), spiral_error_of(""));
+  EXPECT_NE(spiral_error_of("0,1,2,3\n").find("rec.csv:1: the first line holds numbers, not column names"),
             std::string::npos);
-  EXPECT_EQ(error_of("# c\ntime,angle,deflection\n"),
+  EXPECT_EQ(spiral_error_of("# c\ntime,angle,deflection\n"),
             "rec.csv:2: missing column 'radius' (the header must name time, radius, deflection and one of angle / "
             "index)");
-  EXPECT_EQ(error_of("angle,radius,deflection\n").substr(0, 36), "rec.csv:1: missing column 'time' (th");
-  EXPECT_EQ(error_of("time,angle,radius,TIME,deflection\n"),
+  EXPECT_EQ(spiral_error_of("angle,radius,deflection\n").substr(0, 36), "rec.csv:1: missing column 'time' (th");
+  EXPECT_EQ(spiral_error_of("time,angle,radius,TIME,deflection\n"),
             "rec.csv:1: duplicate column 'time' (columns 1 and 4 of the header)");
-  EXPECT_EQ(error_of("time,angle,radius,deflection,index\n"),
+  EXPECT_EQ(spiral_error_of("time,angle,radius,deflection,index\n"),
             "rec.csv:1: both an 'angle' column (2) and an 'index' column (5): give exactly one");
-  EXPECT_EQ(error_of("time,radius,deflection,position\n"),
+  EXPECT_EQ(spiral_error_of("time,radius,deflection,position\n"),
             "rec.csv:1: neither an 'angle' nor an 'index' column: give exactly one (angle [rad] or index pulse 0/1)");
-  EXPECT_EQ(error_of("time,angle,radius,deflection\n# nothing\n"),
+  EXPECT_EQ(spiral_error_of("time,angle,radius,deflection\n# nothing\n"),
             "rec.csv:1: no data rows after the header: a recorded spiral needs at least two revolutions");
 }
 
 TEST(RecordedSpiral, CellErrorsNameLineAndColumn) {
   const std::string h = "time,angle,radius,deflection\n";  // data row k is line k + 2
-  EXPECT_EQ(error_of(h + "0,0,1e-6,0\n0.01,0.5,abc,0\n"), "rec.csv:3: column 'radius': 'abc' is not a finite number");
-  EXPECT_EQ(error_of(h + "0,nan,1e-6,0\n"), "rec.csv:2: column 'angle': 'nan' is not a finite number");
-  EXPECT_EQ(error_of(h + "inf,0,1e-6,0\n"), "rec.csv:2: column 'time': 'inf' is not a finite number");
-  EXPECT_EQ(error_of(h + "0,0,1e-6, \n"), "rec.csv:2: column 'deflection': empty cell");
-  EXPECT_EQ(error_of(h + "0,0,1e-6,0\n0.01,0.5,1e-6\n"),
+  EXPECT_EQ(spiral_error_of(h + "0,0,1e-6,0\n0.01,0.5,abc,0\n"), "rec.csv:3: column 'radius': 'abc' is not a finite number");
+  EXPECT_EQ(spiral_error_of(h + "0,nan,1e-6,0\n"), "rec.csv:2: column 'angle': 'nan' is not a finite number");
+  EXPECT_EQ(spiral_error_of(h + "inf,0,1e-6,0\n"), "rec.csv:2: column 'time': 'inf' is not a finite number");
+  EXPECT_EQ(spiral_error_of(h + "0,0,1e-6, \n"), "rec.csv:2: column 'deflection': empty cell");
+  EXPECT_EQ(spiral_error_of(h + "0,0,1e-6,0\n0.01,0.5,1e-6\n"),
             "rec.csv:3: ragged row: 3 cells, the header (line 1) names 4 columns");
-  EXPECT_EQ(error_of(h + "0,0,1e-6,0,7\n"), "rec.csv:2: ragged row: 5 cells, the header (line 1) names 4 columns");
-  EXPECT_EQ(error_of(h + "0,0,-1e-06,0\n"),
+  EXPECT_EQ(spiral_error_of(h + "0,0,1e-6,0,7\n"), "rec.csv:2: ragged row: 5 cells, the header (line 1) names 4 columns");
+  EXPECT_EQ(spiral_error_of(h + "0,0,-1e-06,0\n"),
             "rec.csv:2: column 'radius': -1e-06 m is negative (the distance from the spindle axis is >= 0)");
   const std::string hi = "time,index,radius,deflection\n";
-  EXPECT_EQ(error_of(hi + "0,0,1,0\n1,2,1,0\n"),
+  EXPECT_EQ(spiral_error_of(hi + "0,0,1,0\n1,2,1,0\n"),
             "rec.csv:3: column 'index': 2 is not 0 or 1 (the index pulse is a logic level)");
-  EXPECT_EQ(error_of(hi + "0,0.5,1,0\n"),
+  EXPECT_EQ(spiral_error_of(hi + "0,0.5,1,0\n"),
             "rec.csv:2: column 'index': 0.5 is not 0 or 1 (the index pulse is a logic level)");
 }
 
 TEST(RecordedSpiral, TimeErrorsNameLineAndColumn) {
   const std::string h = "time,angle,radius,deflection\n";
-  EXPECT_EQ(error_of(h + "0,0,1,0\n0.002,0.5,1,0\n0.001,1,1,0\n"),
+  EXPECT_EQ(spiral_error_of(h + "0,0,1,0\n0.002,0.5,1,0\n0.001,1,1,0\n"),
             "rec.csv:4: column 'time': 0.001 s is not after the previous sample's 0.002 s (line 3): time must "
             "increase strictly");
-  EXPECT_EQ(error_of(h + "0,0,1,0\n0,0.5,1,0\n"),
+  EXPECT_EQ(spiral_error_of(h + "0,0,1,0\n0,0.5,1,0\n"),
             "rec.csv:3: column 'time': 0 s is not after the previous sample's 0 s (line 2): time must increase "
             "strictly");
   // Δt0 = 0.01; 0.0101 is off by 1 %, beyond 0.1 %; 0.010005 (0.05 %) is accepted.
   char interval[32];  // the shortest text that reads back to the double 0.0301 − 0.02
   *std::to_chars(interval, interval + 31, 0.0301 - 0.02).ptr = '\0';
-  EXPECT_EQ(error_of(h + "0,0,1,0\n0.01,0.5,1,0\n0.02,1,1,0\n0.0301,1.5,1,0\n"),
+  EXPECT_EQ(spiral_error_of(h + "0,0,1,0\n0.01,0.5,1,0\n0.02,1,1,0\n0.0301,1.5,1,0\n"),
             std::string("rec.csv:5: column 'time': non-uniform sampling: the interval ") + interval +
                 " s from line 4 differs from the first interval 0.01 s (line 3) by more than 0.1 %");
   std::string jitter = h;
   for (int k = 0; k < 40; ++k) jitter += g17(0.01 * k + (k % 2 ? 5e-6 : 0.0)) + "," + g17(0.5 * k) + ",1,0\n";
-  EXPECT_EQ(error_of(jitter), "");
+  EXPECT_EQ(spiral_error_of(jitter), "");
 }
 
 TEST(RecordedSpiral, AngleErrorsNameLineAndColumn) {
   const std::string h = "time,angle,radius,deflection\n";
-  EXPECT_EQ(error_of(h + "0,1,1,0\n0.01,1.5,1,0\n0.02,1.4,1,0\n"),
+  EXPECT_EQ(spiral_error_of(h + "0,1,1,0\n0.01,1.5,1,0\n0.02,1.4,1,0\n"),
             "rec.csv:4: column 'angle': the spindle goes backwards or stands still: 1.4 rad after 1.5 rad on the "
             "previous sample, 1.4 rad after 1.5 rad unwrapped (a step below -pi counts as one wrap)");
-  EXPECT_NE(error_of(h + "0,1,1,0\n0.01,1,1,0\n").find("rec.csv:3: column 'angle': the spindle goes backwards or "
+  EXPECT_NE(spiral_error_of(h + "0,1,1,0\n0.01,1,1,0\n").find("rec.csv:3: column 'angle': the spindle goes backwards or "
                                                        "stands still"),
             std::string::npos);
   // A step of −7 is one wrap (+2π) and still −0.72: backwards.
-  EXPECT_NE(error_of(h + "0,3,1,0\n0.01,-4,1,0\n").find("rec.csv:3: column 'angle': the spindle goes backwards"),
+  EXPECT_NE(spiral_error_of(h + "0,3,1,0\n0.01,-4,1,0\n").find("rec.csv:3: column 'angle': the spindle goes backwards"),
             std::string::npos);
   // Less than one revolution: at construction; 1.5 revolutions: when the end is reached (line of the last row).
-  EXPECT_EQ(error_of(good_rows(10)),
+  EXPECT_EQ(spiral_error_of(good_rows(10)),
             "rec.csv:11: column 'angle': the data end after 0.716 revolutions: a recorded spiral needs at least two "
             "revolutions");
-  EXPECT_EQ(error_of(good_rows(20) + "# trailing comment\n"),
+  EXPECT_EQ(spiral_error_of(good_rows(20) + "# trailing comment\n"),
             "rec.csv:21: column 'angle': the data end after 1.512 revolutions: a recorded spiral needs at least two "
             "revolutions");
-  EXPECT_EQ(error_of(good_rows(27)), "");  // 13 rad > 4π
+  EXPECT_EQ(spiral_error_of(good_rows(27)), "");  // 13 rad > 4π
 }
 
 TEST(RecordedSpiral, IndexModeNeedsThreeEdges) {
@@ -330,7 +330,7 @@ TEST(RecordedSpiral, IndexModeNeedsThreeEdges) {
     for (std::size_t k = 0; k < levels.size(); ++k) text += std::to_string(k) + "," + levels[k] + ",1,0\n";
     return text;
   };
-  EXPECT_EQ(error_of(file("0100")),
+  EXPECT_EQ(spiral_error_of(file("0100")),
             "rec.csv:5: column 'index': the data end after 1 index edge: a recorded spiral needs at least two "
             "revolutions (three index edges)");
   // Two edges: the first revolution is delivered, then the end of the data fails.
@@ -338,11 +338,11 @@ TEST(RecordedSpiral, IndexModeNeedsThreeEdges) {
   SpiralSample x{};
   for (int m = 0; m < 3; ++m) ASSERT_TRUE(r.next(x));
   EXPECT_THROW(r.next(x), InputError);
-  EXPECT_EQ(error_of(file("01001000")),
+  EXPECT_EQ(spiral_error_of(file("01001000")),
             "rec.csv:9: column 'index': the data end after 2 index edges: a recorded spiral needs at least two "
             "revolutions (three index edges)");
-  EXPECT_EQ(error_of(file("010010010")), "");
-  EXPECT_EQ(error_of(file("111")).substr(0, 51), "rec.csv:4: column 'index': the data end after 0 ind");
+  EXPECT_EQ(spiral_error_of(file("010010010")), "");
+  EXPECT_EQ(spiral_error_of(file("111")).substr(0, 51), "rec.csv:4: column 'index': the data end after 0 ind");
 }
 
 TEST(RecordedSpiral, LateErrorComesFromNextWithItsLineAndStays) {
@@ -369,7 +369,7 @@ TEST(RecordedSpiral, LateErrorComesFromNextWithItsLineAndStays) {
 
 TEST(RecordedSpiral, OverlongLineIsRejected) {
   const std::string text = "time,angle,radius,deflection\n0,0,1," + std::string(1 << 20, '0') + "\n";
-  EXPECT_EQ(error_of(text), "rec.csv:2: line longer than 1048576 bytes (not a recorded spiral CSV?)");
+  EXPECT_EQ(spiral_error_of(text), "rec.csv:2: line longer than 1048576 bytes (not a recorded spiral CSV?)");
 }
 
 TEST(RecordedSpiral, FilesByPath) {
@@ -406,11 +406,11 @@ TEST(RecordedSpiral, FilesByPath) {
 // (nan in every output row); deflections are bounded like the sample heights, [-1, 1] m, naming line and column.
 TEST(RecordedSpiral, ADeflectionBeyondOneMetreIsRefusedNamingLineAndColumn) {
   const std::string h = "time,angle,radius,deflection\n";
-  EXPECT_EQ(error_of(h + "0,0,1e-6,0\n0.01,0.5,1e-6,8.39e197\n"),
+  EXPECT_EQ(spiral_error_of(h + "0,0,1e-6,0\n0.01,0.5,1e-6,8.39e197\n"),
             "rec.csv:3: column 'deflection': 8.39e+197 m is out of range: a recorded deflection must lie in [-1, 1] m");
-  EXPECT_EQ(error_of(h + "0,0,1e-6,-1.5\n"),
+  EXPECT_EQ(spiral_error_of(h + "0,0,1e-6,-1.5\n"),
             "rec.csv:2: column 'deflection': -1.5 m is out of range: a recorded deflection must lie in [-1, 1] m");
-  EXPECT_EQ(error_of(h + "0,0,1e-6,-1\n"), "rec.csv:2: column 'angle': the data end after 0.000 revolutions: a recorded "
+  EXPECT_EQ(spiral_error_of(h + "0,0,1e-6,-1\n"), "rec.csv:2: column 'angle': the data end after 0.000 revolutions: a recorded "
                                            "spiral needs at least two revolutions")
       << "a deflection of exactly 1 m is accepted (the error is the next rule's)";
 }

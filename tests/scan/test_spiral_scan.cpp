@@ -16,11 +16,10 @@
 
 namespace {
 using namespace afmkit::scan;
-constexpr double kPi = std::numbers::pi;
 
 Surface flat_tilted(double half_size, double tilt_deg, double azimuth_deg = 0.0) {
   const Grid g{64, 64, 2 * half_size, 2 * half_size, -half_size, -half_size};
-  return Surface(flat(g), Tilt(tilt_deg * kPi / 180, azimuth_deg * kPi / 180));
+  return Surface(flat(g), Tilt(tilt_deg * std::numbers::pi / 180, azimuth_deg * std::numbers::pi / 180));
 }
 
 // A small, fast instrument: 50 Hz, 400 samples per turn, a ring of radii (slow radial speed).
@@ -34,7 +33,7 @@ InstrumentSpec ring(double r0, double r1, double turns) {
   return s;
 }
 
-struct Recorder final : ScanObserver {
+struct SpiralRecorder final : ScanObserver {
   std::vector<ScanSample> samples;
   bool sample(const ScanSample& s) override {
     samples.push_back(s);
@@ -49,7 +48,7 @@ std::complex<double> harmonic(const std::vector<ScanSample>& v, long turn, int k
   std::complex<double> sum = 0;
   long n = 0;
   for (const ScanSample& s : v)
-    if (static_cast<long>(std::floor(s.angle / (2 * kPi) + 1e-9)) == turn) {
+    if (static_cast<long>(std::floor(s.angle / (2 * std::numbers::pi) + 1e-9)) == turn) {
       sum += value(s) * std::exp(std::complex<double>(0, -k * s.angle));
       ++n;
     }
@@ -66,7 +65,7 @@ TEST(SpiralScan, UncontrolledDeflectionIsTheTiltThroughThePlantResponse) {
   simulate_scan(s, surface, metrics);
   ASSERT_GE(turns.size(), 30u);
   const double omega = s.spiral.rotation_frequency(), gamma = s.plant.bandwidth;
-  const double expected = 1e-3 * std::tan(0.05 * kPi / 180) * gamma / std::hypot(gamma, omega);
+  const double expected = 1e-3 * std::tan(0.05 * std::numbers::pi / 180) * gamma / std::hypot(gamma, omega);
   // ZOH of f over h = 50 µs: the response is γ/(γ+iΩ) e^{−iΩh/2} sinc-like to O((Ωh)²) ≈ 2e-4
   EXPECT_NEAR(turns.back().deflection_first_harmonic / expected, 1.0, 3e-4);
   EXPECT_NEAR(turns.back().surface_first_harmonic / (turns.back().radius * surface.tilt().slope()), 1.0, 1e-9);
@@ -83,7 +82,7 @@ TEST(SpiralScan, ReconstructionEqualsTheUncontrolledDeflectionAndGainErrorShowsE
   off.controller.enabled = false;
   for (double eps : {0.0, 0.1}) {
     s.plant.gain_error = eps;
-    Recorder on, reference;
+    SpiralRecorder on, reference;
     simulate_scan(s, surface, on);
     simulate_scan(off, surface, reference);
     ASSERT_EQ(on.samples.size(), reference.samples.size());
@@ -112,9 +111,9 @@ TEST(SpiralScan, ControllerRemovesTheFirstHarmonicAndKeepsTheSecond) {
       z[j * n + i] = c * (x * x - y * y) / half;
     }
   // bilinear interpolation of a quadratic is exact up to dx²/4 · |∂²z| = c dx²/(2 half) ≈ 5e-15 m: negligible
-  const Surface surface(HeightMap(g, z), Tilt(0.05 * kPi / 180, 0.0));
+  const Surface surface(HeightMap(g, z), Tilt(0.05 * std::numbers::pi / 180, 0.0));
   InstrumentSpec s = ring(r, r + 1e-12, 60);
-  Recorder rec;
+  SpiralRecorder rec;
   simulate_scan(s, surface, rec);
   const long last = 58;
   const auto y = [](const ScanSample& v) { return v.deflection; };
@@ -156,7 +155,7 @@ TEST(SpiralScan, NoiseHasTheRequestedRmsAndIsReproducible) {
   s.controller.enabled = false;
   s.detector.noise = 1e-9;
   const Surface surface = flat_tilted(2e-3, 0.0);
-  Recorder a, b;
+  SpiralRecorder a, b;
   simulate_scan(s, surface, a);
   simulate_scan(s, surface, b);
   double sum = 0;
@@ -170,7 +169,7 @@ TEST(SpiralScan, NoiseHasTheRequestedRmsAndIsReproducible) {
 
 TEST(SpiralScan, BadInstrumentIsNamed) {
   const Surface surface = flat_tilted(2e-3, 0.05);
-  Recorder rec;
+  SpiralRecorder rec;
   const auto param = [&](InstrumentSpec s) {
     try {
       simulate_scan(s, surface, rec);
@@ -202,7 +201,7 @@ TEST(SpiralScan, BadInstrumentIsNamed) {
   t.spiral.sample_rate = 100;  // 2 samples per turn
   EXPECT_EQ(param(t), "sample_rate");
   EXPECT_TRUE(rec.samples.empty());
-  EXPECT_THROW(Tilt(kPi / 2, 0.0), afmkit::InvalidParameter);
+  EXPECT_THROW(Tilt(std::numbers::pi / 2, 0.0), afmkit::InvalidParameter);
 }
 
 }  // namespace

@@ -12,7 +12,6 @@
 
 namespace {
 using namespace afmkit::scan;
-constexpr double kPi = std::numbers::pi;
 
 // 50 Hz, 400 samples per turn, 4 mm disc at 20 µm pitch: 200 turns, 80 000 samples.
 InstrumentSpec small_scan() {
@@ -25,7 +24,7 @@ InstrumentSpec small_scan() {
 
 Surface rough_tilted(double half, double tilt_deg) {
   const Grid g{512, 512, 2 * half, 2 * half, -half, -half};
-  return Surface(rough(g, RoughSpec{20e-9, 400e-6, 3}), Tilt(tilt_deg * kPi / 180, 0.3));
+  return Surface(rough(g, RoughSpec{20e-9, 400e-6, 3}), Tilt(tilt_deg * std::numbers::pi / 180, 0.3));
 }
 
 TEST(VirtualScan, ImagesCoverTheDiscAndTheReconstructionMatchesTheTruth) {
@@ -60,7 +59,7 @@ TEST(VirtualScan, ImagesCoverTheDiscAndTheReconstructionMatchesTheTruth) {
   // turns and 62.5 µm pixels of a surface correlated over 400 µm: (20/400)² · 20 nm ≈ 0.05 nm; and the sample's own
   // bilinear map at 16 µm pixels)
   InstrumentSpec fast = s;
-  fast.plant.bandwidth = 2 * kPi * 1e6;
+  fast.plant.bandwidth = 2 * std::numbers::pi * 1e6;
   fast.controller.enabled = false;
   fast.detector.range = 1e-3;
   const VirtualScan w = run_virtual_scan(fast, surface, grid);

@@ -17,7 +17,7 @@ using namespace afmkit::spectroscopy;
 
 namespace {
 
-FitSettings settings() { return afmkit_test::fit_settings(); }
+FitSettings model_settings() { return afmkit_test::fit_settings(); }
 
 FitOptions dmt() {
   FitOptions o;
@@ -48,7 +48,7 @@ TEST(FitModel, ApproachAndRetractMatchTheInstrumentSweep) {
   o.shooting_tolerance = 1e-11;
   std::vector<double> z;
   for (double l : l_nm) z.push_back(l * 1e-9 - 0.5e-9);
-  FitSettings q100 = settings();
+  FitSettings q100 = model_settings();
   q100.quality_factor = 100.0;
   const AmPrediction pred = predict_am_curve(z, q100, o);
   int touching = 0;
@@ -76,9 +76,9 @@ TEST(FitModel, ApproachAndRetractMatchTheInstrumentSweep) {
 TEST(FitModel, CalibrationEntersAsDocumented) {
   std::vector<double> z = {12e-9, 8e-9, 6e-9, 5e-9};
   FitOptions o = dmt();
-  const AmPrediction a = predict_am_curve(z, settings(), o);
+  const AmPrediction a = predict_am_curve(z, model_settings(), o);
   o.initial["phase_offset"] = 0.25;
-  const AmPrediction b = predict_am_curve(z, settings(), o);
+  const AmPrediction b = predict_am_curve(z, model_settings(), o);
   for (std::size_t i = 0; i < z.size(); ++i) {
     EXPECT_DOUBLE_EQ(a.amplitude[i], b.amplitude[i]);
     EXPECT_NEAR(std::remainder(b.phase[i] - a.phase[i] - 0.25, 2 * M_PI), 0.0, 1e-12);
@@ -86,7 +86,7 @@ TEST(FitModel, CalibrationEntersAsDocumented) {
   // amplitude_scale s: the model runs at A0·s and predicts A_model/s; far from the sample A/A0 is unchanged
   o = dmt();
   o.initial["amplitude_scale"] = 1.2;
-  const AmPrediction c = predict_am_curve({40e-9, 39e-9, 38e-9}, settings(), o);
+  const AmPrediction c = predict_am_curve({40e-9, 39e-9, 38e-9}, model_settings(), o);
   EXPECT_NEAR(c.amplitude[0], 20e-9, 4e-12);
 }
 

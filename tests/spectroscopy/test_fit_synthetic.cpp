@@ -15,16 +15,16 @@ using namespace afmkit::spectroscopy;
 
 namespace {
 
-FitSettings settings() { return afmkit_test::fit_settings(); }
+FitSettings am_settings() { return afmkit_test::fit_settings(); }
 
-constexpr double kHamaker = 1e-19, kModulus = 1e9, kOffset = 0.7e-9, kPhase = 0.1;
+constexpr double kAmHamaker = 1e-19, kAmModulus = 1e9, kAmOffset = 0.7e-9, kPhase = 0.1;
 constexpr double kSigmaA = 0.003, kSigmaP = 0.005;  // A/A0 and rad (0.29°)
 
-FitOptions truth() {
+FitOptions am_truth() {
   FitOptions o;
   o.law = "dmt";
-  o.law_values = {{"effective_modulus", kModulus}, {"tip_radius", 10e-9}, {"hamaker", kHamaker}};
-  o.initial = {{"distance_offset", kOffset}, {"phase_offset", kPhase}};
+  o.law_values = {{"effective_modulus", kAmModulus}, {"tip_radius", 10e-9}, {"hamaker", kAmHamaker}};
+  o.initial = {{"distance_offset", kAmOffset}, {"phase_offset", kPhase}};
   return o;
 }
 
@@ -35,13 +35,13 @@ std::vector<double> distances(double from, double to, int n) {
 }
 
 FitCurve synthetic(const std::vector<double>& z, unsigned seed) {
-  const AmPrediction p = predict_am_curve(z, settings(), truth());
+  const AmPrediction p = predict_am_curve(z, am_settings(), am_truth());
   std::mt19937 rng(seed);
   std::normal_distribution<double> g(0.0, 1.0);
   FitCurve c;
   c.distance = z;
   for (std::size_t i = 0; i < z.size(); ++i) {
-    c.amplitude.push_back(p.amplitude[i] + kSigmaA * settings().free_amplitude * g(rng));
+    c.amplitude.push_back(p.amplitude[i] + kSigmaA * am_settings().free_amplitude * g(rng));
     c.phase.push_back(p.phase[i] + kSigmaP * g(rng));
   }
   return c;
@@ -59,15 +59,15 @@ FitOptions start() {
   return o;
 }
 
-const double kTruth[] = {kHamaker, kModulus, kOffset, kPhase};
+const double kTruth[] = {kAmHamaker, kAmModulus, kAmOffset, kPhase};
 
 }  // namespace
 
 TEST(FitSynthetic, DmtEstimatesNearTheTruth) {
   const FitCurve data = synthetic(distances(4e-9, 21e-9, 60), 7);
-  const FitResult r = fit_am_curve(data, settings(), start());
+  const FitResult r = fit_am_curve(data, am_settings(), start());
   for (std::size_t j = 0; j < r.estimates.size(); ++j)
-    std::printf("%s = %g ± %g (truth %g)\n", r.parameters[j].name.c_str(), r.estimates[j], r.standard_errors[j], kTruth[j]);
+    std::printf("%s = %g ± %g (am_truth %g)\n", r.parameters[j].name.c_str(), r.estimates[j], r.standard_errors[j], kTruth[j]);
   std::printf("rms A %g phase %g, %d it, %ld curves, %ld failed\n", r.rms_amplitude, r.rms_phase, r.iterations, r.curve_evaluations, r.failed_evaluations);
   ASSERT_EQ(r.status, FitStatus::ok) << r.solver_status;
   ASSERT_EQ(r.estimates.size(), 4u);
@@ -79,11 +79,11 @@ TEST(FitSynthetic, DmtEstimatesNearTheTruth) {
     EXPECT_LT(std::abs(r.estimates[j] - kTruth[j]), 3.5 * r.standard_errors[j])
         << r.parameters[j].name << " = " << r.estimates[j] << " ± " << r.standard_errors[j];
   }
-  const AmPrediction at_truth = predict_am_curve(data.distance, settings(), truth());
+  const AmPrediction at_truth = predict_am_curve(data.distance, am_settings(), am_truth());
   double truth_cost = 0.0;
   const auto huber = [](double x) { return std::abs(x) <= 5.0 ? x * x : 10.0 * std::abs(x) - 25.0; };
   for (std::size_t i = 0; i < data.distance.size(); ++i) {
-    truth_cost += huber((data.amplitude[i] - at_truth.amplitude[i]) / settings().free_amplitude / kSigmaA);
+    truth_cost += huber((data.amplitude[i] - at_truth.amplitude[i]) / am_settings().free_amplitude / kSigmaA);
     truth_cost += huber(std::remainder(data.phase[i] - at_truth.phase[i], 2 * M_PI) / kSigmaP);
   }
   EXPECT_LE(r.cost, truth_cost * (1 + 1e-9)) << "the fit stopped above the truth's cost";
@@ -111,10 +111,10 @@ TEST(FitSynthetic, StandardErrorsMatchTheScatterOverSeeds) {
   for (int s = 0; s < seeds; ++s) {
     FitOptions o = start();
     // start at the truth: the scatter, not the convergence, is tested here
-    o.law_values["effective_modulus"] = kModulus;
-    o.law_values["hamaker"] = kHamaker;
-    o.initial = {{"distance_offset", kOffset}, {"phase_offset", kPhase}};
-    const FitResult r = fit_am_curve(synthetic(z, 100 + s), settings(), o);
+    o.law_values["effective_modulus"] = kAmModulus;
+    o.law_values["hamaker"] = kAmHamaker;
+    o.initial = {{"distance_offset", kAmOffset}, {"phase_offset", kPhase}};
+    const FitResult r = fit_am_curve(synthetic(z, 100 + s), am_settings(), o);
     ASSERT_EQ(r.status, FitStatus::ok) << r.solver_status;
     for (int j = 0; j < 4; ++j) {
       est[j].push_back(r.estimates[j]);
@@ -136,7 +136,7 @@ TEST(FitSynthetic, ModulusWithoutContactIsNotIdentifiable) {
   // depend on E*
   const FitCurve data = synthetic(distances(21.5e-9, 28e-9, 30), 3);
   FitOptions o = start();
-  const FitResult r = fit_am_curve(data, settings(), o);
+  const FitResult r = fit_am_curve(data, am_settings(), o);
   for (bool c : r.contact) ASSERT_FALSE(c);
   ASSERT_EQ(r.parameters[1].name, "effective_modulus");
   EXPECT_FALSE(r.identifiable[1]);
@@ -152,7 +152,7 @@ TEST(FitSynthetic, CorrelatedPairIsWarned) {
   const FitCurve data = synthetic(distances(21.5e-9, 28e-9, 30), 5);
   FitOptions o = start();
   o.parameters = {"hamaker", "tip_radius"};
-  const FitResult r = fit_am_curve(data, settings(), o);
+  const FitResult r = fit_am_curve(data, am_settings(), o);
   bool warned = false;
   for (const auto& w : r.warnings) {
     const bool pair = w.find("hamaker") != std::string::npos && w.find("tip_radius") != std::string::npos;

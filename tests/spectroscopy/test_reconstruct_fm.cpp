@@ -17,8 +17,8 @@ namespace sp = afmkit::spectroscopy;
 
 namespace {
 
-constexpr double k = 1800.0;    // qPlus sensor [N/m]
-constexpr double f0 = 25000.0;  // [Hz]
+constexpr double k_qplus = 1800.0;    // qPlus sensor [N/m]
+constexpr double f0_qplus = 25000.0;  // [Hz]
 constexpr double F0 = 1e-9;     // [N]
 constexpr double lambda = 0.1e-9;  // [m]
 
@@ -32,7 +32,7 @@ double forward_midpoint(const F& force, double z, double a) {
     const double th = (i + 0.5) * std::numbers::pi / m;
     sum += force(z + a * (1.0 - std::cos(th))) * std::cos(th);
   }
-  return f0 / (std::numbers::pi * k * a) * sum * std::numbers::pi / m;  // −(f0/πkA)·(−∫ F cos θ dθ)
+  return f0_qplus / (std::numbers::pi * k_qplus * a) * sum * std::numbers::pi / m;  // −(f0/πkA)·(−∫ F cos θ dθ)
 }
 
 double exponential_force(double z) { return -F0 * std::exp(-z / lambda); }
@@ -58,7 +58,7 @@ double max_error(const sp::FmReconstruction& r, double (*law)(double), double z_
 
 TEST(ReconstructFm, ClosedFormsMatchAnIndependentQuadrature) {
   for (double a : {0.01e-9, 0.1e-9, 1e-9, 10e-9}) {
-    const sp::FmSettings s(k, f0, a);
+    const sp::FmSettings s(k_qplus, f0_qplus, a);
     for (double z : {0.05e-9, 0.2e-9, 0.5e-9}) {
       const double exact = sp::exponential_force_frequency_shift(z, F0, lambda, s);
       EXPECT_NEAR(forward_midpoint(exponential_force, z, a), exact, 1e-9 * std::abs(exact)) << a << " " << z;
@@ -66,7 +66,7 @@ TEST(ReconstructFm, ClosedFormsMatchAnIndependentQuadrature) {
       const double vdw = sp::inverse_square_force_frequency_shift(z, c, s);
       EXPECT_NEAR(forward_midpoint([c](double x) { return -c / (x * x); }, z, a), vdw, 1e-6 * std::abs(vdw));
       // the library's forward quadrature
-      EXPECT_NEAR(sp::forward_frequency_shift(exponential_force, z, k, f0, a, {}), exact, 1e-9 * std::abs(exact));
+      EXPECT_NEAR(sp::forward_frequency_shift(exponential_force, z, k_qplus, f0_qplus, a, {}), exact, 1e-9 * std::abs(exact));
     }
   }
 }
@@ -75,7 +75,7 @@ TEST(ReconstructFm, ExponentialForceAtSmallMediumAndLargeAmplitude) {
   // bound: 1 % of F0 (Sader–Jarvis: the formula is within ~5 % of the exact inverse at intermediate amplitudes,
   // measured here below 1 % for the exponential law; matrix method: discretisation only)
   for (double a : {0.01e-9, 0.1e-9, 1e-9, 5e-9}) {
-    const sp::FmSettings s(k, f0, a);
+    const sp::FmSettings s(k_qplus, f0_qplus, a);
     const sp::FmCurve c = exponential_curve(s, 400, 2.0e-9);
     for (auto method : {sp::FmMethod::sader_jarvis, sp::FmMethod::matrix}) {
       sp::FmOptions o;
@@ -99,7 +99,7 @@ double vdw_force(double z) { return -c_vdw / (z * z); }
 TEST(ReconstructFm, VanDerWaalsForceOnAGeometricGrid) {
   // the closed form of the forward integral, Δf = −f0 C/(k (z(z + 2A))^{3/2}), on a non-uniform grid
   for (double a : {0.05e-9, 1e-9, 20e-9}) {
-    const sp::FmSettings s(k, f0, a);
+    const sp::FmSettings s(k_qplus, f0_qplus, a);
     sp::FmCurve c;
     const int n = 300;
     for (int i = 0; i < n; ++i) {
@@ -126,7 +126,7 @@ TEST(ReconstructFm, ExponentialTailRecoversATruncatedCurve) {
   // the curve stops at 0.2 nm (2λ) where |Δf| is still 22 % of its largest value; the zero tail biases the force,
   // the exponential one (fitted to the last points) restores it
   const double a = 1e-9;
-  const sp::FmSettings s(k, f0, a);
+  const sp::FmSettings s(k_qplus, f0_qplus, a);
   const sp::FmCurve c = exponential_curve(s, 200, 0.15e-9);
   for (auto method : {sp::FmMethod::sader_jarvis, sp::FmMethod::matrix}) {
     sp::FmOptions zero, expo;
@@ -145,7 +145,7 @@ TEST(ReconstructFm, ExponentialTailRecoversATruncatedCurve) {
 
 TEST(ReconstructFm, NoiseIsEstimatedAndPropagatedWithAFixedSeed) {
   const double a = 1e-9;
-  const sp::FmSettings s(k, f0, a);
+  const sp::FmSettings s(k_qplus, f0_qplus, a);
   sp::FmCurve c = exponential_curve(s, 400, 2.0e-9);
   double df_max = 0.0;
   for (double v : c.frequency_shift) df_max = std::max(df_max, std::abs(v));
@@ -190,10 +190,10 @@ TEST(ReconstructFm, SeveralCurvesOnOneGridGiveWhatEachGivesAlone) {
     for (bool inside : {false, true}) {
       sp::SaderJarvisTerms terms;
       terms.amplitude_inside_derivative = inside;
-      const auto all = sp::sader_jarvis_forces(t, omegas, amp, k, terms, with_tail);
+      const auto all = sp::sader_jarvis_forces(t, omegas, amp, k_qplus, terms, with_tail);
       ASSERT_EQ(all.size(), omegas.size());
       for (std::size_t m = 0; m < omegas.size(); ++m)
-        EXPECT_EQ(all[m], sp::sader_jarvis_force(t, omegas[m], amp, k, terms, with_tail)) << m;
+        EXPECT_EQ(all[m], sp::sader_jarvis_force(t, omegas[m], amp, k_qplus, terms, with_tail)) << m;
     }
 }
 
@@ -202,7 +202,7 @@ TEST(ReconstructFm, ExactRoundTripOfADenseNoisyCurveReportsItsOrbitsAndStaysAtTh
   // of curvature at each), the hard case of the FM orbits' integration. The round trip at 12 distances finds an
   // orbit at each, counts the one-period simulations of their Newton solves (warm started: a few per orbit), and
   // reproduces the measured Δf to about the ripple (its RMS is 0.71 mHz; the inversion smooths part of it)
-  const sp::FmSettings s(k, f0, 0.5e-9);
+  const sp::FmSettings s(k_qplus, f0_qplus, 0.5e-9);
   sp::FmCurve c;
   double ripple2 = 0.0;
   for (int i = 0; i < 300; ++i) {
@@ -229,7 +229,7 @@ TEST(ReconstructFm, ExactRoundTripOfADenseNoisyCurveReportsItsOrbitsAndStaysAtTh
 }
 
 TEST(ReconstructFm, BadInputNamesTheParameterAndIndex) {
-  const sp::FmSettings s(k, f0, 1e-9);
+  const sp::FmSettings s(k_qplus, f0_qplus, 1e-9);
   sp::FmCurve c = exponential_curve(s, 10, 1e-9);
   auto bad = c;
   bad.frequency_shift[8] = std::nan("");
@@ -244,8 +244,8 @@ TEST(ReconstructFm, BadInputNamesTheParameterAndIndex) {
   bad = c;
   std::swap(bad.distance[3], bad.distance[4]);
   EXPECT_THROW(sp::reconstruct_fm(bad, s), afmkit::InvalidParameter);
-  EXPECT_THROW(sp::FmSettings(k, f0, 0.0), afmkit::InvalidParameter);
-  EXPECT_THROW(sp::FmSettings(-1.0, f0, 1e-9), afmkit::InvalidParameter);
+  EXPECT_THROW(sp::FmSettings(k_qplus, f0_qplus, 0.0), afmkit::InvalidParameter);
+  EXPECT_THROW(sp::FmSettings(-1.0, f0_qplus, 1e-9), afmkit::InvalidParameter);
   // a curve in decreasing distance order is the same curve
   auto reversed = c;
   std::reverse(reversed.distance.begin(), reversed.distance.end());

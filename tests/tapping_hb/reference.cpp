@@ -11,7 +11,7 @@
 namespace afmkit::tapping::test {
 
 namespace {
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;
 
 // Piecewise-linear pieces are polynomial in cos θ: GK31 is exact to rounding at depth 0–1 (depth 3 caps the work
 // when 1e-14 is below the rounding of a large integrand); other laws get a deeper bisection.

@@ -13,7 +13,7 @@ namespace afmkit::tapping {
 namespace {
 
 using impact::PiecewiseLinearLaw;
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;
 
 TappingModel make(double w, const PiecewiseLinearLaw& law, double l = 0.0) {
   return TappingModel(Cantilever(1.0, 100.0), Drive(0.2, w), law, l);

@@ -14,7 +14,7 @@ namespace afmkit::tapping {
 namespace {
 
 using impact::PiecewiseLinearLaw;
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;
 
 TappingModel model_with(const PiecewiseLinearLaw& law, double separation) {
   return TappingModel(Cantilever(1.0, 100.0), Drive(0.2, 1.0), law, separation);

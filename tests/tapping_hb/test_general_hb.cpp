@@ -24,7 +24,7 @@ namespace afmkit::tapping {
 namespace {
 
 using impact::PiecewiseLinearLaw;
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;
 
 impact::ForceLaw normalised(const impact::ForceLaw& law) { return law.scaled(1.0 / 40.0, 2.0 * pi * 3e5); }
 

@@ -17,7 +17,7 @@ namespace afmkit::tapping {
 namespace {
 
 using impact::PiecewiseLinearLaw;
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;
 
 // The same law hidden behind a CustomLaw (piecewise_linear() is null: the numerical path).
 impact::ForceLaw as_custom(const PiecewiseLinearLaw& law) {
@@ -26,7 +26,7 @@ impact::ForceLaw as_custom(const PiecewiseLinearLaw& law) {
 }
 
 // Physical laws in the normalised units of the tapping model (k = 40 N/m, f0 = 300 kHz).
-impact::ForceLaw normalised(const impact::ForceLaw& law) { return law.scaled(1.0 / 40.0, 2.0 * pi * 3e5); }
+impact::ForceLaw normalised_df(const impact::ForceLaw& law) { return law.scaled(1.0 / 40.0, 2.0 * pi * 3e5); }
 
 TEST(NumericalDescribingFunctions, EqualClosedFormsForPiecewiseLinearLaws) {
   const PiecewiseLinearLaw laws[] = {PiecewiseLinearLaw::linear_repulsive(3.0),
@@ -89,12 +89,12 @@ struct LawCase {
 };
 
 std::vector<LawCase> nonlinear_laws() {
-  return {{"dmt", normalised(impact::DmtLaw(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165))},
-          {"dmt hysteresis", normalised(impact::DmtLaw(1.0, 0.8, 10.0, 6.4e-20, 1.0e-19, 0.165))},
-          {"jkr", normalised(impact::make_law<impact::AdhesionHysteresisLaw>(1.0, 10.0, 6.4e-20, 0.165, 0.05, 0.5))},
-          {"kelvin-voigt", normalised(impact::make_law<impact::KelvinVoigtLaw>(1.0, 10.0, 6.4e-20, 0.165, 200.0))},
-          {"lennard-jones", normalised(impact::make_law<impact::LennardJonesLaw>(10.0, 6.4e-20, 0.165))},
-          {"hertz", normalised(impact::make_law<impact::HertzLaw>(1.0, 0.7, 10.0))}};
+  return {{"dmt", normalised_df(impact::DmtLaw(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165))},
+          {"dmt hysteresis", normalised_df(impact::DmtLaw(1.0, 0.8, 10.0, 6.4e-20, 1.0e-19, 0.165))},
+          {"jkr", normalised_df(impact::make_law<impact::AdhesionHysteresisLaw>(1.0, 10.0, 6.4e-20, 0.165, 0.05, 0.5))},
+          {"kelvin-voigt", normalised_df(impact::make_law<impact::KelvinVoigtLaw>(1.0, 10.0, 6.4e-20, 0.165, 200.0))},
+          {"lennard-jones", normalised_df(impact::make_law<impact::LennardJonesLaw>(10.0, 6.4e-20, 0.165))},
+          {"hertz", normalised_df(impact::make_law<impact::HertzLaw>(1.0, 0.7, 10.0))}};
 }
 
 TEST(NumericalDescribingFunctions, MatchIndependentTanhSinhQuadrature) {
@@ -131,8 +131,8 @@ TEST(NumericalDescribingFunctions, MatchIndependentTanhSinhQuadrature) {
 
 TEST(NumericalDescribingFunctions, VelocityTermAndHysteresisGiveDissipation) {
   // Im N1 ≥ 0 for dissipative laws; the Kelvin–Voigt term adds exactly ∫ 2c(d)Bω sin²θ dθ/(πB), proportional to ω.
-  const impact::ForceLaw kv = normalised(impact::make_law<impact::KelvinVoigtLaw>(1.0, 10.0, 6.4e-20, 0.165, 200.0));
-  const impact::ForceLaw elastic = normalised(impact::make_law<impact::KelvinVoigtLaw>(1.0, 10.0, 6.4e-20, 0.165, 0.0));
+  const impact::ForceLaw kv = normalised_df(impact::make_law<impact::KelvinVoigtLaw>(1.0, 10.0, 6.4e-20, 0.165, 200.0));
+  const impact::ForceLaw elastic = normalised_df(impact::make_law<impact::KelvinVoigtLaw>(1.0, 10.0, 6.4e-20, 0.165, 0.0));
   for (const double g : {1.0, 2.5}) {
     const double b = 3.0;
     const auto w1 = DescribingFunctionQuadrature(kv, 1.0).at_gap(g, b);
@@ -155,12 +155,12 @@ TEST(NumericalDescribingFunctions, DispatchAndBadInput) {
   EXPECT_EQ(a.mean, b.mean);
   EXPECT_EQ(a.first_harmonic, b.first_harmonic);
   EXPECT_EQ(describing_functions(pwl, 0.1, 2.0, 0.5, 3.0).first_harmonic, b.first_harmonic);
-  const impact::ForceLaw dmt = normalised(impact::DmtLaw(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165));
+  const impact::ForceLaw dmt = normalised_df(impact::DmtLaw(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165));
   const DescribingFunctions d = describing_functions(dmt, 0.3, 2.0);
   const DescribingFunctions n = numerical_describing_functions(dmt, 0.1, 2.0, 0.5, 1.0);
   EXPECT_EQ(d.first_harmonic, n.first_harmonic);
   EXPECT_EQ(d.mean, n.mean);
-  const impact::ForceLaw kv = normalised(impact::make_law<impact::KelvinVoigtLaw>(1.0, 10.0, 6.4e-20, 0.165, 200.0));
+  const impact::ForceLaw kv = normalised_df(impact::make_law<impact::KelvinVoigtLaw>(1.0, 10.0, 6.4e-20, 0.165, 200.0));
   try {
     describing_functions(kv, 0.3, 2.0);
     FAIL() << "expected InvalidParameter";

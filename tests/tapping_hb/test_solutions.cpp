@@ -13,7 +13,7 @@ namespace afmkit::tapping {
 namespace {
 
 using impact::PiecewiseLinearLaw;
-constexpr double pi = std::numbers::pi;
+using std::numbers::pi;
 
 // docs/theory-tapping.md#two-branch-solution example: Q = 100, ω_n = 1, Γ = 0.2, K_a = 10, K_b = 8, F_a = 0.3,
 // F_b = 0.6, ω = 0.995.

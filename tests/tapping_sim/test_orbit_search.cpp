@@ -33,7 +33,7 @@ TappingModel dmt_model(double l) {
   return {pc.cantilever(), pc.drive(), impact::ForceLaw(dmt).scaled(1.0 / 40.0), l};
 }
 
-SimulationOptions adaptive() {
+SimulationOptions adaptive_options() {
   SimulationOptions o;
   o.integrator = Integrator::adaptive;
   o.relative_tolerance = 1e-10;
@@ -41,25 +41,25 @@ SimulationOptions adaptive() {
 }
 
 /// Stroboscopic state after `periods` drive periods of plain adaptive simulation.
-TipState run(const TappingModel& m, TipState y, int periods) {
-  for (int k = 0; k < periods; ++k) y = simulate(m, 0.0, y, m.period(), adaptive()).state;
+TipState run_periods(const TappingModel& m, TipState y, int periods) {
+  for (int k = 0; k < periods; ++k) y = simulate(m, 0.0, y, m.period(), adaptive_options()).state;
   return y;
 }
 
 /// Quasi-static ramp of the separation (plain adaptive simulation, `hold` periods per separation).
 TipState ramp(const TappingModel& base, TipState y, double from, double to, int steps, int hold) {
-  for (int k = 0; k <= steps; ++k) y = run(base.with_separation(from + (to - from) * k / steps), y, hold);
+  for (int k = 0; k <= steps; ++k) y = run_periods(base.with_separation(from + (to - from) * k / steps), y, hold);
   return y;
 }
 
-double distance(TipState a, TipState b, double omega) {
+double phase_distance(TipState a, TipState b, double omega) {
   return std::hypot(a.position - b.position, (a.velocity - b.velocity) / omega);
 }
 
 /// Index of the orbit of r whose initial state is within tol of y (-1: none).
 int orbit_near(const OrbitSearchResult& r, TipState y, double omega, double tol) {
   for (std::size_t i = 0; i < r.orbits.size(); ++i)
-    if (distance(r.orbits[i].orbit.initial, y, omega) <= tol) return static_cast<int>(i);
+    if (phase_distance(r.orbits[i].orbit.initial, y, omega) <= tol) return static_cast<int>(i);
   return -1;
 }
 
@@ -90,7 +90,7 @@ void expect_bistable_with_saddle(const TappingModel& m, const OrbitSearchResult&
                                  int settle_periods, double tol) {
   const double omega = m.drive.frequency;
   const double scale = std::hypot(y_a.position, y_a.velocity / omega);
-  ASSERT_GT(distance(y_a, y_b, omega), 0.01 * scale) << "the two transients must settle on different orbits";
+  ASSERT_GT(phase_distance(y_a, y_b, omega), 0.01 * scale) << "the two transients must settle on different orbits";
   const int a = orbit_near(r, y_a, omega, tol * scale), b = orbit_near(r, y_b, omega, tol * scale);
   ASSERT_GE(a, 0) << "find_orbits misses the orbit the first transient settles on";
   ASSERT_GE(b, 0) << "find_orbits misses the orbit the second transient settles on";
@@ -101,8 +101,8 @@ void expect_bistable_with_saddle(const TappingModel& m, const OrbitSearchResult&
   for (const FoundOrbit& f : r.orbits) {
     if (f.orbit.stable || f.orbit.period_multiple != 1 || separated) continue;
     // independently periodic: one adaptive period closes it
-    const TipState once = run(m, f.orbit.initial, 1);
-    EXPECT_LT(distance(once, f.orbit.initial, omega), 1e-6 * scale);
+    const TipState once = run_periods(m, f.orbit.initial, 1);
+    EXPECT_LT(phase_distance(once, f.orbit.initial, omega), 1e-6 * scale);
     const Eigen::EigenSolver<Eigen::Matrix2d> eig(f.orbit.monodromy);
     int k = std::abs(eig.eigenvalues()[0]) > std::abs(eig.eigenvalues()[1]) ? 0 : 1;
     if (std::abs(eig.eigenvalues()[k].imag()) > 0) continue;
@@ -111,7 +111,7 @@ void expect_bistable_with_saddle(const TappingModel& m, const OrbitSearchResult&
     for (int side = 0; side < 2; ++side) {
       const double eps = (side ? -1e-4 : 1e-4) * scale;
       const TipState start{f.orbit.initial.position + eps * v.x(), f.orbit.initial.velocity + eps * v.y()};
-      reached[side] = orbit_near(r, run(m, start, settle_periods), omega, tol * scale);
+      reached[side] = orbit_near(r, run_periods(m, start, settle_periods), omega, tol * scale);
     }
     separated = (reached[0] == a && reached[1] == b) || (reached[0] == b && reached[1] == a);
   }
@@ -130,16 +130,16 @@ TEST_P(DemoWindow, FindsBothStableOrbitsAndTheSaddle) {
   // transient 1: from 97 % of the free oscillation (the amplitude approaches A_free < l from below without
   // reaching the sample; from rest it would overshoot, touch and be captured by the contact orbit)
   const TipState f = free_response_state(m);
-  const TipState y_free = run(m, {0.97 * f.position, 0.97 * f.velocity}, 1200);
+  const TipState y_free = run_periods(m, {0.97 * f.position, 0.97 * f.velocity}, 1200);
   // transient 2: the retract — from rest on the sample at l = 8.8 (only the contact orbit exists there), then the
   // separation raised slowly to l
   const TappingModel base = demo_model(8.8);
-  TipState y = run(base, {0.0, 0.0}, 600);
+  TipState y = run_periods(base, {0.0, 0.0}, 600);
   // (near the fold the basin of the contact orbit narrows: steps of 0.005 above l = 9.9)
   const double coarse_end = std::min(l, 9.9);
   y = ramp(base, y, 8.8, coarse_end, static_cast<int>(std::lround((coarse_end - 8.8) / 0.05)), 120);
   if (l > coarse_end) y = ramp(base, y, coarse_end, l, static_cast<int>(std::lround((l - coarse_end) / 0.005)), 120);
-  const TipState y_contact = run(m, y, 1200);
+  const TipState y_contact = run_periods(m, y, 1200);
   expect_bistable_with_saddle(m, r, y_free, y_contact, 1500, 1e-5);
   if (l > 10.1003) {
     EXPECT_EQ(r.harmonic_balance.size(), 1u);  // beyond the HB fold: HB sees the free branch only
@@ -155,13 +155,13 @@ TEST(OrbitSearch, DmtBistableWindowFindsBothStableOrbitsAndTheSaddle) {
   expect_consistent_report(r);
   EXPECT_FALSE(r.harmonic_balance.empty());  // HB for any law (numerical describing functions) seeds the search too
   // transient 1: from rest at l (settles in the repulsive, high-amplitude state)
-  const TipState y_rest = run(m, {0.0, 0.0}, 2000);
+  const TipState y_rest = run_periods(m, {0.0, 0.0}, 2000);
   // transient 2: the approach — the free oscillation at l = 21 (out of reach of the sample), the separation lowered
   // slowly to l (stays in the attractive, low-amplitude state)
   const TappingModel far = dmt_model(21.0);
   TipState y = free_response_state(far);
   y = ramp(far, y, 21.0, l, 14, 150);
-  const TipState y_approach = run(m, y, 2000);
+  const TipState y_approach = run_periods(m, y, 2000);
   expect_bistable_with_saddle(m, r, y_rest, y_approach, 2500, 1e-3);
 }
 
@@ -190,7 +190,7 @@ TEST(OrbitSearch, ClosedFormResolvesContactShorterThanAScanStep) {
   const TipState start{0.0485721216, 19.99976056};
   EventRecorder closed, adapt;
   const auto rc = simulate(m, 0.0, start, m.period(), {}, &closed);
-  const auto ra = simulate(m, 0.0, start, m.period(), adaptive(), &adapt);
+  const auto ra = simulate(m, 0.0, start, m.period(), adaptive_options(), &adapt);
   ASSERT_EQ(adapt.events().size(), 2u);
   ASSERT_EQ(closed.events().size(), 2u);
   EXPECT_NEAR(closed.events()[1].time - closed.events()[0].time, adapt.events()[1].time - adapt.events()[0].time,
