@@ -14,6 +14,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
+#include "afmkit/io/progress.hpp"
 #include "afmkit/io/params.hpp"
 #include "bindings.hpp"
 #include "interrupts.hpp"
@@ -112,6 +113,21 @@ py::list describe(const CommandSpec& s) {
   return out;
 }
 
+/// A progress line of a command (io::Progress) written to Python's sys.stderr as it is then (Jupyter shows it under
+/// the running cell; contextlib.redirect_stderr catches it), from whichever thread advances the progress: the
+/// computation runs without the GIL, so the line takes it. A stderr that fails to write drops the line.
+void progress_to_python(const std::string& line) {
+  py::gil_scoped_acquire gil;
+  try {
+    py::object err = py::module_::import("sys").attr("stderr");
+    if (err.is_none()) return;
+    err.attr("write")(line + "\n");
+    err.attr("flush")();
+  } catch (py::error_already_set&) {
+    // a closed or broken sys.stderr: progress is not worth an error (the computation goes on)
+  }
+}
+
 /// Runs command `path` with `kwargs` (TOML keys; `config`: a TOML file loaded first, as --config).
 py::dict run(const std::string& path, const py::dict& kwargs) {
   std::string name = "afmkit." + path;
@@ -121,6 +137,7 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   cli::Captured captured;
   SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
   captured.cancellation = interrupts.cancellation();
+  io::ProgressSink progress(progress_to_python);  // progress lines to sys.stderr (Jupyter), not to descriptor 2
   interrupts.run([&] { s.run(p, &captured); });
   py::dict out;
   out["results"] = json_to_python(captured.results);

@@ -73,3 +73,28 @@ def test_a_notebook_runs_to_the_end_without_a_cell_error(path, kernel, tmp_path)
     if path.stem == "parameter_study":  # progress of a long run is shown under its cell (standard error)
         stderr = "".join(o.get("text", "") for c in nb.cells for o in c.get("outputs", []) if o.get("name") == "stderr")
         assert "afmkit study: " in stderr and " chunks " in stderr
+
+
+def test_the_progress_of_a_command_goes_to_pythons_stderr_which_jupyter_shows(capfd):
+    """A command's progress lines (C++ io::Progress, at most one a second) are written to sys.stderr as it is at
+    the time (ipykernel's stream: shown under the cell), not to file descriptor 2 (not shown everywhere)."""
+    import contextlib
+    import io
+    import math
+    import time
+
+    import afmkit
+
+    n = 150
+    for _ in range(4):  # a chart of just over a second (the first line comes after one second), whatever the machine
+        caught = io.StringIO()
+        start = time.perf_counter()
+        with contextlib.redirect_stderr(caught):
+            afmkit.control.chart(x_points=n, y_points=n, boundaries_output="")
+        elapsed = time.perf_counter() - start
+        if elapsed > 1.1:
+            break
+        n = int(n * math.sqrt(1.4 / elapsed)) + 1
+    assert elapsed > 1.1
+    assert "control chart (grid points): " in caught.getvalue() and " done, " in caught.getvalue()
+    assert "control chart" not in capfd.readouterr().err  # nothing on descriptor 2
