@@ -145,3 +145,9 @@ def test_study_run_takes_the_options_the_program_declares_and_its_defaults_after
     assert set(RUN_FIELDS) == set(declared) - {"file", "quiet"}
     given = vars(make_parser().parse_args(["run", "s.toml", "--chunk-seconds", "2.5", "--workers", "3", "--quiet"]))
     assert (given["chunk_seconds"], given["workers"], given["quiet"]) == (2.5, 3, True)
+
+
+def test_the_bad_input_page_has_rows_for_every_command():
+    rows = [line for line in (SOURCE / "docs" / "bad-input.md").read_text().splitlines() if line.startswith("|")]
+    for path in PATHS:  # (tests/cli/test_bad_input.cpp runs the rows)
+        assert any(re.search(rf"afmkit {path}(?![a-z])", r) for r in rows), f"docs/bad-input.md: no row for {path}"
