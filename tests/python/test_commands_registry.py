@@ -151,3 +151,10 @@ def test_the_bad_input_page_has_rows_for_every_command():
     rows = [line for line in (SOURCE / "docs" / "bad-input.md").read_text().splitlines() if line.startswith("|")]
     for path in PATHS:  # (tests/cli/test_bad_input.cpp runs the rows)
         assert any(re.search(rf"afmkit {path}(?![a-z])", r) for r in rows), f"docs/bad-input.md: no row for {path}"
+
+
+def test_a_studys_computations_are_commands_of_the_registry_by_their_python_names():
+    from afmkit.study.definition import COMPUTATIONS
+
+    for name, path in COMPUTATIONS.items():
+        assert path in RUNNABLE and _commands.python_name(path) == name, (name, path)
