@@ -55,6 +55,12 @@ def kernel(tmp_path, monkeypatch):
     work.mkdir()
     monkeypatch.setenv("TMPDIR", str(work))
     monkeypatch.setenv("PYDEVD_DISABLE_FILE_VALIDATION", "1")  # the debugger's frozen-modules warning
+    # the kernel's own files (connection file, IPython profile) in tmp_path too, not in $HOME,
+    # and no user configuration of Jupyter or IPython changes the run
+    for variable, folder in (("JUPYTER_RUNTIME_DIR", "runtime"), ("JUPYTER_CONFIG_DIR", "config"),
+                             ("JUPYTER_DATA_DIR", "data"), ("IPYTHONDIR", "ipython")):
+        (tmp_path / "home" / folder).mkdir(parents=True)
+        monkeypatch.setenv(variable, str(tmp_path / "home" / folder))
     return "afmkit-test", work
 
 
