@@ -18,6 +18,11 @@ ProgressSink::ProgressSink(ProgressLines lines) : lines_(std::move(lines)), prev
 
 ProgressSink::~ProgressSink() { current_sink = previous_; }
 
+void message_line(const std::string& line) {
+  if (current_sink != nullptr && current_sink->lines_) current_sink->lines_(line);
+  else std::fprintf(stderr, "%s\n", line.c_str());
+}
+
 Progress::Progress(std::string label, long total, bool enabled, double interval_seconds)
     : label_(std::move(label)), total_(total), enabled_(enabled), interval_(interval_seconds) {
   if (current_sink != nullptr) lines_ = current_sink->lines_;

@@ -79,3 +79,16 @@ TEST(ProgressSink, ADisabledProgressSendsNothing) {
   p.finish();
   EXPECT_TRUE(seen.lines.empty());
 }
+
+TEST(ProgressSink, ACommandsWarningGoesWhereItsProgressGoes) {
+  ProgressLinesSeen seen;
+  testing::internal::CaptureStderr();
+  afmkit::io::message_line("afmkit: warning: before");
+  {
+    ProgressSink sink(seen.sink());
+    afmkit::io::message_line("afmkit: warning: inside");
+  }
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "afmkit: warning: before\n");
+  ASSERT_EQ(seen.lines.size(), 1u);
+  EXPECT_EQ(seen.lines[0], "afmkit: warning: inside");
+}

@@ -104,3 +104,18 @@ def test_the_progress_of_a_command_goes_to_pythons_stderr_which_jupyter_shows(ca
     assert elapsed > 1.1
     assert "control chart (grid points): " in caught.getvalue() and " done, " in caught.getvalue()
     assert "control chart" not in capfd.readouterr().err  # nothing on descriptor 2
+
+
+def test_a_commands_warning_goes_to_pythons_stderr_too(capfd):
+    """A command's warning (here: the scan's loop is unstable at its delay) goes where its progress goes."""
+    import contextlib
+    import io
+
+    import afmkit
+
+    caught = io.StringIO()
+    with contextlib.redirect_stderr(caught):
+        r = afmkit.scan(end_radius=0.0005, radial_speed=0.0005, image_resolution=64, delay=0.015)
+    assert r.results.loop_spectral_abscissa >= 0  # unstable: the warning is due
+    assert "afmkit scan: warning: the loop is unstable at the nominal delay" in caught.getvalue()
+    assert "warning" not in capfd.readouterr().err

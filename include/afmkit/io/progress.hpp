@@ -2,7 +2,8 @@
 // Progress for long runs: prints "label: k/n (p%)" to stderr at most every `interval` seconds.
 // Thread-safe `advance()`; silent when `enabled` is false.
 //
-// Where the lines go: standard error, unless a ProgressSink is alive on the thread that makes the Progress; then
+// Where the lines go (and a command's warnings, message_line): standard error, unless a ProgressSink is alive on the
+// thread that makes the Progress; then
 // to its function (the Python module sends them to Python's sys.stderr, which Jupyter shows under the running
 // cell, rather than to the process's file descriptor 2, which a notebook does not show everywhere).
 #include <atomic>
@@ -30,7 +31,12 @@ class ProgressSink {
   ProgressLines lines_;
   const ProgressSink* previous_;
   friend class Progress;
+  friend void message_line(const std::string& line);
 };
+
+/// Writes `line` (a command's warning; no trailing newline) where this thread's progress lines go: the innermost
+/// ProgressSink alive on it, else standard error.
+void message_line(const std::string& line);
 
 class Progress {
  public:
