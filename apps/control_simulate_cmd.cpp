@@ -189,10 +189,10 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
   report["settings"] = settings_json(c);
   report["settings_si"] = settings_si_json(c);
   if (res.report.diverged)
-    fmt::print(stderr, "afmkit: warning: the closed loop diverged after {} periods (|y| > 1e100); run stopped\n",
-               res.report.periods_completed);
+    io::message_line(fmt::format("afmkit: warning: the closed loop diverged after {} periods (|y| > 1e100); run "
+                                 "stopped", res.report.periods_completed));
   if (res.report.delay_exceeds_period)
-    fmt::print(stderr, "afmkit: warning: the delay reaches one rotation period (the paper assumes tau < T)\n");
+    io::message_line("afmkit: warning: the delay reaches one rotation period (the paper assumes tau < T)");
   out.finish(report, fmt::format("|y_1| over the last period = {:.3e}, max harmonic error = {:.3e} (k <= {}), {:.3e} "
                                  "above, growth rate = {}",
                                  res.report.residual_first_harmonic, res.report.max_harmonic_error,

@@ -72,8 +72,8 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
   if (!points_path.empty()) memory::require_fits("points_every", expected_points, 4.0 * sizeof(double));
   const double abscissa = loop_spectral_abscissa(instrument);
   if (abscissa >= 0.0)
-    fmt::print(stderr, "afmkit scan: warning: the loop is unstable at the nominal delay (spectral abscissa {:.4g} "
-                       "rad/s >= 0; see `afmkit control chart`)\n", abscissa);
+    io::message_line(fmt::format("afmkit scan: warning: the loop is unstable at the nominal delay (spectral abscissa "
+                                 "{:.4g} rad/s >= 0; see `afmkit control chart`)", abscissa));
 
   // the record says what the run used: a generated sample's side when sample_size was left at 0 (2.04 x end_radius)
   io::ParamSet as_run = p;

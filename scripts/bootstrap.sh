@@ -3,7 +3,8 @@
 # Usage: scripts/bootstrap.sh          the main job: the library, the `afmkit` program and the Python module
 #                                      (what `afmkit report` needs), with only the packages those need
 #        scripts/bootstrap.sh --all    everything: also the packages of the tests (GoogleTest programs, pytest,
-#                                      Chromium, Gwyddion, the ARM tool chains, clang for fuzzing, Dask/xarray/Zarr)
+#                                      Chromium, Gwyddion, the ARM tool chains, clang for fuzzing, Dask/xarray/Zarr,
+#                                      Jupyter's nbconvert + ipykernel for the example notebooks)
 #                                      and every target (test programs, benchmarks): what the test command needs
 #        --packages                    with either: install the packages, build nothing
 # Builds with Ninja and ccache (Debian packages, installed here) in Release; docs/development.md gives the times.
@@ -27,6 +28,7 @@ packages=(build-essential cmake ninja-build ccache pkg-config
           python3-dev pybind11-dev python3-numpy python3-matplotlib)   # the Python module and the report
 if [ "$all" = 1 ]; then
   packages+=(python3-pytest
+             python3-nbconvert python3-ipykernel         # tests/python/test_notebooks.py runs examples/notebooks/
              clang-14 libclang-rt-14-dev libomp-14-dev    # clang: libFuzzer targets (scripts/fuzz.sh)
              gwyddion    # gwyddion-thumbnailer: test_scan checks that Gwyddion opens the GSF / GXYZF files afmkit writes
              gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm   # the embedded filter core on a Cortex-M4F (MPS2)

@@ -15,14 +15,14 @@ for a keyword of the wrong Python type; a solver that does not converge raises `
 """
 from . import _afmkit
 from ._afmkit import InputError, InvalidParameter, NumericalFailure
-from ._commands import Result, make_command
+from ._commands import Result, command_functions, make_command
 from . import control, laws, spectroscopy, tapping
 
 __version__ = _afmkit.__version__
 
-impact = make_command("impact")
-scan = make_command("scan")
-demo = make_command("demo")
+# impact, scan, demo: the program's top-level commands, from its command registry (_afmkit.commands())
+_functions = command_functions("")
+globals().update(_functions)
 
-__all__ = ["impact", "tapping", "control", "spectroscopy", "laws", "scan", "demo", "Result", "InvalidParameter",
-           "InputError", "NumericalFailure"]
+__all__ = [*_functions, "tapping", "control", "spectroscopy", "laws", "Result", "InvalidParameter", "InputError",
+           "NumericalFailure"]

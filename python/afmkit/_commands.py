@@ -297,9 +297,54 @@ def _signature_default(p: dict):
     return None if p["follows"] or p["default_text"] else p["default"]
 
 
+# ---- the registry: the program's commands (C++, _afmkit.commands()) and where each is in Python
+
+#: Commands of the program that are not the function afmkit.<path with dots> (afmkit.tapping.orbit for
+#: `tapping orbit`): the name of their Python counterpart in the package. `report` and `study run` are Python
+#: programs the command line starts; `tapping grid` writes a store, which a study of tapping.orbit does from Python.
+_ELSEWHERE = {
+    "spectroscopy prepare": "spectroscopy.prepare_file",  # a wrapper returning a PreparedCurve (SI units)
+    "spectroscopy fit": "spectroscopy_fit.run",           # afmkit.spectroscopy.fit: the same fit on arrays
+    "report": "report.build",
+    "study run": "study.run",
+    "tapping grid": "study.run",
+}
+
+
+def commands() -> list:
+    """Every leaf command of the afmkit program, in registration order (the one list of commands: the C++
+    program's command tree): dicts with path, help, runnable (a command function runs it) and params."""
+    global _COMMANDS
+    if _COMMANDS is None:
+        _COMMANDS = _afmkit.commands(program=True)
+    return _COMMANDS
+
+
+_COMMANDS = None
+
+
+def python_name(path: str) -> str:
+    """Where command ``path`` is in the package, relative to ``afmkit`` ("tapping.orbit", "report.build")."""
+    return _ELSEWHERE.get(path, path.replace(" ", "."))
+
+
+def command_functions(module: str) -> dict:
+    """The command functions of ``afmkit.<module>`` ("" for afmkit itself), generated from the registry: every
+    command the module's functions run whose Python name is ``<module>.<name>``, as {name: function}."""
+    out = {}
+    for spec in commands():
+        parent, _, name = python_name(spec["path"]).rpartition(".")
+        if spec["runnable"] and parent == module:
+            out[name] = make_command(spec["path"])
+    return out
+
+
 def make_command(path: str):
-    """The Python function of command ``path`` ("tapping orbit")."""
-    spec = next(s for s in _afmkit.commands() if s["path"] == path)
+    """The Python function of command ``path`` ("tapping orbit"); its ``__afmkit_command__`` is the path."""
+    spec = next((s for s in commands() if s["path"] == path and s["runnable"]), None)
+    if spec is None:
+        raise ValueError(f"no afmkit command '{path}' that a function runs (commands: "
+                         f"{', '.join(s['path'] for s in commands() if s['runnable'])})")
     keys = {p["key"] for p in spec["params"]}
 
     def command(**kwargs) -> Result:
@@ -314,8 +359,57 @@ def make_command(path: str):
     command.__qualname__ = name
     command.__module__ = "afmkit." + path.split()[0] if " " in path else "afmkit"
     command.__doc__ = _docstring(spec)
+    command.__afmkit_command__ = path
     params = [inspect.Parameter("config", inspect.Parameter.KEYWORD_ONLY, default=None, annotation=str)]
     params += [inspect.Parameter(p["key"], inspect.Parameter.KEYWORD_ONLY, default=_signature_default(p),
                                  annotation=_KINDS[p["kind"]]) for p in spec["params"]]
     command.__signature__ = inspect.Signature(params, return_annotation=Result)
     return command
+
+
+def _spec(path: str) -> dict:
+    spec = next((s for s in commands() if s["path"] == path), None)
+    if spec is None:
+        raise ValueError(f"no afmkit command '{path}' (commands: {', '.join(s['path'] for s in commands())})")
+    return spec
+
+
+def declared_defaults(path: str) -> dict:
+    """The default of every key of command ``path`` as the program declares it; None for a key whose default is
+    computed elsewhere (its help says what it is: "one per core", "the file's [run] store, else ...")."""
+    return {p["key"]: None if p["default_text"] else p["default"] for p in _spec(path)["params"]}
+
+
+def argument_parser(path: str, prog: str | None = None, description: str | None = None, *,
+                    given_only: bool = False, add_help: bool = True):
+    """An argparse parser of the options of command ``path`` as the program declares them (one declaration: the
+    C++ ParamSet, as ``afmkit <path> --help`` shows them): ``--output-dir`` for key ``output_dir``, the kind's
+    type and choices, the help with unit, range and default; the positional key as a positional argument. A key
+    not given parses to its declared default (declared_defaults), or to None (a flag: False) with ``given_only``
+    (when something else comes between the options and the defaults: a study file's [run] table)."""
+    import argparse
+
+    spec = _spec(path)
+    parser = argparse.ArgumentParser(prog=prog or f"afmkit {path}", description=description or spec["help"],
+                                     add_help=add_help)
+    types = {"real": float, "integer": int, "text": str, "file": str}
+    for p in spec["params"]:
+        default = None if p["default_text"] or given_only else p["default"]
+        facts = [f"unit {p['unit']}"] if p["unit"] and p["unit"] != "count" else []
+        facts += [p["allowed"]] if p["allowed"] else []
+        if not p["positional"]:
+            facts.append(f"default: {p['default_text']}" if p["default_text"] else f"default: {p['default']!r}")
+        help_text = (f"{p['help']} ({'; '.join(facts)})" if facts else p["help"]).replace("%", "%%")
+        flag = "--" + p["key"].replace("_", "-")
+        if p["kind"] == "flag":
+            parser.add_argument(flag, dest=p["key"], action="store_true",
+                                default=False if given_only else bool(p["default"]), help=help_text)
+        elif p["kind"] == "reals":
+            parser.add_argument(flag, dest=p["key"], type=lambda t: [float(x) for x in t.split(",")],
+                                default=default, help=help_text)
+        elif p["positional"]:
+            parser.add_argument(p["key"], help=help_text)
+        else:
+            parser.add_argument(flag, dest=p["key"], type=types[p["kind"]], default=default,
+                                choices=p["choices"] or None, help=help_text)
+    return parser

@@ -3,11 +3,11 @@
 ``orbit``, ``hb``, ``sweep`` and ``fm`` are the commands ``afmkit tapping orbit | hb | sweep | fm``; keyword arguments are their
 TOML keys, and each returns an :class:`afmkit.Result`.
 """
-from ._commands import make_command
+from ._commands import command_functions
 
-orbit = make_command("tapping orbit")
-hb = make_command("tapping hb")
-sweep = make_command("tapping sweep")
-fm = make_command("tapping fm")
+# orbit, hb, sweep, fm: every `afmkit tapping …` command a function runs, from the program's command registry
+# (`tapping grid` writes a store: a study of tapping.orbit, afmkit.study)
+_functions = command_functions("tapping")
+globals().update(_functions)
 
-__all__ = ["orbit", "hb", "sweep", "fm"]
+__all__ = list(_functions)

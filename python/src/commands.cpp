@@ -7,6 +7,7 @@
 #include <variant>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -14,6 +15,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
+#include "afmkit/io/progress.hpp"
 #include "afmkit/io/params.hpp"
 #include "bindings.hpp"
 #include "interrupts.hpp"
@@ -91,11 +93,29 @@ py::object column_array(const io::Column& column, const nlohmann::json& rows, st
   return py::module_::import("numpy").attr("array")(l, "str");
 }
 
-py::list describe(const CommandSpec& s) {
-  const io::ParamSet p = python_params(s);
+/// Every leaf command of the program, in registration order (the registry: commands.hpp, program.cpp).
+const std::vector<CommandSpec>& program_specs() {
+  static const std::vector<CommandSpec> all = cli::command_specs();  // built once, read-only afterwards
+  return all;
+}
+
+/// Whether `run` runs command `path` (specs(): not `report`, `study run`, `tapping grid`).
+bool runnable(const std::string& path) {
+  return std::any_of(specs().begin(), specs().end(), [&](const CommandSpec& s) { return s.path == path; });
+}
+
+/// The parameters of `s` as Python sees them: a command `run` runs with its Python defaults (python_params), any
+/// other (a Python program the command line starts) with the command line's. `positional`: also the command's
+/// positional argument (`afmkit study run FILE`).
+py::list describe(const CommandSpec& s, bool python) {
+  io::ParamSet p;
+  if (python) p = python_params(s);
+  else s.declare(p);
+  CLI::App app;  // the options the command line makes of them, to tell which key is positional
+  p.add_options(app);
   py::list out;
   for (const auto& d : p.describe()) {
-    if (d.key == "json") continue;  // always on from Python (nothing printed)
+    if (python && d.key == "json") continue;  // always on from Python (nothing printed)
     py::dict e;
     e["key"] = d.key;
     e["kind"] = d.kind;
@@ -107,9 +127,28 @@ py::list describe(const CommandSpec& s) {
     e["group"] = d.group;
     e["choices"] = d.choices;
     e["follows"] = d.follows;
+    bool positional = false;
+    for (const CLI::Option* o : app.get_options())
+      positional = positional || (o->get_positional() && o->get_name() == d.key);
+    e["positional"] = positional;
     out.append(e);
   }
   return out;
+}
+
+/// A progress line of a command (io::Progress) written to Python's sys.stderr as it is then (Jupyter shows it under
+/// the running cell; contextlib.redirect_stderr catches it), from whichever thread advances the progress: the
+/// computation runs without the GIL, so the line takes it. A stderr that fails to write drops the line.
+void progress_to_python(const std::string& line) {
+  py::gil_scoped_acquire gil;
+  try {
+    py::object err = py::module_::import("sys").attr("stderr");
+    if (err.is_none()) return;
+    err.attr("write")(line + "\n");
+    err.attr("flush")();
+  } catch (py::error_already_set&) {
+    // a closed or broken sys.stderr: progress is not worth an error (the computation goes on)
+  }
 }
 
 /// Runs command `path` with `kwargs` (TOML keys; `config`: a TOML file loaded first, as --config).
@@ -121,6 +160,7 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   cli::Captured captured;
   SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
   captured.cancellation = interrupts.cancellation();
+  io::ProgressSink progress(progress_to_python);  // progress lines to sys.stderr (Jupyter), not to descriptor 2
   interrupts.run([&] { s.run(p, &captured); });
   py::dict out;
   out["results"] = json_to_python(captured.results);
@@ -145,18 +185,24 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
 void bind_commands(py::module_& m) {
   m.def(
       "commands",
-      [] {
+      [](bool program) {
         py::list out;
-        for (const CommandSpec& s : specs()) {
+        for (const CommandSpec& s : program_specs()) {
+          if (!program && !runnable(s.path)) continue;
           py::dict d;
           d["path"] = s.path;
           d["help"] = s.help;
-          d["params"] = describe(s);
+          d["runnable"] = runnable(s.path);
+          d["params"] = describe(s, runnable(s.path));
           out.append(d);
         }
         return out;
       },
-      "Every command of the afmkit program: path, help and parameters (key, kind, default, unit, allowed range).");
+      py::arg("program") = false,
+      "The commands run() runs (program=True: every leaf command of the afmkit program), in registration order: "
+      "path, help, runnable (run() runs it; else it is a Python program of the package the command line starts: "
+      "report, study run, or writes a store: tapping grid) and parameters (key, kind, default, unit, allowed range, "
+      "positional).");
   m.def(
       "require_memory",
       [](const std::string& parameter, double value, double bytes_per_unit) {

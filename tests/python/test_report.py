@@ -95,3 +95,23 @@ def test_a_killed_runs_staging_folder_is_removed_by_the_next_run(tmp_path):
     r = report("--output-dir", str(out), "--figures", "beyond-impact", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert leftovers(out) == []
+
+
+def test_no_text_the_page_is_made_of_cites_a_file_outside_the_repository():
+    """Every string of the report's code (page, captions, key numbers and how each was obtained: afmkit.report and
+    afmkit.figures), read from the source without computing a figure: the whole page's text, cheaply (the browser
+    test reads the rendered page of every figure)."""
+    import ast
+
+    import afmkit.figures
+    import afmkit.report
+
+    files = [f for pkg in (afmkit.report, afmkit.figures) for f in Path(pkg.__file__).resolve().parent.glob("*.py")]
+    assert len(files) >= 6
+    found = []
+    for f in files:
+        for node in ast.walk(ast.parse(f.read_text(), str(f))):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str):
+                found += [(f.name, node.lineno, o) for o in ("MATH.md", "shared/", "/work/", "seeds/", "../")
+                          if o in node.value]
+    assert found == []

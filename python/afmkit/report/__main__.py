@@ -1,19 +1,18 @@
 """python3 -m afmkit.report [--output-dir out/report] [--jobs 2] [--figures all]: what `afmkit report` runs."""
-import argparse
-import os
 import signal
 import sys
 
+from .._commands import argument_parser
 from .build import ReportError, ReportFailure, build
 
 
+def make_parser():
+    """The options as `afmkit report` declares them (its C++ ParamSet): the same keys, defaults and help."""
+    return argument_parser("report", prog="afmkit report")
+
+
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="afmkit report", description=__doc__)
-    parser.add_argument("--output-dir", default="out/report", help="folder for index.html and the figures")
-    parser.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1),
-                        help="figures computed at the same time (processes)")
-    parser.add_argument("--figures", default="all", help="'all' or a comma-separated list of figure ids")
-    args = parser.parse_args(argv)
+    args = make_parser().parse_args(argv)
 
     def terminated(signum, frame):  # SIGTERM cleans up as Ctrl-C does
         raise KeyboardInterrupt

@@ -8,12 +8,15 @@ import os
 import signal
 import sys
 
+from .._commands import argument_parser, commands, declared_defaults
 from .definition import StudyError, Study, read_toml
 from .run import StudyFailure, run
 
-#: The [run] table's fields and the Python types each takes (a wrong type is refused naming the file and field).
-RUN_FIELDS = {"store": (str,), "scheduler": (str,), "workers": (int,), "chunk_seconds": (int, float),
-              "chunk_points": (int,), "netcdf": (str,)}
+_KIND_TYPES = {"file": (str,), "text": (str,), "integer": (int,), "real": (int, float)}
+#: The [run] table's fields — the options of `afmkit study run` as it declares them, but the study file itself and
+#: quiet — and the Python types each takes (a wrong type is refused naming the file and field).
+RUN_FIELDS = {p["key"]: _KIND_TYPES[p["kind"]] for p in next(s for s in commands() if s["path"] == "study run")["params"]
+              if p["key"] not in ("file", "quiet")}
 
 
 def _run_settings(file: str) -> dict:
@@ -34,20 +37,18 @@ def _run_settings(file: str) -> dict:
     return settings
 
 
-def main(argv=None) -> int:
+def make_parser():
+    """`run` with the options as `afmkit study run` declares them (its C++ ParamSet): each one given overrides the
+    file's [run] table, which overrides the declared default (declared_defaults; main)."""
     parser = argparse.ArgumentParser(prog="python3 -m afmkit.study", description=__doc__)
     sub = parser.add_subparsers(dest="action", required=True)
-    p = sub.add_parser("run", help="run (or resume) a study")
-    p.add_argument("file", help="the study's TOML file")
-    p.add_argument("--store", help="Zarr store of the results (default: the file's [run] store, or "
-                                   "out/<name>.zarr)")
-    p.add_argument("--scheduler", help="serial, local (a LocalCluster, the default) or a Dask scheduler address "
-                                       "tcp://host:8786")
-    p.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
-    p.add_argument("--chunk-seconds", type=float, help="computation per chunk in seconds (default 1)")
-    p.add_argument("--chunk-points", type=int, help="points per chunk (instead of --chunk-seconds)")
-    p.add_argument("--netcdf", help="also write the results to this NetCDF file")
-    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    sub.add_parser("run", help="run (or resume) a study",
+                   parents=[argument_parser("study run", given_only=True, add_help=False)])
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = make_parser()
     args = parser.parse_args(argv)
 
     def terminated(signum, frame):  # SIGTERM stops as Ctrl-C does: finished chunks stay
@@ -69,13 +70,17 @@ def main(argv=None) -> int:
         study = Study.from_toml(args.file)
         settings = _run_settings(args.file)
 
-        def pick(name, default=None):
+        declared = declared_defaults("study run")
+
+        def pick(name, default=None):  # given, else the file's [run] table, else the declared default
             value = getattr(args, name)
-            return value if value is not None else settings.get(name, default)
+            if value is None:
+                value = settings.get(name)
+            return value if value is not None else declared[name] if declared[name] is not None else default
 
         store = pick("store", f"out/{study.name}.zarr")
         ds = run(study, store, scheduler=pick("scheduler"), workers=pick("workers"),
-                 chunk_seconds=pick("chunk_seconds", 1.0), chunk_points=pick("chunk_points"),
+                 chunk_seconds=pick("chunk_seconds"), chunk_points=pick("chunk_points"),
                  progress=not args.quiet, netcdf=pick("netcdf"))
     except (StudyError, ValueError, TypeError) as e:
         field = getattr(e, "field", None) or getattr(e, "parameter", None)
