@@ -1,0 +1,70 @@
+#pragma once
+// A force law written in Python as a ForceLawModel (python_law.cpp explains the tabulation and its cost).
+// Units inside: gap nm, force nN, damping nN·s/nm (= N·s/m), as the built-in physical laws (docs/force-laws.md).
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <pybind11/pybind11.h>
+
+#include "afmkit/impact/force_law.hpp"
+
+namespace afmkit::python {
+
+/// One branch (H_a, H_b or c) of a Python law: Chebyshev series of degree `degree` on the pieces between
+/// consecutive `edges` [nm] (coefficients NaN: that piece is evaluated by the callable), the callable beyond them.
+/// `factor` converts the callable's SI value to the law's units (1e9 for N -> nN; 1 for N·s/m -> nN·s/nm).
+class PythonBranch {
+ public:
+  PythonBranch(std::string label, pybind11::object callable, double factor, std::vector<double> edges,
+               std::vector<double> coefficients, std::vector<double> slope_coefficients, int degree);
+  ~PythonBranch();
+  PythonBranch(const PythonBranch&) = delete;
+  PythonBranch& operator=(const PythonBranch&) = delete;
+
+  double value(double gap) const;  ///< at gap [nm], in the law's units
+  double slope(double gap) const;  ///< d value / d gap
+  /// The callable itself at one gap (takes the GIL); InvalidParameter("law", …) naming the callable when it raises
+  /// or returns anything but one finite number.
+  double call(double gap) const;
+
+ private:
+  std::string label_;  // "approach=<function f>": how messages name the callable
+  std::shared_ptr<pybind11::object> callable_;
+  double factor_;
+  std::vector<double> edges_, coefficients_, slopes_;
+  int degree_;
+};
+
+class PythonLawModel final : public impact::ForceLawModel {
+ public:
+  /// `departure` null: the approach branch (a conservative law); `damping` null: no Kelvin–Voigt term.
+  /// `contact_gap` NaN: the lowest switching gap (ForceLawModel's default).
+  PythonLawModel(std::string name, std::shared_ptr<const PythonBranch> approach,
+                 std::shared_ptr<const PythonBranch> departure, std::shared_ptr<const PythonBranch> damping,
+                 std::vector<double> switching_gaps, double contact_gap);
+  std::string name() const override { return name_; }
+  double approach(double gap) const override { return approach_->value(gap); }
+  double departure(double gap) const override { return departure_->value(gap); }
+  bool has_slopes() const override { return true; }
+  double approach_slope(double gap) const override { return approach_->slope(gap); }
+  double departure_slope(double gap) const override { return departure_->slope(gap); }
+  double damping(double gap) const override { return damping_ ? damping_->value(gap) : 0.0; }
+  bool has_damping() const override { return damping_ != nullptr; }
+  std::vector<double> switching_gaps() const override { return switching_gaps_; }
+  double contact_gap() const override;
+  bool branch_dependent(int) const override { return !conservative_; }
+  double hysteresis_area(double, double) const override {
+    return conservative_ ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+  }
+
+ private:
+  std::string name_;
+  std::shared_ptr<const PythonBranch> approach_, departure_, damping_;
+  std::vector<double> switching_gaps_;
+  double contact_gap_;
+  bool conservative_;
+};
+
+}  // namespace afmkit::python
