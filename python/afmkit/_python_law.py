@@ -85,7 +85,7 @@ def tabulate(f, label: str, factor: float, domain_nm, switching_nm, non_negative
         stuck = ~ok & narrow & ~at_switch
         if np.any(stuck):
             i = np.flatnonzero(stuck)[0]
-            raise ValueError(f"afmkit.laws.Python: {label} is not smooth near distance {mid[i] * 1e-9:.9g} m (a "
+            raise ValueError(f"afmkit.laws.Python: {label} is not smooth near distance {mid[i] * 1e-9:.6g} m (a "
                              f"Chebyshev series misses it by {err[i] / factor:.3g} on an interval of "
                              f"{(b[i] - a[i]) * 1e-9:.3g} m): give the distances where it has a kink or a jump as "
                              "switching_gaps=[...] (m)")

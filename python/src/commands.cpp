@@ -139,7 +139,11 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   const io::ParamSet p = params_from_python(path, name, given);
   SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
   captured.cancellation = interrupts.cancellation();
-  interrupts.run([&] { s.run(p, &captured); });
+  try {
+    interrupts.run([&] { s.run(p, &captured); });
+  } catch (const PythonLawError& e) {  // the user's law failed: their error (exit-2 style), not a crash
+    throw InvalidParameter("law", e.what());
+  }
   py::dict out;
   out["results"] = json_to_python(captured.results);
   py::list columns;

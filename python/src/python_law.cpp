@@ -86,19 +86,21 @@ double PythonBranch::call(double gap) const {
     const py::object result = (*callable_)(x);
     const py::array_t<double, py::array::forcecast> y = py::array_t<double, py::array::forcecast>::ensure(result);
     if (!y || y.ndim() != 1 || y.size() != 1)
-      throw InvalidParameter("law", fmt::format("afmkit.laws.Python: {} must return one number per distance (an array "
+      throw PythonLawError(fmt::format("afmkit.laws.Python: {} must return one number per distance (an array "
                                                 "of the shape of its argument), not {} for 1 distance",
                                                 label_, py::repr(result).cast<std::string>()));
     const double v = y.data()[0];
     if (!std::isfinite(v))
-      throw InvalidParameter("law", fmt::format("afmkit.laws.Python: {} returned {} at distance {:.17g} m: a force "
+      throw PythonLawError(fmt::format("afmkit.laws.Python: {} returned {} at distance {:.17g} m: a force "
                                                 "law must be finite wherever the tip goes",
                                                 label_, v, gap * kNm));
     return v * factor_;
   } catch (py::error_already_set& e) {
     if (e.matches(PyExc_KeyboardInterrupt) || e.matches(PyExc_SystemExit)) throw;  // the caller's stop request
-    throw InvalidParameter("law", fmt::format("afmkit.laws.Python: {} raised {} at distance {:.17g} m", label_,
-                                              e.what(), gap * kNm));
+    const std::string type = py::str(e.type().attr("__name__"));
+    const std::string message = py::str(e.value());
+    throw PythonLawError(fmt::format("afmkit.laws.Python: {} raised {}: {} at distance {:.17g} m", label_, type,
+                                     message, gap * kNm));
   }
 }
 
@@ -220,7 +222,11 @@ void bind_python_law(py::module_& m) {
         args.allow_energy_gain = allow_energy_gain;
         if (!law.is_none()) args.model = law.cast<std::shared_ptr<PythonLawModel>>();
         const impact::ForceLaw built = impact::LawRegistry::builtin().build(name, args);
-        return evaluate(built, distance, velocity, in_contact);
+        try {
+          return evaluate(built, distance, velocity, in_contact);
+        } catch (const PythonLawError& e) {
+          throw InvalidParameter("law", e.what());
+        }
       },
       py::arg("law"), py::arg("name"), py::arg("values"), py::arg("force_curve"), py::arg("hysteresis"),
       py::arg("allow_energy_gain"), py::arg("distance"), py::arg("velocity"), py::arg("in_contact"),

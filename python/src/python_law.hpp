@@ -3,6 +3,7 @@
 // Units inside: gap nm, force nN, damping nN·s/nm (= N·s/m), as the built-in physical laws (docs/force-laws.md).
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,14 @@
 #include "afmkit/impact/force_law.hpp"
 
 namespace afmkit::python {
+
+/// A law's callable failed during a run (raised, or returned anything but one finite number): the user's error.
+/// Not an InvalidParameter, which a computation turns into a NumericalFailure of its own (core/computed.hpp): the
+/// Python module reports it as afmkit.InvalidParameter naming `law` once the run has stopped.
+class PythonLawError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 /// One branch (H_a, H_b or c) of a Python law: Chebyshev series of degree `degree` on the pieces between
 /// consecutive `edges` [nm] (coefficients NaN: that piece is evaluated by the callable), the callable beyond them.
@@ -25,8 +34,8 @@ class PythonBranch {
 
   double value(double gap) const;  ///< at gap [nm], in the law's units
   double slope(double gap) const;  ///< d value / d gap
-  /// The callable itself at one gap (takes the GIL); InvalidParameter("law", …) naming the callable when it raises
-  /// or returns anything but one finite number.
+  /// The callable itself at one gap (takes the GIL); PythonLawError naming the callable when it raises or returns
+  /// anything but one finite number.
   double call(double gap) const;
 
  private:
