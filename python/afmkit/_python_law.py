@@ -6,8 +6,9 @@ So each callable is evaluated here in a few vectorised batches, on an adaptive s
 a 2·DEGREE+1 point Lobatto set) matches the callable at the odd points (the midpoints) to ``RTOL`` times the largest
 |value| met on its base interval, else it is halved. The base intervals end at the domain's ends, the switching gaps
 and ±2^k nm (k = -3 … 30) and 0, so far gaps (where the van der Waals force is small) get pieces of their own scale.
-A piece next to a switching gap narrower than ``MIN_WIDTH_NM`` that still misses the tolerance (an endpoint
-singularity such as √δ) is evaluated by the callable itself during runs; anywhere else the callable is not smooth
+On the base intervals next to a switching gap g the series are in u = √|d − g| (smooth for the δ^{1/2} and δ^{3/2}
+of contact mechanics). A piece next to a switching gap narrower than ``MIN_WIDTH_NM`` that still misses the
+tolerance (another endpoint singularity) is evaluated by the callable itself during runs; anywhere else the callable is not smooth
 enough to tabulate, and the law is refused naming the place (a kink or jump must be a declared switching gap).
 """
 from __future__ import annotations
@@ -56,18 +57,36 @@ def values(f, label: str, x):
 
 def tabulate(f, label: str, factor: float, domain_nm, switching_nm, non_negative=False) -> dict:
     """The branch `f` (SI callable) as Chebyshev pieces in nm and the law's units (value · `factor`), for
-    python_law.cpp's PythonBranch."""
+    python_law.cpp's PythonBranch.
+
+    A piece is a series in a variable u: u = d on most pieces; on the base intervals next to a switching gap g,
+    d = g ± u² (u = √|d − g|), so that the endpoint singularities of contact mechanics (δ^{1/2} of a Kelvin–Voigt
+    damping, δ^{3/2} of Hertz) are smooth in u and need a few pieces, not dozens."""
     lo, hi = domain_nm
     switching = np.asarray([g for g in switching_nm if lo < g < hi], dtype=float)
     inner = _BASE_NM[(_BASE_NM > lo) & (_BASE_NM < hi)]
     edges = np.unique(np.concatenate([[lo, hi], inner, switching]))
-    a, b = edges[:-1], edges[1:]
+    ea, eb = edges[:-1], edges[1:]
+    left, right = np.isin(ea, switching), np.isin(eb, switching) & ~np.isin(ea, switching)
+    sign = np.where(left, 1.0, np.where(right, -1.0, 0.0))     # d = anchor + sign·u² (sign 0: d = u)
+    anchor = np.where(left, ea, np.where(right, eb, np.nan))
+    width = np.sqrt(eb - ea)
+    a = np.where(sign != 0, 0.0, ea)                             # u-interval of each piece
+    b = np.where(sign != 0, width, eb)
     base = np.arange(a.size)              # the base interval of each piece
     scale = np.zeros(a.size)              # the largest |value| met on each base interval
-    done_a, done_b, done_c = [], [], []
+    done = []
+
+    def to_d(u, sg, an):
+        return np.where(sg == 0, u, an + sg * u * u)
+
     while a.size:
         mid, half = 0.5 * (a + b), 0.5 * (b - a)
-        x = mid[:, None] + half[:, None] * _LOBATTO[None, :]  # nm
+        sg, an = sign[base], anchor[base]
+        u = mid[:, None] + half[:, None] * _LOBATTO[None, :]
+        x = to_d(u, sg[:, None], an[:, None])  # nm
+        # the ends of the base interval exactly (u² rounds)
+        x = np.clip(x, ea[base][:, None], eb[base][:, None])
         y = values(f, label, x * 1e-9) * factor
         if non_negative and np.any(y < 0):
             i = np.flatnonzero(y.ravel() < 0)[0]
@@ -77,31 +96,32 @@ def tabulate(f, label: str, factor: float, domain_nm, switching_nm, non_negative
         c = y[:, ::2] @ _FIT.T
         err = np.abs(c @ _CHECK.T - y[:, 1::2]).max(axis=1)
         ok = err <= RTOL * scale[base]
-        narrow = (b - a) < MIN_WIDTH_NM
+        da, db = x.min(axis=1), x.max(axis=1)
+        narrow = (db - da) < MIN_WIDTH_NM
         at_switch = np.zeros(a.size, bool)
         if switching.size:
             near = lambda e: np.any(np.abs(e[:, None] - switching[None, :]) <= 1e-12 * (1.0 + np.abs(switching)), 1)
-            at_switch = near(a) | near(b)
+            at_switch = near(da) | near(db)
         stuck = ~ok & narrow & ~at_switch
         if np.any(stuck):
             i = np.flatnonzero(stuck)[0]
-            raise ValueError(f"afmkit.laws.Python: {label} is not smooth near distance {mid[i] * 1e-9:.6g} m (a "
-                             f"Chebyshev series misses it by {err[i] / factor:.3g} on an interval of "
-                             f"{(b[i] - a[i]) * 1e-9:.3g} m): give the distances where it has a kink or a jump as "
-                             "switching_gaps=[...] (m)")
+            raise ValueError(f"afmkit.laws.Python: {label} is not smooth near distance "
+                             f"{0.5 * (da[i] + db[i]) * 1e-9:.6g} m (a Chebyshev series misses it by "
+                             f"{err[i] / factor:.3g} on an interval of {(db[i] - da[i]) * 1e-9:.3g} m): give the "
+                             "distances where it has a kink or a jump as switching_gaps=[...] (m)")
         direct = ~ok & narrow  # next to a switching gap: evaluated by the callable during runs
         c[direct] = np.nan
         keep = ok | direct
-        done_a.append(a[keep])
-        done_b.append(b[keep])
-        done_c.append(c[keep])
+        done.append((da[keep], a[keep], b[keep], sg[keep], an[keep], c[keep]))
         split = ~keep
         a, b, base = (np.concatenate([a[split], mid[split]]), np.concatenate([mid[split], b[split]]),
                       np.concatenate([base[split], base[split]]))
-    pa, pb, pc = np.concatenate(done_a), np.concatenate(done_b), np.concatenate(done_c)
-    order = np.argsort(pa)
-    pa, pb, pc = pa[order], pb[order], pc[order]
-    slopes = chebyshev.chebder(pc, axis=1) * (2.0 / (pb - pa))[:, None]
-    return {"label": label, "callable": f, "factor": float(factor), "edges": np.append(pa, pb[-1]).tolist(),
+    pd, pa, pb, ps, pn, pc = (np.concatenate(parts) for parts in zip(*done))
+    order = np.argsort(pd, kind="stable")
+    pd, pa, pb, ps, pn, pc = pd[order], pa[order], pb[order], ps[order], pn[order], pc[order]
+    slopes = chebyshev.chebder(pc, axis=1) * (2.0 / (pb - pa))[:, None]  # d/du
+    return {"label": label, "callable": f, "factor": float(factor), "edges": np.append(pd, hi).tolist(),
             "coefficients": pc.ravel().tolist(), "slopes": slopes.ravel().tolist(), "degree": DEGREE,
-            "pieces": int(pa.size), "direct": int(np.isnan(pc[:, 0]).sum())}
+            "u_low": pa.tolist(), "u_high": pb.tolist(), "signs": ps.tolist(),
+            "anchors": np.nan_to_num(pn, nan=0.0).tolist(),
+            "pieces": int(pd.size), "direct": int(np.isnan(pc[:, 0]).sum())}

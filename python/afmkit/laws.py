@@ -274,7 +274,8 @@ class Python(Law):
     contact edge), located as events by the integrators; ``contact_gap`` [m]: the gap below which tip and sample
     count as in contact (default: the lowest switching gap). ``domain`` = (lowest, highest) distance [m] over
     which the callables are tabulated (they must be finite there); beyond it they are called point by point
-    (correct, slower). ``name``: how records and messages name the law.
+    (correct, slower). ``name``: how records and messages name the law. ``tabulation``: per branch, the number
+    of pieces and of those evaluated by the callable.
 
     The callables are evaluated once, here, in a few vectorised batches: the law is tabulated as Chebyshev pieces
     to 1e-12 of the largest force on each interval (see docs/force-laws.md#python for the check and the cost), so
@@ -326,7 +327,7 @@ class Python(Law):
                                if departure is not None else None)
         tables["damping"] = (branch(damping_f, damping_label, 1.0, non_negative=True)
                              if damping_f is not None else None)
-        self.pieces = {k: (v["pieces"] if v else 0) for k, v in tables.items()}
+        self.tabulation = {k: {"pieces": v["pieces"], "direct": v["direct"]} for k, v in tables.items() if v}
         self._model = _afmkit.PythonLaw(self.label, tables["approach"], tables["departure"], tables["damping"],
                                         gaps_nm, math.nan if contact_gap is None else float(contact_gap) * 1e9)
 

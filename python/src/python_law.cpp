@@ -55,18 +55,16 @@ double clenshaw(const double* c, int n, double t) {
 
 }  // namespace
 
-PythonBranch::PythonBranch(std::string label, py::object callable, double factor, std::vector<double> edges,
-                           std::vector<double> coefficients, std::vector<double> slope_coefficients, int degree)
+PythonBranch::PythonBranch(std::string label, py::object callable, double factor, BranchTable table)
     : label_(std::move(label)),
       callable_(std::make_shared<py::object>(std::move(callable))),
       factor_(factor),
-      edges_(std::move(edges)),
-      coefficients_(std::move(coefficients)),
-      slopes_(std::move(slope_coefficients)),
-      degree_(degree) {
-  const std::size_t pieces = edges_.empty() ? 0 : edges_.size() - 1;
-  if (degree_ < 1 || coefficients_.size() != pieces * static_cast<std::size_t>(degree_ + 1) ||
-      slopes_.size() != pieces * static_cast<std::size_t>(degree_))
+      t_(std::move(table)) {
+  const std::size_t pieces = t_.edges.empty() ? 0 : t_.edges.size() - 1;
+  const auto n = static_cast<std::size_t>(t_.degree);
+  if (t_.degree < 1 || t_.coefficients.size() != pieces * (n + 1) || t_.slopes.size() != pieces * n ||
+      t_.u_low.size() != pieces || t_.u_high.size() != pieces || t_.signs.size() != pieces ||
+      t_.anchors.size() != pieces)
     throw py::value_error("afmkit.laws.Python: inconsistent tabulation of " + label_ + " (internal)");
 }
 
@@ -104,27 +102,38 @@ double PythonBranch::call(double gap) const {
   }
 }
 
+std::ptrdiff_t PythonBranch::locate(double gap, double& t, double& u) const {
+  if (t_.edges.size() < 2 || !(gap >= t_.edges.front() && gap <= t_.edges.back())) return -1;
+  const auto it = std::upper_bound(t_.edges.begin(), t_.edges.end(), gap);
+  const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - t_.edges.begin()) - 1, t_.edges.size() - 2);
+  const double sign = t_.signs[i];
+  u = sign == 0.0 ? gap : std::sqrt(std::max(0.0, sign * (gap - t_.anchors[i])));
+  t = (2.0 * u - t_.u_low[i] - t_.u_high[i]) / (t_.u_high[i] - t_.u_low[i]);
+  return static_cast<std::ptrdiff_t>(i);
+}
+
 double PythonBranch::value(double gap) const {
-  if (edges_.size() >= 2 && gap >= edges_.front() && gap <= edges_.back()) {
-    const auto it = std::upper_bound(edges_.begin(), edges_.end(), gap);
-    const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - edges_.begin()) - 1, edges_.size() - 2);
-    const double* c = coefficients_.data() + i * static_cast<std::size_t>(degree_ + 1);
-    if (!std::isnan(c[0])) {
-      const double a = edges_[i], b = edges_[i + 1];
-      return clenshaw(c, degree_, (2.0 * gap - a - b) / (b - a));
-    }
+  double t = 0.0, u = 0.0;
+  const std::ptrdiff_t i = locate(gap, t, u);
+  if (i >= 0) {
+    const double* c = t_.coefficients.data() + static_cast<std::size_t>(i) * static_cast<std::size_t>(t_.degree + 1);
+    if (!std::isnan(c[0])) return clenshaw(c, t_.degree, t);
   }
   return call(gap);  // outside the domain, or a piece evaluated directly
 }
 
 double PythonBranch::slope(double gap) const {
-  if (edges_.size() >= 2 && gap >= edges_.front() && gap <= edges_.back()) {
-    const auto it = std::upper_bound(edges_.begin(), edges_.end(), gap);
-    const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - edges_.begin()) - 1, edges_.size() - 2);
-    const double* c = slopes_.data() + i * static_cast<std::size_t>(degree_);
+  double t = 0.0, u = 0.0;
+  const std::ptrdiff_t i = locate(gap, t, u);
+  if (i >= 0) {
+    const double* c = t_.slopes.data() + static_cast<std::size_t>(i) * static_cast<std::size_t>(t_.degree);
     if (!std::isnan(c[0])) {
-      const double a = edges_[i], b = edges_[i + 1];
-      return clenshaw(c, degree_ - 1, (2.0 * gap - a - b) / (b - a));
+      const double sign = t_.signs[i];
+      if (sign == 0.0) return clenshaw(c, t_.degree - 1, t);  // u = d
+      // d = g ± u²: dF/dd = ±(dF/du)/(2u); at the gap itself (u → 0) the slope an instant away
+      const double u_eff = std::max(u, 1e-9 * t_.u_high[i]);
+      return sign * clenshaw(c, t_.degree - 1, (2.0 * u_eff - t_.u_low[i] - t_.u_high[i]) /
+                                                   (t_.u_high[i] - t_.u_low[i])) / (2.0 * u_eff);
     }
   }
   const double h = 1e-6 * std::max(1.0, std::abs(gap));  // nm: central difference of the callable itself
@@ -197,11 +206,18 @@ void bind_python_law(py::module_& m) {
              auto branch = [](const py::object& o) -> std::shared_ptr<const PythonBranch> {
                if (o.is_none()) return nullptr;
                const py::dict b = o.cast<py::dict>();
-               return std::make_shared<const PythonBranch>(
-                   b["label"].cast<std::string>(), py::reinterpret_borrow<py::object>(b["callable"]),
-                   b["factor"].cast<double>(), b["edges"].cast<std::vector<double>>(),
-                   b["coefficients"].cast<std::vector<double>>(), b["slopes"].cast<std::vector<double>>(),
-                   b["degree"].cast<int>());
+               BranchTable t;
+               t.edges = b["edges"].cast<std::vector<double>>();
+               t.coefficients = b["coefficients"].cast<std::vector<double>>();
+               t.slopes = b["slopes"].cast<std::vector<double>>();
+               t.u_low = b["u_low"].cast<std::vector<double>>();
+               t.u_high = b["u_high"].cast<std::vector<double>>();
+               t.signs = b["signs"].cast<std::vector<double>>();
+               t.anchors = b["anchors"].cast<std::vector<double>>();
+               t.degree = b["degree"].cast<int>();
+               return std::make_shared<const PythonBranch>(b["label"].cast<std::string>(),
+                                                           py::reinterpret_borrow<py::object>(b["callable"]),
+                                                           b["factor"].cast<double>(), std::move(t));
              };
              std::sort(switching_gaps.begin(), switching_gaps.end());
              return std::make_shared<PythonLawModel>(name, branch(approach), branch(departure), branch(damping),

@@ -21,13 +21,20 @@ class PythonLawError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// One branch (H_a, H_b or c) of a Python law: Chebyshev series of degree `degree` on the pieces between
-/// consecutive `edges` [nm] (coefficients NaN: that piece is evaluated by the callable), the callable beyond them.
-/// `factor` converts the callable's SI value to the law's units (1e9 for N -> nN; 1 for N·s/m -> nN·s/nm).
+/// The tabulation of one branch (python/afmkit/_python_law.py): piece i covers gaps [edges[i], edges[i+1]) [nm]
+/// and is a Chebyshev series of degree `degree` in u ∈ [u_low[i], u_high[i]], where d = u (signs[i] = 0) or
+/// d = anchors[i] + signs[i]·u² (next to a switching gap: u = √|d − g|); coefficients NaN: evaluated by the
+/// callable. `slopes`: the series of dF/du.
+struct BranchTable {
+  std::vector<double> edges, coefficients, slopes, u_low, u_high, signs, anchors;
+  int degree = 0;
+};
+
+/// One branch (H_a, H_b or c) of a Python law: its table inside the domain, the callable beyond. `factor` converts
+/// the callable's SI value to the law's units (1e9 for N -> nN; 1 for N·s/m -> nN·s/nm).
 class PythonBranch {
  public:
-  PythonBranch(std::string label, pybind11::object callable, double factor, std::vector<double> edges,
-               std::vector<double> coefficients, std::vector<double> slope_coefficients, int degree);
+  PythonBranch(std::string label, pybind11::object callable, double factor, BranchTable table);
   ~PythonBranch();
   PythonBranch(const PythonBranch&) = delete;
   PythonBranch& operator=(const PythonBranch&) = delete;
@@ -42,8 +49,9 @@ class PythonBranch {
   std::string label_;  // "approach=<function f>": how messages name the callable
   std::shared_ptr<pybind11::object> callable_;
   double factor_;
-  std::vector<double> edges_, coefficients_, slopes_;
-  int degree_;
+  BranchTable t_;
+  /// The piece holding `gap` and its variable t ∈ [-1, 1] (and u), or -1 outside the table.
+  std::ptrdiff_t locate(double gap, double& t, double& u) const;
 };
 
 class PythonLawModel final : public impact::ForceLawModel {

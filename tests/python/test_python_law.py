@@ -104,18 +104,18 @@ def test_a_python_laws_force_is_its_callables_within_the_stated_tolerance():
 
 
 def test_a_constant_damping_and_an_endpoint_singularity_are_tabulated():
-    # √δ at the contact edge (Kelvin–Voigt-like damping) cannot be matched by a series up to the edge: the last
-    # sliver is evaluated by the callable, so the law stays exact there
+    # √δ at the contact edge (Kelvin–Voigt-like damping): next to a switching gap the series are in √|d − g|, so
+    # it is tabulated to the edge, with a handful of pieces and no call into Python during runs
     law = laws.Python(dmt_si, damping=lambda d: 1e-3 * np.sqrt(np.clip(A0 - d, 0.0, None)), switching_gaps=[A0])
+    assert law.tabulation["damping"]["direct"] == 0 and law.tabulation["damping"]["pieces"] < 150
     d = A0 - np.geomspace(1e-20, 1e-9, 200)
     c = 1e-3 * np.sqrt(A0 - d)
     # within 1e-10 of the damping's scale on the base interval (0.125, 0.165) nm (the series is checked at its
     # midpoints to 1e-12; next to a singularity the error between them is larger)
     assert np.all(np.abs(law.force(d).damping - c) <= 1e-10 * 1e-3 * np.sqrt(0.04e-9))
-    # inside the last piece (narrower than 1e-6 nm), evaluated by the callable: exact but for the rounding of the
-    # distance to nm and back (an ulp of a0 against δ)
+    # at the edge: exact but for the rounding of the distance to nm (the law's unit inside), an ulp of a0 in δ
     sliver = A0 - np.geomspace(1e-22, 1e-16, 20)
-    np.testing.assert_allclose(law.force(sliver).damping, 1e-3 * np.sqrt(A0 - sliver), rtol=1e-6)
+    assert np.all(np.abs(law.force(sliver).damping - 1e-3 * np.sqrt(A0 - sliver)) <= 1e-3 * np.sqrt(4 * np.spacing(A0)))
     constant = laws.Python(dmt_si, damping=2e-7, switching_gaps=[A0])
     np.testing.assert_allclose(constant.force(np.array([-1e-9, 1e-9])).damping, 2e-7, rtol=1e-14)
 
