@@ -3,7 +3,8 @@ built-in law per orbit).
 
     PYTHONPATH=build/python /usr/bin/python3 bench/python_law.py [--repeat 5]
 
-Runs `tapping orbit` with the built-in DMT and Hertz laws and with the same laws written in Python (afmkit.laws.Python),
+Runs `tapping orbit` with the built-in DMT, Hertz and Kelvin–Voigt laws and with the same laws written in Python
+(afmkit.laws.Python),
 interleaved, and prints the fastest wall time of each, the ratio Python / built-in per orbit (the target: <= 20),
 the one-time cost of tabulating the callables, the cost per law evaluation inside the tabulated domain, and the cost
 of a call into Python (what every evaluation would cost without the tabulation; the law beyond its domain).
@@ -24,6 +25,10 @@ CANTILEVER = dict(spring_constant=40.0, resonance_frequency=300.0, quality_facto
 
 def dmt(d):
     return -A * R / (6.0 * np.maximum(d, A0) ** 2) + 4.0 / 3.0 * E * np.sqrt(R) * np.clip(A0 - d, 0.0, None) ** 1.5
+
+
+def damping(d):  # Kelvin–Voigt: η √(R (a0 − d)) in contact, η = 50 Pa s
+    return 50.0 * np.sqrt(R * np.clip(A0 - d, 0.0, None))
 
 
 def hertz(d):
@@ -51,6 +56,8 @@ def main():
         "dmt": (laws.DMT(effective_modulus=1.0, tip_radius=10.0, hamaker=1e-19), py_dmt, dict(separation=8.0)),
         "hertz": (laws.Hertz(effective_modulus=1.0, tip_radius=10.0), laws.Python(hertz, switching_gaps=[0.0]),
                   dict(separation=8.0)),
+        "kelvin_voigt": (laws.KelvinVoigt(effective_modulus=1.0, tip_radius=10.0, hamaker=1e-19, viscosity=50.0),
+                         laws.Python(dmt, damping=damping, switching_gaps=[A0]), dict(separation=8.0)),
     }
     print(f"tabulating the DMT callable: {tabulate * 1e3:.2f} ms once ({py_dmt.tabulation['approach']['pieces']} Chebyshev "
           "pieces of degree 16)")
