@@ -8,7 +8,7 @@ import pytest
 import afmkit
 from afmkit import laws
 
-CANTILEVER = dict(spring_constant=40.0, resonance_frequency=300.0, quality_factor=30.0, free_amplitude=10.0)
+CANTILEVER = dict(spring_constant=40.0, resonance_frequency=300.0, quality_factor=10.0, free_amplitude=10.0)
 KA, KB = 400.0, 320.0  # N/m: the seed's linear hysteresis (seed-1 eq. 11) in physical units
 E, R, A, A0 = 1e9, 10e-9, 1e-19, 0.165e-9  # DMT in SI: E* [Pa], R [m], A_H [J], a0 [m]
 
@@ -78,6 +78,12 @@ def test_the_builtin_laws_force_is_the_closed_form():
     np.testing.assert_allclose(h(d, +1.0), seed_departure(d), rtol=1e-14)
     np.testing.assert_allclose(h(d, 0.0), 0.5 * (seed_approach(d) + seed_departure(d)), rtol=1e-14)
     assert h(np.zeros((2, 3)), 1.0).shape == (2, 3)
+    # a table with the memory of contact: departing, the retract branch only once in contact
+    z = np.linspace(-2e-9, 20e-9, 45)
+    table = laws.Table(z, dmt_si(z), np.where(z < 1e-9, 1.3 * dmt_si(z), dmt_si(z)))
+    np.testing.assert_allclose(table(z, 1.0, in_contact=False), dmt_si(z), rtol=1e-12, atol=1e-24)
+    np.testing.assert_allclose(table(z, 1.0), table.retract, rtol=1e-12, atol=1e-24)
+    np.testing.assert_allclose(table.force(z).approach, dmt_si(z), rtol=1e-12, atol=1e-24)
 
 
 def test_a_python_laws_force_is_its_callables_within_the_stated_tolerance():
