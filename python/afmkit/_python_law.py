@@ -87,7 +87,7 @@ def tabulate(f, label: str, factor: float, domain_nm, switching_nm, non_negative
         x = to_d(u, sg[:, None], an[:, None])  # nm
         # the ends of the base interval exactly (u² rounds)
         x = np.clip(x, ea[base][:, None], eb[base][:, None])
-        y = values(f, label, x * 1e-9) * factor
+        y = values(f, label, x.ravel() * 1e-9).reshape(x.shape) * factor  # a 1-D array, as the callable expects
         if non_negative and np.any(y < 0):
             i = np.flatnonzero(y.ravel() < 0)[0]
             raise ValueError(f"afmkit.laws.Python: {label} returned {y.flat[i] / factor} at distance "

@@ -122,7 +122,12 @@ def test_a_constant_damping_and_an_endpoint_singularity_are_tabulated():
     # at the edge: exact but for the rounding of the distance to nm (the law's unit inside), an ulp of a0 in δ
     sliver = A0 - np.geomspace(1e-22, 1e-16, 20)
     assert np.all(np.abs(law.force(sliver).damping - 1e-3 * np.sqrt(A0 - sliver)) <= 1e-3 * np.sqrt(4 * np.spacing(A0)))
-    constant = laws.Python(dmt_si, damping=2e-7, switching_gaps=[A0])
+    # the callables receive 1-D arrays (code written for a vector of distances works as it is)
+    def one_d(d):
+        assert d.ndim == 1
+        return np.array([dmt_si(x) for x in d[:3]] + list(dmt_si(d[3:])))
+
+    constant = laws.Python(one_d, damping=2e-7, switching_gaps=[A0])
     np.testing.assert_allclose(constant.force(np.array([-1e-9, 1e-9])).damping, 2e-7, rtol=1e-14)
 
 
