@@ -104,8 +104,13 @@ double PythonBranch::call(double gap) const {
 
 std::ptrdiff_t PythonBranch::locate(double gap, double& t, double& u) const {
   if (t_.edges.size() < 2 || !(gap >= t_.edges.front() && gap <= t_.edges.back())) return -1;
-  const auto it = std::upper_bound(t_.edges.begin(), t_.edges.end(), gap);
-  const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - t_.edges.begin()) - 1, t_.edges.size() - 2);
+  const std::size_t last = t_.edges.size() - 2;  // the last piece
+  std::size_t i = hint_.load(std::memory_order_relaxed);
+  if (!(i <= last && gap >= t_.edges[i] && (gap < t_.edges[i + 1] || (i == last && gap <= t_.edges[i + 1])))) {
+    const auto it = std::upper_bound(t_.edges.begin(), t_.edges.end(), gap);
+    i = std::min<std::size_t>(static_cast<std::size_t>(it - t_.edges.begin()) - 1, last);
+    hint_.store(i, std::memory_order_relaxed);
+  }
   const double sign = t_.signs[i];
   u = sign == 0.0 ? gap : std::sqrt(std::max(0.0, sign * (gap - t_.anchors[i])));
   t = (2.0 * u - t_.u_low[i] - t_.u_high[i]) / (t_.u_high[i] - t_.u_low[i]);

@@ -1,6 +1,8 @@
 #pragma once
 // A force law written in Python as a ForceLawModel (python_law.cpp explains the tabulation and its cost).
 // Units inside: gap nm, force nN, damping nN·s/nm (= N·s/m), as the built-in physical laws (docs/force-laws.md).
+#include <atomic>
+#include <cstddef>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -50,6 +52,9 @@ class PythonBranch {
   std::shared_ptr<pybind11::object> callable_;
   double factor_;
   BranchTable t_;
+  /// The piece of the last evaluation: the integrators ask for nearby gaps in turn, so it is tried first (shared by
+  /// the threads of a run: any value is a valid guess).
+  mutable std::atomic<std::size_t> hint_{0};
   /// The piece holding `gap` and its variable t ∈ [-1, 1] (and u), or -1 outside the table.
   std::ptrdiff_t locate(double gap, double& t, double& u) const;
 };
