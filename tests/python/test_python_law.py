@@ -2,6 +2,9 @@
 built-in law gives the same orbits (to integration tolerance) and the same HB curves; every law's force() equals its
 closed form, with the branch the velocity selects and the Kelvin–Voigt term; a callable that raises, returns the
 wrong shape or a value that is not finite is refused naming it, also when called during a run (GIL released)."""
+import threading
+import time
+
 import numpy as np
 import pytest
 
@@ -37,7 +40,21 @@ def seed_law():
 
 def test_a_python_law_gives_the_orbits_of_the_same_builtin_law(seed_law):
     builtin = afmkit.tapping.orbit(separation=8.0, **SEED, **CANTILEVER)
-    python = afmkit.tapping.orbit(law=seed_law, separation=8.0, **CANTILEVER)
+    ticks, done = [0], threading.Event()
+
+    def other_thread():  # runs while the orbit search does: the run holds no GIL (no Python inside the domain)
+        while not done.is_set():
+            ticks[0] += 1
+            time.sleep(0.001)
+
+    thread = threading.Thread(target=other_thread)
+    thread.start()
+    try:
+        python = afmkit.tapping.orbit(law=seed_law, separation=8.0, **CANTILEVER)
+    finally:
+        done.set()
+        thread.join()
+    assert ticks[0] >= 10
     assert python.params["law"] == "python" and python.params["units"] == "physical"
     assert len(python) == len(builtin) >= 1
     # the built-in law flows in closed form, the Python law is integrated: equal to the integration tolerance
@@ -170,6 +187,15 @@ def test_a_callable_failing_during_a_run_is_the_users_error_not_a_crash():
                             switching_gaps=[0.0], domain=(-5e-9, 5e-9))
     with pytest.raises(afmkit.InvalidParameter, match="must return one number per distance"):
         afmkit.tapping.orbit(law=bad_shape, separation=8.0, **CANTILEVER)
+
+    def interrupted(d):  # Ctrl-C while the callable runs: the run stops with KeyboardInterrupt, as any run
+        if np.any(d > 6e-9):
+            raise KeyboardInterrupt
+        return seed_approach(d)
+
+    with pytest.raises(KeyboardInterrupt):
+        afmkit.tapping.orbit(law=laws.Python(interrupted, switching_gaps=[0.0], domain=(-5e-9, 5e-9)), separation=8.0,
+                             **CANTILEVER)
 
 
 def test_law_python_without_its_object_and_commands_that_fit_a_law_are_refused():
