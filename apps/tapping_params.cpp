@@ -54,6 +54,8 @@ const LawKeyAliases physical_aliases = {{"sample_stiffness_approach", "approach_
 impact::ForceLaw law_from(const io::ParamSet& p, const tapping::PhysicalCantilever* pc,
                           const std::shared_ptr<const impact::ForceLawModel>& object) {
   const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  // law = python without its object (the command line): say so first, whatever the units
+  if (registry.find(p.text("law")).needs_object && !object) return law_from_params(p, registry, {}, object);
   if (!pc) {
     if (!registry.find(p.text("law")).piecewise_linear)
       throw InvalidParameter("law", fmt::format("law = {} needs physical units (units = physical): its parameters are "
