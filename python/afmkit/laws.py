@@ -275,7 +275,8 @@ class Python(Law):
     count as in contact (default: the lowest switching gap). ``domain`` = (lowest, highest) distance [m] over
     which the callables are tabulated (they must be finite there); beyond it they are called point by point
     (correct, slower). ``name``: how records and messages name the law. ``tabulation``: per branch, the number
-    of pieces and of those evaluated by the callable.
+    of pieces and of those evaluated by the callable. A departure branch above the approach branch somewhere
+    creates energy: the commands refuse the law then unless ``allow_energy_gain=True`` (``energy_gain``: where).
 
     The callables are evaluated once, here, in a few vectorised batches: the law is tabulated as Chebyshev pieces
     to 1e-12 of the largest force on each interval (see docs/force-laws.md#python for the check and the cost), so
@@ -330,6 +331,17 @@ class Python(Law):
         self.tabulation = {k: {"pieces": v["pieces"], "direct": v["direct"]} for k, v in tables.items() if v}
         self._model = _afmkit.PythonLaw(self.label, tables["approach"], tables["departure"], tables["damping"],
                                         gaps_nm, math.nan if contact_gap is None else float(contact_gap) * 1e9)
+        self.energy_gain = None if departure is None else self._energy_gain(tables)
+
+    def _energy_gain(self, tables):
+        """(distance [m], H_a [N], H_b [N]) where the departure branch lies above the approach branch (the law
+        creates energy there: docs/force-laws.md#convention), else None. Checked at the edges and midpoints of
+        every tabulated piece of both branches, to 1e-9 of the larger force."""
+        edges = np.unique(np.concatenate([tables["approach"]["edges"], tables["departure"]["edges"]]))
+        d = np.sort(np.concatenate([edges, 0.5 * (edges[1:] + edges[:-1])])) * 1e-9
+        b = self.force(d)
+        bad = np.flatnonzero(b.departure - b.approach > 1e-9 * np.maximum(np.abs(b.approach), np.abs(b.departure)))
+        return None if bad.size == 0 else (float(d[bad[0]]), float(b.approach[bad[0]]), float(b.departure[bad[0]]))
 
     @property
     def physical(self) -> bool:
@@ -385,4 +397,12 @@ def expand(path: str, kwargs: dict, keys) -> dict:
         out[key] = value
     if "units" in keys and law.physical and out.get("units") is None:
         out["units"] = "physical"
+    gain = getattr(law, "energy_gain", None)
+    if gain is not None and not out.get("allow_energy_gain"):  # as every command refuses a built-in law's gain
+        err = _afmkit.InvalidParameter(
+            f"{path}: the departure branch of {law!r} lies above its approach branch at distance {gain[0]:.6g} m "
+            f"(H_b = {gain[2]:.6g} N > H_a = {gain[1]:.6g} N): the law creates energy; give allow_energy_gain=True to "
+            "run it anyway (docs/force-laws.md#convention)")
+        err.parameter = "law"
+        raise err
     return out

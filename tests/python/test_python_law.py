@@ -198,6 +198,19 @@ def test_a_callable_failing_during_a_run_is_the_users_error_not_a_crash():
                              **CANTILEVER)
 
 
+def test_a_python_law_that_creates_energy_needs_the_opt_in_as_a_builtin_one():
+    gain = laws.Python(seed_approach, departure=lambda d: np.where(d < 0, -1.1 * KA * d, 0.0), switching_gaps=[0.0])
+    assert gain.energy_gain is not None and gain.energy_gain[0] < 0
+    with pytest.raises(afmkit.InvalidParameter, match=r"departure branch .* lies above its approach branch at "
+                                                      r"distance -.* creates energy; give allow_energy_gain=True"):
+        afmkit.tapping.hb(law=gain, separation=8.0, points=10, **CANTILEVER)
+    with pytest.raises(afmkit.InvalidParameter, match="must be <= approach_stiffness"):  # the built-in law alike
+        afmkit.tapping.hb(separation=8.0, points=10, **{**SEED, "sample_stiffness_departure": 1.1 * KA},
+                          **CANTILEVER)
+    assert len(afmkit.tapping.hb(law=gain, allow_energy_gain=True, separation=8.0, points=10, **CANTILEVER)) > 0
+    assert laws.Python(seed_approach, departure=seed_departure, switching_gaps=[0.0]).energy_gain is None
+
+
 def test_law_python_without_its_object_and_commands_that_fit_a_law_are_refused():
     with pytest.raises(afmkit.InvalidParameter, match=r"law = python is a force law written in Python"):
         afmkit.tapping.orbit(law="python", units="physical", separation=8.0, **CANTILEVER)
