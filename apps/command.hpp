@@ -11,6 +11,7 @@
 // describing every column; empty path: no file) and prints a one-line summary, or with --json the summary as JSON
 // (plus, when no file is written, the table itself: {"columns": [...], "rows": [[...], ...]}).
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <optional>
 #include <string>
@@ -24,6 +25,9 @@
 
 namespace CLI {
 class App;
+}
+namespace afmkit::impact {
+class ForceLawModel;
 }
 
 namespace afmkit::cli {
@@ -41,6 +45,8 @@ struct Captured {
   Cancellation cancellation;
   /// The parameters as run (what the sidecar records: computed defaults filled in); null until the command finishes.
   nlohmann::json parameters;
+  /// law = python: the force law the caller gave as an object (afmkit.laws.Python), built into the run's law.
+  std::shared_ptr<const impact::ForceLawModel> law;
 };
 
 /// A run that computed no answer of the kind asked for: its results carry `status` other than "ok" and a `note`
@@ -54,6 +60,10 @@ class NoAnswer : public std::runtime_error {
 
 /// The caller's stop request (empty on the command line).
 inline Cancellation cancellation_of(const Captured* capture) { return capture ? capture->cancellation : Cancellation{}; }
+/// The caller's law object (law = python; null on the command line).
+inline std::shared_ptr<const impact::ForceLawModel> law_object_of(const Captured* capture) {
+  return capture ? capture->law : nullptr;
+}
 
 using Declare = std::function<void(io::ParamSet&)>;
 /// Runs a command on resolved parameters; `capture` is nullptr on the command line.

@@ -63,7 +63,7 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
   if (!(l_min < l_max))
     throw InvalidParameter("separation_max",
                            fmt::format("separation_max = {} is out of range: must be > separation_min = {}", l_max, l_min));
-  const tapping::TappingModel model = tapping_model_from(p);
+  const tapping::TappingModel model = tapping_model_from(p, law_object_of(capture));
   const TappingScales scales = tapping_scales_from(p);
   const std::string dir = p.text("output_dir");
   const int points = static_cast<int>(p.integer("points"));

@@ -86,7 +86,7 @@ void reject_foreign_keys(const io::ParamSet& p) {
     throw InvalidParameter("velocity", "give either velocity (relative approach speed) or v1 and v2, not both");
 }
 
-impact::ImpactProblem problem_from(const io::ParamSet& p) {
+impact::ImpactProblem problem_from(const io::ParamSet& p, const Captured* capture) {
   reject_foreign_keys(p);
   const double m1 = p.real("mass1"), m2 = p.real("mass2"), total = m1 + m2, gap = p.real("gap");
   if (!std::isfinite(total))
@@ -104,7 +104,7 @@ impact::ImpactProblem problem_from(const io::ParamSet& p) {
   impact::ExternalForces ext;
   ext.on_body1 = p.real("force1");
   ext.on_body2 = p.real("force2");
-  return {{m1, -m2 / total * gap, v1}, {m2, m1 / total * gap, v2}, law_from_params(p, impact::LawRegistry::builtin()), ext};
+  return {{m1, -m2 / total * gap, v1}, {m2, m1 / total * gap, v2}, law_from_params(p, impact::LawRegistry::builtin(), {}, law_object_of(capture)), ext};
 }
 
 nlohmann::json body_json(const impact::Body& b) {
@@ -196,7 +196,7 @@ void print_summary(const impact::ImpactResult& r, const impact::ForceLaw& law) {
 }
 
 void run_impact(const io::ParamSet& p, Captured* capture) {
-  const impact::ImpactProblem problem = problem_from(p);
+  const impact::ImpactProblem problem = problem_from(p, capture);
   impact::ImpactOptions options;
   const std::string& method = p.text("method");
   options.method = method == "closed_form" ? impact::ImpactMethod::closed_form

@@ -54,13 +54,14 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
 }
 
 impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistry& registry,
-                                 const LawKeyAliases& aliases) {
+                                 const LawKeyAliases& aliases, std::shared_ptr<const impact::ForceLawModel> object) {
   const std::string& name = p.text("law");
   const impact::LawSpec& spec = registry.find(name);
   impact::LawArguments args;
   args.allow_energy_gain = p.flag("allow_energy_gain");
   args.force_curve = p.text("force_curve");
   args.hysteresis = p.text("hysteresis");
+  args.model = std::move(object);
   auto reads = [&](const std::string& key) { return std::find(spec.keys.begin(), spec.keys.end(), key) != spec.keys.end(); };
   std::vector<std::string> replaced;  // keys a given alternative stands for (restitution -> departure_stiffness)
   for (const auto& k : registry.keys())

@@ -2,6 +2,7 @@
 // The force-law parameters of every command, declared and read in one place from impact::LawRegistry
 // (docs/force-laws.md): `law`, `force_curve`, `allow_energy_gain` and every law parameter with its unit.
 #include <map>
+#include <memory>
 #include <string>
 
 #include "afmkit/impact/law_registry.hpp"
@@ -23,7 +24,9 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
                     const std::vector<std::string>& skip = {}, const LawKeyAliases& aliases = {});
 /// The law the parameters describe (InvalidParameter naming the key for a key of another law, a value out of
 /// range or an unknown law). `aliases`: command keys whose values stand for registry keys.
+/// `object`: the law object of law = python (the caller's, law_object_of; null on the command line).
 impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistry& registry,
-                                 const LawKeyAliases& aliases = {});
+                                 const LawKeyAliases& aliases = {},
+                                 std::shared_ptr<const impact::ForceLawModel> object = nullptr);
 
 }  // namespace afmkit::cli

@@ -65,7 +65,7 @@ std::vector<io::Column> fm_columns(const FmUnits& u) {
 
 void run_fm(const io::ParamSet& p, Captured* capture) {
   reject_keys_not_for_fm(p);
-  const tapping::TappingModel base = tapping_model_from(p);
+  const tapping::TappingModel base = tapping_model_from(p, law_object_of(capture));
   const FmUnits u{p.text("units") == "physical", tapping_scales_from(p)};
   const std::vector<double> separations = fm_separations(p, u.s.length);
   memory::require_fits("points", static_cast<double>(separations.size()), sizeof(tapping::FmPoint));

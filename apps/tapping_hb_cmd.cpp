@@ -62,7 +62,7 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   const double q_max = p.real("q_max");
   if (!(q_min < q_max))
     throw InvalidParameter("q_max", fmt::format("q_max = {} is out of range: must be > q_min = {}", q_max, q_min));
-  const tapping::TappingModel model = tapping_model_from(p);
+  const tapping::TappingModel model = tapping_model_from(p, law_object_of(capture));
   const TappingScales scales = tapping_scales_from(p);
 
   tapping::HbCurveOptions options;

@@ -131,7 +131,7 @@ nlohmann::json orbit_units(const TappingScales& s) {
 }
 
 void run_orbit(const io::ParamSet& p, Captured* capture) {
-  const tapping::TappingModel model = tapping_model_from(p);
+  const tapping::TappingModel model = tapping_model_from(p, law_object_of(capture));
   const TappingScales scales = tapping_scales_from(p);
   tapping::OrbitSearchOptions options;
   options.shooting = shooting_options_from(p);

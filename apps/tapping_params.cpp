@@ -51,17 +51,20 @@ const LawKeyAliases physical_aliases = {{"sample_stiffness_approach", "approach_
                                         {"adhesion_approach", "approach_adhesion"},
                                         {"adhesion_departure", "departure_adhesion"}};
 
-impact::ForceLaw law_from(const io::ParamSet& p, const tapping::PhysicalCantilever* pc) {
+impact::ForceLaw law_from(const io::ParamSet& p, const tapping::PhysicalCantilever* pc,
+                          const std::shared_ptr<const impact::ForceLawModel>& object) {
   const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  // law = python without its object (the command line): say so first, whatever the units
+  if (registry.find(p.text("law")).needs_object && !object) return law_from_params(p, registry, {}, object);
   if (!pc) {
     if (!registry.find(p.text("law")).piecewise_linear)
       throw InvalidParameter("law", fmt::format("law = {} needs physical units (units = physical): its parameters are "
                                                 "in GPa, nm, J (docs/force-laws.md)",
                                                 p.text("law")));
-    return law_from_params(p, registry);
+    return law_from_params(p, registry, {}, object);
   }
   // physical law (nm, nN, nm/s) -> per unit mass (nm·ω_n²) in normalised time (1/ω_n)
-  return pc->normalised_law(law_from_params(p, registry, physical_aliases));
+  return pc->normalised_law(law_from_params(p, registry, physical_aliases, object));
 }
 
 tapping::PhysicalCantilever physical_cantilever(const io::ParamSet& p) {
@@ -126,15 +129,15 @@ void add_tapping_model_params(io::ParamSet& p) {
                  physical_aliases);
 }
 
-tapping::TappingModel tapping_model_from(const io::ParamSet& p) {
+tapping::TappingModel tapping_model_from(const io::ParamSet& p, std::shared_ptr<const impact::ForceLawModel> law_object) {
   reject_foreign_keys(p);
   if (physical(p)) {
     const auto pc = physical_cantilever(p);
-    return {pc.cantilever(), pc.drive(), law_from(p, &pc), p.real("separation")};
+    return {pc.cantilever(), pc.drive(), law_from(p, &pc, law_object), p.real("separation")};
   }
   const double wn = p.real("natural_frequency");
   return {tapping::Cantilever(wn, p.real("quality_factor")), tapping::Drive(p.real("drive_amplitude"), p.real("frequency_ratio") * wn),
-          law_from(p, nullptr), p.real("separation")};
+          law_from(p, nullptr, law_object), p.real("separation")};
 }
 
 TappingScales tapping_scales_from(const io::ParamSet& p) {

@@ -1,6 +1,7 @@
 #pragma once
 // Model parameters shared by `afmkit tapping orbit | hb | sweep` (and the demo), in normalised or physical
 // units (docs/units.md). Keys of the other unit system are rejected when given explicitly.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,8 +19,10 @@ inline std::vector<std::string> uniform_grid_keys() { return {"separation_min", 
 
 /// units, cantilever, drive, force law, separation.
 void add_tapping_model_params(io::ParamSet& p);
-/// The normalised model at the parameter `separation` (nm in physical units).
-tapping::TappingModel tapping_model_from(const io::ParamSet& p);
+/// The normalised model at the parameter `separation` (nm in physical units). `law_object`: the caller's law of
+/// law = python (law_object_of(capture); null on the command line).
+tapping::TappingModel tapping_model_from(const io::ParamSet& p,
+                                         std::shared_ptr<const impact::ForceLawModel> law_object = nullptr);
 using TappingScales = tapping::UnitScales;
 /// Factors converting model quantities to the user's units (all 1 for normalised units).
 TappingScales tapping_scales_from(const io::ParamSet& p);

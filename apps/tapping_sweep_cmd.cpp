@@ -127,7 +127,7 @@ std::vector<double> sweep_separations(const io::ParamSet& p, double length_scale
 }
 
 void run_sweep(const io::ParamSet& p, Captured* capture) {
-  const tapping::TappingModel base = tapping_model_from(p);
+  const tapping::TappingModel base = tapping_model_from(p, law_object_of(capture));
   const TappingScales scales = tapping_scales_from(p);
   const std::vector<double> list = sweep_separations(p, scales.length);
   double l_min = p.real("separation_min") / scales.length, l_max = p.real("separation_max") / scales.length;

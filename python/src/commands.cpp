@@ -21,6 +21,7 @@
 #include "interrupts.hpp"
 #include "command.hpp"
 #include "params_from_python.hpp"
+#include "python_law.hpp"
 
 namespace py = pybind11;
 
@@ -29,6 +30,13 @@ namespace afmkit::python {
 namespace {
 
 using cli::CommandSpec;
+
+/// The commands whose law comes from law_from_params with the caller's law object (cli::law_object_of).
+bool takes_law_object(const std::string& path) {
+  for (const char* p : {"tapping orbit", "tapping hb", "tapping sweep", "tapping fm", "demo", "impact"})
+    if (path == p) return true;
+  return false;
+}
 
 py::object value_to_python(const io::ParamSet::Value& v) {
   return std::visit([](const auto& x) -> py::object { return py::cast(x); }, v);
@@ -156,12 +164,26 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   std::string name = "afmkit." + path;
   std::replace(name.begin(), name.end(), ' ', '.');
   const CommandSpec& s = command_spec(path);
-  const io::ParamSet p = params_from_python(path, name, kwargs);
   cli::Captured captured;
+  py::dict given = kwargs;
+  if (kwargs.contains("law") && py::isinstance<PythonLawModel>(kwargs["law"])) {
+    // law = python: the law object goes to the run, the record says law = python (docs/force-laws.md#python)
+    if (!takes_law_object(path))
+      throw InvalidParameter("law", name + ": law = afmkit.laws.Python(...) applies only to the commands that "
+                                           "simulate with a given law (tapping orbit, hb, sweep, fm, demo, impact)");
+    captured.law = kwargs["law"].cast<std::shared_ptr<PythonLawModel>>();
+    given = py::dict();
+    for (const auto& [k, v] : kwargs) given[k] = py::str(k).cast<std::string>() == "law" ? py::str("python") : v;
+  }
+  const io::ParamSet p = params_from_python(path, name, given);
   SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
   captured.cancellation = interrupts.cancellation();
   io::ProgressSink progress(progress_to_python);  // progress lines to sys.stderr (Jupyter), not to descriptor 2
-  interrupts.run([&] { s.run(p, &captured); });
+  try {
+    interrupts.run([&] { s.run(p, &captured); });
+  } catch (const PythonLawError& e) {  // the user's law failed: their error (exit-2 style), not a crash
+    throw InvalidParameter("law", e.what());
+  }
   py::dict out;
   out["results"] = json_to_python(captured.results);
   py::list columns;

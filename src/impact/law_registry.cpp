@@ -127,6 +127,18 @@ LawRegistry LawRegistry::builtin() {
            return make_law<TableLaw>(read_force_curve(a.force_curve), gain(a),
                                      velocity ? Hysteresis::velocity : Hysteresis::contact, v("release_tolerance"));
          }});
+  LawSpec python{"python",
+                 "a law written in Python: afmkit.laws.Python(approach=f, departure=g, damping=c), given from the "
+                 "Python module",
+                 {}, false, false, [](const V&, const LawArguments& a) {
+                   if (!a.model)
+                     throw InvalidParameter("law", "law = python is a force law written in Python: give it from the "
+                                                   "Python module as law=afmkit.laws.Python(approach=..., ...) (a "
+                                                   "command line or TOML file cannot hold one; docs/force-laws.md#python)");
+                   return ForceLaw(a.model);
+                 }};
+  python.needs_object = true;
+  r.add(std::move(python));
   return r;
 }
 

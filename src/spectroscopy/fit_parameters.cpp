@@ -194,6 +194,10 @@ void ModelValues::set(const std::string& name, double p) {
 std::vector<FitParameterInfo> fit_parameter_info(const FitOptions& options, FitMode mode) {
   const impact::LawRegistry registry = impact::LawRegistry::builtin();
   const impact::LawSpec& spec = registry.find(options.law);
+  if (spec.needs_object)  // its callables are given, not parameters
+    throw InvalidParameter("law", fmt::format("law = {} cannot be fitted: the fit adjusts the parameters of a built-in "
+                                              "law (docs/force-laws.md), and a law written in Python has none",
+                                              options.law));
   if (options.parameters.empty())
     throw InvalidParameter("parameters", fmt::format("no parameter to fit: name at least one (a key of the law, or "
                                                      "of the calibration: {})",

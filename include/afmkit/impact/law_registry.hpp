@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,8 @@ struct LawArguments {
   /// Branch selection (docs/force-laws.md#hysteresis): "" or "law" (the law's own: contact for table, velocity
   /// for the others), "contact" or "velocity" (law = table only; the other laws accept only their own).
   std::string hysteresis;
+  /// law = python: the law object the caller gave (the Python module's afmkit.laws.Python; null elsewhere).
+  std::shared_ptr<const ForceLawModel> model;
 
   /// A given value, else the default (or followed key) from `key`.
   double real(const LawKey& key, const std::vector<LawKey>& all) const;
@@ -52,12 +55,13 @@ struct LawSpec {
   bool piecewise_linear = false;    // works in any consistent unit set (else the physical units above)
   /// Builds the law; `value(key)` gives each parameter (given, default or followed), already range-checked.
   std::function<ForceLaw(const std::function<double(const std::string&)>& value, const LawArguments& args)> build;
+  bool needs_object = false;        // reads LawArguments::model (law = python: only a program can give one)
 };
 
 class LawRegistry {
  public:
   /// The built-in laws: linear (10), hysteresis (11), attractive (26), hertz, dmt, jkr, lennard_jones,
-  /// kelvin_voigt, table.
+  /// kelvin_voigt, table; and python (a law object written in Python, given by the Python module).
   static LawRegistry builtin();
   /// Adds a law (and the keys it introduces; a key already declared must be declared identically or omitted).
   /// InvalidParameter("law", …) for a duplicate name or a key that is neither new nor declared.
