@@ -208,9 +208,9 @@ double orbit_min_gap(const detail::ParameterPath& path, const SweepPoint& p, con
 
 namespace {
 
-/// The parameter value where the free amplitude reaches the contact edge, shifted to the free side by a relative
-/// 1e-12 of the gap (so that the free orbit clears the edge despite rounding), found by secant iterations from
-/// `from`; the direction of the free side (+1: increasing p). nullopt when it does not converge.
+/// Just beyond the parameter value where the free amplitude reaches the contact edge (found by secant iterations
+/// from `from`), on the free side by two difference steps; and the direction of the free side (+1: increasing p).
+/// nullopt when it does not converge.
 std::optional<std::pair<double, double>> grazing_value(const detail::ParameterPath& path, double from,
                                                        double contact_edge) {
   const double l = path.base.separation;
@@ -226,10 +226,13 @@ std::optional<std::pair<double, double>> grazing_value(const detail::ParameterPa
       g0 = g1;
       p1 = p2;
       g1 = g(p1) + margin;
-      if (std::abs(g1) <= 1e-3 * margin) {
+      if (std::abs(g1) <= 0.1 * margin) {  // g within [−1.1, −0.9]·margin: free, just
         const double slope = (g(p1 + h) - g(p1 - h)) / (2 * h);
         if (!(slope != 0.0) || !std::isfinite(slope)) return std::nullopt;
-        return std::make_pair(p1, slope > 0 ? -1.0 : 1.0);
+        // the hop lands two difference steps inside the free side, so that the central difference of the map
+        // (ParameterPath::map_derivative) does not straddle the grazing corner
+        const double direction = slope > 0 ? -1.0 : 1.0;
+        return std::make_pair(p1 + direction * 2.0 * path.difference_step(p1), direction);
       }
     }
   } catch (const InvalidParameter&) {
@@ -282,7 +285,14 @@ ContinuationResult continue_checked(const TappingModel& base, const SweepParamet
                                          last.parameter * path.scale))
                         .norm();
         out.grazing.push_back(p_graze);
-        stop = tracer.trace(z, r, Eigen::Vector3d(0.0, 0.0, graze->second));
+        // the free branch: along l its state does not change (tangent (0, 0, 1)); along another parameter the
+        // tangent of the Jacobian, towards the free side
+        Eigen::Vector3d t_free(0.0, 0.0, graze->second);
+        if (!parameter.is_separation()) {
+          t_free = tangent(r.jacobian);
+          if ((t_free.z() > 0) != (graze->second > 0)) t_free = -t_free;
+        }
+        stop = tracer.trace(z, r, t_free);
       }
     }
   }

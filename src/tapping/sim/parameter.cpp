@@ -51,6 +51,8 @@ ParameterPath make_path(const TappingModel& base, const SweepParameter& paramete
   return path;
 }
 
+double ParameterPath::difference_step(double value) const { return 1e-5 * std::max(std::abs(value), width); }
+
 namespace {
 
 /// ∂P^n/∂p at `start` by central differences of the map (P^n(start) = `end` at p = value), one-sided where the
@@ -59,7 +61,7 @@ Eigen::Vector2d difference_of_map(const ParameterPath& path, double value, TipSt
                                   const SimulationOptions& simulation) {
   SimulationOptions plain = simulation;
   plain.sensitivity = false;
-  const double h = 1e-5 * std::max(std::abs(value), path.width);
+  const double h = path.difference_step(value);
   const auto end_at = [&](double p) -> std::optional<TipState> {
     std::optional<TappingModel> model;
     try {

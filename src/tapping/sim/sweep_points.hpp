@@ -20,6 +20,8 @@ struct ParameterPath {
   double width = 0.0;  // of the range (difference steps of ∂P/∂p: 1e-5·max(|p|, width))
 
   TappingModel at(double value) const { return parameter.at(base, value); }
+  /// Step of the central differences of ∂P/∂p at `value`.
+  double difference_step(double value) const;
   /// ∂(x, ẋ)(T)/∂p of one drive period from `start` at p = `value` (`end`: the map's value there), by central
   /// differences (one-sided where the model refuses p ± step). Not for the separation (exact column of the map).
   Eigen::Vector2d map_derivative(double value, TipState start, TipState end, const SimulationOptions& simulation) const;
