@@ -145,7 +145,15 @@ struct Tracer {
       bool converged = false;
       int it = 0;
       for (; it < options.max_corrector_iterations; ++it) {
-        rc = residual(path, zc, sim, it == 0 ? r.memory : rc.memory);
+        try {
+          rc = residual(path, zc, sim, it == 0 ? r.memory : rc.memory);
+        } catch (const InvalidParameter&) {
+          // the model does not exist at this value of the parameter (e.g. an adhesion beyond the other branch's):
+          // beyond the range the branch has left it; inside, the failure propagates (a computed value refused)
+          const double at = zc.z() / path.scale;
+          if (zc.allFinite() && (at < l_min || at > l_max)) return Stop::left_range;
+          throw;
+        }
         const double scale = std::max(1.0, zc.head<2>().cwiseAbs().maxCoeff());
         if (it > 0 && rc.value.cwiseAbs().maxCoeff() <= options.tolerance * scale && rc.memory_repeats()) {
           converged = true;
