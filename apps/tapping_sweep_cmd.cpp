@@ -434,6 +434,9 @@ void register_tapping_sweep(CLI::App& tapping) {
             .real("parameter_max", 0.0, "largest value of the swept parameter, > parameter_min", io::Range::any())
             .unit("the unit of the swept parameter")
             .only_if_given();
+        // the records of a sweep in another parameter do not list the separation grid it did not use
+        for (const char* key : {"separation_min", "separation_max", "separations", "separations_file"})
+          p.applies_when(key, "parameter", {"separation"});
         add_output_params(p, "out/tapping_sweep.csv", "sweep");
         p.flag("quiet", false, "no progress output");
       },
