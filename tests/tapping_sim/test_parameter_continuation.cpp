@@ -95,10 +95,10 @@ TEST(ParameterContinuation, DriveFrequencyWithoutContactIsTheLinearResonanceCurv
   EXPECT_GT(highest, 1.1 - 0.01);
 }
 
-// The down and up sweeps without contact: no jump, every row on the resonance curve.
+// The down and up sweeps without contact: no jump, every row on the resonance curve, and so is the harmonic balance
+// beside each row (evaluated at each row's own drive frequency: exact for the linear oscillator).
 TEST(ParameterContinuation, DriveFrequencySweepWithoutContactHasNoJumps) {
   SweepOptions o;
-  o.harmonic_balance = false;
   const SweepResult r = sweep_instrument(pc_model(1000.0), SweepParameter::drive_frequency(), 0.95, 1.05, 11, o);
   EXPECT_TRUE(r.jumps.empty());
   ASSERT_EQ(r.approach.size(), 11u);
@@ -107,8 +107,10 @@ TEST(ParameterContinuation, DriveFrequencySweepWithoutContactHasNoJumps) {
   for (const auto* side : {&r.approach, &r.retract})
     for (const SweepPoint& p : *side) {
       const double w = p.parameter;
-      EXPECT_NEAR(p.metrics.amplitude, kPcDrive / std::abs(std::complex<double>(1.0 - w * w, w / kPcQuality)),
-                  1e-9 * p.metrics.amplitude);
+      const double exact = kPcDrive / std::abs(std::complex<double>(1.0 - w * w, w / kPcQuality));
+      EXPECT_NEAR(p.metrics.amplitude, exact, 1e-9 * exact);
+      EXPECT_EQ(p.hb_solutions, 1);
+      EXPECT_NEAR(p.hb_amplitude, exact, 1e-9 * exact);
     }
 }
 

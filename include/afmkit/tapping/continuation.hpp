@@ -63,7 +63,8 @@ ContinuationResult sweep_continuation(const TappingModel& base, double l_min, do
 
 /// continue_orbits in any parameter: `start` is a converged orbit of parameter.at(base, start_value); p stays
 /// within [p_min, p_max] (InvalidParameter naming <name>_min / <name>_max otherwise). Each point's `parameter` is
-/// its value of p; its `separation` that of its model.
+/// its value of p; its `separation` that of its model. Harmonic balance beside each point (options.harmonic_balance)
+/// only for piecewise-linear laws, whose HB is a closed form at each point's model; other laws: hb_* NaN.
 ContinuationResult continue_orbits(const TappingModel& base, const SweepParameter& parameter,
                                    const PeriodicOrbit& start, double start_value, double p_min, double p_max,
                                    bool increasing, const ContinuationOptions& options = {});

@@ -136,7 +136,8 @@ SweepResult sweep_instrument(const TappingModel& base, double l_min, double l_ma
 SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separations,
                              const SweepOptions& options = {});
 
-/// The instrument sweep in any parameter (parameter.hpp): "approach" visits the values from p_max down to p_min,
+/// The instrument sweep in any parameter (parameter.hpp) — like continue_orbits in a parameter, harmonic balance
+/// beside each point only for piecewise-linear laws (closed form; other laws: hb_* NaN, hb_solutions 0): "approach" visits the values from p_max down to p_min,
 /// "retract" back up (a down and an up sweep); each point's `parameter` is its value, each jump's `parameter` where
 /// it is located (approach_jumps, retract_jumps: those values). The jump tolerance and the transient sub-step are
 /// then jump_tolerance·max|p| and transient_step·max|p| (the free amplitude at the scale of the separation).

@@ -469,8 +469,11 @@ void finish_points(const ParameterPath& path, std::vector<SweepPoint>& points, c
       SweepPoint& p = points[i];
       const TappingModel model = path.at(p.parameter);
       p.metrics = analyse_orbit(model, p.orbit, simulation);
-      // every point has its own model: one HB evaluation each (closed form for piecewise-linear laws)
-      if (harmonic_balance) attach_from(HarmonicBalance(model, cancellation).solutions(model.separation), p);
+      // every point has its own model: one HB evaluation each, done where it is a closed form (piecewise-linear
+      // laws, microseconds); for another law it traces a describing-function curve per point (7 ms for DMT to
+      // 0.3 s for a table, measured): not evaluated (hb_* NaN, hb_solutions 0)
+      if (harmonic_balance && model.law.piecewise_linear())
+        attach_from(HarmonicBalance(model, cancellation).solutions(model.separation), p);
     });
   }
   errors.rethrow();

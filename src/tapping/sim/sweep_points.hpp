@@ -34,7 +34,8 @@ ParameterPath make_path(const TappingModel& base, const SweepParameter& paramete
 void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
                    bool harmonic_balance, bool parallel, const Cancellation& cancellation = {});
 /// The same along any parameter: the metrics at each point's model, harmonic balance of each point's model (one
-/// HB evaluation per point; the separation uses finish_points).
+/// HB evaluation per point) when the law is piecewise linear (closed form); else hb_* stay NaN. (The separation
+/// uses finish_points with one HB object for all points.)
 void finish_points(const ParameterPath& path, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
                    bool harmonic_balance, bool parallel, const Cancellation& cancellation = {});
 /// Metrics of the orbits on both sides of each jump.
