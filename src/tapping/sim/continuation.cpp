@@ -35,6 +35,7 @@ struct Residual {
   Eigen::Vector2d value;
   Eigen::Matrix<double, 2, 3> jacobian;
   StroboscopicMap map;
+  double separation = 0.0;  // of the model at this value of the parameter
   bool memory = false;  // the memory of contact the map started with (contact-aware laws; docs/force-laws.md)
   bool memory_repeats() const { return map.end.contact == memory; }
 };
@@ -57,6 +58,7 @@ Residual residual(const detail::ParameterPath& path, const Eigen::Vector3d& z, c
   const double value = z.z() / path.scale;
   const TappingModel model = path.at(value);
   Residual r;
+  r.separation = model.separation;
   r.memory = memory;
   r.map = stroboscopic_map(model, {z.x(), z.y() * omega, memory}, 1, sim);
   if (!r.memory_repeats()) {
@@ -82,7 +84,7 @@ SweepPoint make_point(const detail::ParameterPath& path, const Eigen::Vector3d& 
                       double arclength, int iterations) {
   SweepPoint p;
   p.parameter = z.z() / path.scale;
-  p.separation = path.parameter.is_separation() ? z.z() : path.base.separation;
+  p.separation = r.separation;  // = z.z() when continuing in l
   p.direction = SweepDirection::continuation;
   p.arclength = arclength;
   PeriodicOrbit& o = p.orbit;
@@ -186,7 +188,7 @@ struct Tracer {
       if (fold) {
         const double at = fold_separation(s, z.z(), t.z(), s_new, zc.z(), t_new.z());  // scaled
         f.parameter = at / path.scale;
-        f.separation = path.parameter.is_separation() ? f.parameter : path.base.separation;
+        f.separation = path.parameter.is_separation() ? f.parameter : rc.separation;
         f.separation_maximum = t.z() > 0;
         // the point nearer the fold: the one before (index size − 1) or the one about to be added (index size)
         f.point = out.points.size() - (std::abs(zc.z() - at) <= std::abs(z.z() - at) ? 0 : 1);
@@ -221,9 +223,11 @@ namespace {
 /// nullopt when it does not converge.
 std::optional<std::pair<double, double>> grazing_value(const detail::ParameterPath& path, double from,
                                                        double contact_edge) {
-  const double l = path.base.separation;
-  const auto g = [&](double p) { return path.at(p).free_amplitude() + contact_edge - l; };  // < 0: free
-  const double margin = 1e-12 * (std::abs(l) + 1.0);
+  const auto g = [&](double p) {  // < 0: free
+    const TappingModel model = path.at(p);
+    return model.free_amplitude() + contact_edge - model.separation;
+  };
+  const double margin = 1e-12 * (std::abs(path.base.separation) + 1.0);
   double h = 1e-6 * std::max(std::abs(from), path.width);
   double p0 = from, p1 = from + h;
   try {

@@ -332,7 +332,7 @@ SweepJump make_jump(const detail::ParameterPath& path, double separation, double
                     bool located, const PeriodicOrbit& from, double from_at, const SweepPoint& landed) {
   SweepJump j;
   j.parameter = separation;
-  j.separation = path.parameter.is_separation() ? separation : path.base.separation;
+  j.separation = path.parameter.is_separation() ? separation : path.at(separation).separation;
   j.from_parameter = from_at;
   j.to_parameter = landed.parameter;
   j.tolerance = tolerance;
