@@ -128,7 +128,7 @@ std::vector<double> sweep_separations(const io::ParamSet& p, double length_scale
 }
 
 /// Records sorted by the value of `key`.
-nlohmann::json sorted_by(nlohmann::json records, const std::string& key) {
+nlohmann::json records_sorted_by(nlohmann::json records, const std::string& key) {
   std::stable_sort(records.begin(), records.end(), [&](const nlohmann::json& a, const nlohmann::json& b) {
     return a[key].get<double>() < b[key].get<double>();
   });
@@ -208,7 +208,7 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
                        {"amplitude_before", j.from_metrics.amplitude * scales.length},
                        {"amplitude_after", j.to_metrics.amplitude * scales.length},
                        {"landed_periodic", j.landed_periodic}});
-    results["jumps"] = sorted_by(std::move(jumps), name);
+    results["jumps"] = records_sorted_by(std::move(jumps), name);
     const double tolerance = options.jump_tolerance * magnitude;
     results["jump_tolerance"] = tolerance;
     summary += fmt::format("instrument sweep in {}: jumps down at {}; up at {} (located to ±{})", name,
@@ -240,7 +240,7 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
       at.push_back(f.parameter);
     }
     std::sort(at.begin(), at.end());
-    results["folds"] = sorted_by(std::move(folds), name);
+    results["folds"] = records_sorted_by(std::move(folds), name);
     results["grazing"] = c.grazing;
     results["continuation_stop"] = c.stop_reason;
     results["continuation_points"] = c.points.size();

@@ -14,7 +14,7 @@ namespace afmkit::cli {
 namespace {
 
 /// The numeric keys of the tapping model (cantilever, drive, law) other than the separation.
-std::vector<std::string> model_keys() {
+std::vector<std::string> sweepable_model_keys() {
   io::ParamSet scratch;
   add_tapping_model_params(scratch);
   std::vector<std::string> keys;
@@ -24,7 +24,7 @@ std::vector<std::string> model_keys() {
 }
 
 /// The keys of `keys` this run uses (recorded: its unit system, its law).
-std::vector<std::string> keys_of_run(const io::ParamSet& p, const std::vector<std::string>& keys) {
+std::vector<std::string> sweepable_keys_of_run(const io::ParamSet& p, const std::vector<std::string>& keys) {
   const nlohmann::json recorded = p.to_json();
   std::vector<std::string> out;
   for (const std::string& k : keys)
@@ -36,14 +36,14 @@ std::vector<std::string> keys_of_run(const io::ParamSet& p, const std::vector<st
 
 std::vector<std::string> sweep_parameter_names() {
   std::vector<std::string> names{"separation", "drive_frequency"};
-  for (const std::string& k : model_keys()) names.push_back(k);
+  for (const std::string& k : sweepable_model_keys()) names.push_back(k);
   return names;
 }
 
 SweptParameter swept_parameter_from(const io::ParamSet& p) {
   const std::string name = p.text("parameter");
   std::vector<std::string> allowed{"drive_frequency"};
-  for (const std::string& k : keys_of_run(p, model_keys())) allowed.push_back(k);
+  for (const std::string& k : sweepable_keys_of_run(p, sweepable_model_keys())) allowed.push_back(k);
   if (std::find(allowed.begin(), allowed.end(), name) == allowed.end())
     throw InvalidParameter("parameter", fmt::format("parameter = {} is not a parameter of this run (units = {}, law = "
                                                     "{}): one of separation, {}",
