@@ -24,6 +24,7 @@
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
+#include "tapping_sweep_parameter.hpp"
 #include "tapping_tables.hpp"
 #include "work_budget.hpp"
 
@@ -126,7 +127,170 @@ std::vector<double> sweep_separations(const io::ParamSet& p, double length_scale
   return list;
 }
 
+/// Records sorted by the value of `key`.
+nlohmann::json records_sorted_by(nlohmann::json records, const std::string& key) {
+  std::stable_sort(records.begin(), records.end(), [&](const nlohmann::json& a, const nlohmann::json& b) {
+    return a[key].get<double>() < b[key].get<double>();
+  });
+  return records;
+}
+
+/// A sweep in another parameter than the separation (--parameter): the same instrument sweep (down from
+/// parameter_max, then up) and continuation through folds, with the swept value first in every row and record.
+void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
+  const tapping::TappingModel base = tapping_model_from(p, law_object_of(capture));
+  const TappingScales scales = tapping_scales_from(p);
+  const SweptParameter swept = swept_parameter_from(p, law_object_of(capture));
+  const std::string& name = swept.name;
+  const int points = static_cast<int>(p.integer("points"));
+  memory::require_fits("points", static_cast<double>(points), 2.0 * sizeof(tapping::SweepPoint));
+  const std::string& mode = p.text("mode");
+  const bool instrument = mode == "instrument" || mode == "both";
+  const bool continuation = mode == "continuation" || mode == "both";
+  const bool quiet = p.flag("json") || p.flag("quiet");
+  const std::string unit = swept.unit;
+  // values of the swept parameter in its own unit (none for ω/ω_n)
+  const auto values_text = [&](const std::vector<double>& v) {
+    if (v.empty()) return std::string("none");
+    std::string text;
+    for (double x : v) text += fmt::format("{}{:.4g}", text.empty() ? "" : ", ", x);
+    return unit == "dimensionless" ? text : text + " " + unit;
+  };
+
+  CommandOutput out(p, capture, "tapping sweep");
+  std::vector<io::Column> columns{{name, unit,
+                                   name == "drive_frequency"
+                                       ? std::string("drive frequency over natural frequency ω/ω_n (the drive force held)")
+                                       : fmt::format("value of the swept parameter {}", name)}};
+  for (io::Column& c : sweep_columns(scales)) columns.push_back(std::move(c));
+  columns[2].description = "separation l of the orbit (fixed: the sweep moves " + name + ")";
+  columns[3].description = "down (from parameter_max to parameter_min), up (back) or continuation";
+  out.open(columns);
+  long trapped = 0;
+  const auto write_rows = [&](const std::vector<tapping::SweepPoint>& pts) {
+    write_sweep_rows(out, pts, scales, 1.0);
+    for (const tapping::SweepPoint& pt : pts) trapped += tapping::tip_trapped(pt.metrics) ? 1 : 0;
+  };
+  nlohmann::json results = nlohmann::json::object();
+  results["parameter"] = name;
+  // HB beside each point where it is a closed form at each value (docs/commands.md#sweeps-in-another-parameter)
+  results["harmonic_balance"] =
+      base.law.piecewise_linear()
+          ? std::string("beside each point (closed form at each point's model)")
+          : fmt::format("not evaluated (hb_* columns nan): law = {} has no closed-form harmonic balance, and a "
+                        "describing-function curve per point costs 7 ms to 0.3 s; use tapping hb at chosen values",
+                        p.text("law"));
+  std::string summary;
+  const double magnitude = std::max(std::abs(swept.min), std::abs(swept.max));
+  if (instrument) {
+    io::Progress progress(fmt::format("tapping sweep in {} (down + up)", name), 2L * points, !quiet);
+    tapping::SweepOptions options;
+    options.shooting = shooting_options_from(p);
+    options.transient = transient_options_from(p);
+    options.progress = [&progress](long n) { progress.advance(n); };
+    options.cancellation = cancellation_of(capture);
+    options.validate();
+    const tapping::SweepResult r = computed("instrument sweep", [&] {
+      return tapping::sweep_instrument(base, swept.parameter, swept.min, swept.max, points, options);
+    });
+    progress.finish();
+    write_rows(r.approach);
+    write_rows(r.retract);
+    results["down_jumps"] = r.approach_jumps;
+    results["up_jumps"] = r.retract_jumps;
+    nlohmann::json jumps = nlohmann::json::array();
+    for (const tapping::SweepJump& j : r.jumps)
+      jumps.push_back({{name, j.parameter},
+                       {"tolerance", j.tolerance},
+                       {"direction", sweep_direction_label(j.direction, false)},
+                       {"located", j.located},
+                       {"branch", branch_of(j.from_metrics)},
+                       {"amplitude_before", j.from_metrics.amplitude * scales.length},
+                       {"amplitude_after", j.to_metrics.amplitude * scales.length},
+                       {"landed_periodic", j.landed_periodic}});
+    results["jumps"] = records_sorted_by(std::move(jumps), name);
+    const double tolerance = options.jump_tolerance * magnitude;
+    results["jump_tolerance"] = tolerance;
+    summary += fmt::format("instrument sweep in {}: jumps down at {}; up at {} (located to ±{})", name,
+                           values_text(r.approach_jumps), values_text(r.retract_jumps),
+                           values_text({tolerance}));
+  }
+  if (continuation) {
+    tapping::ContinuationOptions options;
+    options.shooting = shooting_options_from(p);
+    options.max_step = p.real("max_arclength_step") / scales.length;
+    options.initial_step = std::min(options.initial_step, options.max_step);
+    options.max_points = static_cast<int>(p.integer("max_continuation_points"));
+    options.cancellation = cancellation_of(capture);
+    options.validate();
+    const tapping::ContinuationResult c = computed("branch continuation", [&] {
+      return tapping::sweep_continuation(base, swept.parameter, swept.min, swept.max, options);
+    });
+    write_rows(c.points);
+    nlohmann::json folds = nlohmann::json::array();
+    std::vector<double> at;
+    for (const tapping::ContinuationFold& f : c.folds) {
+      const tapping::OrbitMetrics& m = c.points.at(f.point).metrics;
+      folds.push_back({{name, f.parameter},
+                       {"amplitude", m.amplitude * scales.length},
+                       {"offset", m.offset * scales.length},
+                       {"phase", m.phase},
+                       {"branch", branch_of(m)},
+                       {"kind", f.separation_maximum ? "maximum" : "minimum"}});
+      at.push_back(f.parameter);
+    }
+    std::sort(at.begin(), at.end());
+    results["folds"] = records_sorted_by(std::move(folds), name);
+    results["grazing"] = c.grazing;
+    results["continuation_stop"] = c.stop_reason;
+    results["continuation_points"] = c.points.size();
+    summary += fmt::format("{}continuation in {}: {} points, folds at {}; grazing at {} ({})",
+                           summary.empty() ? "" : "\n", name, c.points.size(), values_text(at),
+                           values_text(c.grazing), c.stop_reason);
+  }
+  results["free_amplitude"] = base.free_amplitude() * scales.length;
+  results["rows"] = out.rows();
+  results["trapped_rows"] = trapped;
+  const bool all_trapped = out.rows() > 0 && trapped == static_cast<long>(out.rows());
+  results["status"] = all_trapped ? "tip_trapped" : "ok";
+  results["note"] = all_trapped ? fmt::format("tip trapped: the tip sticks to the sample or stays in contact over "
+                                              "the whole period at every value of the sweep ({} rows; column "
+                                              "trapped): no tapping",
+                                              out.rows())
+                                : trapped > 0 ? fmt::format("{} of {} rows with the tip trapped (stuck to the sample or "
+                                                            "in contact over the whole period; column trapped)",
+                                                            trapped, out.rows())
+                                              : std::string();
+  if (trapped > 0) summary += fmt::format("\n{}", results["note"].get<std::string>());
+  const std::string L = scales.length_unit;
+  results["units"] = {{"length", L},
+                      {"energy", scales.energy_unit},
+                      {"force", scales.force_unit},
+                      {"parameter", "label"},
+                      {"harmonic_balance", "label"},
+                      {"down_jumps", unit},
+                      {"up_jumps", unit},
+                      {"jump_tolerance", unit},
+                      {"jumps", {{name, unit}, {"tolerance", unit}, {"direction", "label"}, {"located", "boolean (0/1)"},
+                                 {"branch", "label"}, {"amplitude_before", L}, {"amplitude_after", L},
+                                 {"landed_periodic", "boolean (0/1)"}}},
+                      {"folds", {{name, unit}, {"amplitude", L}, {"offset", L}, {"phase", "rad"}, {"branch", "label"},
+                                 {"kind", "label"}}},
+                      {"grazing", unit},
+                      {"continuation_points", "count"},
+                      {"free_amplitude", L},
+                      {"trapped_rows", "count"},
+                      {"rows", "count"}};
+  out.finish(results, summary);
+}
+
 void run_sweep(const io::ParamSet& p, Captured* capture) {
+  if (p.text("parameter") != "separation") return run_parameter_sweep(p, capture);
+  for (const char* key : {"parameter_min", "parameter_max"})
+    if (p.was_set(key))
+      throw InvalidParameter(key, fmt::format("{} applies only with a parameter other than the separation (the "
+                                              "separation's range is separation_min, separation_max)",
+                                              key));
   const tapping::TappingModel base = tapping_model_from(p, law_object_of(capture));
   const TappingScales scales = tapping_scales_from(p);
   const std::vector<double> list = sweep_separations(p, scales.length);
@@ -236,8 +400,9 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
 void register_tapping_sweep(CLI::App& tapping) {
   add_command(
       tapping, "sweep",
-      "separation sweep of periodic orbits: instrument approach/retract (jumps, hysteresis) and/or continuation "
-      "through folds; HB beside each point",
+      "sweep of periodic orbits in the separation (or --parameter: drive frequency, drive amplitude, a law "
+      "parameter): instrument approach/retract or down/up (jumps, hysteresis) and/or continuation through folds; HB "
+      "beside each point",
       [](io::ParamSet& p) {
         add_tapping_model_params(p);
         add_tapping_sim_params(p);
@@ -263,7 +428,23 @@ void register_tapping_sweep(CLI::App& tapping) {
                   {"instrument", "continuation", "both"})
             .real("max_arclength_step", 0.2, "largest continuation step (scaled arclength)", io::Range::positive())
             .unit(kLengthUnit)
-            .integer("max_continuation_points", 5000, "continuation point budget", 2, 100000000);
+            .integer("max_continuation_points", 5000, "continuation point budget", 2, 100000000)
+            .text("parameter", "separation",
+                  "the parameter swept: separation (separation_min .. separation_max), drive_frequency (ω/ω_n, the "
+                  "drive force held: resonance curves), or a numeric model or law key of the run (drive_amplitude, "
+                  "free_amplitude, quality_factor, approach_stiffness, effective_modulus, ...) over parameter_min .. "
+                  "parameter_max in that key's unit, the separation fixed at `separation`",
+                  sweep_parameter_names())
+            .only_if_given()
+            .real("parameter_min", 0.0, "smallest value of the swept parameter (not the separation)", io::Range::any())
+            .unit("the unit of the swept parameter")
+            .only_if_given()
+            .real("parameter_max", 0.0, "largest value of the swept parameter, > parameter_min", io::Range::any())
+            .unit("the unit of the swept parameter")
+            .only_if_given();
+        // the records of a sweep in another parameter do not list the separation grid it did not use
+        for (const char* key : {"separation_min", "separation_max", "separations", "separations_file"})
+          p.applies_when(key, "parameter", {"separation"});
         add_output_params(p, "out/tapping_sweep.csv", "sweep");
         p.flag("quiet", false, "no progress output");
       },

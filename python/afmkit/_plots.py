@@ -67,7 +67,8 @@ def _phase_values(values, phase, native: str, degrees: bool):
 
 
 # ------------------------------------------------------------------------------------------ tapping sweep / fm
-_DIRECTION_COLORS = {"approach": "#1f77b4", "retract": "#d62728", "continuation": "#2ca02c"}
+_DIRECTION_COLORS = {"approach": "#1f77b4", "retract": "#d62728", "down": "#1f77b4", "up": "#d62728",
+                     "continuation": "#2ca02c"}
 
 
 def _with_breaks(x, y, jumped):
@@ -108,14 +109,16 @@ def _branch_panels(r, ax, panels, x: str, xlabel: str, folds=()):
 
 
 def _sweep(r, ax=None, *, phase=None, degrees=False):
-    """amplitude and phase against separation, per direction (approach, retract, continuation)."""
+    """amplitude and phase against the swept parameter (separation, or --parameter: drive_frequency, ...), per
+    direction (approach / retract or down / up, continuation)."""
     ph, ph_label = _phase(r, "phase", phase, "lag", degrees)
-    folds = list(r.results.get("folds", []))  # mode continuation: folds of l along the branches
-    fl = np.array([f["separation"] for f in folds], float)
+    x = r.results.get("parameter", "separation")
+    folds = list(r.results.get("folds", []))  # mode continuation: folds of the parameter along the branches
+    fl = np.array([f[x] for f in folds], float)
     fa = np.array([f["amplitude"] for f in folds], float)
     fp = _phase_values(np.array([f["phase"] for f in folds], float), phase, "lag", degrees)
     panels = [(np.asarray(r["amplitude"], float), _label(r, "amplitude"), fa), (ph, ph_label, fp)]
-    return _branch_panels(r, ax, panels, "separation", _label(r, "separation"), fl)
+    return _branch_panels(r, ax, panels, x, _label(r, x), fl)
 
 
 def _fm(r, ax=None, *, x="separation"):

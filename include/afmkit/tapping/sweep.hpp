@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "afmkit/tapping/orbit.hpp"
+#include "afmkit/tapping/parameter.hpp"
 
 namespace afmkit::tapping {
 
@@ -57,6 +58,7 @@ struct SweepOptions {
 /// One orbit of a sweep.
 struct SweepPoint {
   double separation = 0.0;  // l
+  double parameter = 0.0;   // value of the swept parameter (= l in separation sweeps; parameter.hpp)
   SweepDirection direction = SweepDirection::approach;
   PeriodicOrbit orbit;
   OrbitMetrics metrics;
@@ -76,6 +78,9 @@ struct SweepPoint {
 /// A jump of the instrument sweep: where the followed branch ceased to be stable and the tip landed on another.
 struct SweepJump {
   double separation = 0.0;  // located: the middle of the last bracket [last stable orbit, first failed sub-step]
+                            // (sweeps in another parameter: the separation of the model)
+  double parameter = 0.0;   // where the jump is located in the swept parameter (= separation in separation sweeps)
+  double from_parameter = 0.0, to_parameter = 0.0;  // the values of `from` and `to`
   double tolerance = 0.0;   // half the bracket: |separation − where the branch ceases to be stable| <= tolerance
   SweepDirection direction = SweepDirection::approach;
   bool located = true;      // false: after a non-periodic point (reported at the grid point, grid resolution)
@@ -111,6 +116,7 @@ std::optional<PeriodicOrbit> follow_branch(const TappingModel& base, const Perio
 struct BranchFollow {
   std::optional<PeriodicOrbit> reached;  // the orbit at l_to
   PeriodicOrbit last;                    // the last stable orbit of the branch (= *reached when reached)
+  double last_parameter = 0.0;           // its value of the followed parameter (its separation in l)
   /// Not reached: the separation of the first sub-step that failed (no stable continuation); the branch ceases
   /// to be stable in (last.separation, failed_at]. NaN when the sub-step budget ran out first.
   double failed_at = 0.0;
@@ -128,6 +134,17 @@ SweepResult sweep_instrument(const TappingModel& base, double l_min, double l_ma
 /// The same over an explicit list of separations (any order, duplicates merged; at least 2 distinct, finite):
 /// approach visits them from the largest down, retract from the smallest up.
 SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separations,
+                             const SweepOptions& options = {});
+
+/// The instrument sweep in any parameter (parameter.hpp) — like continue_orbits in a parameter, harmonic balance
+/// beside each point only for piecewise-linear laws (closed form; other laws: hb_* NaN, hb_solutions 0): "approach" visits the values from p_max down to p_min,
+/// "retract" back up (a down and an up sweep); each point's `parameter` is its value, each jump's `parameter` where
+/// it is located (approach_jumps, retract_jumps: those values). The jump tolerance and the transient sub-step are
+/// then jump_tolerance·max|p| and transient_step·max|p| (the free amplitude at the scale of the separation).
+/// Validates finite p_min < p_max (InvalidParameter naming <name>_min), points >= 2.
+SweepResult sweep_instrument(const TappingModel& base, const SweepParameter& parameter, double p_min, double p_max,
+                             int points, const SweepOptions& options = {});
+SweepResult sweep_instrument(const TappingModel& base, const SweepParameter& parameter, std::vector<double> values,
                              const SweepOptions& options = {});
 
 /// Every orbit (find_orbits) at each separation, the separations processed in parallel.

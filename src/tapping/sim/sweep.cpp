@@ -63,18 +63,21 @@ namespace {
 /// The length scale of the sweep's tolerances: the free amplitude.
 double base_amplitude(const TappingModel& model) { return std::max(model.free_amplitude(), 1e-300); }
 
-void check_range(double l_min, double l_max, int points) {
-  validate::finite("separation_min", l_min);
-  validate::finite("separation_max", l_max);
-  validate::require(l_min < l_max, "separation_min", l_min, fmt::format("< separation_max = {}", l_max));
+void check_range(const SweepParameter& parameter, double l_min, double l_max, int points) {
+  const std::string lo = parameter.name() + "_min", hi = parameter.name() + "_max";
+  validate::finite(lo, l_min);
+  validate::finite(hi, l_max);
+  validate::require(l_min < l_max, lo, l_min, fmt::format("< {} = {}", hi, l_max));
   validate::require(points >= 2, "points", points, ">= 2");
 }
 
-/// Settle a transient from `state` at the model's separation; the point is marked jumped.
-SweepPoint from_transient(const TappingModel& model, TipState state, SweepDirection direction,
+/// Settle a transient from `state` at the parameter value `value`; the point is marked jumped.
+SweepPoint from_transient(const detail::ParameterPath& path, double value, TipState state, SweepDirection direction,
                           const SweepOptions& options) {
+  const TappingModel model = path.at(value);
   SweepPoint p;
   p.separation = model.separation;
+  p.parameter = value;
   p.direction = direction;
   p.jumped = true;
   TransientOptions transient = options.transient;
@@ -96,11 +99,13 @@ SweepPoint from_transient(const TappingModel& model, TipState state, SweepDirect
 /// Scaled state z = (x, ẋ/ω) of an orbit and the slope dz/dl of its branch, −(M − I)⁻¹ ∂P/∂l (implicit
 /// function theorem on P_l(z) = z); nullopt at a fold (M − I singular).
 Eigen::Vector2d scaled(TipState s, double omega) { return {s.position, s.velocity / omega}; }
-std::optional<Eigen::Vector2d> branch_slope(const PeriodicOrbit& orbit, double omega) {
+/// The same along any parameter p: −(M − I)⁻¹ ∂P/∂p (`sensitivity` = ∂P/∂p at the orbit, ParameterPath).
+std::optional<Eigen::Vector2d> branch_slope(const PeriodicOrbit& orbit, const Eigen::Vector2d& sensitivity,
+                                            double omega) {
   const Eigen::Matrix2d j = orbit.monodromy - Eigen::Matrix2d::Identity();
   const Eigen::FullPivLU<Eigen::Matrix2d> lu(j);
   if (!lu.isInvertible()) return std::nullopt;
-  const Eigen::Vector2d dydl = -lu.solve(orbit.separation_sensitivity);  // d(x, ẋ)/dl
+  const Eigen::Vector2d dydl = -lu.solve(sensitivity);  // d(x, ẋ)/dl
   if (!dydl.allFinite()) return std::nullopt;
   return Eigen::Vector2d(dydl.x(), dydl.y() / omega);
 }
@@ -160,17 +165,34 @@ constexpr double kMaxMultiplierMove = 0.25;
 
 }  // namespace
 
+namespace {
+/// follow_stable_branch along any parameter: `from` is an orbit at p = l_from, l_to the value to reach.
+BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit& from, double l_from, double l_to,
+                          const SweepOptions& options);
+}  // namespace
+
 BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
                                   const SweepOptions& options) {
   validate::finite("separation", l_to);
   options.validate();
+  const SweepParameter separation = SweepParameter::separation();
+  return follow_along(detail::make_path(base, separation, from.separation, l_to), from, from.separation, l_to,
+                      options);
+}
+
+namespace {
+
+BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit& from, double l_from, double l_to,
+                          const SweepOptions& options) {
+  const TappingModel& base = path.base;
   const ShootingOptions& shooting = options.shooting;
   const double omega = base.drive.frequency;
   const int n = from.period_multiple;
   BranchFollow out;
   out.last = from;
-  out.failed_at = from.separation;
-  const double span = l_to - from.separation;
+  out.last_parameter = l_from;
+  out.failed_at = l_from;
+  const double span = l_to - l_from;
   if (!from.stable) return out;  // nothing stable to follow
   if (span == 0.0) {
     out.reached = from;
@@ -179,7 +201,8 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
   const double scale = std::max(1.0, scaled(from.initial, omega).norm());
   const double amplitude = base_amplitude(base);
   // below this sub-step the branch is taken to end (fold, loss of stability, or a corner into another branch)
-  const double h_min = options.jump_tolerance * amplitude;
+  // (parameter units: the free amplitude over the scale of the parameter, ParameterPath)
+  const double h_min = options.jump_tolerance * amplitude / path.scale;
   // largest move of the scaled state per sub-step (relative to the larger of A_free and the state, e.g. a deep
   // static deflection in contact)
   const double max_move = options.state_resolution * amplitude;
@@ -188,27 +211,34 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
   quick.max_iterations = std::min(quick.max_iterations, 8);
   const double closeness = 1e-8 * scale;  // Newton-level agreement
   PeriodicOrbit current = from;
+  double at = l_from;  // the parameter value of `current`
+  const SimulationOptions& simulation = shooting.simulation;
+  std::optional<Eigen::Vector2d> slope;
+  try {
+    slope = branch_slope(current, path.orbit_derivative(current, at, simulation), omega);
+  } catch (const NumericalFailure&) {
+    slope.reset();  // no derivative of the map: no branch to follow from here
+  }
   double h = span;  // try the whole step first
   for (int k = 0; k < options.max_substeps; ++k) {
-    const double remaining = l_to - current.separation;
+    const double remaining = l_to - at;
     if (remaining == 0.0) break;
     if (std::abs(h) > std::abs(remaining)) h = remaining;
-    const auto slope = branch_slope(current, omega);
     if (!slope) {
-      out.failed_at = current.separation + h;
+      out.failed_at = at + h;
       return out;  // M − I singular: a fold (reached exactly)
     }
-    const double l_next = std::abs(remaining - h) <= 1e-14 * std::max(1.0, std::abs(l_to)) ? l_to : current.separation + h;
+    const double l_next = std::abs(remaining - h) <= 1e-14 * std::max(1.0, std::abs(l_to)) ? l_to : at + h;
     const Eigen::Vector2d z = scaled(current.initial, omega);
-    const Eigen::Vector2d predicted = z + (l_next - current.separation) * *slope;
+    const Eigen::Vector2d predicted = z + (l_next - at) * *slope;
     std::optional<PeriodicOrbit> next;
     ++out.substeps;
     try {
-      next = try_shoot(base.with_separation(l_next), {predicted.x(), predicted.y() * omega, current.initial.contact}, n,
-                       quick);
+      next = try_shoot(path.at(l_next), {predicted.x(), predicted.y() * omega, current.initial.contact}, n, quick);
     } catch (const NumericalFailure&) {
       next.reset();
     }
+    std::optional<Eigen::Vector2d> slope_next;  // of the new orbit's branch
     bool accepted = false;
     bool resolved = true;  // false: the sub-step was too long to see the stability (not a failure of the branch)
     if (next && next->stable && next->period_multiple == n) {
@@ -217,8 +247,12 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
       // branch stays a finite distance away however small Δl is); (2) the step taken back from the new orbit
       // returns to the current one (after a jump, Newton from the new orbit's tangent prediction lands on the
       // other branch's continuation instead — this catches a jump hidden inside a long step)
-      const double dl = l_next - current.separation;
-      const auto slope_next = branch_slope(*next, omega);
+      const double dl = l_next - at;
+      try {
+        slope_next = branch_slope(*next, path.orbit_derivative(*next, l_next, simulation), omega);
+      } catch (const NumericalFailure&) {
+        slope_next.reset();
+      }
       const double bound = std::abs(dl) * std::max(slope->norm(), slope_next ? slope_next->norm() : 0.0) + closeness;
       accepted = slope_next && (scaled(next->initial, omega) - predicted).norm() <= bound;
       // (3) the Floquet multipliers along the step: the margins to instability and the move of the orbit are
@@ -231,7 +265,7 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
       }
       if (accepted) {
         const Eigen::Vector2d back_guess = scaled(next->initial, omega) - dl * *slope_next;
-        const TappingModel at_current = base.with_separation(current.separation);
+        const TappingModel at_current = path.at(at);
         // usually one Newton step from the backward prediction shows where it goes: it closes 90 % of the
         // distance to the current orbit (quadratic convergence towards it). Otherwise Newton decides in full.
         accepted = newton_heads_for(at_current, back_guess, z, n, omega, quick.simulation, current.initial.contact);
@@ -248,8 +282,10 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
     }
     if (accepted) {
       current = *next;
-      current.separation = l_next;
+      at = l_next;
+      slope = slope_next;
       out.last = current;
+      out.last_parameter = at;
       h *= 2.0;  // grow again after a successful sub-step
       continue;
     }
@@ -257,13 +293,15 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
     h *= 0.5;
     if (std::abs(h) < h_min) return out;
   }
-  if (current.separation == l_to) {
+  if (at == l_to) {
     out.reached = current;
   } else {
     out.failed_at = std::numeric_limits<double>::quiet_NaN();  // budget spent before l_to
   }
   return out;
 }
+
+}  // namespace
 
 std::optional<PeriodicOrbit> follow_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
                                            const ShootingOptions& shooting, int max_substeps) {
@@ -279,20 +317,24 @@ namespace {
 /// (then the tip is left to settle at the grid point).
 constexpr int kMaxPassesPerStep = 64;
 
-/// Whether the orbit reached from `p` (followed back to `previous` at its separation) is the same branch.
-bool connects_back(const TappingModel& model, const PeriodicOrbit& p, const PeriodicOrbit& previous,
-                   const SweepOptions& options) {
-  const double omega = model.drive.frequency;
-  const auto back = follow_stable_branch(model, p, previous.separation, options).reached;
+/// Whether the orbit reached from `p` (at p_at, followed back to `previous` at its value previous_at) is the same
+/// branch.
+bool connects_back(const detail::ParameterPath& path, const PeriodicOrbit& p, double p_at,
+                   const PeriodicOrbit& previous, double previous_at, const SweepOptions& options) {
+  const double omega = path.base.drive.frequency;
+  const auto back = follow_along(path, p, p_at, previous_at, options).reached;
   const double scale = std::max(1.0, detail::phase_magnitude(previous.initial, omega));
   return back && back->period_multiple == previous.period_multiple &&
          detail::phase_distance(back->initial, previous.initial, omega) <= 1e-6 * scale;
 }
 
-SweepJump make_jump(double separation, double tolerance, SweepDirection direction, bool located,
-                    const PeriodicOrbit& from, const SweepPoint& landed) {
+SweepJump make_jump(const detail::ParameterPath& path, double separation, double tolerance, SweepDirection direction,
+                    bool located, const PeriodicOrbit& from, double from_at, const SweepPoint& landed) {
   SweepJump j;
-  j.separation = separation;
+  j.parameter = separation;
+  j.separation = path.parameter.is_separation() ? separation : path.at(separation).separation;
+  j.from_parameter = from_at;
+  j.to_parameter = landed.parameter;
   j.tolerance = tolerance;
   j.direction = direction;
   j.located = located;
@@ -306,47 +348,48 @@ SweepJump make_jump(double separation, double tolerance, SweepDirection directio
 /// jump on the way (appended to `jumps`). A stable orbit is followed along its branch; where the branch ceases to
 /// be stable the tip lands (transient) just beyond; a response that does not settle is stepped by transients in
 /// sub-steps of transient_step·A_free until it settles on a periodic orbit.
-SweepPoint continue_point(const TappingModel& model, const SweepPoint& previous, SweepDirection direction,
-                          const SweepOptions& options, std::vector<SweepJump>& jumps) {
-  const double l_to = model.separation;
+SweepPoint continue_point(const detail::ParameterPath& path, double l_to, const SweepPoint& previous,
+                          SweepDirection direction, const SweepOptions& options, std::vector<SweepJump>& jumps) {
   if (previous.periodic && !previous.orbit.stable) {
     // a neutrally stable periodic response (e.g. a tip resting on the sample) has no stable branch to follow: it
-    // settles (or not) at the new separation; a jump is known to the grid's resolution only
-    SweepPoint p = from_transient(model, previous.orbit.initial, direction, options);
-    if (p.periodic && connects_back(model, p.orbit, previous.orbit, options)) p.jumped = false;
+    // settles (or not) at the new value; a jump is known to the grid's resolution only
+    SweepPoint p = from_transient(path, l_to, previous.orbit.initial, direction, options);
+    if (p.periodic && connects_back(path, p.orbit, l_to, previous.orbit, previous.parameter, options)) p.jumped = false;
     if (p.jumped)
-      jumps.push_back(make_jump(l_to, std::abs(l_to - previous.separation), direction, false, previous.orbit, p));
+      jumps.push_back(make_jump(path, l_to, std::abs(l_to - previous.parameter), direction, false, previous.orbit,
+                                previous.parameter, p));
     return p;
   }
-  const double step_np = options.transient_step * base_amplitude(model);
+  const double step_np = options.transient_step * base_amplitude(path.base) / path.scale;
   bool following = previous.periodic;  // else: a non-periodic response, stepped by transients
   PeriodicOrbit orbit = previous.orbit;  // the followed orbit, or (non-periodic) the last state in orbit.initial
-  double l_at = previous.separation;
+  double l_at = previous.parameter;
   bool jumped = false;
   for (int pass = 0; pass < kMaxPassesPerStep; ++pass) {
     const bool last_pass = pass + 1 == kMaxPassesPerStep;
     if (!following) {
       const double l_next = std::abs(l_to - l_at) <= step_np || last_pass ? l_to : l_at + std::copysign(step_np, l_to - l_at);
-      SweepPoint p = from_transient(model.with_separation(l_next), orbit.initial, direction, options);
+      SweepPoint p = from_transient(path, l_next, orbit.initial, direction, options);
       if (p.periodic) {  // it settled: the tip leaves the non-periodic response (known to the sub-step)
-        jumps.push_back(make_jump(0.5 * (l_at + l_next), 0.5 * std::abs(l_next - l_at), direction, false, orbit, p));
+        jumps.push_back(make_jump(path, 0.5 * (l_at + l_next), 0.5 * std::abs(l_next - l_at), direction, false, orbit,
+                                  l_at, p));
         jumped = true;
       }
       if (l_next == l_to || (p.periodic && !p.orbit.stable)) {
-        if (l_next != l_to) p = from_transient(model, p.orbit.initial, direction, options);
+        if (l_next != l_to) p = from_transient(path, l_to, p.orbit.initial, direction, options);
         p.jumped = jumped;
         return p;
       }
       following = p.periodic;
       orbit = p.orbit;
-      orbit.separation = l_next;
       l_at = l_next;
       continue;
     }
-    const BranchFollow f = follow_stable_branch(model, orbit, l_to, options);
+    const BranchFollow f = follow_along(path, orbit, l_at, l_to, options);
     if (f.reached) {
       SweepPoint p;
-      p.separation = l_to;
+      p.separation = f.reached->separation;
+      p.parameter = l_to;
       p.direction = direction;
       p.orbit = *f.reached;
       p.jumped = jumped;
@@ -354,33 +397,33 @@ SweepPoint continue_point(const TappingModel& model, const SweepPoint& previous,
     }
     // The followed branch ceases to be stable in (last, failed_at] (budget spent: somewhere before l_to). Do what
     // the instrument does: the tip keeps moving from where it was and settles on whatever attracts it, just beyond.
-    const double l_last = f.last.separation;
+    const double l_last = f.last_parameter;
     const bool located = std::isfinite(f.failed_at) && !last_pass;
     const double l_land = located ? f.failed_at : l_to;
-    SweepPoint landed = from_transient(model.with_separation(l_land), f.last.initial, direction, options);
+    SweepPoint landed = from_transient(path, l_land, f.last.initial, direction, options);
     // Not a jump if the branch of the new orbit, followed back to the last stable orbit through stable orbits
     // without a fold, arrives at it (the forward follow can fail where the backward one does not, e.g. through a
     // grazing corner entered from the other side).
-    if (!(landed.periodic && connects_back(model, landed.orbit, f.last, options))) {
-      jumps.push_back(make_jump(located ? 0.5 * (l_last + l_land) : l_land,
-                                std::abs(l_land - l_last) * (located ? 0.5 : 1.0), direction, located, f.last, landed));
+    if (!(landed.periodic && connects_back(path, landed.orbit, l_land, f.last, l_last, options))) {
+      jumps.push_back(make_jump(path, located ? 0.5 * (l_last + l_land) : l_land,
+                                std::abs(l_land - l_last) * (located ? 0.5 : 1.0), direction, located, f.last, l_last,
+                                landed));
       jumped = true;
     }
     if (l_land == l_to || (landed.periodic && !landed.orbit.stable)) {
-      if (l_land != l_to) landed = from_transient(model, landed.orbit.initial, direction, options);
+      if (l_land != l_to) landed = from_transient(path, l_to, landed.orbit.initial, direction, options);
       landed.jumped = jumped;
       return landed;
     }
     following = landed.periodic;
     orbit = landed.orbit;
-    orbit.separation = l_land;
     l_at = l_land;
   }
   return {};  // not reached: the last pass ends at l_to
 }
 
-std::vector<SweepPoint> run_direction(const TappingModel& base, const std::vector<double>& ls, SweepPoint first,
-                                      SweepDirection direction, const SweepOptions& options,
+std::vector<SweepPoint> run_direction(const detail::ParameterPath& path, const std::vector<double>& ls,
+                                      SweepPoint first, SweepDirection direction, const SweepOptions& options,
                                       std::vector<SweepJump>& jumps) {
   std::vector<SweepPoint> out;
   out.reserve(ls.size());
@@ -389,7 +432,7 @@ std::vector<SweepPoint> run_direction(const TappingModel& base, const std::vecto
   if (options.progress) options.progress(1);
   for (std::size_t k = 1; k < ls.size(); ++k) {
     options.cancellation.check();
-    out.push_back(continue_point(base.with_separation(ls[k]), out[k - 1], direction, options, jumps));
+    out.push_back(continue_point(path, ls[k], out[k - 1], direction, options, jumps));
     if (options.progress) options.progress(1);
   }
   return out;
@@ -416,15 +459,35 @@ void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, co
   errors.rethrow();
 }
 
-void finish_jumps(const TappingModel& base, std::vector<SweepJump>& jumps, const SimulationOptions& simulation,
+void finish_points(const ParameterPath& path, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
+                   bool harmonic_balance, bool parallel, const Cancellation& cancellation) {
+  ExceptionCollector errors;
+#pragma omp parallel for schedule(dynamic) if (parallel)
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    errors.run([&] {
+      cancellation.check();
+      SweepPoint& p = points[i];
+      const TappingModel model = path.at(p.parameter);
+      p.metrics = analyse_orbit(model, p.orbit, simulation);
+      // every point has its own model: one HB evaluation each, done where it is a closed form (piecewise-linear
+      // laws, microseconds); for another law it traces a describing-function curve per point (7 ms for DMT to
+      // 0.3 s for a table, measured): not evaluated (hb_* NaN, hb_solutions 0)
+      if (harmonic_balance && model.law.piecewise_linear())
+        attach_from(HarmonicBalance(model, cancellation).solutions(model.separation), p);
+    });
+  }
+  errors.rethrow();
+}
+
+void finish_jumps(const ParameterPath& path, std::vector<SweepJump>& jumps, const SimulationOptions& simulation,
                   bool parallel) {
   ExceptionCollector errors;
 #pragma omp parallel for schedule(dynamic) if (parallel)
   for (std::size_t i = 0; i < jumps.size(); ++i) {
     errors.run([&] {
       SweepJump& j = jumps[i];
-      j.from_metrics = analyse_orbit(base.with_separation(j.from.separation), j.from, simulation);
-      j.to_metrics = analyse_orbit(base.with_separation(j.to.separation), j.to, simulation);
+      j.from_metrics = analyse_orbit(path.at(j.from_parameter), j.from, simulation);
+      j.to_metrics = analyse_orbit(path.at(j.to_parameter), j.to, simulation);
     });
   }
   errors.rethrow();
@@ -434,7 +497,7 @@ void finish_jumps(const TappingModel& base, std::vector<SweepJump>& jumps, const
 
 namespace {
 // the computations of sweep_instrument and sweep_grid on checked input (below)
-SweepResult sweep_checked(const TappingModel& base, const std::vector<double>& separations,
+SweepResult sweep_checked(const TappingModel& base, const SweepParameter& parameter, const std::vector<double>& values,
                           const SweepOptions& options);
 std::vector<OrbitSearchResult> grid_checked(const TappingModel& base, const std::vector<double>& separations,
                                             const OrbitSearchOptions& options,
@@ -443,24 +506,35 @@ std::vector<OrbitSearchResult> grid_checked(const TappingModel& base, const std:
 
 SweepResult sweep_instrument(const TappingModel& base, double l_min, double l_max, int points,
                              const SweepOptions& options) {
-  check_range(l_min, l_max, points);
-  std::vector<double> up(points);
-  for (int k = 0; k < points; ++k) up[k] = l_min + (l_max - l_min) * k / (points - 1);
-  up.front() = l_min;
-  up.back() = l_max;
-  return sweep_instrument(base, up, options);
+  return sweep_instrument(base, SweepParameter::separation(), l_min, l_max, points, options);
 }
 
 SweepResult sweep_instrument(const TappingModel& base, std::vector<double> separations, const SweepOptions& options) {
-  for (double l : separations) validate::finite("separations", l);
-  std::sort(separations.begin(), separations.end());
-  separations.erase(std::unique(separations.begin(), separations.end()), separations.end());
-  validate::require(separations.size() >= 2, "separations", static_cast<double>(separations.size()),
-                    "at least 2 distinct separations");
+  return sweep_instrument(base, SweepParameter::separation(), std::move(separations), options);
+}
+
+SweepResult sweep_instrument(const TappingModel& base, const SweepParameter& parameter, double p_min, double p_max,
+                             int points, const SweepOptions& options) {
+  check_range(parameter, p_min, p_max, points);
+  std::vector<double> up(points);
+  for (int k = 0; k < points; ++k) up[k] = p_min + (p_max - p_min) * k / (points - 1);
+  up.front() = p_min;
+  up.back() = p_max;
+  return sweep_instrument(base, parameter, up, options);
+}
+
+SweepResult sweep_instrument(const TappingModel& base, const SweepParameter& parameter, std::vector<double> values,
+                             const SweepOptions& options) {
+  const std::string key = parameter.is_separation() ? "separations" : parameter.name();
+  for (double l : values) validate::finite(key, l);
+  std::sort(values.begin(), values.end());
+  values.erase(std::unique(values.begin(), values.end()), values.end());
+  validate::require(values.size() >= 2, key, static_cast<double>(values.size()),
+                    parameter.is_separation() ? "at least 2 distinct separations" : "at least 2 distinct values");
   options.validate();
-  // the input is checked: a separation or model refused from here on was computed (core/computed.hpp), never the
+  // the input is checked: a value or model refused from here on was computed (core/computed.hpp), never the
   // user's error
-  return computed("instrument sweep", [&] { return sweep_checked(base, separations, options); });
+  return computed("instrument sweep", [&] { return sweep_checked(base, parameter, values, options); });
 }
 
 std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::vector<double>& separations,
@@ -473,15 +547,17 @@ std::vector<OrbitSearchResult> sweep_grid(const TappingModel& base, const std::v
 
 namespace {
 
-SweepResult sweep_checked(const TappingModel& base, const std::vector<double>& separations,
+SweepResult sweep_checked(const TappingModel& base, const SweepParameter& parameter, const std::vector<double>& values,
                           const SweepOptions& options) {
-  const std::vector<double> up = separations;
-  const std::vector<double> down(separations.rbegin(), separations.rend());
+  const std::vector<double> up = values;
+  const std::vector<double> down(values.rbegin(), values.rend());
   const double l_max = up.back();
-  // start far from the sample: the free response, settled if it touches at l_max
-  const TappingModel start_model = base.with_separation(l_max);
+  const detail::ParameterPath path = detail::make_path(base, parameter, up.front(), l_max);
+  // start far from the sample (or at the largest value of the parameter): the free response, settled if it touches
+  const TappingModel start_model = path.at(l_max);
   SweepPoint start;
-  start.separation = l_max;
+  start.separation = start_model.separation;
+  start.parameter = l_max;
   std::optional<PeriodicOrbit> orbit;
   try {
     orbit = try_shoot(start_model, free_response_state(start_model), 1, options.shooting);
@@ -491,21 +567,28 @@ SweepResult sweep_checked(const TappingModel& base, const std::vector<double>& s
   if (orbit && orbit->stable)
     start.orbit = *orbit;
   else
-    start = from_transient(start_model, free_response_state(start_model), SweepDirection::approach, options);
+    start = from_transient(path, l_max, free_response_state(start_model), SweepDirection::approach, options);
   start.jumped = false;
 
   SweepResult result;
-  result.approach = run_direction(base, down, start, SweepDirection::approach, options, result.jumps);
+  result.approach = run_direction(path, down, start, SweepDirection::approach, options, result.jumps);
   SweepPoint turn = result.approach.back();
   turn.jumped = false;
-  result.retract = run_direction(base, up, turn, SweepDirection::retract, options, result.jumps);
+  result.retract = run_direction(path, up, turn, SweepDirection::retract, options, result.jumps);
   for (const SweepJump& j : result.jumps)
-    (j.direction == SweepDirection::approach ? result.approach_jumps : result.retract_jumps).push_back(j.separation);
-  detail::finish_points(base, result.approach, options.shooting.simulation, options.harmonic_balance, options.parallel,
-                        options.cancellation);
-  detail::finish_points(base, result.retract, options.shooting.simulation, options.harmonic_balance, options.parallel,
-                        options.cancellation);
-  detail::finish_jumps(base, result.jumps, options.shooting.simulation, options.parallel);
+    (j.direction == SweepDirection::approach ? result.approach_jumps : result.retract_jumps).push_back(j.parameter);
+  if (parameter.is_separation()) {
+    detail::finish_points(base, result.approach, options.shooting.simulation, options.harmonic_balance,
+                          options.parallel, options.cancellation);
+    detail::finish_points(base, result.retract, options.shooting.simulation, options.harmonic_balance,
+                          options.parallel, options.cancellation);
+  } else {
+    detail::finish_points(path, result.approach, options.shooting.simulation, options.harmonic_balance,
+                          options.parallel, options.cancellation);
+    detail::finish_points(path, result.retract, options.shooting.simulation, options.harmonic_balance,
+                          options.parallel, options.cancellation);
+  }
+  detail::finish_jumps(path, result.jumps, options.shooting.simulation, options.parallel);
   return result;
 }
 
