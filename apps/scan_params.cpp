@@ -206,7 +206,16 @@ void add_scan_params(io::ParamSet& p) {
       .unit("Omega")
       .real("gain", 0.0, "controller gain K (0: the design rule K = bandwidth)", non_negative)
       .unit("rad/s")
-      .follows("bandwidth");  // recorded as the gain used
+      .follows("bandwidth")  // recorded as the gain used
+      .group("Reconstruction (docs/scan.md#reconstruction)")
+      .text("reconstruction", "inverse",
+            "what the topography image shows: inverse (the plant's first-order lag removed, seed 2 eq. 1) or lagged "
+            "(deflection + actuator displacement); the other is written as <prefix>_topography_<other>",
+            {"inverse", "lagged"})
+      .real("reconstruction_bandwidth", 0.0,
+            "plant rate gamma the reconstruction and the actuator model assume (0: the true bandwidth)", non_negative)
+      .unit("rad/s")
+      .follows("bandwidth");  // recorded as the rate used
 }
 
 namespace {
@@ -275,7 +284,8 @@ const std::vector<std::string>& simulation_only_keys() {
       "grating_height", "grating_duty", "steps_width", "steps_height", "particles_count", "particles_radius",
       "rough_rms", "rough_correlation_length", "tilt_angle", "tilt_azimuth", "spindle_frequency", "start_radius",
       "end_radius", "radial_speed", "sample_rate", "bandwidth", "delay", "delay_drift", "delay_drift_period",
-      "gain_error", "detector_range", "detector_noise", "noise_seed", "control", "gain"};
+      "gain_error", "detector_range", "detector_noise", "noise_seed", "control", "gain", "reconstruction",
+      "reconstruction_bandwidth"};
   return keys;
 }
 
@@ -311,6 +321,9 @@ scan::InstrumentSpec instrument_from(const io::ParamSet& p) {
   s.controller.alpha = p.real("alpha");
   s.controller.beta = p.real("beta");
   s.controller.gain = p.real("gain");
+  s.reconstruction.method =
+      p.text("reconstruction") == "lagged" ? scan::Reconstruction::lagged : scan::Reconstruction::inverse;
+  s.reconstruction.assumed_bandwidth = p.real("reconstruction_bandwidth");
   s.validate();
   return s;
 }

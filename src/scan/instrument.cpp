@@ -69,6 +69,7 @@ void InstrumentSpec::validate() const {
   plant.validate(spiral);
   detector.validate();
   controller.validate();
+  reconstruction.validate();
   if (controller.enabled) {
     const double top = controller.harmonics * spiral.spindle_frequency;
     if (!(top < 0.5 * spiral.sample_rate))
@@ -77,6 +78,10 @@ void InstrumentSpec::validate() const {
                                          "below the Nyquist frequency sample_rate/2 = {} Hz", controller.harmonics,
                                          spiral.spindle_frequency, top, 0.5 * spiral.sample_rate));
   }
+}
+
+double InstrumentSpec::assumed_bandwidth() const {
+  return reconstruction.assumed_bandwidth > 0.0 ? reconstruction.assumed_bandwidth : plant.bandwidth;
 }
 
 double InstrumentSpec::controller_gain() const { return controller.gain > 0.0 ? controller.gain : plant.bandwidth; }
