@@ -51,12 +51,17 @@ TEST(ScanCli, WritesImagesGwyddionOpensAndTheControllerBuysArea) {
   EXPECT_EQ(meta["parameter_units"]["radial_speed"], "m/s");
   EXPECT_EQ(meta["parameter_units"]["tilt_angle"], "deg");
   EXPECT_EQ(meta["columns"][2]["name"], "deflection_first_harmonic");
-  EXPECT_EQ(sidecar(dir, "out/series.csv")["columns"].size(), 9u);
+  EXPECT_EQ(sidecar(dir, "out/series.csv")["columns"].size(), 10u);
+  // the inverse reconstruction (the default) against the lagged one beside it (docs/scan.md#reconstruction)
+  EXPECT_EQ(printed["reconstruction"], "inverse");
+  EXPECT_LT(printed["error_budget"]["reconstruction"].get<double>(), 1e-6 * printed["sample_rms_height"].get<double>());
+  EXPECT_GT(printed["lagged_rms_error"].get<double>(), 3 * printed["inverse_rms_error"].get<double>());  // 15 vs 3.5 nm
+  EXPECT_EQ(printed["error_budget"]["units"]["noise_gain"], "dimensionless");
 
   const std::string thumbnailer = gwyddion_client::find_thumbnailer();
   ASSERT_FALSE(thumbnailer.empty()) << gwyddion_client::missing_thumbnailer_message;
   int gsf_files = 0;
-  for (const std::string name : {"deflection", "topography", "truth"})
+  for (const std::string name : {"deflection", "topography", "topography_lagged", "truth"})
     for (const std::string suffix : {"", "_mask"}) {
       const std::string path = dir.file("out/scan/scan_" + name + suffix + ".gsf");
       ASSERT_TRUE(std::filesystem::exists(path)) << path;
@@ -66,7 +71,7 @@ TEST(ScanCli, WritesImagesGwyddionOpensAndTheControllerBuysArea) {
       ++gsf_files;
       ASSERT_TRUE(std::filesystem::exists(dir.file("out/scan/scan_" + name + ".png")));
     }
-  EXPECT_EQ(gsf_files, 6);
+  EXPECT_EQ(gsf_files, 8);
   // the point cloud: Gwyddion's loader accepts it (it has no image to preview), and afmkit reads it back
   const auto cloud = gwyddion_client::render(thumbnailer, dir.file("out/points.gxyzf"), dir.file("gwy_points"));
   EXPECT_TRUE(cloud.no_previewable_data()) << cloud.error_output;
