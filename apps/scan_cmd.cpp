@@ -145,7 +145,6 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
        {{"imaging", budget.imaging},
         {"reconstruction", budget.reconstruction},
         {"reconstruction_relative", budget.reconstruction / result.sample_rms_height},
-        {"lagged_reconstruction", budget.lagged_reconstruction},
         {"plant_mismatch", budget.plant_mismatch},
         {"plant", budget.plant},
         {"noise_gain", budget.noise_gain},
@@ -153,8 +152,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
         {"predicted", budget.predicted},
         {"pole", budget.pole},
         {"settle_samples", budget.settle_samples},
-        {"units", {{"imaging", "m"}, {"reconstruction", "m"}, {"reconstruction_relative", "dimensionless"},
-                   {"lagged_reconstruction", "m"}, {"plant_mismatch", "dimensionless"}, {"plant", "m"},
+        {"units", {{"imaging", "m"}, {"reconstruction", "m"}, {"reconstruction_relative", "dimensionless"}, {"plant_mismatch", "dimensionless"}, {"plant", "m"},
                    {"noise_gain", "dimensionless"}, {"noise", "m"}, {"predicted", "m"}, {"pole", "dimensionless"},
                    {"settle_samples", "count"}}}}},
       {"deflection_rms", result.deflection_rms},
@@ -179,7 +177,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       "afmkit scan: {} samples, {} turns, controller {}; saturated {:.3g} % of samples; largest radius before the "
       "detector saturates {} in this run{}, {} with the controller off; scan-area gain {}; topography RMS "
       "error {} (levelled; {} reconstruction; {:.3g} % of the sample's RMS height {}; {} reconstruction: {}); error "
-      "budget of the inverse: imaging {}, reconstruction {} ({:.3g} %; lagged {}), plant knowledge {} (assumed rate {:+.3g} %), noise {} (gain {:.4g}), "
+      "budget of the inverse: imaging {}, reconstruction {} ({:.3g} %), plant knowledge {} (assumed rate {:+.3g} %), noise {} (gain {:.4g}), "
       "predicted {}{}",
       result.run.samples, result.turns, instrument.controller.enabled ? "on" : "off",
       100.0 * result.saturated_fraction, io::quantity(result.max_radius_with_control, "m"),
@@ -189,7 +187,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       100.0 * result.topography_rms_error / result.sample_rms_height, io::quantity(result.sample_rms_height, "m"),
       other, io::quantity(inverse ? result.lagged_rms_error : result.inverse_rms_error, "m"),
       io::quantity(budget.imaging, "m"), io::quantity(budget.reconstruction, "m"),
-      100.0 * budget.reconstruction / result.sample_rms_height, io::quantity(budget.lagged_reconstruction, "m"),
+      100.0 * budget.reconstruction / result.sample_rms_height,
       io::quantity(budget.plant, "m"), 100.0 * budget.plant_mismatch,
       io::quantity(budget.noise, "m"), budget.noise_gain, io::quantity(budget.predicted, "m"),
       files.empty() ? std::string() : fmt::format("; wrote {} files with prefix {}", files.size(), prefix));

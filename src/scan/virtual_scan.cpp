@@ -147,14 +147,20 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   out.lagged_rms_error = error_of(lagged);
   out.inverse_rms_error = error_of(inverted);
   out.sample_rms_height = kNaN;
-  if (out.truth.valid_count() >= 3) {
+  if (out.truth.valid_count() >= 3) {  // the truth minus its least-squares plane, without building that map
+    const Plane plane = fit_plane(out.truth);
+    const Grid& g = out.truth.grid();
     double sum = 0.0;
     std::size_t n = 0;
-    for (double v : level(out.truth).data())
-      if (std::isfinite(v)) {
-        sum += v * v;
-        ++n;
-      }
+    for (long j = 0; j < g.y_resolution; ++j) {
+      const double y = g.y_offset + (static_cast<double>(j) + 0.5) * out.truth.dy();
+      for (long i = 0; i < g.x_resolution; ++i)
+        if (out.truth.valid(i, j)) {
+          const double v = out.truth(i, j) - plane(g.x_offset + (static_cast<double>(i) + 0.5) * out.truth.dx(), y);
+          sum += v * v;
+          ++n;
+        }
+    }
     out.sample_rms_height = std::sqrt(sum / static_cast<double>(n));
   }
   // the budget of the inverse reconstruction (plant_inverse.hpp)
@@ -166,7 +172,6 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
     return image.valid_count() >= 3 ? levelled_rms_difference(image, sampled_truth) : kNaN;
   };
   b.reconstruction = against_samples(inverted);
-  b.lagged_reconstruction = against_samples(lagged);
   b.plant_mismatch = instrument.assumed_bandwidth() / instrument.plant.bandwidth - 1.0;
   b.plant = std::abs(instrument.plant.bandwidth / instrument.assumed_bandwidth() - 1.0) * out.lagged_rms_error;
   b.noise_gain = model.noise_gain();
@@ -175,7 +180,7 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   b.pole = model.pole();
   b.settle_samples = model.settle_samples();
   if (out.topography.valid_count() >= 3) {
-    out.topography_rms_error = levelled_rms_difference(out.topography, out.truth);
+    out.topography_rms_error = inverse ? out.inverse_rms_error : out.lagged_rms_error;  // computed above
     const HeightMap flat_deflection = level(out.deflection);
     double sum = 0.0;
     std::size_t n = 0;

@@ -47,7 +47,6 @@ struct ErrorBudget {
                                 ///< floor set by the sampling along the turn and the pitch (no reconstruction beats it)
   double reconstruction = 0.0;  ///< the inverse image against the imaged true heights (the previous term's image):
                                 ///< what the reconstruction itself adds, whatever the sampling
-  double lagged_reconstruction = 0.0;  ///< the same for the lagged image
   double plant_mismatch = 0.0;  ///< γ̂/γ − 1 [dimensionless]: how wrong the assumed plant rate is
   double plant = 0.0;           ///< first-order plant-knowledge term |γ/γ̂ − 1| × lagged_rms_error
   double noise_gain = 0.0;      ///< G of the inverse [dimensionless] (white noise on w comes out × G)
