@@ -108,8 +108,20 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
   progress.finish();
 
   const bool inverse = result.method == scan::Reconstruction::inverse;
+  if (inverse && result.inverse_rms_error > result.lagged_rms_error)
+    fmt::print(stderr, "afmkit scan: warning: the lagged reconstruction is closer to the truth in this run ({} against "
+                       "{} for the inverse, whose noise gain {:.4g} turns detector_noise into {}): see "
+                       "--reconstruction lagged (docs/scan.md#reconstruction)\n",
+               io::quantity(result.lagged_rms_error, "m"), io::quantity(result.inverse_rms_error, "m"),
+               result.budget.noise_gain, io::quantity(result.budget.noise, "m"));
   const std::string method = inverse ? "inverse" : "lagged", other = inverse ? "lagged" : "inverse";
   const scan::ErrorBudget& budget = result.budget;
+  // errors relative to the sample's RMS height; a truth that levels to a plane (sample = flat: rounding, ~1e-19 m)
+  // has none (null in the sidecar)
+  const bool flat_truth = !(result.sample_rms_height > 1e-15);
+  const auto relative = [&](double error) {
+    return flat_truth ? std::numeric_limits<double>::quiet_NaN() : error / result.sample_rms_height;
+  };
   std::vector<std::string> files;
   if (!prefix.empty())
     files = stage_images(prefix, {{"deflection", "Deflection", &result.deflection, false},
@@ -137,14 +149,14 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       {"scan_area_gain_is_lower_bound", result.scan_area_gain_is_lower_bound},
       {"reconstruction", method},
       {"topography_rms_error", result.topography_rms_error},
-      {"topography_relative_error", result.topography_rms_error / result.sample_rms_height},
+      {"topography_relative_error", relative(result.topography_rms_error)},
       {"inverse_rms_error", result.inverse_rms_error},
       {"lagged_rms_error", result.lagged_rms_error},
       {"sample_rms_height", result.sample_rms_height},
       {"error_budget",
        {{"imaging", budget.imaging},
         {"reconstruction", budget.reconstruction},
-        {"reconstruction_relative", budget.reconstruction / result.sample_rms_height},
+        {"reconstruction_relative", relative(budget.reconstruction)},
         {"plant_mismatch", budget.plant_mismatch},
         {"plant", budget.plant},
         {"noise_gain", budget.noise_gain},
@@ -173,21 +185,26 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       std::isnan(result.scan_area_gain)
           ? std::string("nan (the uncontrolled scan does not saturate)")
           : fmt::format("{}{:.3f}", result.scan_area_gain_is_lower_bound ? ">= " : "", result.scan_area_gain);
+  const auto percent = [&](double error) {
+    return flat_truth ? std::string("flat truth") : fmt::format("{:.3g} %", 100.0 * relative(error));
+  };
   const std::string summary = fmt::format(
       "afmkit scan: {} samples, {} turns, controller {}; saturated {:.3g} % of samples; largest radius before the "
       "detector saturates {} in this run{}, {} with the controller off; scan-area gain {}; topography RMS "
-      "error {} (levelled; {} reconstruction; {:.3g} % of the sample's RMS height {}; {} reconstruction: {}); error "
-      "budget of the inverse: imaging {}, reconstruction {} ({:.3g} %), plant knowledge {} (assumed rate {:+.3g} %), noise {} (gain {:.4g}), "
-      "predicted {}{}",
+      "error {} (levelled; {} reconstruction; {}; {} reconstruction: {}); error "
+      "budget of the inverse: imaging {}, reconstruction {} ({}), plant knowledge {} (assumed rate {:+.3g} %), "
+      "noise {} (gain {:.4g}), predicted {}{}",
       result.run.samples, result.turns, instrument.controller.enabled ? "on" : "off",
       100.0 * result.saturated_fraction, io::quantity(result.max_radius_with_control, "m"),
       result.saturates_with_control ? "" : " (never saturated)",
       !instrument.controller.enabled ? std::string("(this run)") : io::quantity(result.max_radius_without_control, "m"),
       gain, io::quantity(result.topography_rms_error, "m"), method,
-      100.0 * result.topography_rms_error / result.sample_rms_height, io::quantity(result.sample_rms_height, "m"),
+      flat_truth ? std::string("no relative error: the levelled truth is flat")
+                 : fmt::format("{} of the sample's RMS height {}", percent(result.topography_rms_error),
+                               io::quantity(result.sample_rms_height, "m")),
       other, io::quantity(inverse ? result.lagged_rms_error : result.inverse_rms_error, "m"),
       io::quantity(budget.imaging, "m"), io::quantity(budget.reconstruction, "m"),
-      100.0 * budget.reconstruction / result.sample_rms_height,
+      percent(budget.reconstruction),
       io::quantity(budget.plant, "m"), 100.0 * budget.plant_mismatch,
       io::quantity(budget.noise, "m"), budget.noise_gain, io::quantity(budget.predicted, "m"),
       files.empty() ? std::string() : fmt::format("; wrote {} files with prefix {}", files.size(), prefix));

@@ -324,7 +324,8 @@ scan::InstrumentSpec instrument_from(const io::ParamSet& p) {
   s.controller.gain = p.real("gain");
   s.reconstruction.method =
       p.text("reconstruction") == "lagged" ? scan::Reconstruction::lagged : scan::Reconstruction::inverse;
-  s.reconstruction.assumed_bandwidth = p.real("reconstruction_bandwidth");
+  // not given: 0, the true bandwidth (the record shows that value: follows("bandwidth"))
+  s.reconstruction.assumed_bandwidth = p.was_set("reconstruction_bandwidth") ? p.real("reconstruction_bandwidth") : 0.0;
   s.validate();
   return s;
 }
