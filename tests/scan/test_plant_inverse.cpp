@@ -112,6 +112,31 @@ TEST(PlantInverseRecursion, RestartsAfterAGapAndReportsTheSettlingSamplesAsMissi
   EXPECT_THROW(PlantInverse(0.0, 50e3), afmkit::InvalidParameter);
 }
 
+TEST(PlantInverseRecursion, RestartsOnARampFromTheIntervalMeanNotTheLaggedValue) {
+  // f ramps by c per sample; w is its exact lag (lag error c/(γh) ≈ 8c at γh = 0.126). After a gap the restart
+  // error is the interval mean's ≈ c/2, so the first sample shown (after settle_samples) is within 1 % of that;
+  // a restart from w would leave 1 % of 8c
+  const double fs = 50e3, gamma = 2 * kInversePi * 1000, c = 1e-9;
+  PlantInverse inverse(gamma, fs);
+  const double x = gamma / fs, a = std::exp(-x), m = -std::expm1(-x) / x, b0 = m - a, b1 = 1 - m;
+  const auto f = [&](long n) { return c * static_cast<double>(n); };
+  double w = f(0);
+  inverse.step(w);
+  long shown = -1;
+  double error = 0;
+  for (long n = 1; n < 2000 && shown < 0; ++n) {
+    w = a * w + b0 * f(n - 1) + b1 * f(n);
+    const double out = inverse.step(n >= 500 && n < 510 ? std::numeric_limits<double>::quiet_NaN() : w);
+    if (n >= 510 && std::isfinite(out)) {
+      shown = n;
+      error = std::abs(out - f(n));
+    }
+  }
+  EXPECT_EQ(shown, 510 + inverse.settle_samples() + 1);
+  EXPECT_LT(error, 0.01 * 0.6 * c);
+  EXPECT_GT(0.01 * c / x, 10 * 0.01 * 0.6 * c);  // what a restart from w would leave: 13 times more
+}
+
 // 50 Hz, 400 samples per turn, a 2 mm disc at 20 µm pitch: 100 turns, 40 000 samples; images of 64² pixels.
 InstrumentSpec inverse_test_scan() {
   InstrumentSpec s;

@@ -18,8 +18,9 @@
 // (G ≈ 107 at the defaults, γh = 0.126: the price of undoing a lag from samples; the lagged reconstruction passes
 // noise with gain 1). With an assumed γ̂ instead of the true γ, to first order in the mismatch and for frequencies
 // well below γ, f̂ − f = (1/γ̂ − 1/γ) ḟ = (γ/γ̂ − 1) (f − w): the lagged reconstruction's error scaled by γ/γ̂ − 1.
-// After a gap (a saturated sample: w unknown) the recursion restarts from f̂ = w; the restart error decays as |p|^k,
-// so the next `settle_samples()` samples (|p|^k > 1 %) are reported as NaN.
+// After a gap (a saturated sample: w unknown) the recursion restarts from the interval mean of the first two samples,
+// f̂_k = (w_{k+1} − a w_k)/(1 − a) (the b-weighted mean of f_k and f_{k+1}: error ≈ (f_{k+1} − f_k)/2); the restart
+// error decays as |p|^j, so the next `settle_samples()` samples (|p|^j > 1 %) are reported as NaN.
 #include <cmath>
 #include <cstdint>
 
@@ -57,8 +58,15 @@ class PlantInverse {
       f_ = w;
       w_ = w;
       settling_ = started_ ? settle_ : 0;
+      pending_ = started_;
       started_ = true;
       return settling_ > 0 ? nan() : w;
+    }
+    // the first sample after a gap: f̂ of the previous one is the interval mean (w_{n+1} − a w_n)/(1 − a) = the
+    // b-weighted mean of f_n and f_{n+1} (error ≈ (f_{n+1} − f_n)/2, instead of the lag error f − w)
+    if (pending_) {
+      f_ = (w - a_ * w_) / (b0_ + 1.0 / inv_b1_);
+      pending_ = false;
     }
     f_ = (w - a_ * w_ - b0_ * f_) * inv_b1_;
     w_ = w;
@@ -81,7 +89,7 @@ class PlantInverse {
   double a_ = 0, b0_ = 0, inv_b1_ = 0;
   double w_ = 0, f_ = 0;
   std::int64_t settle_ = 0, settling_ = 0;
-  bool restart_ = true, started_ = false;
+  bool restart_ = true, started_ = false, pending_ = false;
 };
 
 }  // namespace afmkit::scan
