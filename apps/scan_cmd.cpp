@@ -160,12 +160,14 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
         {"plant_mismatch", budget.plant_mismatch},
         {"plant", budget.plant},
         {"noise_gain", budget.noise_gain},
+        {"image_noise_gain", budget.image_noise_gain},
         {"noise", budget.noise},
         {"predicted", budget.predicted},
         {"pole", budget.pole},
         {"settle_samples", budget.settle_samples},
         {"units", {{"imaging", "m"}, {"reconstruction", "m"}, {"reconstruction_relative", "dimensionless"}, {"plant_mismatch", "dimensionless"}, {"plant", "m"},
-                   {"noise_gain", "dimensionless"}, {"noise", "m"}, {"predicted", "m"}, {"pole", "dimensionless"},
+                   {"noise_gain", "dimensionless"}, {"image_noise_gain", "dimensionless"},
+                   {"noise", "m"}, {"predicted", "m"}, {"pole", "dimensionless"},
                    {"settle_samples", "count"}}}}},
       {"deflection_rms", result.deflection_rms},
       {"valid_pixels", result.topography.valid_count()},
@@ -193,7 +195,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       "detector saturates {} in this run{}, {} with the controller off; scan-area gain {}; topography RMS "
       "error {} (levelled; {} reconstruction; {}; {} reconstruction: {}); error "
       "budget of the inverse: imaging {}, reconstruction {} ({}), plant knowledge {} (assumed rate {:+.3g} %), "
-      "noise {} (gain {:.4g}), predicted {}{}",
+      "noise {} (gain {:.4g} at the samples, {:.4g} in the image), predicted {}{}",
       result.run.samples, result.turns, instrument.controller.enabled ? "on" : "off",
       100.0 * result.saturated_fraction, io::quantity(result.max_radius_with_control, "m"),
       result.saturates_with_control ? "" : " (never saturated)",
@@ -206,7 +208,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       io::quantity(budget.imaging, "m"), io::quantity(budget.reconstruction, "m"),
       percent(budget.reconstruction),
       io::quantity(budget.plant, "m"), 100.0 * budget.plant_mismatch,
-      io::quantity(budget.noise, "m"), budget.noise_gain, io::quantity(budget.predicted, "m"),
+      io::quantity(budget.noise, "m"), budget.noise_gain, budget.image_noise_gain, io::quantity(budget.predicted, "m"),
       files.empty() ? std::string() : fmt::format("; wrote {} files with prefix {}", files.size(), prefix));
   out.finish(results, summary);
 }

@@ -36,6 +36,16 @@ double PlantInverse::noise_gain() const {
   return std::sqrt(1.0 + (p - a_) * (p - a_) / (1.0 - p * p)) * inv_b1_;
 }
 
+double PlantInverse::noise_correlation() const {
+  const double p = pole(), q = p - a_;
+  const double g = noise_gain() / inv_b1_;  // G b1
+  return (q + q * q * p / (1.0 - p * p)) / (g * g);
+}
+
+double PlantInverse::image_noise_gain() const {
+  return noise_gain() * std::sqrt((2.0 / 3.0) * (2.0 / 3.0 + noise_correlation() / 3.0));
+}
+
 double PlantInverse::nan() noexcept { return std::numeric_limits<double>::quiet_NaN(); }
 
 }  // namespace afmkit::scan

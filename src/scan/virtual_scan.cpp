@@ -175,7 +175,8 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   b.plant_mismatch = instrument.assumed_bandwidth() / instrument.plant.bandwidth - 1.0;
   b.plant = std::abs(instrument.plant.bandwidth / instrument.assumed_bandwidth() - 1.0) * out.lagged_rms_error;
   b.noise_gain = model.noise_gain();
-  b.noise = b.noise_gain * instrument.detector.noise;
+  b.image_noise_gain = model.image_noise_gain();
+  b.noise = b.image_noise_gain * instrument.detector.noise;
   b.predicted = std::sqrt(b.imaging * b.imaging + b.plant * b.plant + b.noise * b.noise);
   b.pole = model.pole();
   b.settle_samples = model.settle_samples();

@@ -15,7 +15,7 @@
 // recursion is stable; p → −(1 − x/3) as x → 0: an error (noise, a restart) rings at the Nyquist frequency and
 // decays by |p| per sample. White noise of RMS σ on w comes out with RMS G σ, the noise gain
 //   G² = Σ h_k² = (1 + (p − a)²/(1 − p²)) / b1²        (h_0 = 1/b1, h_k = p^{k−1}(p − a)/b1)
-// (G ≈ 107 at the defaults, γh = 0.126: the price of undoing a lag from samples; the lagged reconstruction passes
+// (G ≈ 109 at the defaults, γh = 0.126: the price of undoing a lag from samples; the lagged reconstruction passes
 // noise with gain 1). With an assumed γ̂ instead of the true γ, to first order in the mismatch and for frequencies
 // well below γ, f̂ − f = (1/γ̂ − 1/γ) ḟ = (γ/γ̂ − 1) (f − w): the lagged reconstruction's error scaled by γ/γ̂ − 1.
 // After a gap (a saturated sample: w unknown) the recursion restarts from the interval mean of the first two samples,
@@ -82,6 +82,13 @@ class PlantInverse {
   double b1() const { return 1.0 / inv_b1_; }  ///< weight of f_{n+1}
   double pole() const { return -b0_ * inv_b1_; }  ///< p = −b0/b1, in (−1, 0)
   double noise_gain() const;                ///< G (above), dimensionless
+  /// ρ1: correlation of consecutive outputs for white noise on w, Σ h_k h_{k+1} / Σ h_k² =
+  /// ((p − a) + (p − a)² p/(1 − p²)) / (G b1)² (≈ −0.98 at the defaults: the noise comes out near Nyquist)
+  double noise_correlation() const;
+  /// The noise gain of an image: G √((2/3)(2/3 + ρ1/3)) — the imager interpolates linearly between neighbouring
+  /// samples along the turn (weights 1 − s, s; E[(1 − s)² + s² + 2 s(1 − s) ρ1] = 2/3 + ρ1/3 for s uniform) and
+  /// between neighbouring turns (independent noise: 2/3); ≈ 0.48 G at the defaults.
+  double image_noise_gain() const;
   std::int64_t settle_samples() const { return settle_; }  ///< samples after a restart until |p|^k <= 1 %
 
  private:

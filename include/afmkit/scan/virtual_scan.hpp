@@ -49,9 +49,9 @@ struct ErrorBudget {
                                 ///< what the reconstruction itself adds, whatever the sampling
   double plant_mismatch = 0.0;  ///< γ̂/γ − 1 [dimensionless]: how wrong the assumed plant rate is
   double plant = 0.0;           ///< first-order plant-knowledge term |γ/γ̂ − 1| × lagged_rms_error
-  double noise_gain = 0.0;      ///< G of the inverse [dimensionless] (white noise on w comes out × G)
-  double noise = 0.0;           ///< G σ_d: the detector noise through the inverse (at the samples; the imaging's
-                                ///< interpolation averages some of it away, so an upper estimate)
+  double noise_gain = 0.0;      ///< G of the inverse [dimensionless] (white noise on w comes out × G at the samples)
+  double image_noise_gain = 0.0;  ///< the same in the image (PlantInverse::image_noise_gain) [dimensionless]
+  double noise = 0.0;           ///< image_noise_gain · σ_d: the detector noise through the inverse and the imaging
   double predicted = 0.0;       ///< √(imaging² + plant² + noise²), to compare with inverse_rms_error
   double pole = 0.0;            ///< p = −b0/b1 of the inverse recursion [dimensionless]
   std::int64_t settle_samples = 0;  ///< samples left out after each saturated stretch
