@@ -110,10 +110,10 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
   const bool inverse = result.method == scan::Reconstruction::inverse;
   if (inverse && result.inverse_rms_error > result.lagged_rms_error)
     fmt::print(stderr, "afmkit scan: warning: the lagged reconstruction is closer to the truth in this run ({} against "
-                       "{} for the inverse, whose noise gain {:.4g} turns detector_noise into {}): see "
+                       "{} for the inverse, whose image noise gain {:.4g} turns detector_noise into {}): see "
                        "--reconstruction lagged (docs/scan.md#reconstruction)\n",
                io::quantity(result.lagged_rms_error, "m"), io::quantity(result.inverse_rms_error, "m"),
-               result.budget.noise_gain, io::quantity(result.budget.noise, "m"));
+               result.budget.image_noise_gain, io::quantity(result.budget.noise, "m"));
   const std::string method = inverse ? "inverse" : "lagged", other = inverse ? "lagged" : "inverse";
   const scan::ErrorBudget& budget = result.budget;
   // errors relative to the sample's RMS height; a truth that levels to a plane (sample = flat: rounding, ~1e-19 m)
