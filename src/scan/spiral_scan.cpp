@@ -78,6 +78,7 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
   const double drift_rate = 2.0 * std::numbers::pi / plant.delay_drift_period;
   const double actuator_gain = (1.0 + plant.gain_error) / gamma;  // y* = f + (1 + ε) u / γ
   const double calibrated_gain = 1.0 / gamma_hat;
+  const double lag_per_step = fs / gamma;  // (slope / γ) per unit height change over one sample
 
   std::mt19937_64 rng(detector.seed);
   std::normal_distribution<double> noise(0.0, detector.noise > 0.0 ? detector.noise : 1.0);
@@ -132,7 +133,7 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
     const DelaySplit split = drifts ? DelaySplit::of(plant.delay + plant.delay_drift * std::sin(drift_rate * t),
                                                      fs, gamma)
                                     : actual;
-    const double lag = (f_next - f) * fs / gamma;  // slope / γ
+    const double lag = (f_next - f) * lag_per_step;  // slope / γ
     const double f_split = f + (f_next - f) * split.fraction;
     const double before = actuator_gain * past(n - split.whole - 1), after = actuator_gain * past(n - split.whole);
     y = relax_ramp(y, f + before, f_split + before, lag, split.e_first);
