@@ -84,7 +84,9 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
   std::optional<SeriesWriter> series;
   if (!series_path.empty()) series.emplace(series_path, series_every, false);
   std::optional<PointCloud> points;
-  if (!points_path.empty()) points.emplace(points_every, false, static_cast<std::size_t>(expected_points));
+  if (!points_path.empty())
+    points.emplace(points_every, false, static_cast<std::size_t>(expected_points),
+                   instrument.reconstruction.method == scan::Reconstruction::inverse);
   std::vector<scan::ScanObserver*> extra;
   if (series) extra.push_back(&*series);
   if (points) extra.push_back(&*points);

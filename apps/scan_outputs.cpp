@@ -48,17 +48,19 @@ bool SeriesWriter::sample(const scan::ScanSample& s) {
   return true;
 }
 
-PointCloud::PointCloud(long every, bool recorded, std::size_t expected) : every_(every), recorded_(recorded) {
+PointCloud::PointCloud(long every, bool recorded, std::size_t expected, bool inverse)
+    : every_(every), recorded_(recorded), inverse_(inverse) {
   for (auto* v : {&x_, &y_, &a_, &b_}) v->reserve(expected);
 }
 
 bool PointCloud::sample(const scan::ScanSample& s) {
   if (s.index % every_ != 0) return true;
-  if (!std::isfinite(s.deflection) || !std::isfinite(s.topography)) return true;
+  const double topography = inverse_ ? s.inverse : s.topography;
+  if (!std::isfinite(s.deflection) || !std::isfinite(topography)) return true;
   x_.push_back(s.radius * std::cos(s.angle));
   y_.push_back(s.radius * std::sin(s.angle));
   a_.push_back(s.deflection);
-  b_.push_back(s.topography);
+  b_.push_back(topography);
   return true;
 }
 

@@ -78,6 +78,22 @@ TEST(ScanCli, WritesImagesGwyddionOpensAndTheControllerBuysArea) {
   const afmkit::scan::XyzField points = afmkit::scan::read_gxyzf(dir.file("out/points.gxyzf"));
   EXPECT_EQ(points.size(), printed["point_cloud_points"].get<std::size_t>());
   EXPECT_EQ(points.channels().size(), 2u);
+  {  // its topography channel is the chosen reconstruction (inverse): sample 350 m is point 50 m and series row 7 m
+    std::ifstream series(dir.file("out/series.csv"));
+    std::string line;
+    std::getline(series, line);  // header
+    long row = 0, compared = 0;
+    while (std::getline(series, line)) {
+      if (row % 7 == 0 && static_cast<std::size_t>(row / 7 * 50) < points.size()) {
+        const double inverse = std::stod(line.substr(line.rfind(',') + 1));  // topography_inverse, the last column
+        EXPECT_NEAR(points.channels()[1].values[static_cast<std::size_t>(row / 7 * 50)], inverse,
+                    1e-9 * std::abs(inverse) + 1e-18) << "series row " << row;
+        ++compared;
+      }
+      ++row;
+    }
+    EXPECT_GT(compared, 100);
+  }
 
   // the GSF image reads back as written: metres, the scanned square, the mask
   const auto image = afmkit::scan::read_gsf_with_mask(dir.file("out/scan/scan_topography.gsf"),
