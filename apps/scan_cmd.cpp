@@ -84,7 +84,9 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
   std::optional<SeriesWriter> series;
   if (!series_path.empty()) series.emplace(series_path, series_every, false);
   std::optional<PointCloud> points;
-  if (!points_path.empty()) points.emplace(points_every, false, static_cast<std::size_t>(expected_points));
+  if (!points_path.empty())
+    points.emplace(points_every, false, static_cast<std::size_t>(expected_points),
+                   instrument.reconstruction.method == scan::Reconstruction::inverse);
   std::vector<scan::ScanObserver*> extra;
   if (series) extra.push_back(&*series);
   if (points) extra.push_back(&*points);
@@ -107,10 +109,28 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
   const scan::VirtualScan result = scan::run_virtual_scan(instrument, surface, grid, options);
   progress.finish();
 
+  const bool inverse = result.method == scan::Reconstruction::inverse;
+  if (inverse && result.inverse_rms_error > result.lagged_rms_error)
+    fmt::print(stderr, "afmkit scan: warning: the lagged reconstruction is closer to the truth in this run ({} against "
+                       "{} for the inverse, whose image noise gain {:.4g} turns detector_noise into {}): see "
+                       "--reconstruction lagged (docs/scan.md#reconstruction)\n",
+               io::quantity(result.lagged_rms_error, "m"), io::quantity(result.inverse_rms_error, "m"),
+               result.budget.image_noise_gain, io::quantity(result.budget.noise, "m"));
+  const std::string method = inverse ? "inverse" : "lagged", other = inverse ? "lagged" : "inverse";
+  const scan::ErrorBudget& budget = result.budget;
+  // errors relative to the sample's RMS height; a truth that levels to a plane (sample = flat: rounding, ~1e-19 m)
+  // has none (null in the sidecar)
+  const bool flat_truth = !(result.sample_rms_height > 1e-15);
+  const auto relative = [&](double error) {
+    return flat_truth ? std::numeric_limits<double>::quiet_NaN() : error / result.sample_rms_height;
+  };
   std::vector<std::string> files;
   if (!prefix.empty())
     files = stage_images(prefix, {{"deflection", "Deflection", &result.deflection, false},
-                                  {"topography", "Topography (reconstructed)", &result.topography, true},
+                                  {"topography", fmt::format("Topography (reconstructed, {})", method), &result.topography,
+                                   true},
+                                  {"topography_" + other, fmt::format("Topography (reconstructed, {})", other),
+                                   &result.alternative, true},
                                   {"truth", "Ground truth (topography + tilt)", &result.truth, true}},
                          out.outputs());
   std::size_t n_points = 0;
@@ -129,7 +149,28 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       {"max_radius_without_control", result.max_radius_without_control},
       {"scan_area_gain", result.scan_area_gain},
       {"scan_area_gain_is_lower_bound", result.scan_area_gain_is_lower_bound},
+      {"reconstruction", method},
       {"topography_rms_error", result.topography_rms_error},
+      {"topography_relative_error", relative(result.topography_rms_error)},
+      {"inverse_rms_error", result.inverse_rms_error},
+      {"lagged_rms_error", result.lagged_rms_error},
+      {"sample_rms_height", result.sample_rms_height},
+      {"error_budget",
+       {{"imaging", budget.imaging},
+        {"reconstruction", budget.reconstruction},
+        {"reconstruction_relative", relative(budget.reconstruction)},
+        {"plant_mismatch", budget.plant_mismatch},
+        {"plant", budget.plant},
+        {"noise_gain", budget.noise_gain},
+        {"image_noise_gain", budget.image_noise_gain},
+        {"noise", budget.noise},
+        {"predicted", budget.predicted},
+        {"pole", budget.pole},
+        {"settle_samples", budget.settle_samples},
+        {"units", {{"imaging", "m"}, {"reconstruction", "m"}, {"reconstruction_relative", "dimensionless"}, {"plant_mismatch", "dimensionless"}, {"plant", "m"},
+                   {"noise_gain", "dimensionless"}, {"image_noise_gain", "dimensionless"},
+                   {"noise", "m"}, {"predicted", "m"}, {"pole", "dimensionless"},
+                   {"settle_samples", "count"}}}}},
       {"deflection_rms", result.deflection_rms},
       {"valid_pixels", result.topography.valid_count()},
       {"loop_spectral_abscissa", abscissa},
@@ -138,7 +179,9 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       {"files", files},
       {"units", {{"pitch", "m"}, {"saturated_fraction", "dimensionless"}, {"max_radius_with_control", "m"},
                  {"max_radius_without_control", "m"}, {"scan_area_gain", "dimensionless"},
-                 {"topography_rms_error", "m"}, {"deflection_rms", "m"}, {"valid_pixels", "count"},
+                 {"topography_rms_error", "m"}, {"topography_relative_error", "dimensionless"},
+                 {"inverse_rms_error", "m"}, {"lagged_rms_error", "m"}, {"sample_rms_height", "m"},
+                 {"deflection_rms", "m"}, {"valid_pixels", "count"},
                  {"loop_spectral_abscissa", "1/s"}, {"samples", "count"}, {"turns", "count"},
                  {"filter_skipped_samples", "count"}, {"point_cloud_points", "count"}}}};
   if (series) series->stage(io::make_sidecar("scan (time series)", as_run, results), out.outputs());
@@ -146,15 +189,28 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       std::isnan(result.scan_area_gain)
           ? std::string("nan (the uncontrolled scan does not saturate)")
           : fmt::format("{}{:.3f}", result.scan_area_gain_is_lower_bound ? ">= " : "", result.scan_area_gain);
+  const auto percent = [&](double error) {
+    return flat_truth ? std::string("flat truth") : fmt::format("{:.3g} %", 100.0 * relative(error));
+  };
   const std::string summary = fmt::format(
       "afmkit scan: {} samples, {} turns, controller {}; saturated {:.3g} % of samples; largest radius before the "
       "detector saturates {} in this run{}, {} with the controller off; scan-area gain {}; topography RMS "
-      "error {} (levelled){}",
+      "error {} (levelled; {} reconstruction; {}; {} reconstruction: {}); error "
+      "budget of the inverse: imaging {}, reconstruction {} ({}), plant knowledge {} (assumed rate {:+.3g} %), "
+      "noise {} (gain {:.4g} at the samples, {:.4g} in the image), predicted {}{}",
       result.run.samples, result.turns, instrument.controller.enabled ? "on" : "off",
       100.0 * result.saturated_fraction, io::quantity(result.max_radius_with_control, "m"),
       result.saturates_with_control ? "" : " (never saturated)",
       !instrument.controller.enabled ? std::string("(this run)") : io::quantity(result.max_radius_without_control, "m"),
-      gain, io::quantity(result.topography_rms_error, "m"),
+      gain, io::quantity(result.topography_rms_error, "m"), method,
+      flat_truth ? std::string("no relative error: the levelled truth is flat")
+                 : fmt::format("{} of the sample's RMS height {}", percent(result.topography_rms_error),
+                               io::quantity(result.sample_rms_height, "m")),
+      other, io::quantity(inverse ? result.lagged_rms_error : result.inverse_rms_error, "m"),
+      io::quantity(budget.imaging, "m"), io::quantity(budget.reconstruction, "m"),
+      percent(budget.reconstruction),
+      io::quantity(budget.plant, "m"), 100.0 * budget.plant_mismatch,
+      io::quantity(budget.noise, "m"), budget.noise_gain, budget.image_noise_gain, io::quantity(budget.predicted, "m"),
       files.empty() ? std::string() : fmt::format("; wrote {} files with prefix {}", files.size(), prefix));
   out.finish(results, summary);
 }

@@ -28,9 +28,10 @@ std::vector<io::Column> series_columns(bool recorded) {
           {"deflection", "m", "detector reading d (clamped to +-detector_range)"},
           {"control", "m/s", "controller output u (seed 2, eq. 1)"},
           {"actuator", "m", "calibrated actuator displacement (minus the nominal plant response to u)"},
-          {"topography", "m", "reconstructed height: deflection + actuator"},
+          {"topography", "m", "lagged reconstruction: deflection + actuator"},
           {"surface", "m", "true height under the tip (topography + tilt)"},
-          {"saturated", "boolean", "1 when the detector saturated at this sample"}};
+          {"saturated", "boolean", "1 when the detector saturated at this sample"},
+          {"topography_inverse", "m", "inverse reconstruction: the plant's lag removed (NaN: saturated or settling)"}};
 }
 }  // namespace
 
@@ -43,21 +44,23 @@ bool SeriesWriter::sample(const scan::ScanSample& s) {
     writer_.row(s.time, s.radius, s.angle, s.deflection, s.control, s.topography);
   else
     writer_.row(s.time, s.radius, s.angle, s.deflection, s.control, s.actuator, s.topography, s.surface,
-                s.saturated);
+                s.saturated, s.inverse);
   return true;
 }
 
-PointCloud::PointCloud(long every, bool recorded, std::size_t expected) : every_(every), recorded_(recorded) {
+PointCloud::PointCloud(long every, bool recorded, std::size_t expected, bool inverse)
+    : every_(every), recorded_(recorded), inverse_(inverse) {
   for (auto* v : {&x_, &y_, &a_, &b_}) v->reserve(expected);
 }
 
 bool PointCloud::sample(const scan::ScanSample& s) {
   if (s.index % every_ != 0) return true;
-  if (!std::isfinite(s.deflection) || !std::isfinite(s.topography)) return true;
+  const double topography = inverse_ ? s.inverse : s.topography;
+  if (!std::isfinite(s.deflection) || !std::isfinite(topography)) return true;
   x_.push_back(s.radius * std::cos(s.angle));
   y_.push_back(s.radius * std::sin(s.angle));
   a_.push_back(s.deflection);
-  b_.push_back(s.topography);
+  b_.push_back(topography);
   return true;
 }
 
@@ -70,7 +73,8 @@ std::size_t PointCloud::stage(const std::string& path, io::OutputSet& set) {
 }
 
 namespace {
-constexpr const char* image_channels[] = {"deflection", "topography", "truth", "tilt_free"};  // every scan's names
+constexpr const char* image_channels[] = {"deflection", "topography", "topography_lagged", "topography_inverse",
+                                          "truth", "tilt_free"};  // every scan's names
 }
 
 std::vector<std::string> stage_images(const std::string& prefix, const std::vector<NamedImage>& images,

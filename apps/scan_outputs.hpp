@@ -31,7 +31,9 @@ class SeriesWriter final : public scan::ScanObserver {
 /// Collects every `every`-th sample's (x, y) and channels for a GXYZF point cloud.
 class PointCloud final : public scan::ScanObserver {
  public:
-  PointCloud(long every, bool recorded, std::size_t expected);
+  /// `inverse`: the topography channel is the inverse reconstruction (else the lagged one, or the recorded tilt-free
+  /// signal).
+  PointCloud(long every, bool recorded, std::size_t expected, bool inverse = false);
   bool sample(const scan::ScanSample& s) override;
   /// Stages the GXYZF file for `path` into `set`; returns the number of points.
   std::size_t stage(const std::string& path, io::OutputSet& set);
@@ -39,6 +41,7 @@ class PointCloud final : public scan::ScanObserver {
  private:
   long every_;
   bool recorded_;
+  bool inverse_;
   std::vector<double> x_, y_, a_, b_;
 };
 

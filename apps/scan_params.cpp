@@ -206,16 +206,26 @@ void add_scan_params(io::ParamSet& p) {
       .unit("Omega")
       .real("gain", 0.0, "controller gain K (0: the design rule K = bandwidth)", non_negative)
       .unit("rad/s")
-      .follows("bandwidth");  // recorded as the gain used
+      .follows("bandwidth")  // recorded as the gain used
+      .group("Reconstruction (docs/scan.md#reconstruction)")
+      .text("reconstruction", "inverse",
+            "what the topography image shows: inverse (the plant's first-order lag removed, seed 2 eq. 1) or lagged "
+            "(deflection + actuator displacement); the other is written as <prefix>_topography_<other>",
+            {"inverse", "lagged"})
+      .real("reconstruction_bandwidth", 0.0,
+            "plant rate gamma the reconstruction and the actuator model assume (0: the true bandwidth)", non_negative)
+      .unit("rad/s")
+      .follows("bandwidth");  // recorded as the rate used
 }
 
 namespace {
 // Peak bytes per pixel (docs/development.md#memory-and-sizes), rounded up: the images of a simulated scan (the
-// imager's two channels with its sorted pixel radii, then deflection, topography and the ground truth with their
-// masks, levelling and the GSF/PNG encoding of one image at a time; measured 55 bytes from the peak resident
-// memory at 1024² and 2048² pixels), of a recorded one (two images: at most that), and a generated sample map
-// (measured 8 bytes, the rough generator's spectrum 18.4 bytes).
-constexpr double kSimulatedImageBytes = 64.0;
+// imager's four channels — deflection, both reconstructions, the true heights at the samples — with its sorted
+// pixel radii, then those images and the ground truth with their masks, levelling and the GSF/PNG encoding of one
+// image at a time; measured 73.4 bytes from the peak resident memory at 1024² and 2048² pixels), of a recorded one
+// (two images: at most that), and a generated sample map (measured 8 bytes, the rough generator's spectrum 18.4
+// bytes).
+constexpr double kSimulatedImageBytes = 80.0;
 constexpr double kRecordedImageBytes = 64.0;
 constexpr double kSampleBytes = 24.0;
 // A sample file held in memory: its bytes, then the decoded values and the height map (GSF: 4 bytes a value in
@@ -275,7 +285,8 @@ const std::vector<std::string>& simulation_only_keys() {
       "grating_height", "grating_duty", "steps_width", "steps_height", "particles_count", "particles_radius",
       "rough_rms", "rough_correlation_length", "tilt_angle", "tilt_azimuth", "spindle_frequency", "start_radius",
       "end_radius", "radial_speed", "sample_rate", "bandwidth", "delay", "delay_drift", "delay_drift_period",
-      "gain_error", "detector_range", "detector_noise", "noise_seed", "control", "gain"};
+      "gain_error", "detector_range", "detector_noise", "noise_seed", "control", "gain", "reconstruction",
+      "reconstruction_bandwidth"};
   return keys;
 }
 
@@ -311,6 +322,10 @@ scan::InstrumentSpec instrument_from(const io::ParamSet& p) {
   s.controller.alpha = p.real("alpha");
   s.controller.beta = p.real("beta");
   s.controller.gain = p.real("gain");
+  s.reconstruction.method =
+      p.text("reconstruction") == "lagged" ? scan::Reconstruction::lagged : scan::Reconstruction::inverse;
+  // not given: 0, the true bandwidth (the record shows that value: follows("bandwidth"))
+  s.reconstruction.assumed_bandwidth = p.was_set("reconstruction_bandwidth") ? p.real("reconstruction_bandwidth") : 0.0;
   s.validate();
   return s;
 }

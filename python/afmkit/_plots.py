@@ -274,7 +274,7 @@ _impact = _signals([("gap",), ("force",)])
 
 
 # ------------------------------------------------------------------------------------------ scan
-_CHANNELS = ("topography", "deflection", "truth")
+_CHANNELS = ("topography", "deflection", "truth", "topography_lagged", "topography_inverse")
 
 
 def _read_gsf(path):
@@ -292,10 +292,13 @@ def _read_gsf(path):
 
 
 def _scan(r, ax=None, *, channel="topography", colorbar=True):
-    """one image of the scan (channel topography, deflection or truth, from the GSF files it wrote); pixels
-    outside the scanned disc blank."""
+    """one image of the scan (channel topography — the chosen reconstruction —, deflection, truth, or the other
+    reconstruction topography_lagged / topography_inverse, from the GSF files it wrote); pixels outside the scanned
+    disc blank."""
     if channel not in _CHANNELS:
         raise ValueError(f"channel = {channel!r} is not allowed: must be one of {', '.join(_CHANNELS)}")
+    if channel == f"topography_{r.results.get('reconstruction')}":
+        channel = "topography"  # the chosen reconstruction is written as <prefix>_topography
     files = [str(f) for f in r.results.get("files", [])]
     image = next((f for f in files if f.endswith(f"_{channel}.gsf")), None)
     mask = next((f for f in files if f.endswith(f"_{channel}_mask.gsf")), None)

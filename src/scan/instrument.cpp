@@ -69,6 +69,24 @@ void InstrumentSpec::validate() const {
   plant.validate(spiral);
   detector.validate();
   controller.validate();
+  reconstruction.validate();
+  // the assumed plant rate is an estimate of the true one (docs/scan.md#reconstruction), and the inverse needs
+  // γ̂/f_s >= 1e-6: below, its noise gain (≈ 4.9 (γ̂/f_s)^−3/2, 5e9 there) leaves nothing of the height
+  const double assumed = assumed_bandwidth();
+  if (reconstruction.assumed_bandwidth > 0.0 &&
+      !(assumed >= 0.01 * plant.bandwidth && assumed <= 100.0 * plant.bandwidth))
+    throw InvalidParameter("reconstruction_bandwidth",
+                           fmt::format("reconstruction_bandwidth = {} rad/s is out of range: the plant rate the "
+                                       "reconstruction assumes must lie within a factor 100 of bandwidth = {} rad/s: "
+                                       "[{}, {}] rad/s (0: the true bandwidth)",
+                                       assumed, plant.bandwidth, 0.01 * plant.bandwidth, 100.0 * plant.bandwidth));
+  if (!(assumed >= 1e-6 * spiral.sample_rate))
+    throw InvalidParameter(reconstruction.assumed_bandwidth > 0.0 ? "reconstruction_bandwidth" : "bandwidth",
+                           fmt::format("{} = {} rad/s is out of range: the inverse reconstruction needs the plant rate "
+                                       ">= 1e-6 x sample_rate = {:.6g} rad/s (below, its noise gain exceeds 5e9)",
+                                       reconstruction.assumed_bandwidth > 0.0 ? "reconstruction_bandwidth"
+                                                                              : "bandwidth",
+                                       assumed, 1e-6 * spiral.sample_rate));
   if (controller.enabled) {
     const double top = controller.harmonics * spiral.spindle_frequency;
     if (!(top < 0.5 * spiral.sample_rate))
@@ -77,6 +95,10 @@ void InstrumentSpec::validate() const {
                                          "below the Nyquist frequency sample_rate/2 = {} Hz", controller.harmonics,
                                          spiral.spindle_frequency, top, 0.5 * spiral.sample_rate));
   }
+}
+
+double InstrumentSpec::assumed_bandwidth() const {
+  return reconstruction.assumed_bandwidth > 0.0 ? reconstruction.assumed_bandwidth : plant.bandwidth;
 }
 
 double InstrumentSpec::controller_gain() const { return controller.gain > 0.0 ? controller.gain : plant.bandwidth; }

@@ -144,7 +144,8 @@ RecordedScan filter_recorded_scan(const std::string& path, const RecordedSurvey&
     const double m = in.deflection + previous_u / kGain;
     const double u = filter.step(m);
     previous_u = u;
-    const ScanSample s{n, in.time, in.angle, in.radius, in.deflection, in.deflection, u, m - in.deflection, m, false};
+    const ScanSample s{n, in.time, in.angle, in.radius, in.deflection, in.deflection, u, m - in.deflection, m, m,
+                       false};
     const double values[2] = {in.deflection, m};
     imager.add(in.angle, in.radius, values);
     swapped.sample(s);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -69,11 +70,15 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
   std::vector<double> history(ring_size, 0.0);
   const auto past = [&](std::int64_t j) { return j < 0 ? 0.0 : history[static_cast<std::uint64_t>(j) & mask]; };
 
-  const DelaySplit nominal = DelaySplit::of(plant.delay, fs, gamma);
+  const double gamma_hat = instrument.assumed_bandwidth();
+  const DelaySplit actual = DelaySplit::of(plant.delay, fs, gamma);      // the plant at the nominal delay
+  const DelaySplit nominal = DelaySplit::of(plant.delay, fs, gamma_hat);  // the calibrated actuator model
+  PlantInverse inverse(gamma_hat, fs);
   const bool drifts = plant.delay_drift > 0.0;
   const double drift_rate = 2.0 * std::numbers::pi / plant.delay_drift_period;
   const double actuator_gain = (1.0 + plant.gain_error) / gamma;  // y* = f + (1 + ε) u / γ
-  const double calibrated_gain = 1.0 / gamma;
+  const double calibrated_gain = 1.0 / gamma_hat;
+  const double lag_per_step = fs / gamma;  // (slope / γ) per unit height change over one sample
 
   std::mt19937_64 rng(detector.seed);
   std::normal_distribution<double> noise(0.0, detector.noise > 0.0 ? detector.noise : 1.0);
@@ -113,7 +118,9 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
       ++run.saturated_samples;
     }
     ++run.samples;
-    const ScanSample s{n, t, theta, r, f, d, u, -y_hat, d - y_hat, saturated};
+    const double w = d - y_hat;
+    const double f_hat = inverse.step(saturated ? std::numeric_limits<double>::quiet_NaN() : w);
+    const ScanSample s{n, t, theta, r, f, d, u, -y_hat, w, f_hat, saturated};
     if (!observer.sample(s)) {
       run.stopped_early = true;
       break;
@@ -125,8 +132,8 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
     const double f_next = height_at(n + 1);
     const DelaySplit split = drifts ? DelaySplit::of(plant.delay + plant.delay_drift * std::sin(drift_rate * t),
                                                      fs, gamma)
-                                    : nominal;
-    const double lag = (f_next - f) * fs / gamma;  // slope / γ
+                                    : actual;
+    const double lag = (f_next - f) * lag_per_step;  // slope / γ
     const double f_split = f + (f_next - f) * split.fraction;
     const double before = actuator_gain * past(n - split.whole - 1), after = actuator_gain * past(n - split.whole);
     y = relax_ramp(y, f + before, f_split + before, lag, split.e_first);

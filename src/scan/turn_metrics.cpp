@@ -21,6 +21,20 @@ void FirstHarmonicFit::add(double c, double s, double v) noexcept {
   svs_ += v * s;
 }
 
+void FirstHarmonicFit::add_pair(FirstHarmonicFit& first, FirstHarmonicFit& second, double c, double s, double v,
+                                double w) noexcept {
+  first.add(c, s, v);
+  second.n_ = first.n_;
+  second.sc_ = first.sc_;
+  second.ss_ = first.ss_;
+  second.scc_ = first.scc_;
+  second.scs_ = first.scs_;
+  second.sss_ = first.sss_;
+  second.sv_ += w;
+  second.svc_ += w * c;
+  second.svs_ += w * s;
+}
+
 double FirstHarmonicFit::amplitude() const noexcept {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   if (n_ < 3) return nan;
@@ -49,8 +63,37 @@ void TurnMetrics::close_turn() {
   if (on_turn_) on_turn_(r);
 }
 
+void TurnMetrics::angle_trig(double angle) noexcept {
+  const double step = angle - last_angle_;
+  const double change = step - step_;
+  if (since_exact_ >= 0 && since_exact_ < 1024 && std::abs(change) <= 1e-6) {
+    const double cd = 1.0 - 0.5 * change * change, sd = change;  // cos δ, sin δ to O(δ³)
+    const double cs = cos_step_ * cd - sin_step_ * sd, ss = sin_step_ * cd + cos_step_ * sd;
+    const double c = cos_ * cs - sin_ * ss;
+    sin_ = sin_ * cs + cos_ * ss;
+    cos_ = c;
+    ++since_exact_;
+  } else {
+    cos_ = std::cos(angle);
+    sin_ = std::sin(angle);
+    if (since_exact_ >= 0 && std::abs(change) > 1e-6) {  // a new step: cache its rotation
+      step_ = step;
+      cos_step_ = std::cos(step);
+      sin_step_ = std::sin(step);
+    }
+    since_exact_ = 0;
+  }
+  last_angle_ = angle;
+}
+
 bool TurnMetrics::sample(const ScanSample& s) {
-  const auto turn = static_cast<std::int64_t>(std::floor(s.angle / (2.0 * std::numbers::pi)));
+  // the turn index floor(θ/2π), recomputed only when θ leaves the current turn's angles
+  const bool same_turn = s.angle >= turn_begin_ && s.angle < turn_end_;
+  const auto turn = same_turn ? current_ : static_cast<std::int64_t>(std::floor(s.angle / (2.0 * std::numbers::pi)));
+  if (!same_turn) {
+    turn_begin_ = 2.0 * std::numbers::pi * static_cast<double>(turn);
+    turn_end_ = 2.0 * std::numbers::pi * static_cast<double>(turn + 1);
+  }
   if (turn != current_) {
     if (current_ >= 0 && deflection_.count() > 0) close_turn();
     current_ = turn;
@@ -59,9 +102,9 @@ bool TurnMetrics::sample(const ScanSample& s) {
     radius_sum_ = 0.0;
     saturated_ = 0;
   }
-  const double c = std::cos(s.angle), sn = std::sin(s.angle);
-  deflection_.add(c, sn, s.deflection);
-  surface_.add(c, sn, s.surface);
+  angle_trig(s.angle);
+  const double c = cos_, sn = sin_;
+  FirstHarmonicFit::add_pair(deflection_, surface_, c, sn, s.deflection, s.surface);
   radius_sum_ += s.radius;
   saturated_ += s.saturated ? 1 : 0;
   return true;

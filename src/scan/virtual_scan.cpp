@@ -17,12 +17,17 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Feeds the imager: deflection and topography, NaN where the detector saturated.
+// The imager's channels.
+enum VirtualScanChannel : std::size_t { kDeflectionChannel, kLaggedChannel, kInverseChannel, kSampledTruthChannel };
+
+// Feeds the imager: deflection, both reconstructions (NaN where the detector saturated; the inverse also while it
+// settles) and the true height at the samples (for the imaging floor).
 class ImagingObserver final : public ScanObserver {
  public:
   explicit ImagingObserver(SpiralImager& imager) : imager_(imager) {}
   bool sample(const ScanSample& s) override {
-    const double values[2] = {s.saturated ? kNaN : s.deflection, s.saturated ? kNaN : s.topography};
+    const double values[4] = {s.saturated ? kNaN : s.deflection, s.saturated ? kNaN : s.topography, s.inverse,
+                              s.saturated ? kNaN : s.surface};
     imager_.add(s.angle, s.radius, values);
     return true;
   }
@@ -92,7 +97,7 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   const SpiralSpec& spiral = instrument.spiral;
 
   const auto per_turn = static_cast<int>(std::clamp(std::round(spiral.samples_per_turn()), 16.0, 4194304.0));
-  SpiralImager imager(grid, {"m", "m"}, per_turn);
+  SpiralImager imager(grid, {"m", "m", "m", "m"}, per_turn);
   ImagingObserver imaging(imager);
   std::int64_t turns = 0;
   TurnMetrics metrics(surface.tilt().slope(), [&](const TurnRecord& r) {
@@ -105,8 +110,12 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   const ScanRun run = simulate_scan(instrument, surface, observers, options.progress, options.cancellation);
   std::vector<HeightMap> images = imager.finish();
 
-  VirtualScan out{run, std::move(images.at(0)), std::move(images.at(1)),
-                  HeightMap(Grid{}, std::vector<double>{0.0})};
+  const bool inverse = instrument.reconstruction.method == Reconstruction::inverse;
+  HeightMap& chosen = images.at(inverse ? kInverseChannel : kLaggedChannel);
+  HeightMap& other = images.at(inverse ? kLaggedChannel : kInverseChannel);
+  VirtualScan out{run, instrument.reconstruction.method, std::move(images.at(kDeflectionChannel)), std::move(chosen),
+                  std::move(other), HeightMap(Grid{}, std::vector<double>{0.0}), 0, 0.0, 0.0, false, 0.0, false, 0.0,
+                  false, 0.0, 0.0, 0.0, 0.0, ErrorBudget{}, 0.0};
   out.truth = truth_on(out.topography, surface);
   out.turns = turns;
   out.saturated_fraction =
@@ -130,8 +139,49 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
       out.scan_area_gain_is_lower_bound = !out.saturates_with_control;
     }
   }
+  const auto error_of = [&](const HeightMap& image) {
+    return image.valid_count() >= 3 ? levelled_rms_difference(image, out.truth) : kNaN;
+  };
+  const HeightMap& lagged = inverse ? out.alternative : out.topography;
+  const HeightMap& inverted = inverse ? out.topography : out.alternative;
+  out.lagged_rms_error = error_of(lagged);
+  out.inverse_rms_error = error_of(inverted);
+  out.sample_rms_height = kNaN;
+  if (out.truth.valid_count() >= 3) {  // the truth minus its least-squares plane, without building that map
+    const Plane plane = fit_plane(out.truth);
+    const Grid& g = out.truth.grid();
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (long j = 0; j < g.y_resolution; ++j) {
+      const double y = g.y_offset + (static_cast<double>(j) + 0.5) * out.truth.dy();
+      for (long i = 0; i < g.x_resolution; ++i)
+        if (out.truth.valid(i, j)) {
+          const double v = out.truth(i, j) - plane(g.x_offset + (static_cast<double>(i) + 0.5) * out.truth.dx(), y);
+          sum += v * v;
+          ++n;
+        }
+    }
+    out.sample_rms_height = std::sqrt(sum / static_cast<double>(n));
+  }
+  // the budget of the inverse reconstruction (plant_inverse.hpp)
+  const PlantInverse model(instrument.assumed_bandwidth(), spiral.sample_rate);
+  ErrorBudget& b = out.budget;
+  const HeightMap& sampled_truth = images.at(kSampledTruthChannel);
+  b.imaging = error_of(sampled_truth);
+  const auto against_samples = [&](const HeightMap& image) {
+    return image.valid_count() >= 3 ? levelled_rms_difference(image, sampled_truth) : kNaN;
+  };
+  b.reconstruction = against_samples(inverted);
+  b.plant_mismatch = instrument.assumed_bandwidth() / instrument.plant.bandwidth - 1.0;
+  b.plant = std::abs(instrument.plant.bandwidth / instrument.assumed_bandwidth() - 1.0) * out.lagged_rms_error;
+  b.noise_gain = model.noise_gain();
+  b.image_noise_gain = model.image_noise_gain();
+  b.noise = b.image_noise_gain * instrument.detector.noise;
+  b.predicted = std::sqrt(b.imaging * b.imaging + b.plant * b.plant + b.noise * b.noise);
+  b.pole = model.pole();
+  b.settle_samples = model.settle_samples();
   if (out.topography.valid_count() >= 3) {
-    out.topography_rms_error = levelled_rms_difference(out.topography, out.truth);
+    out.topography_rms_error = inverse ? out.inverse_rms_error : out.lagged_rms_error;  // computed above
     const HeightMap flat_deflection = level(out.deflection);
     double sum = 0.0;
     std::size_t n = 0;

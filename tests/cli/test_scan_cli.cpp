@@ -51,12 +51,17 @@ TEST(ScanCli, WritesImagesGwyddionOpensAndTheControllerBuysArea) {
   EXPECT_EQ(meta["parameter_units"]["radial_speed"], "m/s");
   EXPECT_EQ(meta["parameter_units"]["tilt_angle"], "deg");
   EXPECT_EQ(meta["columns"][2]["name"], "deflection_first_harmonic");
-  EXPECT_EQ(sidecar(dir, "out/series.csv")["columns"].size(), 9u);
+  EXPECT_EQ(sidecar(dir, "out/series.csv")["columns"].size(), 10u);
+  // the inverse reconstruction (the default) against the lagged one beside it (docs/scan.md#reconstruction)
+  EXPECT_EQ(printed["reconstruction"], "inverse");
+  EXPECT_LT(printed["error_budget"]["reconstruction"].get<double>(), 1e-6 * printed["sample_rms_height"].get<double>());
+  EXPECT_GT(printed["lagged_rms_error"].get<double>(), 3 * printed["inverse_rms_error"].get<double>());  // 15 vs 3.5 nm
+  EXPECT_EQ(printed["error_budget"]["units"]["noise_gain"], "dimensionless");
 
   const std::string thumbnailer = gwyddion_client::find_thumbnailer();
   ASSERT_FALSE(thumbnailer.empty()) << gwyddion_client::missing_thumbnailer_message;
   int gsf_files = 0;
-  for (const std::string name : {"deflection", "topography", "truth"})
+  for (const std::string name : {"deflection", "topography", "topography_lagged", "truth"})
     for (const std::string suffix : {"", "_mask"}) {
       const std::string path = dir.file("out/scan/scan_" + name + suffix + ".gsf");
       ASSERT_TRUE(std::filesystem::exists(path)) << path;
@@ -66,13 +71,29 @@ TEST(ScanCli, WritesImagesGwyddionOpensAndTheControllerBuysArea) {
       ++gsf_files;
       ASSERT_TRUE(std::filesystem::exists(dir.file("out/scan/scan_" + name + ".png")));
     }
-  EXPECT_EQ(gsf_files, 6);
+  EXPECT_EQ(gsf_files, 8);
   // the point cloud: Gwyddion's loader accepts it (it has no image to preview), and afmkit reads it back
   const auto cloud = gwyddion_client::render(thumbnailer, dir.file("out/points.gxyzf"), dir.file("gwy_points"));
   EXPECT_TRUE(cloud.no_previewable_data()) << cloud.error_output;
   const afmkit::scan::XyzField points = afmkit::scan::read_gxyzf(dir.file("out/points.gxyzf"));
   EXPECT_EQ(points.size(), printed["point_cloud_points"].get<std::size_t>());
   EXPECT_EQ(points.channels().size(), 2u);
+  {  // its topography channel is the chosen reconstruction (inverse): sample 350 m is point 50 m and series row 7 m
+    std::ifstream series(dir.file("out/series.csv"));
+    std::string line;
+    std::getline(series, line);  // header
+    long row = 0, compared = 0;
+    while (std::getline(series, line)) {
+      if (row % 7 == 0 && static_cast<std::size_t>(row / 7 * 50) < points.size()) {
+        const double inverse = std::stod(line.substr(line.rfind(',') + 1));  // topography_inverse, the last column
+        EXPECT_NEAR(points.channels()[1].values[static_cast<std::size_t>(row / 7 * 50)], inverse,
+                    1e-9 * std::abs(inverse) + 1e-18) << "series row " << row;
+        ++compared;
+      }
+      ++row;
+    }
+    EXPECT_GT(compared, 100);
+  }
 
   // the GSF image reads back as written: metres, the scanned square, the mask
   const auto image = afmkit::scan::read_gsf_with_mask(dir.file("out/scan/scan_topography.gsf"),

@@ -11,9 +11,12 @@
 // The deflection detector reads d = clamp(y + n, −R_d, R_d) (n: white Gaussian noise of RMS σ_d; beyond the linear
 // range ±R_d the reading saturates). The controller of seed 2 (bank of N oscillators, couplings (20), gain K;
 // eqs. 15, 6, 20) runs on the samples d_n through control::RealtimeFilter, exactly as it would be embedded.
-// The topography is reconstructed as d + z_a: the deflection plus the calibrated actuator displacement z_a = −ŷ_u,
-// ŷ_u the response of the nominal plant (γ, τ, ε = 0, no drift) to u.
+// The topography is reconstructed from w = d + z_a, the deflection plus the calibrated actuator displacement
+// z_a = −ŷ_u, ŷ_u the response of the nominal plant (γ̂, τ, ε = 0, no drift) to u: either w itself (the lagged
+// reconstruction) or w with the plant's first-order lag removed (the inverse, plant_inverse.hpp).
 #include <cstdint>
+
+#include "afmkit/scan/plant_inverse.hpp"
 
 namespace afmkit::scan {
 
@@ -67,9 +70,13 @@ struct InstrumentSpec {
   PlantSpec plant;
   DetectorSpec detector;
   ControllerSpec controller;
+  ReconstructionSpec reconstruction;
   /// All of the above, plus the cross-checks (delay below a period, Nyquist for N Ω).
   void validate() const;
   double controller_gain() const;  ///< K [rad/s]: controller.gain, or γ when it is 0
+  /// γ̂ [rad/s] of the reconstruction and of the calibrated actuator model: reconstruction.assumed_bandwidth, or γ
+  /// when it is 0.
+  double assumed_bandwidth() const;
 };
 
 }  // namespace afmkit::scan

@@ -9,9 +9,11 @@
 // (i = floor(τ f_s)), and on each piece the plant (eq. 1) is advanced by its exact solution for a ramped target
 // g = f + (1 + ε) u / γ with slope ġ:
 //   y ← g(end) − ġ/γ + (y − g(start) + ġ/γ) e^{−γ δ}.
-// The same update with the nominal values (ε = 0, τ without drift) gives ŷ_u, the part of y the calibrated actuator
-// model attributes to u; the calibrated actuator displacement is z_a = −ŷ_u (it moves the tip by what it removes
-// from the deflection), so the topography is d + z_a.
+// The same update with the nominal values (γ̂ = InstrumentSpec::assumed_bandwidth(), ε = 0, τ without drift) gives
+// ŷ_u, the part of y the calibrated actuator model attributes to u; the calibrated actuator displacement is
+// z_a = −ŷ_u (it moves the tip by what it removes from the deflection), so the lagged reconstruction is
+// w = d + z_a, and the inverse one f̂ = PlantInverse(γ̂) applied to w (plant_inverse.hpp; exact for this stepping
+// when γ̂ = γ, ε = 0, no drift, no noise, no saturation).
 // The sample observed at t_n is taken before the update: d_n from y(t_n), u_n = filter output for the state before
 // d_n is added (the real-time filter has no direct feed-through).
 #include <cstdint>
@@ -34,7 +36,8 @@ struct ScanSample {
   double deflection;   ///< detector reading d_n [m] (clamped to ±R_d when saturated)
   double control;      ///< controller output u_n [m/s] (0 with the controller off)
   double actuator;     ///< calibrated actuator displacement z_a = −ŷ_u(t_n) [m]
-  double topography;   ///< reconstruction d_n + z_a [m]
+  double topography;   ///< lagged reconstruction w_n = d_n + z_a [m]
+  double inverse;      ///< inverse reconstruction f̂_n [m] (NaN when saturated and while settling after it)
   bool saturated;      ///< |y + noise| > R_d at this sample
 };
 

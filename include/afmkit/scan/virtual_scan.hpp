@@ -14,13 +14,16 @@
 //   * scan_area_gain = (r_on² − r_0²) / (r_off² − r_0²): how much more area is scanned before the detector
 //     saturates; a lower bound when the controlled run never saturates, NaN when the uncontrolled one never does;
 //   * topography_rms_error: RMS of the topography image against the ground truth (the surface, tilt included, at
-//     the pixel centres) after each is levelled by its own least-squares plane, over the pixels valid in the image.
+//     the pixel centres) after each is levelled by its own least-squares plane, over the pixels valid in the image;
+//     the same for each reconstruction (lagged_rms_error, inverse_rms_error);
+//   * the error budget of the inverse reconstruction (ErrorBudget; docs/scan.md#reconstruction).
 // Saturated samples carry no height: they are given to the imager as NaN, so pixels that depend on them are invalid.
 #include <cstdint>
 #include <functional>
 #include <string>
 
 #include "afmkit/scan/height_map.hpp"
+#include "afmkit/scan/plant_inverse.hpp"
 #include "afmkit/scan/spiral_scan.hpp"
 #include "afmkit/scan/turn_metrics.hpp"
 
@@ -37,10 +40,29 @@ struct VirtualScanOptions {
   Cancellation cancellation;  ///< checked every 65536 samples of both runs (core/cancellation.hpp)
 };
 
+/// What the inverse reconstruction's image error is made of (plant_inverse.hpp, docs/scan.md#reconstruction).
+/// Lengths in metres; each term is an RMS over the image after levelling (as topography_rms_error).
+struct ErrorBudget {
+  double imaging = 0.0;         ///< the true heights at the samples, imaged the same way, against the truth: the
+                                ///< floor set by the sampling along the turn and the pitch (no reconstruction beats it)
+  double reconstruction = 0.0;  ///< the inverse image against the imaged true heights (the previous term's image):
+                                ///< what the reconstruction itself adds, whatever the sampling
+  double plant_mismatch = 0.0;  ///< γ̂/γ − 1 [dimensionless]: how wrong the assumed plant rate is
+  double plant = 0.0;           ///< first-order plant-knowledge term |γ/γ̂ − 1| × lagged_rms_error
+  double noise_gain = 0.0;      ///< G of the inverse [dimensionless] (white noise on w comes out × G at the samples)
+  double image_noise_gain = 0.0;  ///< the same in the image (PlantInverse::image_noise_gain) [dimensionless]
+  double noise = 0.0;           ///< image_noise_gain · σ_d: the detector noise through the inverse and the imaging
+  double predicted = 0.0;       ///< √(imaging² + plant² + noise²), to compare with inverse_rms_error
+  double pole = 0.0;            ///< p = −b0/b1 of the inverse recursion [dimensionless]
+  std::int64_t settle_samples = 0;  ///< samples left out after each saturated stretch
+};
+
 struct VirtualScan {
   ScanRun run;
+  Reconstruction method = Reconstruction::inverse;  ///< the reconstruction `topography` shows
   HeightMap deflection;   ///< image of the detector reading d [m]
-  HeightMap topography;   ///< image of the reconstruction d + z_a (deflection + actuator displacement) [m]
+  HeightMap topography;   ///< image of the chosen reconstruction [m]
+  HeightMap alternative;  ///< image of the other reconstruction (lagged when `method` is inverse, and vice versa)
   HeightMap truth;        ///< the surface (tilt included) at the pixel centres, valid where `topography` is [m]
   std::int64_t turns = 0;
   double saturated_fraction = 0.0;        ///< saturated samples / samples of the main run
@@ -50,7 +72,11 @@ struct VirtualScan {
   bool saturates_without_control = false;
   double scan_area_gain = 0.0;            ///< [dimensionless] (see above)
   bool scan_area_gain_is_lower_bound = false;
-  double topography_rms_error = 0.0;      ///< [m] (see above)
+  double topography_rms_error = 0.0;      ///< [m] (see above), of the chosen reconstruction
+  double lagged_rms_error = 0.0;          ///< [m] of the lagged reconstruction w = d + z_a
+  double inverse_rms_error = 0.0;         ///< [m] of the inverse reconstruction f̂
+  double sample_rms_height = 0.0;         ///< RMS of the levelled truth image [m]
+  ErrorBudget budget;
   double deflection_rms = 0.0;            ///< RMS of the levelled deflection image [m]
 };
 

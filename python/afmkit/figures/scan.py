@@ -108,7 +108,7 @@ def scan_images(out=None, *, sample: str = SCAN["sample"], sample_resolution: in
     a = axes[0, 2]
     im = a.imshow(_level(topo_on) * 1e9, cmap=cmap, **kw)
     fig.colorbar(im, ax=a, label="height (plane-levelled) [nm]", shrink=0.85)
-    a.set_title("controller on: reconstruction\nd + z_a (plane-levelled)", fontsize=10)
+    a.set_title("controller on: reconstruction\n(plant's lag removed; plane-levelled)", fontsize=10)
     for a in axes[0]:
         a.set_xlabel("x [mm]")
         a.set_ylabel("y [mm]")
@@ -162,8 +162,9 @@ def scan_images(out=None, *, sample: str = SCAN["sample"], sample_resolution: in
                 "afmkit scan: max_radius_with_control"),
                ("saturated fraction of samples, controller on / off",
                 f"{g(res['saturated_fraction'])} / {g(r_off.results['saturated_fraction'])}", "afmkit scan"),
-               ("topography RMS error (levelled)", f"{g(res['topography_rms_error'] * 1e9)} nm",
-                "afmkit scan: topography_rms_error"),
+               ("topography RMS error (levelled), inverse / lagged reconstruction",
+                f"{g(res['inverse_rms_error'] * 1e9)} / {g(res['lagged_rms_error'] * 1e9)} nm",
+                "afmkit scan: inverse_rms_error, lagged_rms_error (docs/scan.md#reconstruction)"),
                ("residual first harmonic of the last turn, controller on",
                 f"{g(float(r_on['deflection_first_harmonic'][-1]) * 1e9)} nm", "afmkit scan: per-turn table"),
                ("loop spectral abscissa at the nominal delay", f"{g(res['loop_spectral_abscissa'], 4)} 1/s",
@@ -181,8 +182,9 @@ def scan_images(out=None, *, sample: str = SCAN["sample"], sample_resolution: in
                  f"r = {r_no * 1e3:.2f} mm; with control the deflection keeps only the grating lines and the whole "
                  f"disc is imaged (scan-area gain {lb}{gain:.2f}). The controller also removes the grating's own "
                  "first harmonic on each circle (the rings in the controlled deflection); the reconstruction "
-                 "d + z_a restores it and matches the truth after levelling, up to the plant's low-pass (lag "
-                 "atan(Ω/γ) ≈ 2.9°, rounded edges). Without control the valid area is the band |x| < r_off "
+                 "(deflection + actuator with the plant's first-order lag removed, seed 2 eq. 1) restores it and "
+                 "matches the truth after levelling up to the imaging's interpolation between samples; without the "
+                 "inversion (d + z_a) the image is turned by the lag atan(Ω/γ) ≈ 2.9°. Without control the valid area is the band |x| < r_off "
                  f"(tilt along x). Images {image_resolution} × {image_resolution} pixels, read back from the GSF "
                  "files afmkit writes."),
         numbers=numbers)
