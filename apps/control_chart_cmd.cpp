@@ -223,6 +223,7 @@ void add_control_chart(CLI::App& control) {
                                  "likewise; replaces delay", Range::non_negative())
             .unit("T")
             .default_text("= delay");
+        add_si_alternative(p, "delays", SiUnit::Auto, Range::non_negative());
         add_window_params(p, kSingleWindow, kCouplingsWindow);
         p.integer("x_points", 200, "grid points along x", 2, 100000)
             .integer("y_points", 200, "grid points along y", 2, 100000)
@@ -234,7 +235,7 @@ void add_control_chart(CLI::App& control) {
                   "document)")
             .writes(io::table_and_sidecar);
       },
-      run_chart);
+      with_si_inputs(run_chart));
 }
 
 }  // namespace afmkit::cli

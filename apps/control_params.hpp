@@ -16,6 +16,7 @@
 #include "afmkit/control/settings.hpp"
 #include "afmkit/control/units.hpp"
 #include "afmkit/io/params.hpp"
+#include "command.hpp"
 
 namespace afmkit::cli {
 
@@ -28,6 +29,20 @@ inline constexpr long kMaxHarmonicsSpectra = 1000;
 
 /// Adds the shared parameters (with their units) to `params`; `max_harmonics` bounds `harmonics` (and `rejected`).
 void add_control_params(io::ParamSet& params, long max_harmonics = kMaxHarmonicsSpectra);
+/// SI alternatives of the keys in rotation units (docs/commands.md#control-si-keys): for `key` in units of Omega,
+/// `key_rad_per_s` [rad/s] (or, with SiUnit::Hz, `key_hz` [Hz]: 2 pi f); in units of T, `key_seconds` [s]; for
+/// rotation_frequency [rad/s], `rotation_frequency_hz`. Declared right after `key` (same kind: real or reals), counted
+/// only when given (the record then holds it instead of `key`).
+enum class SiUnit { Auto, Hz };
+void add_si_alternative(io::ParamSet& params, const std::string& key, SiUnit unit = SiUnit::Auto,
+                        io::Range range = io::Range::any());
+/// `params` with every given SI alternative converted into its key (rotation_frequency first, then the others with
+/// that Omega: value / Omega, value / T, 2 pi f / Omega); InvalidParameter naming both when a quantity is given in
+/// two forms, naming the SI key when its value converts out of the key's range.
+io::ParamSet resolve_si_inputs(const io::ParamSet& params);
+/// `run` on resolve_si_inputs(params): what every control command runs.
+Run with_si_inputs(Run run);
+
 /// Throws InvalidParameter(parameter, …) when `value` units of `bytes_per_unit` bytes held in memory do not fit in
 /// half of the available memory (MemAvailable), before any work.
 void require_memory(const std::string& parameter, double value, double bytes_per_unit);

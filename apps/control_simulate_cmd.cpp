@@ -229,17 +229,18 @@ void register_control_simulate(CLI::App& control) {
             .integer("disturbance_seed", 1, "seed of the random phases", 0, 4294967295L)
             .real("delay_variation", 0.0, "amplitude of a slow sinusoidal delay variation (<= delay)",
                   io::Range::non_negative())
-            .unit("T")
-            .real("delay_variation_frequency", 0.0, "angular frequency of the delay variation",
-                  io::Range::non_negative())
-            .unit("Omega")
-            .integer("record_every", 10, "keep every n-th step in the CSV", 1, 1000000000)
+            .unit("T");
+        add_si_alternative(p, "delay_variation", SiUnit::Auto, io::Range::non_negative());
+        p.real("delay_variation_frequency", 0.0, "angular frequency of the delay variation", io::Range::non_negative())
+            .unit("Omega");
+        add_si_alternative(p, "delay_variation_frequency", SiUnit::Auto, io::Range::non_negative());
+        p.integer("record_every", 10, "keep every n-th step in the CSV", 1, 1000000000)
             .integer("max_order", 15, "highest harmonic order k in the report (above N: what the controller does to "
                                      "harmonics it does not model); below steps_per_period/2", 1, 100000000)
             .default_text("5 above the highest of N and of the harmonics of f");
         add_output_params(p, "out/control_simulate.csv", "time-series");
       },
-      run_simulate);
+      with_si_inputs(run_simulate));
 }
 
 }  // namespace afmkit::cli

@@ -128,8 +128,9 @@ void add_control_tune(CLI::App& control) {
         add_control_params(p);
         p.group("Tuning")
             .real("delay_max", 0.25, "largest delay", Range::non_negative())
-            .unit("T")
-            .integer("delay_points", 6, "delay grid points on [0, delay_max]", 1, 10000)
+            .unit("T");
+        add_si_alternative(p, "delay_max", SiUnit::Auto, Range::non_negative());
+        p.integer("delay_points", 6, "delay grid points on [0, delay_max]", 1, 10000)
             .real("gain_ratio_min", 0.5, "smallest rho = K/gamma", Range::positive())
             .unit("dimensionless")
             .real("gain_ratio_max", 2.0, "largest rho = K/gamma", Range::positive())
@@ -142,7 +143,7 @@ void add_control_tune(CLI::App& control) {
         add_output_params(p, "out/control_tune.csv", "coarse-grid");
         p.flag("progress", true, "show progress on stderr");
       },
-      run_tune);
+      with_si_inputs(run_tune));
 }
 
 }  // namespace afmkit::cli
