@@ -12,5 +12,6 @@ void bind_spectroscopy_prepare(pybind11::module_& m);  // spectroscopy_prepare.c
 void bind_spectroscopy_fit(pybind11::module_& m); // spectroscopy_fit.cpp: the law fit on NumPy arrays
 void bind_spectroscopy_reconstruct(pybind11::module_& m);  // spectroscopy_reconstruct.cpp: force reconstruction
 void bind_laws(pybind11::module_& m);              // laws.cpp: the force-law registry (afmkit.laws)
+void bind_control_state_space(pybind11::module_& m);  // control_state_space.cpp: A, B, C, D of controller, plant
 
 }  // namespace afmkit::python
