@@ -160,11 +160,11 @@ io::ParamSet resolve_si_inputs(const io::ParamSet& given) {
       }
     } catch (const InvalidParameter& e) {
       if (e.parameter() != base) throw;
-      throw InvalidParameter(si_key, fmt::format("{} = {} {} is out of range: in the units of {}, {}", si_key,
+      throw InvalidParameter(si_key, fmt::format("{} = {} {} is out of range: converted to {} ({}): {}", si_key,
                                                  std::holds_alternative<std::vector<double>>(p.value(si_key))
                                                      ? fmt::format("[{}]", fmt::join(p.reals(si_key), ", "))
                                                      : fmt::format("{}", p.real(si_key)),
-                                                 si_unit, base, e.what()));
+                                                 si_unit, base, base_unit, e.what()));
     }
   }
   return p;
