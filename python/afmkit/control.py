@@ -145,9 +145,19 @@ def _design(value):
     return None
 
 
+# The keys that define a controller of each kind (and its Smith predictor); the plant's keys define its gain rule.
+_COMMON = {"controller", "rotation_frequency", "gain", "plant", "plant_rate"}
+_OF_KIND = {"single": {"a", "b"}, "bank": {"harmonics", "alpha", "beta", "rejected"}, "infinite": {"alpha", "beta"},
+            "smith": {"smith_bank", "smith_structure", "model_plant", "model_rate", "model_delay"}}
+
+
 def _tuned(r: Result) -> Controller:
-    """The design ``tune`` found: its settings with the optimum couplings (units of Ω)."""
-    params = {k: v for k, v in r.params.items() if k in _KEYS}
+    """The design ``tune`` found: the keys of its record that define the controller (not the delay, which tune
+    spans from 0 to delay_max) with the optimum couplings (units of Ω)."""
+    kind = r.params.get("controller", "bank")
+    inner = r.params.get("smith_bank", "bank") if kind == "smith" else kind
+    wanted = _COMMON | _OF_KIND[kind] | _OF_KIND[inner]
+    params = {k: v for k, v in r.params.items() if k in _KEYS and _base(k) in wanted}
     optimum = dict(r.results["optimum"])
     params = {k: v for k, v in params.items() if _base(k) not in optimum}
     params.update(optimum)
