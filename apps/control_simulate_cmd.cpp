@@ -20,6 +20,7 @@
 
 #include "afmkit/control/closed_loop_simulation.hpp"
 #include "afmkit/control/sampled_disturbance.hpp"
+#include "afmkit/io/curves/text_column.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/progress.hpp"
 #include "command.hpp"
@@ -167,22 +168,34 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
                                        "delay must stay >= 0)", p.real("delay_variation"), p.real("delay")));
   const control::RotationUnits u = c.units();
   const control::ControlSettingsSi si = control::to_si(c);
-  const bool sampled = p.was_set("signal");
+  if (p.was_set("signal") && p.was_set("signal_file"))
+    throw InvalidParameter("signal_file", "signal and signal_file were both given: give the samples in one of them");
+  if (p.was_set("signal_column") && !p.was_set("signal_file"))
+    throw InvalidParameter("signal_column", "signal_column is given without signal_file: it chooses a column of it");
+  const bool sampled = p.was_set("signal") || p.was_set("signal_file");
+  const std::string signal_key = p.was_set("signal_file") ? "signal_file" : "signal";
   for (const auto& key : fourier_keys())
     if (sampled && p.was_set(key))
-      throw InvalidParameter(key, fmt::format("signal and {} were both given: signal gives the disturbance f as "
-                                              "samples, instead of its Fourier form (disturbance_*); give one", key));
+      throw InvalidParameter(key, fmt::format("{} and {} were both given: {} gives the disturbance f as samples, "
+                                              "instead of its Fourier form (disturbance_*); give one",
+                                              signal_key, key, signal_key));
   if (!sampled)
     for (const char* key : {"signal_step", "signal_step_seconds", "signal_sample_rate", "signal_harmonics"})
       if (p.was_set(key))
         throw InvalidParameter(key, fmt::format("{} is given without signal: it describes the samples of signal",
                                                 key));
   std::optional<control::SampledDisturbance> from_samples;
+  std::size_t signal_samples = 0;
   if (sampled) {
     const int per_period = samples_per_period(p, u);
-    require_memory("signal", static_cast<double>(per_period), 3.0 * sizeof(double));
-    from_samples = control::disturbance_from_samples(p.reals("signal"), per_period,
-                                                     static_cast<int>(p.integer("signal_harmonics")));
+    require_memory(signal_key, static_cast<double>(per_period), 3.0 * sizeof(double));
+    const std::vector<double> samples = p.was_set("signal_file")
+                                            ? io::curves::read_text_column(p.text("signal_file"), p.text("signal_column"))
+                                            : p.reals("signal");
+    from_samples = control::disturbance_from_samples(samples, per_period,
+                                                     static_cast<int>(p.integer("signal_harmonics")),
+                                                     signal_key.c_str());
+    signal_samples = samples.size();
   }
   const control::Disturbance disturbance = sampled ? from_samples->disturbance : disturbance_from(p);
   control::SimulationOptions o;
@@ -239,7 +252,7 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
   report["settings_si"] = settings_si_json(c);
   if (from_samples) {
     const control::SampledDisturbance& d = *from_samples;
-    report["signal"] = {{"samples", p.reals("signal").size()}, {"samples_per_period", d.samples_per_period},
+    report["signal"] = {{"samples", signal_samples}, {"samples_per_period", d.samples_per_period},
                         {"periods", d.periods}, {"harmonics", d.harmonics},
                         {"harmonics_used", d.disturbance.harmonics.size()}, {"offset", d.disturbance.offset},
                         {"rms", d.rms}, {"non_periodic_rms", d.non_periodic_rms},
@@ -300,6 +313,14 @@ void register_control_simulate(CLI::App& control) {
             .unit("signal")
             .default_text("not given: f from disturbance_*")
             .only_if_given(fourier_keys())
+            .file("signal_file", "", "the samples of signal as a column of a text file (CSV, tab- or blank-separated; "
+                                     "docs/curve-files.md#text-exports), instead of signal")
+            .default_text("not given")
+            .only_if_given(fourier_keys())
+            .text("signal_column", "", "the column of signal_file: header name or 1-based position (not given: the "
+                                       "file's only column)")
+            .default_text("the only column")
+            .only_if_given()
             .real("signal_sample_rate", 1.0, "sample rate 1/h of signal: sample_rate x T must be a whole number",
                   io::Range::positive())
             .unit("samples/s")

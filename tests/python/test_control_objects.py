@@ -185,6 +185,17 @@ def test_sampled_signal_against_a_discrete_simulation_written_here():
     np.testing.assert_allclose(r["y"], ys, rtol=0, atol=1e-9 * np.max(np.abs(ys)))
 
 
+def test_signal_from_a_text_file_column_is_the_array(tmp_path):
+    f = np.random.default_rng(3).normal(size=9)
+    path = tmp_path / "measured.csv"
+    path.write_text("time (s), height (nm)\n" + "".join(f"{i / 450.0!r}, {x!r}\n" for i, x in enumerate(f)))
+    common = dict(harmonics=3, periods=4, steps_per_period=40, rotation_frequency_hz=F_HZ, signal_sample_rate=450.0)
+    from_file = ctl.simulate(signal_file=str(path), signal_column="height", **common)
+    _same(from_file, ctl.simulate(signal=f, **common))
+    _same(from_file, ctl.simulate(signal_file=str(path), signal_column="2", **common))
+    assert from_file.params["signal_file"] == str(path) and "signal" not in from_file.params
+
+
 def test_signal_mistakes_are_named():
     with pytest.raises(ValueError, match="without its sampling"):
         ctl.simulate(signal=[0.0, 1.0, 0.0])
