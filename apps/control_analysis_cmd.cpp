@@ -107,6 +107,10 @@ void run_roots(const io::ParamSet& p, Captured* capture) {
   if (p.was_set("max_imag")) o.max_imag = u.rate(p.real("max_imag"));
   o.count = static_cast<int>(p.integer("count"));
   o.collocation_nodes = static_cast<int>(p.integer("nodes"));
+  if (c.controller == ControllerKind::Smith && c.model_delay_value() > c.delay)
+    require_delay_work(p, "model_delay", c.model_delay_value(), u, 1.0, c.harmonics, "one spectrum");
+  else
+    require_delay_work(p, "delay", c.delay, u, 1.0, c.harmonics, "one spectrum");
   const control::Spectrum sp = control::rightmost_roots(loop, o);
   // the record holds the box searched: the automatic edge and the proven half-height when not given
   io::ParamSet as_run = params_as_run(p, c);
@@ -241,6 +245,12 @@ void run_margin(const io::ParamSet& p, Captured* capture) {
   const control::RotationUnits u = c.units();
   control::MarginOptions o;
   if (p.was_set("reference_delay")) o.reference_delay = u.delay(p.real("reference_delay"));
+  // the stability check at the reference delay is one spectrum (0, or the Smith predictor's model delay)
+  if (p.was_set("reference_delay"))
+    require_delay_work(p, "reference_delay", p.real("reference_delay"), u, 1.0, c.harmonics, "stability at the "
+                       "reference delay");
+  else if (c.controller == ControllerKind::Smith)
+    require_delay_work(p, "model_delay", c.model_delay_value(), u, 1.0, c.harmonics, "stability at the model delay");
   o.grid_points_per_omega = static_cast<int>(p.integer("points_per_omega"));
   const control::DelayMargin m = control::delay_margin(loop, o);
   io::ParamSet as_run = params_as_run(p, c);

@@ -2,6 +2,7 @@
 // several (`delays`: one chart per delay in the same table, column `delay`), with the exact D-subdivision
 // boundaries in a second table; or (quantity = margin) the delay-margin map τ_c(x, y). Units: control_params.hpp
 // (couplings, abscissa and frequencies in units of Ω, delays in units of T).
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -100,6 +101,15 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
   if (p.text("quantity") == "margin") return run_margin_map(p, runs.front(), win, capture);
   const control::RotationUnits u = c.units();
   const int nx = static_cast<int>(p.integer("x_points")), ny = static_cast<int>(p.integer("y_points"));
+  {
+    // each grid point tracks the spectrum at its delay: the work grows with the largest delay
+    double largest = 0;
+    for (const auto& r : runs) largest = std::max({largest, r.delay, r.controller == control::ControllerKind::Smith
+                                                                          ? r.model_delay_value() : 0.0});
+    require_delay_work(p, p.reals("delays").empty() ? "delay" : "delays", largest, u,
+                       static_cast<double>(nx) * ny * static_cast<double>(runs.size()), c.harmonics,
+                       "x_points x y_points per delay");
+  }
   std::vector<std::pair<std::string, double>> values = window_values(win);
   io::ParamSet as_run = params_as_run(p, c, values);
   std::string delays_text;

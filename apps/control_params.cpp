@@ -1,6 +1,7 @@
 #include "control_params.hpp"
 
 #include "afmkit/io/quantity.hpp"
+#include "work_budget.hpp"
 
 #include <cmath>
 #include <map>
@@ -168,6 +169,25 @@ io::ParamSet resolve_si_inputs(const io::ParamSet& given) {
     }
   }
   return p;
+}
+
+namespace {
+// Time of one closed-loop spectrum per oscillator (N + 1) per period T of delay: measured 1.8e-4 … 4.5e-4 s (roots
+// and chart, N = 10 … 100, delays 100 … 3000 T, 2-core test machine under load, Release; it grows faster than the
+// delay), taken as 1e-5 s: the estimate is a lower bound, so only requests that cannot fit are refused.
+constexpr double kSpectrumSecondsPerPeriod = 1e-5;
+}  // namespace
+
+void require_delay_work(const io::ParamSet& p, const std::string& key, double delay_in_periods,
+                        const control::RotationUnits& units, double spectra, int harmonics, const std::string& what) {
+  const double per_period = spectra * (harmonics + 1.0) * kSpectrumSecondsPerPeriod;
+  const std::string model = fmt::format("{:g} closed-loop spectra ({}) with harmonics = {}, each at least {:.2g} s per "
+                                        "period T of delay (the roots in the search box grow with the delay)",
+                                        spectra, what, harmonics, (harmonics + 1.0) * kSpectrumSecondsPerPeriod);
+  if (p.was_set(key + "_seconds"))  // the user's key and unit
+    require_work(key + "_seconds", units.delay(delay_in_periods), per_period / units.period(), model);
+  else
+    require_work(key, delay_in_periods, per_period, model);
 }
 
 Run with_si_inputs(Run run) {

@@ -46,6 +46,13 @@ Run with_si_inputs(Run run);
 /// Throws InvalidParameter(parameter, …) when `value` units of `bytes_per_unit` bytes held in memory do not fit in
 /// half of the available memory (MemAvailable), before any work.
 void require_memory(const std::string& parameter, double value, double bytes_per_unit);
+/// Refuses (work_budget.hpp: InvalidParameter naming `parameter`, exit 2) a request of `spectra` closed-loop spectra
+/// at a delay of `delay_in_periods` T whose estimate exceeds the work limit: the roots in a search box grow with the
+/// delay, so a spectrum costs at least kSpectrumSecondsPerPeriod x (N + 1) x tau/T (docs/commands.md, sizes and costs).
+/// The message names `key`, or its SI form (`key`_seconds, the value in s) when that was given.
+void require_delay_work(const io::ParamSet& params, const std::string& key, double delay_in_periods,
+                        const control::RotationUnits& units, double spectra, int harmonics, const std::string& what);
+
 /// The settings given (after params.resolve()), validated: InvalidParameter naming the parameter.
 control::ControlSettings control_settings_from(const io::ParamSet& params);
 

@@ -68,6 +68,11 @@ void run_tune(const io::ParamSet& p, Captured* capture) {
                              "= {}: at least {:.2g} s per evaluation",
                              s.gain_points, c.harmonics, evaluation),
                  2.0);
+    // each spectrum's roots grow with the delay: delay_points x gain_points spectra per evaluation up to delay_max
+    const double spectra = (static_cast<double>(s.coarse_points) * s.coarse_points + s.max_evaluations) *
+                           s.delay_points * s.gain_points;
+    require_delay_work(p, "delay_max", p.real("delay_max"), u, spectra, c.harmonics,
+                       "(coarse_points^2 + max_evaluations) x delay_points x gain_points");
     require_work("max_evaluations", static_cast<double>(s.max_evaluations), evaluation,
                  fmt::format("objective evaluations of gain_points = {} spectra each, with harmonics = {}: at least "
                              "{:.2g} s per evaluation",
