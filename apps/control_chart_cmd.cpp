@@ -101,15 +101,6 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
   if (p.text("quantity") == "margin") return run_margin_map(p, runs.front(), win, capture);
   const control::RotationUnits u = c.units();
   const int nx = static_cast<int>(p.integer("x_points")), ny = static_cast<int>(p.integer("y_points"));
-  {
-    // each grid point tracks the spectrum at its delay: the work grows with the largest delay
-    double largest = 0;
-    for (const auto& r : runs) largest = std::max({largest, r.delay, r.controller == control::ControllerKind::Smith
-                                                                          ? r.model_delay_value() : 0.0});
-    require_delay_work(p, p.reals("delays").empty() ? "delay" : "delays", largest, u,
-                       static_cast<double>(nx) * ny * static_cast<double>(runs.size()), c.harmonics,
-                       "x_points x y_points per delay");
-  }
   std::vector<std::pair<std::string, double>> values = window_values(win);
   io::ParamSet as_run = params_as_run(p, c, values);
   std::string delays_text;
@@ -122,6 +113,15 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
   require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * 64.0);
   if (json && !out.writes_file())
     require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * 320.0 * runs.size());
+  {
+    // each grid point tracks the spectrum at its delay: the work grows with the largest delay
+    double largest = 0;
+    for (const auto& r : runs) largest = std::max({largest, r.delay, r.controller == control::ControllerKind::Smith
+                                                                          ? r.model_delay_value() : 0.0});
+    require_delay_work(p, p.reals("delays").empty() ? "delay" : "delays", largest, u,
+                       static_cast<double>(nx) * ny * static_cast<double>(runs.size()), c.harmonics,
+                       "x_points x y_points per delay");
+  }
   const std::vector<io::Column> boundary_columns = {
       {"curve", "label", "polyline id (within its delay)"},
       {"frequency", "Omega", "crossing frequency nu of the imaginary-axis roots on the curve (0: root at s = 0)"},

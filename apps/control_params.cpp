@@ -180,6 +180,8 @@ constexpr double kSpectrumSecondsPerPeriod = 1e-5;
 
 void require_delay_work(const io::ParamSet& p, const std::string& key, double delay_in_periods,
                         const control::RotationUnits& units, double spectra, int harmonics, const std::string& what) {
+  // up to one period the spectra cost what the grid and N make them (their own checks); beyond it, the delay's share
+  if (!(delay_in_periods > 1.0)) return;
   const double per_period = spectra * (harmonics + 1.0) * kSpectrumSecondsPerPeriod;
   const std::string model = fmt::format("{:g} closed-loop spectra ({}) with harmonics = {}, each at least {:.2g} s per "
                                         "period T of delay (the roots in the search box grow with the delay)",

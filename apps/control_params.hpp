@@ -48,7 +48,8 @@ Run with_si_inputs(Run run);
 void require_memory(const std::string& parameter, double value, double bytes_per_unit);
 /// Refuses (work_budget.hpp: InvalidParameter naming `parameter`, exit 2) a request of `spectra` closed-loop spectra
 /// at a delay of `delay_in_periods` T whose estimate exceeds the work limit: the roots in a search box grow with the
-/// delay, so a spectrum costs at least kSpectrumSecondsPerPeriod x (N + 1) x tau/T (docs/commands.md, sizes and costs).
+/// delay, so a spectrum costs at least kSpectrumSecondsPerPeriod x (N + 1) x tau/T (docs/commands.md, sizes and costs);
+/// checked for delays above one period (below, the other size options' own checks apply).
 /// The message names `key`, or its SI form (`key`_seconds, the value in s) when that was given.
 void require_delay_work(const io::ParamSet& params, const std::string& key, double delay_in_periods,
                         const control::RotationUnits& units, double spectra, int harmonics, const std::string& what);
