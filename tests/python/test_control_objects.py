@@ -136,10 +136,10 @@ def test_tune_returns_a_design_every_command_takes():
 
 def test_export_takes_a_design(tmp_path):
     d = ctl.Controller(harmonics=3, alpha=0.1, beta=-0.1, rotation_frequency_hz=F_HZ)
-    path = tmp_path / "f.h"
-    d.export(sample_rate=10000.0, output=str(path))
-    text = path.read_text()
-    assert "harmonics" in text.lower() or "AFMKIT" in text
+    d.export(sample_rate=10000.0, test_vectors=20, output=str(tmp_path / "design.h"))
+    ctl.export(harmonics=3, alpha=0.1, beta=-0.1, rotation_frequency=OMEGA, sample_rate=10000.0, test_vectors=20,
+               output=str(tmp_path / "keywords.h"))
+    assert (tmp_path / "design.h").read_bytes() == (tmp_path / "keywords.h").read_bytes()
 
 
 # ---------------------------------------------------------------- 3. simulate driven by the user's samples
