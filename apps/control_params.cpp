@@ -1,20 +1,17 @@
 #include "control_params.hpp"
 
-#include "afmkit/io/quantity.hpp"
-#include "work_budget.hpp"
-
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
 
 #include <fmt/format.h>
-
-#include <algorithm>
 #include <fmt/ranges.h>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/quantity.hpp"
+#include "work_budget.hpp"
 
 namespace afmkit::cli {
 
