@@ -60,7 +60,12 @@ SampledDisturbance disturbance_from_samples(const std::vector<double>& samples, 
   std::vector<Disturbance::Harmonic> h;
   for (int k = 1; k <= out.harmonics; ++k) {
     std::complex<double> c = 0;
-    for (std::size_t j = 0, m = 0; j < s; ++j, m = (m + static_cast<std::size_t>(k)) % s) c += mean[j] * twiddle[m];
+    const auto step = static_cast<std::size_t>(k);  // < S: index k·j mod S by one subtraction per sample
+    for (std::size_t j = 0, m = 0; j < s; ++j) {
+      c += mean[j] * twiddle[m];
+      m += step;
+      if (m >= s) m -= s;
+    }
     c /= static_cast<double>(s);
     const double amplitude = 2.0 * std::abs(c);
     if (amplitude > kRounding * out.rms) h.push_back({k, amplitude, std::arg(c) + std::numbers::pi / 2});
