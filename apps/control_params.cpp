@@ -189,8 +189,35 @@ void require_delay_work(const io::ParamSet& p, const std::string& key, double de
     require_work(key, delay_in_periods, per_period, model);
 }
 
+namespace {
+// The SI key given for `key` (its _seconds, _rad_per_s or _hz form), or "".
+std::string si_key_given(const io::ParamSet& p, const std::string& key) {
+  for (const char* suffix : kSiSuffixes)
+    for (const auto& d : p.describe())
+      if (d.key == key + suffix && p.was_set(d.key)) return d.key;
+  return "";
+}
+
+std::string value_text(const io::ParamSet& p, const std::string& key) {
+  if (std::holds_alternative<std::vector<double>>(p.value(key))) return fmt::format("[{}]", fmt::join(p.reals(key), ", "));
+  return fmt::format("{}", p.real(key));
+}
+}  // namespace
+
 Run with_si_inputs(Run run) {
-  return [run = std::move(run)](const io::ParamSet& p, Captured* capture) { run(resolve_si_inputs(p), capture); };
+  return [run = std::move(run)](const io::ParamSet& p, Captured* capture) {
+    const io::ParamSet resolved = resolve_si_inputs(p);
+    try {
+      run(resolved, capture);
+    } catch (const InvalidParameter& e) {
+      // a check of the key, given in its SI form: the message names the key the user gave
+      const std::string si = si_key_given(p, e.parameter());
+      if (si.empty()) throw;
+      throw InvalidParameter(si, fmt::format("{} = {} {} (that is {} = {} {}): {}", si, value_text(p, si), p.unit_of(si),
+                                             e.parameter(), value_text(resolved, e.parameter()),
+                                             resolved.unit_of(e.parameter()), e.what()));
+    }
+  };
 }
 
 void require_memory(const std::string& parameter, double value, double bytes_per_unit) {
