@@ -42,6 +42,7 @@ void add_window_params(io::ParamSet& p, const Window& single, const Window& coup
     p.real(key, couplings.*field, help).unit("Omega");
     if (single.*field != couplings.*field)
       p.default_text(fmt::format("{:g} single, {:g} otherwise", single.*field, couplings.*field));
+    add_si_alternative(p, key);
   };
   bound("x_min", &Window::x_min, "a or alpha lower bound");
   bound("x_max", &Window::x_max, "a or alpha upper bound");
@@ -106,6 +107,10 @@ void run_roots(const io::ParamSet& p, Captured* capture) {
   if (p.was_set("max_imag")) o.max_imag = u.rate(p.real("max_imag"));
   o.count = static_cast<int>(p.integer("count"));
   o.collocation_nodes = static_cast<int>(p.integer("nodes"));
+  if (c.controller == ControllerKind::Smith && c.model_delay_value() > c.delay)
+    require_delay_work(p, "model_delay", c.model_delay_value(), u, 1.0, c.harmonics, "one spectrum");
+  else
+    require_delay_work(p, "delay", c.delay, u, 1.0, c.harmonics, "one spectrum");
   const control::Spectrum sp = control::rightmost_roots(loop, o);
   // the record holds the box searched: the automatic edge and the proven half-height when not given
   io::ParamSet as_run = params_as_run(p, c);
@@ -240,6 +245,12 @@ void run_margin(const io::ParamSet& p, Captured* capture) {
   const control::RotationUnits u = c.units();
   control::MarginOptions o;
   if (p.was_set("reference_delay")) o.reference_delay = u.delay(p.real("reference_delay"));
+  // the stability check at the reference delay is one spectrum (0, or the Smith predictor's model delay)
+  if (p.was_set("reference_delay"))
+    require_delay_work(p, "reference_delay", p.real("reference_delay"), u, 1.0, c.harmonics, "stability at the "
+                       "reference delay");
+  else if (c.controller == ControllerKind::Smith)
+    require_delay_work(p, "model_delay", c.model_delay_value(), u, 1.0, c.harmonics, "stability at the model delay");
   o.grid_points_per_omega = static_cast<int>(p.integer("points_per_omega"));
   const control::DelayMargin m = control::delay_margin(loop, o);
   io::ParamSet as_run = params_as_run(p, c);
@@ -277,15 +288,17 @@ void register_control_analysis(CLI::App& control) {
         p.group("Root search")
             .real("min_real", 0.0, "left edge of the search box")
             .unit("Omega")
-            .default_text("automatic")
-            .real("max_imag", 1.0, "half-height of the search box", Range::positive())
+            .default_text("automatic");
+        add_si_alternative(p, "min_real");
+        p.real("max_imag", 1.0, "half-height of the search box", Range::positive())
             .unit("Omega")
-            .default_text("proven bound")
-            .integer("count", 12, "automatic box: about this many rightmost roots", 1, 10000)
+            .default_text("proven bound");
+        add_si_alternative(p, "max_imag", SiUnit::Auto, Range::positive());
+        p.integer("count", 12, "automatic box: about this many rightmost roots", 1, 10000)
             .integer("nodes", 0, "Chebyshev collocation nodes per delay for the initial guesses (0: automatic)", 0, 400);
         add_output_params(p, "out/control_roots.csv", "roots");
       },
-      run_roots);
+      with_si_inputs(run_roots));
   add_command(
       control, "margin",
       "delay margin tau_c (largest delay keeping the loop stable; crossing formulas of "
@@ -296,13 +309,14 @@ void register_control_analysis(CLI::App& control) {
         p.group("Delay margin")
             .real("reference_delay", 0.0, "delay where stability is required", Range::non_negative())
             .unit("T")
-            .default_text("0; Smith predictor: model_delay")
-            .integer("points_per_omega", 64, "crossing-frequency bracketing grid density (points per Omega)", 4, 100000)
+            .default_text("0; Smith predictor: model_delay");
+        add_si_alternative(p, "reference_delay", SiUnit::Auto, Range::non_negative());
+        p.integer("points_per_omega", 64, "crossing-frequency bracketing grid density (points per Omega)", 4, 100000)
             .flag("compare", false, "tabulate tau_c for variants: rejected harmonics {1},{1,2},{1,3},{2},{1,2,3},"
                                     "{1,3,5}, N = inf, single oscillator, Smith predictor (periodic, classic)");
         add_output_params(p, "out/control_margin.csv", "crossings (with --compare: variants)");
       },
-      run_margin);
+      with_si_inputs(run_margin));
   add_control_chart(control);
   add_control_tune(control);
 }

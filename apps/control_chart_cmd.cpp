@@ -2,6 +2,7 @@
 // several (`delays`: one chart per delay in the same table, column `delay`), with the exact D-subdivision
 // boundaries in a second table; or (quantity = margin) the delay-margin map τ_c(x, y). Units: control_params.hpp
 // (couplings, abscissa and frequencies in units of Ω, delays in units of T).
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -112,6 +113,15 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
   require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * 64.0);
   if (json && !out.writes_file())
     require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * 320.0 * runs.size());
+  {
+    // each grid point tracks the spectrum at its delay: the work grows with the largest delay
+    double largest = 0;
+    for (const auto& r : runs) largest = std::max({largest, r.delay, r.controller == control::ControllerKind::Smith
+                                                                          ? r.model_delay_value() : 0.0});
+    require_delay_work(p, p.reals("delays").empty() ? "delay" : "delays", largest, u,
+                       static_cast<double>(nx) * ny * static_cast<double>(runs.size()), c.harmonics,
+                       "x_points x y_points per delay");
+  }
   const std::vector<io::Column> boundary_columns = {
       {"curve", "label", "polyline id (within its delay)"},
       {"frequency", "Omega", "crossing frequency nu of the imaginary-axis roots on the curve (0: root at s = 0)"},
@@ -223,6 +233,7 @@ void add_control_chart(CLI::App& control) {
                                  "likewise; replaces delay", Range::non_negative())
             .unit("T")
             .default_text("= delay");
+        add_si_alternative(p, "delays", SiUnit::Auto, Range::non_negative());
         add_window_params(p, kSingleWindow, kCouplingsWindow);
         p.integer("x_points", 200, "grid points along x", 2, 100000)
             .integer("y_points", 200, "grid points along y", 2, 100000)
@@ -234,7 +245,7 @@ void add_control_chart(CLI::App& control) {
                   "document)")
             .writes(io::table_and_sidecar);
       },
-      run_chart);
+      with_si_inputs(run_chart));
 }
 
 }  // namespace afmkit::cli

@@ -134,7 +134,7 @@ void register_control_export(CLI::App& control) {
             .unit("bytes")
             .flag("json", false, "print the summary as JSON");
       },
-      run_export);
+      with_si_inputs(run_export));
 }
 
 }  // namespace afmkit::cli

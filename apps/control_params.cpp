@@ -1,14 +1,17 @@
 #include "control_params.hpp"
 
-#include "afmkit/io/quantity.hpp"
-
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <numbers>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
 #include "afmkit/io/quantity.hpp"
+#include "work_budget.hpp"
 
 namespace afmkit::cli {
 
@@ -21,44 +24,200 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
          {"single", "bank", "infinite", "smith"})
       .real("rotation_frequency", 1.0, "rotation angular frequency Omega; rates below are in units of Omega, delays "
                                        "in units of T = 2 pi/Omega", Range{0.0, 1e12, true, false})
-      .unit("rad/s")
-      .integer("harmonics", 10,
-               max_harmonics == kMaxHarmonicsTf
-                   ? "number N of oscillators of the bank (eq. 15); cost O(N) per frequency"
-                   : "number N of oscillators of the bank (eq. 15); cost O(N) per characteristic evaluation, "
-                     "O(N^2) per spectrum / per simulated period",
-               1, max_harmonics)
+      .unit("rad/s");
+  add_si_alternative(p, "rotation_frequency", SiUnit::Hz, Range::positive());
+  p.integer("harmonics", 10,
+            max_harmonics == kMaxHarmonicsTf
+                ? "number N of oscillators of the bank (eq. 15); cost O(N) per frequency"
+                : "number N of oscillators of the bank (eq. 15); cost O(N) per characteristic evaluation, "
+                  "O(N^2) per spectrum / per simulated period",
+            1, max_harmonics)
       .real("alpha", 0.1, "coupling alpha of eq. (20)")
-      .unit("Omega")
-      .real("beta", -0.1, "coupling beta of eq. (20)")
-      .unit("Omega")
-      .real("a", 0.5, "coupling a of the single oscillator (eq. 5)")
-      .unit("Omega")
-      .real("b", 0.0, "coupling b of the single oscillator (eq. 5)")
-      .unit("Omega")
-      .reals("rejected", {1.0}, "harmonic numbers removed from the output (bank controller), e.g. 1,3",
-             Range::closed(1, static_cast<double>(max_harmonics)))
+      .unit("Omega");
+  add_si_alternative(p, "alpha");
+  p.real("beta", -0.1, "coupling beta of eq. (20)").unit("Omega");
+  add_si_alternative(p, "beta");
+  p.real("a", 0.5, "coupling a of the single oscillator (eq. 5)").unit("Omega");
+  add_si_alternative(p, "a");
+  p.real("b", 0.0, "coupling b of the single oscillator (eq. 5)").unit("Omega");
+  add_si_alternative(p, "b");
+  p.reals("rejected", {1.0}, "harmonic numbers removed from the output (bank controller), e.g. 1,3",
+          Range::closed(1, static_cast<double>(max_harmonics)))
       .unit("count")
       .real("gain", 20.0, "controller gain K (design rule K = gamma)", Range{0.0, 1e12, true, false})
       .unit("Omega")
-      .default_text("= plant_rate")
-      .group("Plant and delay")
+      .default_text("= plant_rate");
+  add_si_alternative(p, "gain", SiUnit::Auto, Range::positive());
+  p.group("Plant and delay")
       .text("plant", "static", "plant: static y = f + u/gamma (eq. 3) or first order (eq. 1)", {"static", "first_order"})
       .real("plant_rate", 20.0, "plant rate gamma", Range{0.0, 1e12, true, false})
-      .unit("Omega")
-      .real("delay", 0.1, "measurement delay tau", Range::non_negative())
-      .unit("T")
-      .group("Smith predictor")
+      .unit("Omega");
+  add_si_alternative(p, "plant_rate", SiUnit::Auto, Range::positive());
+  p.real("delay", 0.1, "measurement delay tau", Range::non_negative()).unit("T");
+  add_si_alternative(p, "delay", SiUnit::Auto, Range::non_negative());
+  p.group("Smith predictor")
       .text("smith_bank", "bank", "controller inside the Smith predictor", {"bank", "infinite", "single"})
       .text("smith_structure", "periodic", "Smith predictor structure (periodic keeps exact rejection)",
             {"periodic", "classic"})
       .text("model_plant", "same", "kind of the Smith predictor's plant model", {"same", "static", "first_order"})
       .real("model_rate", 20.0, "Smith model rate gamma_hat", Range{0.0, 1e12, true, false})
       .unit("Omega")
-      .default_text("= plant_rate")
-      .real("model_delay", 0.1, "Smith model delay tau_hat", Range::non_negative())
-      .unit("T")
-      .default_text("= delay");
+      .default_text("= plant_rate");
+  add_si_alternative(p, "model_rate", SiUnit::Auto, Range::positive());
+  p.real("model_delay", 0.1, "Smith model delay tau_hat", Range::non_negative()).unit("T").default_text("= delay");
+  add_si_alternative(p, "model_delay", SiUnit::Auto, Range::non_negative());
+}
+
+namespace {
+// The SI form of a key in the rotation units (docs/units.md): suffix and unit of the alternative.
+struct SiForm {
+  const char* suffix;
+  const char* unit;
+};
+SiForm si_form(const std::string& base_unit, SiUnit unit) {
+  if (unit == SiUnit::Hz) return {"_hz", "Hz"};
+  if (base_unit == control::RotationUnits::delay_unit) return {"_seconds", "s"};
+  return {"_rad_per_s", "rad/s"};
+}
+constexpr const char* kSiSuffixes[] = {"_hz", "_rad_per_s", "_seconds"};
+}  // namespace
+
+void add_si_alternative(io::ParamSet& p, const std::string& key, SiUnit unit, Range range) {
+  const auto all = p.describe();
+  const auto it = std::find_if(all.begin(), all.end(), [&](const auto& d) { return d.key == key; });
+  if (it == all.end()) throw std::logic_error("add_si_alternative: '" + key + "' is not declared");
+  const io::ParamSet::Description& d = *it;
+  const bool rotation = d.unit == control::RotationUnits::si_rate_unit;  // Omega itself, in rad/s
+  if (!rotation && d.unit != control::RotationUnits::rate_unit && d.unit != control::RotationUnits::delay_unit)
+    throw std::logic_error("add_si_alternative: '" + key + "' is not in units of Omega or T");
+  if (rotation && unit != SiUnit::Hz) throw std::logic_error("add_si_alternative: rotation_frequency has Hz only");
+  const SiForm form = si_form(d.unit, unit);
+  const std::string si_key = key + form.suffix;
+  const std::string conversion =
+      rotation ? fmt::format("{} = 2 pi x {}", key, si_key)
+      : unit == SiUnit::Hz ? fmt::format("{} = 2 pi x {} / Omega", key, si_key)
+      : d.unit == control::RotationUnits::delay_unit ? fmt::format("{} = {} / T", key, si_key)
+                                                      : fmt::format("{} = {} / Omega", key, si_key);
+  const std::string help = fmt::format("{} in {} instead of units of {}: {} (give one of the two)", key, form.unit,
+                                       rotation ? "rad/s" : d.unit, conversion);
+  if (d.kind == "reals")
+    p.reals(si_key, {}, help, range);
+  else
+    p.real(si_key, 1.0, help, range);  // the default is never used (counted only when given)
+  p.unit(form.unit).default_text("not given").only_if_given({key});
+}
+
+io::ParamSet resolve_si_inputs(const io::ParamSet& given) {
+  io::ParamSet p = given;
+  // base key -> its SI alternatives declared in `p` (add_si_alternative), rotation_frequency first
+  std::vector<std::pair<std::string, std::vector<std::string>>> pairs;
+  std::map<std::string, std::string> unit_of;
+  const auto all = p.describe();
+  for (const auto& d : all) unit_of[d.key] = d.unit;
+  for (const auto& d : all)
+    for (const char* suffix : kSiSuffixes) {
+      const std::string s(suffix);
+      if (d.key.size() <= s.size() || d.key.compare(d.key.size() - s.size(), s.size(), s) != 0) continue;
+      const std::string base = d.key.substr(0, d.key.size() - s.size());
+      if (!unit_of.count(base)) continue;
+      auto at = std::find_if(pairs.begin(), pairs.end(), [&](const auto& x) { return x.first == base; });
+      if (at == pairs.end()) {
+        pairs.push_back({base, {}});
+        at = pairs.end() - 1;
+      }
+      at->second.push_back(d.key);
+    }
+  std::stable_partition(pairs.begin(), pairs.end(), [](const auto& x) { return x.first == "rotation_frequency"; });
+  for (const auto& [base, alternatives] : pairs) {
+    std::vector<std::string> set;
+    if (p.was_set(base)) set.push_back(base);
+    for (const auto& a : alternatives)
+      if (p.was_set(a)) set.push_back(a);
+    if (set.size() > 1)
+      throw InvalidParameter(set[1], fmt::format("{} and {} were both given: they are the same quantity in different "
+                                                 "units ({} in {}, {} in {}); give one of them",
+                                                 set[0], set[1], set[0], unit_of.at(set[0]), set[1], unit_of.at(set[1])));
+    if (set.empty() || set[0] == base) continue;
+    const std::string& si_key = set[0];
+    const std::string& si_unit = unit_of.at(si_key);
+    const std::string& base_unit = unit_of.at(base);
+    // Omega is resolved first; the others convert with it (RotationUnits: the same products as control::to_si)
+    const auto convert = [&](double v) {
+      if (base_unit == control::RotationUnits::si_rate_unit) return 2.0 * std::numbers::pi * v;  // Hz -> rad/s
+      const control::RotationUnits u(p.real("rotation_frequency"));
+      if (base_unit == control::RotationUnits::delay_unit) return u.in_periods(v);
+      return u.in_omega(si_unit == "Hz" ? 2.0 * std::numbers::pi * v : v);
+    };
+    try {
+      if (std::holds_alternative<std::vector<double>>(p.value(si_key))) {
+        std::vector<double> values = p.reals(si_key);
+        for (double& v : values) v = convert(v);
+        p.set_value(base, values);
+      } else {
+        p.set_value(base, convert(p.real(si_key)));
+      }
+    } catch (const InvalidParameter& e) {
+      if (e.parameter() != base) throw;
+      throw InvalidParameter(si_key, fmt::format("{} = {} {} is out of range: converted to {} ({}): {}", si_key,
+                                                 std::holds_alternative<std::vector<double>>(p.value(si_key))
+                                                     ? fmt::format("[{}]", fmt::join(p.reals(si_key), ", "))
+                                                     : fmt::format("{}", p.real(si_key)),
+                                                 si_unit, base, base_unit, e.what()));
+    }
+  }
+  return p;
+}
+
+namespace {
+// Time of one closed-loop spectrum per oscillator (N + 1) per period T of delay: measured 1.8e-4 … 4.5e-4 s (roots
+// and chart, N = 10 … 100, delays 100 … 3000 T, 2-core test machine under load, Release; it grows faster than the
+// delay), taken as 1e-5 s: the estimate is a lower bound, so only requests that cannot fit are refused.
+constexpr double kSpectrumSecondsPerPeriod = 1e-5;
+}  // namespace
+
+void require_delay_work(const io::ParamSet& p, const std::string& key, double delay_in_periods,
+                        const control::RotationUnits& units, double spectra, int harmonics, const std::string& what) {
+  // up to one period the spectra cost what the grid and N make them (their own checks); beyond it, the delay's share
+  if (!(delay_in_periods > 1.0)) return;
+  const double per_period = spectra * (harmonics + 1.0) * kSpectrumSecondsPerPeriod;
+  const std::string model = fmt::format("{:g} closed-loop spectra ({}) with harmonics = {}, each at least {:.2g} s per "
+                                        "period T of delay (the roots in the search box grow with the delay)",
+                                        spectra, what, harmonics, (harmonics + 1.0) * kSpectrumSecondsPerPeriod);
+  if (p.was_set(key + "_seconds"))  // the user's key and unit
+    require_work(key + "_seconds", units.delay(delay_in_periods), per_period / units.period(), model);
+  else
+    require_work(key, delay_in_periods, per_period, model);
+}
+
+namespace {
+// The SI key given for `key` (its _seconds, _rad_per_s or _hz form), or "".
+std::string si_key_given(const io::ParamSet& p, const std::string& key) {
+  for (const char* suffix : kSiSuffixes)
+    for (const auto& d : p.describe())
+      if (d.key == key + suffix && p.was_set(d.key)) return d.key;
+  return "";
+}
+
+std::string value_text(const io::ParamSet& p, const std::string& key) {
+  if (std::holds_alternative<std::vector<double>>(p.value(key))) return fmt::format("[{}]", fmt::join(p.reals(key), ", "));
+  return fmt::format("{}", p.real(key));
+}
+}  // namespace
+
+Run with_si_inputs(Run run) {
+  return [run = std::move(run)](const io::ParamSet& p, Captured* capture) {
+    const io::ParamSet resolved = resolve_si_inputs(p);
+    try {
+      run(resolved, capture);
+    } catch (const InvalidParameter& e) {
+      // a check of the key, given in its SI form: the message names the key the user gave
+      const std::string si = si_key_given(p, e.parameter());
+      if (si.empty()) throw;
+      throw InvalidParameter(si, fmt::format("{} = {} {} (that is {} = {} {}): {}", si, value_text(p, si), p.unit_of(si),
+                                             e.parameter(), value_text(resolved, e.parameter()),
+                                             resolved.unit_of(e.parameter()), e.what()));
+    }
+  };
 }
 
 void require_memory(const std::string& parameter, double value, double bytes_per_unit) {

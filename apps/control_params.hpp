@@ -16,6 +16,7 @@
 #include "afmkit/control/settings.hpp"
 #include "afmkit/control/units.hpp"
 #include "afmkit/io/params.hpp"
+#include "command.hpp"
 
 namespace afmkit::cli {
 
@@ -28,9 +29,31 @@ inline constexpr long kMaxHarmonicsSpectra = 1000;
 
 /// Adds the shared parameters (with their units) to `params`; `max_harmonics` bounds `harmonics` (and `rejected`).
 void add_control_params(io::ParamSet& params, long max_harmonics = kMaxHarmonicsSpectra);
+/// SI alternatives of the keys in rotation units (docs/commands.md#control-si-keys): for `key` in units of Omega,
+/// `key_rad_per_s` [rad/s] (or, with SiUnit::Hz, `key_hz` [Hz]: 2 pi f); in units of T, `key_seconds` [s]; for
+/// rotation_frequency [rad/s], `rotation_frequency_hz`. Declared right after `key` (same kind: real or reals), counted
+/// only when given (the record then holds it instead of `key`).
+enum class SiUnit { Auto, Hz };
+void add_si_alternative(io::ParamSet& params, const std::string& key, SiUnit unit = SiUnit::Auto,
+                        io::Range range = io::Range::any());
+/// `params` with every given SI alternative converted into its key (rotation_frequency first, then the others with
+/// that Omega: value / Omega, value / T, 2 pi f / Omega); InvalidParameter naming both when a quantity is given in
+/// two forms, naming the SI key when its value converts out of the key's range.
+io::ParamSet resolve_si_inputs(const io::ParamSet& params);
+/// `run` on resolve_si_inputs(params): what every control command runs.
+Run with_si_inputs(Run run);
+
 /// Throws InvalidParameter(parameter, …) when `value` units of `bytes_per_unit` bytes held in memory do not fit in
 /// half of the available memory (MemAvailable), before any work.
 void require_memory(const std::string& parameter, double value, double bytes_per_unit);
+/// Refuses (work_budget.hpp: InvalidParameter naming `parameter`, exit 2) a request of `spectra` closed-loop spectra
+/// at a delay of `delay_in_periods` T whose estimate exceeds the work limit: the roots in a search box grow with the
+/// delay, so a spectrum costs at least kSpectrumSecondsPerPeriod x (N + 1) x tau/T (docs/commands.md, sizes and costs);
+/// checked for delays above one period (below, the other size options' own checks apply).
+/// The message names `key`, or its SI form (`key`_seconds, the value in s) when that was given.
+void require_delay_work(const io::ParamSet& params, const std::string& key, double delay_in_periods,
+                        const control::RotationUnits& units, double spectra, int harmonics, const std::string& what);
+
 /// The settings given (after params.resolve()), validated: InvalidParameter naming the parameter.
 control::ControlSettings control_settings_from(const io::ParamSet& params);
 

@@ -9,6 +9,7 @@
 // T). Disturbance (seed-2 eq. 14): f = c0 + Σ F_k sin(kΩt + φ_k); default = the Fig. 5 example
 // (c0 = 0.2, F1 = 1, F_k = 0.3/k for k = 2..8, random phases from disturbance_seed, φ1 = 0).
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -18,6 +19,8 @@
 #include <nlohmann/json.hpp>
 
 #include "afmkit/control/closed_loop_simulation.hpp"
+#include "afmkit/control/sampled_disturbance.hpp"
+#include "afmkit/io/curves/text_column.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/progress.hpp"
 #include "command.hpp"
@@ -70,6 +73,35 @@ std::vector<double> phases_used(const io::ParamSet& p, const control::Disturbanc
   for (const auto& h : f.harmonics)
     if (h.order >= 1 && static_cast<std::size_t>(h.order) <= phases.size()) phases[h.order - 1] = h.phase;
   return phases;
+}
+
+// The keys of the Fourier form of f, which `signal` replaces.
+const std::vector<std::string>& fourier_keys() {
+  static const std::vector<std::string> keys = {"disturbance_offset", "disturbance_amplitudes", "disturbance_phases",
+                                                "disturbance_seed"};
+  return keys;
+}
+
+// Samples per rotation period of `signal` from signal_step (T; or signal_step_seconds, converted) or
+// signal_sample_rate (samples/s): a whole number, else InvalidParameter naming the key given.
+int samples_per_period(const io::ParamSet& p, const control::RotationUnits& u) {
+  const bool step = p.was_set("signal_step"), rate = p.was_set("signal_sample_rate");
+  const std::string step_key = p.was_set("signal_step_seconds") ? "signal_step_seconds" : "signal_step";
+  if (step && rate)
+    throw InvalidParameter("signal_sample_rate", fmt::format("{} and signal_sample_rate were both given: they are the "
+                                                             "same sampling in different units; give one of them",
+                                                             step_key));
+  if (!step && !rate)
+    throw InvalidParameter("signal_step", "signal is given without its sampling: give signal_sample_rate "
+                                          "(samples/s), signal_step_seconds (s) or signal_step (units of T)");
+  const std::string key = step ? step_key : "signal_sample_rate";
+  const double per_period = step ? 1.0 / p.real("signal_step") : p.real("signal_sample_rate") * u.period();
+  const double whole = std::round(per_period);
+  if (!(std::abs(per_period - whole) <= 1e-9 * whole) || whole < 2.0 || whole > 1e9)
+    throw InvalidParameter(key, fmt::format("{} = {} gives {:.12g} samples per rotation period T = {:.6g} s: must give "
+                                            "a whole number of samples per period, at least 2 (f is T-periodic in "
+                                            "the model)", key, p.real(key), per_period, u.period()));
+  return static_cast<int>(whole);
 }
 
 int highest_order(const control::Disturbance& f) {
@@ -136,7 +168,36 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
                                        "delay must stay >= 0)", p.real("delay_variation"), p.real("delay")));
   const control::RotationUnits u = c.units();
   const control::ControlSettingsSi si = control::to_si(c);
-  const control::Disturbance disturbance = disturbance_from(p);
+  if (p.was_set("signal") && p.was_set("signal_file"))
+    throw InvalidParameter("signal_file", "signal and signal_file were both given: give the samples in one of them");
+  if (p.was_set("signal_column") && !p.was_set("signal_file"))
+    throw InvalidParameter("signal_column", "signal_column is given without signal_file: it chooses a column of it");
+  const bool sampled = p.was_set("signal") || p.was_set("signal_file");
+  const std::string signal_key = p.was_set("signal_file") ? "signal_file" : "signal";
+  for (const auto& key : fourier_keys())
+    if (sampled && p.was_set(key))
+      throw InvalidParameter(key, fmt::format("{} and {} were both given: {} gives the disturbance f as samples, "
+                                              "instead of its Fourier form (disturbance_*); give one",
+                                              signal_key, key, signal_key));
+  if (!sampled)
+    for (const char* key : {"signal_step", "signal_step_seconds", "signal_sample_rate", "signal_harmonics"})
+      if (p.was_set(key))
+        throw InvalidParameter(key, fmt::format("{} is given without signal: it describes the samples of signal",
+                                                key));
+  std::optional<control::SampledDisturbance> from_samples;
+  std::size_t signal_samples = 0;
+  if (sampled) {
+    const int per_period = samples_per_period(p, u);
+    require_memory(signal_key, static_cast<double>(per_period), 3.0 * sizeof(double));
+    const std::vector<double> samples = p.was_set("signal_file")
+                                            ? io::curves::read_text_column(p.text("signal_file"), p.text("signal_column"))
+                                            : p.reals("signal");
+    from_samples = control::disturbance_from_samples(samples, per_period,
+                                                     static_cast<int>(p.integer("signal_harmonics")),
+                                                     signal_key.c_str());
+    signal_samples = samples.size();
+  }
+  const control::Disturbance disturbance = sampled ? from_samples->disturbance : disturbance_from(p);
   control::SimulationOptions o;
   o.periods = static_cast<int>(p.integer("periods"));
   o.steps_per_period = static_cast<int>(p.integer("steps_per_period"));
@@ -151,8 +212,9 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
                                                     "(below half of steps_per_period = {})",
                                                     o.report_max_order, nyquist_order, o.steps_per_period));
   io::ParamSet as_run = params_as_run(p, c, {{"max_order", o.report_max_order}});
-  if (!p.was_set("disturbance_phases")) as_run.record_used("disturbance_phases", phases_used(p, disturbance));
-  if (!p.was_set("disturbance_amplitudes"))
+  if (!sampled && !p.was_set("disturbance_phases"))
+    as_run.record_used("disturbance_phases", phases_used(p, disturbance));
+  if (!sampled && !p.was_set("disturbance_amplitudes"))
     as_run.record_used("disturbance_amplitudes", amplitudes_used(p, disturbance));
   CommandOutput out(as_run, capture, "control simulate");
   const bool keep_rows = p.flag("json") && !out.writes_file();
@@ -188,6 +250,24 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
   report["loop"] = control::describe_in_rotation_units(control::loop_from(c));
   report["settings"] = settings_json(c);
   report["settings_si"] = settings_si_json(c);
+  if (from_samples) {
+    const control::SampledDisturbance& d = *from_samples;
+    report["signal"] = {{"samples", signal_samples}, {"samples_per_period", d.samples_per_period},
+                        {"periods", d.periods}, {"harmonics", d.harmonics},
+                        {"harmonics_used", d.disturbance.harmonics.size()}, {"offset", d.disturbance.offset},
+                        {"rms", d.rms}, {"non_periodic_rms", d.non_periodic_rms},
+                        {"unrepresented_rms", d.unrepresented_rms}};
+    report["units"]["signal"] = {{"samples", "count"}, {"samples_per_period", "count"}, {"periods", "count"},
+                                 {"harmonics", "count"}, {"harmonics_used", "count"}, {"offset", "signal"},
+                                 {"rms", "signal"}, {"non_periodic_rms", "signal"}, {"unrepresented_rms", "signal"}};
+    report["notes"]["signal"] = "f from the samples: their period average (non_periodic_rms: what differs from "
+                                "period to period) as c0 + sum F_k sin(k Omega t + phi_k), k = 1 .. harmonics "
+                                "(unrepresented_rms: what these harmonics leave of the average)";
+    if (d.non_periodic_rms > 1e-9 * d.rms)
+      fmt::print(stderr, "afmkit: warning: signal varies from period to period (RMS {:.3g} of {:.3g} signal): the "
+                         "model's f is T-periodic, the simulation uses the average over its {} periods\n",
+                 d.non_periodic_rms, d.rms, d.periods);
+  }
   if (res.report.diverged)
     io::message_line(fmt::format("afmkit: warning: the closed loop diverged after {} periods (|y| > 1e100); run "
                                  "stopped", res.report.periods_completed));
@@ -227,19 +307,48 @@ void register_control_simulate(CLI::App& control) {
             .unit("rad")
             .default_text("random from disturbance_seed, phi_1 = 0")
             .integer("disturbance_seed", 1, "seed of the random phases", 0, 4294967295L)
+            .reals("signal", {}, "the disturbance f as samples f(0), f(h), f(2h), ... over whole rotation periods "
+                                 "(sampling: signal_sample_rate, signal_step_seconds or signal_step); replaces the "
+                                 "disturbance_* keys")
+            .unit("signal")
+            .default_text("not given: f from disturbance_*")
+            .only_if_given(fourier_keys())
+            .file("signal_file", "", "the samples of signal as a column of a text file (CSV, tab- or blank-separated; "
+                                     "docs/curve-files.md#text-exports), instead of signal")
+            .default_text("not given")
+            .only_if_given(fourier_keys())
+            .text("signal_column", "", "the column of signal_file: header name or 1-based position (not given: the "
+                                       "file's only column)")
+            .default_text("the only column")
+            .only_if_given()
+            .real("signal_sample_rate", 1.0, "sample rate 1/h of signal: sample_rate x T must be a whole number",
+                  io::Range::positive())
+            .unit("samples/s")
+            .default_text("not given")
+            .only_if_given()
+            .real("signal_step", 1.0, "sample step h of signal: 1/signal_step must be a whole number",
+                  io::Range::positive())
+            .unit("T")
+            .default_text("not given")
+            .only_if_given();
+        add_si_alternative(p, "signal_step", SiUnit::Auto, io::Range::positive());
+        p.integer("signal_harmonics", 0, "highest harmonic of f taken from signal (0: every k below half the samples "
+                                         "per period)", 0, 100000000)
+            .only_if_given()
             .real("delay_variation", 0.0, "amplitude of a slow sinusoidal delay variation (<= delay)",
                   io::Range::non_negative())
-            .unit("T")
-            .real("delay_variation_frequency", 0.0, "angular frequency of the delay variation",
-                  io::Range::non_negative())
-            .unit("Omega")
-            .integer("record_every", 10, "keep every n-th step in the CSV", 1, 1000000000)
+            .unit("T");
+        add_si_alternative(p, "delay_variation", SiUnit::Auto, io::Range::non_negative());
+        p.real("delay_variation_frequency", 0.0, "angular frequency of the delay variation", io::Range::non_negative())
+            .unit("Omega");
+        add_si_alternative(p, "delay_variation_frequency", SiUnit::Auto, io::Range::non_negative());
+        p.integer("record_every", 10, "keep every n-th step in the CSV", 1, 1000000000)
             .integer("max_order", 15, "highest harmonic order k in the report (above N: what the controller does to "
                                      "harmonics it does not model); below steps_per_period/2", 1, 100000000)
             .default_text("5 above the highest of N and of the harmonics of f");
         add_output_params(p, "out/control_simulate.csv", "time-series");
       },
-      run_simulate);
+      with_si_inputs(run_simulate));
 }
 
 }  // namespace afmkit::cli

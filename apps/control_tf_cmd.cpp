@@ -5,6 +5,7 @@
 // units of the system: the controller C in units of Ω (C/Ω), the plant P in units of 1/Ω (P·Ω), the loop,
 // sensitivity and closed loop dimensionless; phase = arg G(iω) unwrapped along the grid [rad].
 #include <complex>
+#include <numbers>
 #include <string>
 
 #include <fmt/format.h>
@@ -42,10 +43,17 @@ struct ResponseUnit {
   std::string unit;
   double factor;
 };
-ResponseUnit response_unit(const std::string& system, double w) {
-  if (system == "controller") return {"Omega", 1.0 / w};  // C = W/M: a rate
-  if (system == "plant") return {"1/Omega", w};           // P = Y/U: an inverse rate
+ResponseUnit response_unit(const std::string& system, double w, bool si) {
+  if (system == "controller") return si ? ResponseUnit{"1/s", 1.0} : ResponseUnit{"Omega", 1.0 / w};  // C: a rate
+  if (system == "plant") return si ? ResponseUnit{"s", 1.0} : ResponseUnit{"1/Omega", w};  // P: an inverse rate
   return {"dimensionless", 1.0};
+}
+
+// The frequency column in `unit` (frequency_unit) from omega [rad/s]: Omega (omega / Omega), rad/s, Hz.
+double frequency_in(const std::string& unit, double omega, double w) {
+  if (unit == "rad/s") return omega;
+  if (unit == "Hz") return omega / (2.0 * std::numbers::pi);
+  return omega / w;
 }
 
 // τ = 0 verdicts (units of Ω): eigenvalues for finite banks (any K, plant), closed-form conditions at the design
@@ -150,12 +158,15 @@ void run_tf(const io::ParamSet& p, Captured* capture) {
   nlohmann::json res = summary(c, loop);
   const double w = c.rotation_frequency;
   const std::string system = p.text("system");
-  const ResponseUnit unit = response_unit(system, w);
+  const std::string frequency_unit = p.text("frequency_unit");
+  const ResponseUnit unit = response_unit(system, w, frequency_unit != "Omega");
   const control::LoopSystem which = system_from(system);
   res["system"] = system;
   res["rows"] = points;
   res["cost"] = "O(N) per frequency (sum over the oscillators); rows streamed to the file";
-  out.open({{"frequency", "Omega", "angular frequency omega of the grid point (omega = k Omega at harmonic k)"},
+  out.open({{"frequency", frequency_unit,
+             frequency_unit == "Hz" ? "frequency omega/(2 pi) of the grid point (k Omega/(2 pi) at harmonic k)"
+                                    : "angular frequency omega of the grid point (omega = k Omega at harmonic k)"},
             {"magnitude", unit.unit, "|G(i omega)| of the system"},
             {"phase", "rad", "arg G(i omega), unwrapped along the grid"},
             {"real", unit.unit, "Re G(i omega)"},
@@ -169,7 +180,7 @@ void run_tf(const io::ParamSet& p, Captured* capture) {
     const std::complex<double> g = control::evaluate(loop, which, {0.0, omega});
     double magnitude, phase;
     control::magnitude_phase(g, magnitude, phase);
-    out.row(omega / w, magnitude * unit.factor, unwrap(phase), g.real() * unit.factor, g.imag() * unit.factor);
+    out.row(frequency_in(frequency_unit, omega, w), magnitude * unit.factor, unwrap(phase), g.real() * unit.factor, g.imag() * unit.factor);
   }
   progress.finish();
   out.finish(res, fmt::format("{} frequencies of the {} ({})", points, system, res["loop"].get<std::string>()));
@@ -190,15 +201,24 @@ void register_control_tf(CLI::App& control) {
                   "dimensionless)",
                   {"controller", "plant", "loop", "sensitivity", "closed_loop"})
             .real("frequency_min", 0.01, "lowest frequency of the grid", io::Range::closed(0.0, 1e12))
-            .unit("Omega")
-            .real("frequency_max", 10.0, "highest frequency of the grid", io::Range{0.0, 1e12, true, false})
-            .unit("Omega")
+            .unit("Omega");
+        add_si_alternative(p, "frequency_min", SiUnit::Auto, io::Range::non_negative());
+        add_si_alternative(p, "frequency_min", SiUnit::Hz, io::Range::non_negative());
+        p.real("frequency_max", 10.0, "highest frequency of the grid", io::Range{0.0, 1e12, true, false})
+            .unit("Omega");
+        add_si_alternative(p, "frequency_max", SiUnit::Auto, io::Range::positive());
+        add_si_alternative(p, "frequency_max", SiUnit::Hz, io::Range::positive());
+        p.text("frequency_unit", "Omega",
+               "unit of the frequency column: Omega (harmonic number at k Omega), rad/s or Hz; with rad/s or Hz the "
+               "controller's response is in 1/s and the plant's in s (Omega: in units of Omega and 1/Omega)",
+               {"Omega", "rad/s", "Hz"})
+            .only_if_given()  // recorded when given: the records of earlier runs stay as they were
             .integer("points", 1000, "number of grid points (rows are streamed: O(N) work and O(1) memory per row)",
                      2, 10000000)
             .flag("log_spacing", true, "logarithmic grid (false: linear)");
         add_output_params(p, "out/control_tf.csv", "frequency-response");
       },
-      run_tf);
+      with_si_inputs(run_tf));
 }
 
 }  // namespace afmkit::cli

@@ -68,6 +68,11 @@ void run_tune(const io::ParamSet& p, Captured* capture) {
                              "= {}: at least {:.2g} s per evaluation",
                              s.gain_points, c.harmonics, evaluation),
                  2.0);
+    // each spectrum's roots grow with the delay: delay_points x gain_points spectra per evaluation up to delay_max
+    const double spectra = (static_cast<double>(s.coarse_points) * s.coarse_points + s.max_evaluations) *
+                           s.delay_points * s.gain_points;
+    require_delay_work(p, "delay_max", p.real("delay_max"), u, spectra, c.harmonics,
+                       "(coarse_points^2 + max_evaluations) x delay_points x gain_points");
     require_work("max_evaluations", static_cast<double>(s.max_evaluations), evaluation,
                  fmt::format("objective evaluations of gain_points = {} spectra each, with harmonics = {}: at least "
                              "{:.2g} s per evaluation",
@@ -128,8 +133,9 @@ void add_control_tune(CLI::App& control) {
         add_control_params(p);
         p.group("Tuning")
             .real("delay_max", 0.25, "largest delay", Range::non_negative())
-            .unit("T")
-            .integer("delay_points", 6, "delay grid points on [0, delay_max]", 1, 10000)
+            .unit("T");
+        add_si_alternative(p, "delay_max", SiUnit::Auto, Range::non_negative());
+        p.integer("delay_points", 6, "delay grid points on [0, delay_max]", 1, 10000)
             .real("gain_ratio_min", 0.5, "smallest rho = K/gamma", Range::positive())
             .unit("dimensionless")
             .real("gain_ratio_max", 2.0, "largest rho = K/gamma", Range::positive())
@@ -142,7 +148,7 @@ void add_control_tune(CLI::App& control) {
         add_output_params(p, "out/control_tune.csv", "coarse-grid");
         p.flag("progress", true, "show progress on stderr");
       },
-      run_tune);
+      with_si_inputs(run_tune));
 }
 
 }  // namespace afmkit::cli

@@ -13,5 +13,6 @@ void bind_spectroscopy_fit(pybind11::module_& m); // spectroscopy_fit.cpp: the l
 void bind_spectroscopy_reconstruct(pybind11::module_& m);  // spectroscopy_reconstruct.cpp: force reconstruction
 void bind_laws(pybind11::module_& m);              // laws.cpp: the force-law registry (afmkit.laws)
 void bind_python_law(pybind11::module_& m);        // python_law.cpp: laws written in Python; any law's values
+void bind_control_state_space(pybind11::module_& m);  // control_state_space.cpp: A, B, C, D of controller, plant
 
 }  // namespace afmkit::python

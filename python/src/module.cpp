@@ -16,4 +16,5 @@ PYBIND11_MODULE(_afmkit, m) {
   afmkit::python::bind_spectroscopy_reconstruct(m);
   afmkit::python::bind_laws(m);
   afmkit::python::bind_python_law(m);
+  afmkit::python::bind_control_state_space(m);
 }

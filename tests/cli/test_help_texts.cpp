@@ -18,7 +18,8 @@ const std::set<std::string> kTextOptions = {"figures",     // a list of figure i
                                             "height-column", "deflection-column", "force-column", "segment-column",
                                             "retract-height-column", "retract-deflection-column",
                                             "retract-force-column",
-                                            "parameters"};  // spectroscopy fit: a list of parameter names
+                                            "parameters",      // spectroscopy fit: a list of parameter names
+                                            "signal-column"};  // control simulate: a column of signal_file
 }  // namespace
 
 class HelpText : public ::testing::TestWithParam<std::string> {};

@@ -15,12 +15,15 @@ namespace afmkit::control {
 /// trigonometric polynomial of degree < M/2. Throws InvalidParameter if max_order ≥ M/2 or the span is empty.
 std::vector<std::complex<double>> fourier_coefficients(std::span<const double> one_period, int max_order);
 
-/// Complex amplitude of harmonic k of the disturbance f (seed-2 eq. 14): f_0 = c0, f_k = −i F_k e^{iφ_k}.
+/// Complex amplitude of harmonic k of the disturbance f (seed-2 eq. 14): f_0 = c0, f_k = −i F_k e^{iφ_k}. O(K) for
+/// K harmonics (a search); the overload for one of f's harmonics is O(1).
 std::complex<double> disturbance_harmonic(const Disturbance& f, int k);
+std::complex<double> disturbance_harmonic(const Disturbance::Harmonic& h);
 
 /// Harmonic k of the uncontrolled plant output in steady state: f_k (static plant, eq. 3) or
-/// γ f_k/(γ + ikΩ) (first-order plant, eq. 1).
+/// γ f_k/(γ + ikΩ) (first-order plant, eq. 1). The overload for one of the disturbance's harmonics is O(1).
 std::complex<double> uncontrolled_harmonic(const Plant& plant, int k);
+std::complex<double> uncontrolled_harmonic(const Plant& plant, const Disturbance::Harmonic& h);
 
 /// Uncontrolled steady-state output y(t) (the signal the plant produced before the controller was switched on).
 double uncontrolled_output(const Plant& plant, double t);

@@ -217,12 +217,12 @@ LoopContext make_context(const Plant& plant, const SimulationOptions& o, std::sp
   };
   std::vector<Term> terms;
   for (const auto& hk : f.harmonics) {
-    const std::complex<double> fk = disturbance_harmonic(f, hk.order);
+    const std::complex<double> fk = disturbance_harmonic(hk);
     const bool rej = std::find(rejected.begin(), rejected.end(), hk.order) != rejected.end();
     // ∫₀ʰ e^{−γ(h−s)} γ e^{ikΩs} ds = γ (e^{ikΩh} − e^{−γh})/(γ + ikΩ)
     const std::complex<double> gain =
         g * (std::polar(1.0, hk.order * w * h) - cx.decay) / std::complex<double>(g, hk.order * w);
-    terms.push_back({hk.order, fk, rej ? 0.0 : uncontrolled_harmonic(plant, hk.order), fk * gain});
+    terms.push_back({hk.order, fk, rej ? 0.0 : uncontrolled_harmonic(plant, hk), fk * gain});
   }
   const std::complex<double> f1 = disturbance_harmonic(f, 1);
   for (int i = 0; i < M; ++i) {

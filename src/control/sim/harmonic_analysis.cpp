@@ -37,18 +37,31 @@ std::vector<std::complex<double>> fourier_coefficients(std::span<const double> x
   return c;
 }
 
+std::complex<double> disturbance_harmonic(const Disturbance::Harmonic& h) {
+  return std::complex<double>(0.0, -1.0) * std::polar(h.amplitude, h.phase);
+}
+
 std::complex<double> disturbance_harmonic(const Disturbance& f, int k) {
   if (k == 0) return f.offset;
   for (const auto& h : f.harmonics)
-    if (h.order == k) return std::complex<double>(0.0, -1.0) * std::polar(h.amplitude, h.phase);
+    if (h.order == k) return disturbance_harmonic(h);
   return 0.0;
 }
 
-std::complex<double> uncontrolled_harmonic(const Plant& plant, int k) {
-  const std::complex<double> fk = disturbance_harmonic(plant.disturbance, k);
+namespace {
+std::complex<double> uncontrolled_of(const Plant& plant, std::complex<double> fk, int k) {
   if (plant.kind == PlantKind::Static) return fk;
   const double g = plant.rate;
   return g * fk / std::complex<double>(g, k * plant.rotation_frequency);
+}
+}  // namespace
+
+std::complex<double> uncontrolled_harmonic(const Plant& plant, int k) {
+  return uncontrolled_of(plant, disturbance_harmonic(plant.disturbance, k), k);
+}
+
+std::complex<double> uncontrolled_harmonic(const Plant& plant, const Disturbance::Harmonic& h) {
+  return uncontrolled_of(plant, disturbance_harmonic(h), h.order);
 }
 
 namespace {
@@ -57,7 +70,7 @@ double output_without(const Plant& plant, double t, std::span<const int> rejecte
   const double theta = plant.rotation_frequency * t;
   for (const auto& h : plant.disturbance.harmonics) {
     if (std::find(rejected.begin(), rejected.end(), h.order) != rejected.end()) continue;
-    const std::complex<double> ck = uncontrolled_harmonic(plant, h.order);
+    const std::complex<double> ck = uncontrolled_harmonic(plant, h);  // O(1): the whole sum is O(K)
     y += (ck * std::polar(1.0, h.order * theta)).real();
   }
   return y;
