@@ -262,6 +262,46 @@ class Study:
                 raise StudyError(f"parameters.{key}", f"parameters.{key}: unknown parameter '{key}' of afmkit "
                                                       f"{self.command} (allowed: {', '.join(params)})")
 
+    def point(self, index) -> dict:
+        """The keyword arguments of the command at grid point `index` (a tuple, one position per axis, as the store's
+        arrays are indexed): the fixed parameters and the axes' values there, exactly as the study ran it, so that
+        ``afmkit.<command>(**study.point(i))`` (and ``afmkit <command> --config`` of :meth:`point_toml`) reproduces
+        that point bit for bit."""
+        index = tuple(index) if isinstance(index, (tuple, list)) else (index,)
+        if len(index) != len(self.axes):
+            raise StudyError("index", f"index {index!r} has {len(index)} position(s): the study has "
+                                      f"{len(self.axes)} axes ({', '.join(a.name for a in self.axes)})")
+        params = parameters_of(self.command)
+        out = dict(self.parameters)
+        for a, i in zip(self.axes, index):
+            if not isinstance(i, (int, np.integer)) or isinstance(i, bool) or not -len(a.values) <= i < len(a.values):
+                raise StudyError("index", f"index {i!r} of axis {a.name} is out of range: must be an integer in "
+                                          f"[0, {len(a.values) - 1}]")
+            v = a.values[int(i)]
+            out[a.name] = int(v) if params[a.name]["kind"] == "integer" else float(v)
+        return out
+
+    def point_toml(self, index) -> str:
+        """The TOML configuration of grid point `index` for ``afmkit <command> --config FILE`` (numbers written so
+        that they read back exactly)."""
+        def value(v) -> str:
+            if isinstance(v, bool):
+                return "true" if v else "false"
+            if isinstance(v, (int, np.integer)):
+                return str(int(v))
+            if isinstance(v, (float, np.floating)):
+                f = float(v)
+                return "nan" if math.isnan(f) else ("inf" if f > 0 else "-inf") if math.isinf(f) else repr(f)
+            if isinstance(v, str):
+                return json.dumps(v)  # a basic TOML string: the same escapes as JSON for what keys hold
+            if isinstance(v, (list, tuple, np.ndarray)):
+                return "[" + ", ".join(value(x) for x in v) + "]"
+            raise StudyError("parameters", f"parameter value {v!r} cannot be written to TOML")
+        lines = [f"# afmkit {self.command}: point {tuple(int(i) for i in np.atleast_1d(index))} of study "
+                 f"'{self.name}'"]
+        lines += [f"{k} = {value(v)}" for k, v in self.point(index).items()]
+        return "\n".join(lines) + "\n"
+
     def units(self) -> dict:
         """The unit of every axis (the command's parameter units; "nm (physical) or L (normalised)" resolved by the
         study's `units` parameter)."""
