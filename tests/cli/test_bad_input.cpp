@@ -77,7 +77,9 @@ TEST_P(BadInputRow, GivesItsStatusAndMessageAndWritesNothingWhenRejected) {
   EXPECT_EQ(r.status, row.status) << row.command << "\n" << r.err;
   EXPECT_NE(r.err.find(row.message), std::string::npos)
       << row.command << "\nexpected in the message: " << row.message << "\ngot: " << r.err;
-  if (row.status == 2) EXPECT_EQ(dir.count_files(), before) << row.command << ": a file was written";
+  if (row.status == 2) {
+    EXPECT_EQ(dir.count_files(), before) << row.command << ": a file was written";
+  }
 }
 
 // One test per row of the page (named by its row number), so ctest runs and reports them one by one.

@@ -35,14 +35,19 @@ TEST_P(HelpText, EveryOptionIsTypedHasOneDefaultAndCitesOnlyTheProject) {
   ASSERT_GT(options.size(), 3u) << command;
   for (const HelpOption& o : options) {
     if (o.name == "help" || o.name == "version") continue;
-    if (o.type == "TEXT") EXPECT_TRUE(kTextOptions.count(o.name)) << command << " --" << o.name << " is untyped (TEXT)";
-    if (o.flag) EXPECT_EQ(o.description.find("TEXT=true"), std::string::npos) << command << " --" << o.name;
+    if (o.type == "TEXT") {
+      EXPECT_TRUE(kTextOptions.count(o.name)) << command << " --" << o.name << " is untyped (TEXT)";
+    }
+    if (o.flag) {
+      EXPECT_EQ(o.description.find("TEXT=true"), std::string::npos) << command << " --" << o.name;
+    }
     // every number carries its unit, named and not empty
     if (o.type == "FLOAT" || o.type == "INT" || o.type == "FLOAT,...") {
       const std::size_t at = o.description.find("[unit: ");
       EXPECT_NE(at, std::string::npos) << command << " --" << o.name << " has no unit: " << o.description;
-      if (at != std::string::npos)
+      if (at != std::string::npos) {
         EXPECT_NE(o.description[at + 7], ';') << command << " --" << o.name << " has an empty unit";
+      }
     }
     // one default: the [default …] the parameter set prints, no second "(default: …)" in the help text
     std::size_t defaults = 0;

@@ -97,7 +97,9 @@ TEST_P(HostileCampaign, EveryOptionWithEveryHostileValueEndsWithAStatusAndLeaves
       for (const auto& e : std::filesystem::recursive_directory_iterator(dir.path))
         EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos)
             << "afmkit " << args << " left " << e.path();
-      if (r.status == 2) EXPECT_FALSE(std::filesystem::exists(dir.path / "out.csv")) << "afmkit " << args;
+      if (r.status == 2) {
+        EXPECT_FALSE(std::filesystem::exists(dir.path / "out.csv")) << "afmkit " << args;
+      }
     }
   }
   RecordProperty("runs", runs);

@@ -82,9 +82,10 @@ TEST(HonestyInternalFailure, OrbitOnAStickyMeasuredLawIsNeverReportedAsABadSepar
   const auto r = run_cli("tapping orbit " + kSticky + " --separation 5 --output o.csv", dir);
   expect_not_blamed_on_input(r, "tapping orbit");
   ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;
-  if (r.status == 1)  // either no answer (status in the written results) or a numerical failure naming the step
+  if (r.status == 1) {  // either no answer (status in the written results) or a numerical failure naming the step
     EXPECT_TRUE(r.err.find("no answer") != std::string::npos || r.err.find("numerical failure") != std::string::npos)
         << r.err;
+  }
 }
 
 TEST(HonestyInternalFailure, EveryTappingCommandOnTheStickyLawBlamesNoInput) {
@@ -172,9 +173,13 @@ TEST(HonestyStatus, SweepMarksRowsOfATrappedTipAndCountsThem) {
     n_trapped += t ? 1 : 0;
     // independent of the flag's definition: a trapped tip's highest gap (min gap + peak-to-peak motion, at most
     // 4 B for a near-harmonic motion) stays below the curve's contact gap; a tapping tip leaves it
-    if (t) EXPECT_LT(g + 4.0 * a, kA0 + 1e-6) << "row " << i;
+    if (t) {
+      EXPECT_LT(g + 4.0 * a, kA0 + 1e-6) << "row " << i;
+    }
     // a motion below a picometre at an amplitude-20-nm drive is the tip stuck to the sample: it must be marked
-    if (a < 1e-3 && g < kA0) EXPECT_TRUE(t) << "row " << i << ": amplitude " << a << " nm, offset " << rows[i][offset];
+    if (a < 1e-3 && g < kA0) {
+      EXPECT_TRUE(t) << "row " << i << ": amplitude " << a << " nm, offset " << rows[i][offset];
+    }
   }
   const auto results = nlohmann::json::parse(slurp(dir.path / "s.csv.json")).at("results");
   EXPECT_EQ(results.at("trapped_rows").get<long>(), n_trapped);
@@ -197,7 +202,9 @@ TEST(HonestyStatus, OrbitStatusMatchesItsOrbits) {
   const std::string status = results.at("status");
   EXPECT_EQ(status, orbits.empty() ? "no_orbit" : tapping ? "ok" : "tip_trapped");
   EXPECT_EQ(r.status, status == "ok" ? 0 : 1) << r.err;
-  if (status != "ok") EXPECT_NE(r.err.find("no answer: status " + status), std::string::npos) << r.err;
+  if (status != "ok") {
+    EXPECT_NE(r.err.find("no answer: status " + status), std::string::npos) << r.err;
+  }
 }
 
 // `tapping grid`'s Zarr store said nothing of trapped tips or missing orbits, which the CSV outputs of `orbit` and

@@ -15,7 +15,7 @@ namespace {
 ImpactResult run(Hysteresis h, double speed) {
   const ForceLaw law = make_law<TableLaw>(afmkit_test::neck_curve(), false, h);
   // unit masses, gap 20 nm, a constant 1 nN pulling body 2 away: a slow approach turns near 8 nm
-  const ImpactProblem p(Body{1.0, 0.0, 0.0}, Body{1.0, 20.0, -speed}, law, ExternalForces{0.0, 1.0});
+  const ImpactProblem p(Body{1.0, 0.0, 0.0}, Body{1.0, 20.0, -speed}, law, ExternalForces{0.0, 1.0, {}, {}});
   ImpactOptions o;
   o.method = ImpactMethod::integrator;
   return simulate_impact(p, o);
@@ -50,7 +50,7 @@ TEST(ContactImpact, AboveTheReleaseGapTheDepartureIsTheApproachBranch) {
   const auto curve = afmkit_test::neck_curve(0.02, 70.0);
   const ForceLaw law = make_law<TableLaw>(curve, false, Hysteresis::contact, 0.03);
   ASSERT_LT(law.release_gap(), 12.0);
-  const ImpactProblem p(Body{1.0, 0.0, 0.0}, Body{1.0, 20.0, -30.0}, law, ExternalForces{0.0, 1.0});
+  const ImpactProblem p(Body{1.0, 0.0, 0.0}, Body{1.0, 20.0, -30.0}, law, ExternalForces{0.0, 1.0, {}, {}});
   ImpactOptions o;
   o.method = ImpactMethod::integrator;
   const auto r = simulate_impact(p, o);

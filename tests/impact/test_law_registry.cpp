@@ -46,7 +46,9 @@ TEST(LawRegistry, BuiltinLawsAreAllBuildableWithDefaults) {
     SCOPED_TRACE(name);
     const ForceLaw law = r.build(name, {});
     // a piecewise-linear law is named by what it is (attractive with F_a = F_b = 0 is the hysteresis law (11))
-    if (!r.find(name).piecewise_linear) EXPECT_EQ(law.name(), name);
+    if (!r.find(name).piecewise_linear) {
+      EXPECT_EQ(law.name(), name);
+    }
     EXPECT_NO_THROW(law.require_dissipative());
     EXPECT_TRUE(std::isfinite(law.approach(-0.5)));
   }
@@ -95,8 +97,8 @@ TEST(LawRegistry, AUserLawIsOneClassAndOneRegistrationLine) {
          [](const auto& value, const auto&) {
            return make_law<ExponentialLaw>(value("repulsion_force"), value("decay_length"));
          }},
-        {{"repulsion_force", "nN", 5.0, "F0", 0.0, INFINITY, true, ""},
-         {"decay_length", "nm", 0.5, "λ", 0.0, INFINITY, true, ""}});
+        {{"repulsion_force", "nN", 5.0, "F0", 0.0, INFINITY, true, "", false, ""},
+         {"decay_length", "nm", 0.5, "λ", 0.0, INFINITY, true, "", false, ""}});
   const ForceLaw law = r.build("exponential", args({{"decay_length", 2.0}}));
   EXPECT_DOUBLE_EQ(law.approach(1.0), 5.0 * std::exp(-0.5));
   EXPECT_EQ(r.laws_using("tip_radius").size(), 5u);
@@ -106,7 +108,7 @@ TEST(LawRegistry, AUserLawIsOneClassAndOneRegistrationLine) {
                InvalidParameter);
   EXPECT_THROW(r.add({"other", "x", {"tip_radius"}, false, false,
                       [](const auto&, const auto&) { return ForceLaw(DmtLaw(1, 1, 1, 0, 0, 1)); }},
-                     {{"tip_radius", "m", 10.0, "R", 0.0, INFINITY, true, ""}}),
+                     {{"tip_radius", "m", 10.0, "R", 0.0, INFINITY, true, "", false, ""}}),
                InvalidParameter);
   EXPECT_THROW(r.add({"third", "x", {"undeclared"}, false, false,
                       [](const auto&, const auto&) { return ForceLaw(DmtLaw(1, 1, 1, 0, 0, 1)); }}),

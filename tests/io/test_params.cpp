@@ -160,7 +160,9 @@ TEST(ParamSetRecords, AFollowerNotGivenTakesAndRecordsTheFollowedValue) {
 TEST(ParamSetRecords, FollowsShowsTheKeyInHelpAndRefusesAnUndeclaredOrOtherKind) {
   ParamSet p = law_like();
   for (const auto& d : p.describe())
-    if (d.key == "departure_hamaker") EXPECT_EQ(d.default_text, "= hamaker");
+    if (d.key == "departure_hamaker") {
+      EXPECT_EQ(d.default_text, "= hamaker");
+    }
   ParamSet q;
   q.real("a", 1.0, "a").unit("m");
   EXPECT_THROW(q.follows("nothing"), std::logic_error);

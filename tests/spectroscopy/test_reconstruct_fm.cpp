@@ -114,10 +114,12 @@ TEST(ReconstructFm, VanDerWaalsForceOnAGeometricGrid) {
       // relative bound over z ≤ 3 nm: 5 % (Sader–Jarvis interpolation formula), 2 % (matrix: discretisation on a
       // grid 1.6 % geometric steps)
       const double bound = method == sp::FmMethod::sader_jarvis ? 0.05 : 0.02;
-      for (std::size_t i = 0; i < r.distance.size(); ++i)
-        if (r.distance[i] <= 3e-9)
+      for (std::size_t i = 0; i < r.distance.size(); ++i) {
+        if (r.distance[i] <= 3e-9) {
           EXPECT_NEAR(r.force[i], vdw_force(r.distance[i]), bound * std::abs(vdw_force(r.distance[i])))
               << sp::to_string(method) << " A = " << a << " z = " << r.distance[i];
+        }
+      }
     }
   }
 }
