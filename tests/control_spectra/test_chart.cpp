@@ -170,7 +170,9 @@ TEST(StabilityChart, MarginMapMatchesDelayMargin) {
     for (int i = 0; i < 4; ++i) {
       const DelayMargin d = delay_margin(f.at(m.x[i], m.y[j]));
       const double v = m.critical_delay[j * 4 + i];
-      if (d.stable_at_reference) EXPECT_DOUBLE_EQ(v, d.upper);
+      if (d.stable_at_reference) {
+        EXPECT_DOUBLE_EQ(v, d.upper);
+      }
       else EXPECT_TRUE(std::isnan(v));
     }
 }

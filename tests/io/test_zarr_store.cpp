@@ -68,7 +68,9 @@ TEST(ZarrStore, ChunksAreCOrderBlocksPaddedWithTheFillValue) {
         for (int b = 0; b < 2; ++b) {
           const int i = 2 * ci + a, j = 2 * cj + b;
           const double got = chunk[2 * a + b];
-          if (i < 5 && j < 3) EXPECT_EQ(got, 10.0 * i + j) << i << "," << j;
+          if (i < 5 && j < 3) {
+            EXPECT_EQ(got, 10.0 * i + j) << i << "," << j;
+          }
           else EXPECT_TRUE(std::isnan(got)) << "padding is the fill value NaN at " << i << "," << j;
         }
     }

@@ -116,7 +116,9 @@ TEST(LawFidelity, EnergyBalanceOfConvergedOrbitsForEveryLaw) {
                   m.drive_work, (m.drive_work - m.viscous_dissipation - m.contact_dissipation) / m.drive_work);
       // per drive period, per unit mass: W = ∫Γcos ωt ẋ dt = ∫2ξω_n ẋ² dt + ∫h ẋ dt
       EXPECT_NEAR(m.drive_work, m.viscous_dissipation + m.contact_dissipation, 1e-9 * std::abs(m.drive_work));
-      if (c.law == "lennard_jones") EXPECT_NEAR(m.contact_dissipation, 0.0, 1e-9 * std::abs(m.drive_work));
+      if (c.law == "lennard_jones") {
+        EXPECT_NEAR(m.contact_dissipation, 0.0, 1e-9 * std::abs(m.drive_work));
+      }
       else EXPECT_GT(m.contact_dissipation, 0.0);
     }
   }

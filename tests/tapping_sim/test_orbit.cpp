@@ -131,12 +131,16 @@ TEST(Orbit, HarmonicsMatchDiscreteFourierTransformOfSampledOrbit) {
     for (int k = 0; k < n; ++k) c += rec.states()[k].position * std::polar(1.0, -2 * std::numbers::pi * h * k / n);
     c /= n;
     // the DFT of a function with kinks (contact) converges as 1/n²: a few 1e-7 here
-    if (h == 0) EXPECT_NEAR(m.offset, c.real(), 1e-6);
+    if (h == 0) {
+      EXPECT_NEAR(m.offset, c.real(), 1e-6);
+    }
     if (h == 1) {
       EXPECT_NEAR(m.amplitude, 2 * std::abs(c), 1e-6);
       EXPECT_NEAR(m.phase, -std::arg(c), 1e-6);
     }
-    if (h >= 2) EXPECT_NEAR(m.harmonics[h - 2], 2 * std::abs(c), 1e-6);
+    if (h >= 2) {
+      EXPECT_NEAR(m.harmonics[h - 2], 2 * std::abs(c), 1e-6);
+    }
   }
   EXPECT_GT(m.harmonics[0], 1e-3);  // contact makes real higher harmonics
 }

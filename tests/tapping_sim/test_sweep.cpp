@@ -35,7 +35,9 @@ TEST_F(HysteresisSweep, ApproachJumpsIntoContactAtGrazing) {
   const double jump = result_->approach_jumps[0];
   EXPECT_NEAR(jump, l_free, SweepOptions{}.jump_tolerance * l_free);  // located at grazing, not at a grid point
   for (const SweepPoint& p : result_->approach) {
-    if (p.separation > l_free) EXPECT_NEAR(p.metrics.amplitude, l_free, 1e-9);  // free response above grazing
+    if (p.separation > l_free) {  // free response above grazing
+      EXPECT_NEAR(p.metrics.amplitude, l_free, 1e-9);
+    }
     EXPECT_TRUE(p.orbit.stable);
   }
 }
@@ -51,7 +53,9 @@ TEST_F(HysteresisSweep, RetractStaysInContactUpToTheFold) {
     EXPECT_TRUE(p.orbit.stable);
     if (p.separation < result_->retract_jumps[0] - 1e-9) {
       EXPECT_LT(p.metrics.min_gap, 0.0);  // contact branch
-      if (p.separation > l_free) EXPECT_GT(p.metrics.amplitude, l_free + 1e-3);  // above the free amplitude
+      if (p.separation > l_free) {  // above the free amplitude
+        EXPECT_GT(p.metrics.amplitude, l_free + 1e-3);
+      }
       // HB tracks this branch to within 0.3 % (docs/theory-tapping.md#hb-accuracy: 0.22 % for the RK4 simulation)
       EXPECT_NEAR(p.hb_amplitude, p.metrics.amplitude, 3e-3 * p.metrics.amplitude);
     } else {
@@ -117,7 +121,9 @@ TEST(Sweep, ContinuationPassesTheFoldWithUnstableMiddleBranch) {
     EXPECT_EQ(p.direction, SweepDirection::continuation);
     if (phase == 0 && !p.orbit.stable) phase = 1;
     if (phase == 1 && p.orbit.stable) phase = 2;
-    if (phase == 0) EXPECT_LT(p.separation, c.folds[0].separation + 1e-9);
+    if (phase == 0) {
+      EXPECT_LT(p.separation, c.folds[0].separation + 1e-9);
+    }
     if (phase == 1) {
       ++unstable;
       EXPECT_GT(p.separation, model.free_amplitude());
