@@ -66,6 +66,21 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
   add_si_alternative(p, "model_rate", SiUnit::Auto, Range::positive());
   p.real("model_delay", 0.1, "Smith model delay tau_hat", Range::non_negative()).unit("T").default_text("= delay");
   add_si_alternative(p, "model_delay", SiUnit::Auto, Range::non_negative());
+  // The records list the keys of the controller in use only (docs/commands.md#recorded-parameters): the Smith
+  // predictor's keys with controller = smith; a, b for the single oscillator; alpha, beta for a bank (finite or
+  // infinite); rejected for a finite bank — of the inner controller (smith_bank) when controller = smith.
+  for (const char* key : {"smith_bank", "smith_structure", "model_plant", "model_rate", "model_delay"})
+    p.applies_when(key, "controller", {"smith"});
+  const auto in_use = [](std::vector<std::string> kinds) {
+    return [kinds = std::move(kinds)](const io::ParamSet& q) {
+      const std::string& c = q.text("controller");
+      const std::string& inner = c == "smith" ? q.text("smith_bank") : c;
+      return std::find(kinds.begin(), kinds.end(), inner) != kinds.end();
+    };
+  };
+  for (const char* key : {"a", "b"}) p.applies_if(key, in_use({"single"}));
+  for (const char* key : {"alpha", "beta"}) p.applies_if(key, in_use({"bank", "infinite"}));
+  p.applies_if("rejected", in_use({"bank"}));
 }
 
 namespace {

@@ -219,6 +219,13 @@ ParamSet& ParamSet::applies_when(const std::string& param, const std::string& ke
   it->second.applies.push_back({key, std::move(values)});
   return *this;
 }
+ParamSet& ParamSet::applies_if(const std::string& param, std::function<bool(const ParamSet&)> condition) {
+  const auto it = entries_.find(param);
+  if (it == entries_.end() || !condition)
+    throw std::logic_error(fmt::format("ParamSet::applies_if: '{}' is not declared or has no condition", param));
+  it->second.applies_if.push_back(std::move(condition));
+  return *this;
+}
 ParamSet& ParamSet::recorded_only_if_given(const std::string& param) {
   const auto it = entries_.find(param);
   if (it == entries_.end())
@@ -597,6 +604,8 @@ bool ParamSet::recorded(const std::string& key) const {
   for (const auto& [on, values] : e.applies)  // a key of another unit system or law than the run's
     if (std::find(values.begin(), values.end(), std::get<std::string>(current(on).value)) == values.end())
       return false;
+  for (const auto& condition : e.applies_if)  // a key of another controller than the run's
+    if (!condition(*this)) return false;
   for (const auto& [other, o] : entries_)
     if (o.only_if_given && o.set && std::find(o.instead_of.begin(), o.instead_of.end(), key) != o.instead_of.end())
       return false;

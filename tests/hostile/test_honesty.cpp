@@ -340,11 +340,17 @@ TEST(HonestyRecords, ComputedDefaultsAreRecordedAsComputed) {
   EXPECT_EQ(side["parameters"]["min_real"], side["results"]["box"]["real_min"]);
   EXPECT_EQ(side["parameters"]["max_imag"], side["results"]["box"]["imag_max"]);
   // control gain / model_delay follow plant_rate / delay
-  r = run_cli("control tf --harmonics 3 --plant-rate 7 --points 20 --output t.csv", dir);
+  r = run_cli("control tf --controller smith --harmonics 3 --plant-rate 7 --points 20 --output t.csv", dir);
   ASSERT_EQ(r.status, 0) << r.err;
   side = nlohmann::json::parse(slurp(dir.path / "t.csv.json"));
   EXPECT_EQ(side["parameters"]["gain"].get<double>(), 7.0);
   EXPECT_EQ(side["parameters"]["model_rate"].get<double>(), 7.0);
+  // a bank without the Smith predictor: its keys did not apply and are not recorded
+  r = run_cli("control tf --harmonics 3 --plant-rate 7 --points 20 --output t.csv", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  side = nlohmann::json::parse(slurp(dir.path / "t.csv.json"));
+  EXPECT_FALSE(side["parameters"].contains("model_rate"));
+  EXPECT_FALSE(side["parameters"].contains("a"));
   // control margin of a Smith predictor: the reference delay is the model delay
   r = run_cli("control margin --controller smith --harmonics 3 --model-delay 0.05 --output m.csv", dir);
   ASSERT_EQ(r.status, 0) << r.err;

@@ -81,6 +81,27 @@ def test_python_replays_from_its_record(path, tmp_path):
     assert len(r) > 0 or path in ("control export", "demo")  # these write files only
 
 
+CONTROLLER_KEYS = {"single": {"a", "b"}, "bank": {"alpha", "beta", "rejected"}, "infinite": {"alpha", "beta"}}
+SMITH_KEYS = {"smith_bank", "smith_structure", "model_plant", "model_rate", "model_delay"}
+
+
+@pytest.mark.parametrize("path", ["control tf", "control margin", "control simulate", "control tune"])
+@pytest.mark.parametrize("kind", ["single", "bank", "infinite", "smith"])
+def test_a_control_record_holds_only_the_controller_in_use_and_replays(path, kind, tmp_path):
+    if (path, kind) == ("control simulate", "smith"):
+        pytest.skip("the Smith predictor is not simulated in the time domain (refused as bad input)")
+    f = make_command(path)
+    r = f(**{**CASES[path](tmp_path), "controller": kind})
+    inner = "bank" if kind == "smith" else kind  # smith_bank's default
+    keys = set(r.params)
+    every = set().union(*CONTROLLER_KEYS.values())
+    assert CONTROLLER_KEYS[inner] <= keys and not (every - CONTROLLER_KEYS[inner]) & keys, sorted(keys)
+    assert (SMITH_KEYS <= keys) if kind == "smith" else not SMITH_KEYS & keys, sorted(keys)
+    again = f(**r.params)
+    assert again.params == r.params
+    same_table(r, again)
+
+
 def test_an_fm_fit_records_the_parameters_it_fitted(tmp_path):
     # the FM default of `parameters` differs from the declared (AM) default: the record names what was fitted
     fit = make_command("spectroscopy fit")

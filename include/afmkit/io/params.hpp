@@ -84,6 +84,10 @@ class ParamSet {
   /// and replays as given. Conditions add up (all must hold). A parameter declared in a group with a condition
   /// (group(name, when_key, when_value)) has that condition.
   ParamSet& applies_when(const std::string& param, const std::string& key, std::vector<std::string> values);
+  /// Parameter `param` (declared before) applies only when `condition` holds of the run's values: a rule
+  /// applies_when cannot say (one of two keys decides, e.g. the controller, or the Smith predictor's inner
+  /// controller when the controller is the Smith predictor). Otherwise as applies_when: left out of the records.
+  ParamSet& applies_if(const std::string& param, std::function<bool(const ParamSet&)> condition);
   /// Records the value a run used for a parameter whose value the command computes or chooses itself
   /// ("automatic", "proven bound", a default that depends on other values): value() and the records give it from
   /// now on; it does not count as given (was_set). Validated as a given value is (InvalidParameter naming the key).
@@ -182,6 +186,7 @@ class ParamSet {
     std::vector<std::string> instead_of;  // given: these parameters are not recorded
     bool used = false;                    // value recorded by record_used
     std::vector<std::pair<std::string, std::vector<std::string>>> applies;  // (text key, values): applies_when
+    std::vector<std::function<bool(const ParamSet&)>> applies_if;           // applies_if
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;
