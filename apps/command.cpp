@@ -37,11 +37,14 @@ CLI::App& add_command_group(CLI::App& parent, const std::string& name, const std
   return *group;
 }
 
+void add_json_flag(io::ParamSet& p, const std::string& help) { p.flag("json", false, help); }
+
+void add_quiet_flag(io::ParamSet& p, const std::string& help) { p.flag("quiet", false, help); }
+
 void add_output_params(io::ParamSet& p, const std::string& default_path, const std::string& what) {
-  p.group("Output")
-      .flag("json", false, "print the results as JSON to standard output instead of a summary line (with the table "
-                           "itself when no file is written)")
-      .file("output", default_path, what + " CSV path (JSON sidecar describing every column next to it); empty: no file")
+  p.group("Output");
+  add_json_flag(p);
+  p.file("output", default_path, what + " CSV path (JSON sidecar describing every column next to it); empty: no file")
       .writes(io::table_and_sidecar);
 }
 

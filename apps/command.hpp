@@ -96,6 +96,12 @@ void require_answer(const nlohmann::json& results);
 /// The "Output" group every table command has: `output` (CSV path, default `default_path`; empty: no file) and
 /// the `json` flag.
 void add_output_params(io::ParamSet& p, const std::string& default_path, const std::string& what);
+/// The `json` flag alone (a command whose output is not a table declares it here, once for all commands).
+void add_json_flag(io::ParamSet& p, const std::string& help = "print the results as JSON to standard output instead "
+                                                              "of a summary line (with the table itself when no file "
+                                                              "is written)");
+/// The `quiet` flag of the commands that show progress on standard error.
+void add_quiet_flag(io::ParamSet& p, const std::string& help = "no progress output");
 
 /// A command's table: written to the --output file when one is given, else (with --json) kept for the printed
 /// document. finish() commits the file and prints the summary.

@@ -236,11 +236,11 @@ void add_control_chart(CLI::App& control) {
         add_si_alternative(p, "delays", SiUnit::Auto, Range::non_negative());
         add_window_params(p, kSingleWindow, kCouplingsWindow);
         p.integer("x_points", 200, "grid points along x", 2, 100000)
-            .integer("y_points", 200, "grid points along y", 2, 100000)
-            .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024);
+            .integer("y_points", 200, "grid points along y", 2, 100000);
+        add_threads_param(p);
         add_output_params(p, "out/control_chart.csv", "grid");
-        p.flag("progress", true, "show progress on stderr")
-            .file("boundaries_output", "out/control_chart_boundaries.csv",
+        add_progress_flag(p);
+        p.file("boundaries_output", "out/control_chart_boundaries.csv",
                   "boundary curves CSV path (JSON sidecar next to it); empty: no file (with --json: in the printed "
                   "document)")
             .writes(io::table_and_sidecar);

@@ -131,8 +131,8 @@ void register_control_export(CLI::App& control) {
                                         "0: none (a target holds 12 bytes per sample in float, 16 in double)", 0, 1000000)
             .integer("target_memory", 0, "bytes available for one filter (coefficients + state + handle); 0: no "
                                          "limit", 0, 1099511627776L)
-            .unit("bytes")
-            .flag("json", false, "print the summary as JSON");
+            .unit("bytes");
+        add_json_flag(p, "print the summary as JSON");
       },
       with_si_inputs(run_export));
 }

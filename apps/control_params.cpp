@@ -17,6 +17,14 @@ namespace afmkit::cli {
 
 using io::Range;
 
+void add_coupling_alpha(io::ParamSet& p) { p.real("alpha", 0.1, "coupling alpha of eq. (20)").unit("Omega"); }
+
+void add_coupling_beta(io::ParamSet& p) { p.real("beta", -0.1, "coupling beta of eq. (20)").unit("Omega"); }
+
+void add_threads_param(io::ParamSet& p) { p.integer("threads", 0, "OpenMP threads (0: default)", 0, 1024); }
+
+void add_progress_flag(io::ParamSet& p) { p.flag("progress", true, "show progress on stderr"); }
+
 void add_control_params(io::ParamSet& p, long max_harmonics) {
   p.group("Controller");
   p.text("controller", "bank", "controller: single oscillator (eqs. 5-6), bank of N oscillators (eq. 15), "
@@ -31,11 +39,10 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
                 ? "number N of oscillators of the bank (eq. 15); cost O(N) per frequency"
                 : "number N of oscillators of the bank (eq. 15); cost O(N) per characteristic evaluation, "
                   "O(N^2) per spectrum / per simulated period",
-            1, max_harmonics)
-      .real("alpha", 0.1, "coupling alpha of eq. (20)")
-      .unit("Omega");
+            1, max_harmonics);
+  add_coupling_alpha(p);
   add_si_alternative(p, "alpha");
-  p.real("beta", -0.1, "coupling beta of eq. (20)").unit("Omega");
+  add_coupling_beta(p);
   add_si_alternative(p, "beta");
   p.real("a", 0.5, "coupling a of the single oscillator (eq. 5)").unit("Omega");
   add_si_alternative(p, "a");

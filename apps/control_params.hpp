@@ -29,6 +29,12 @@ inline constexpr long kMaxHarmonicsSpectra = 1000;
 
 /// Adds the shared parameters (with their units) to `params`; `max_harmonics` bounds `harmonics` (and `rejected`).
 void add_control_params(io::ParamSet& params, long max_harmonics = kMaxHarmonicsSpectra);
+/// The couplings alpha and beta of the bank (eq. 20), in units of Omega: shared by the control commands and scan.
+void add_coupling_alpha(io::ParamSet& params);
+void add_coupling_beta(io::ParamSet& params);
+/// `threads` (OpenMP threads of a grid computation) and the `progress` flag, shared by chart and tune.
+void add_threads_param(io::ParamSet& params);
+void add_progress_flag(io::ParamSet& params);
 /// SI alternatives of the keys in rotation units (docs/commands.md#control-si-keys): for `key` in units of Omega,
 /// `key_rad_per_s` [rad/s] (or, with SiUnit::Hz, `key_hz` [Hz]: 2 pi f); in units of T, `key_seconds` [s]; for
 /// rotation_frequency [rad/s], `rotation_frequency_hz`. Declared right after `key` (same kind: real or reals), counted

@@ -143,10 +143,10 @@ void add_control_tune(CLI::App& control) {
             .integer("gain_points", 3, "rho grid points (geometric)", 1, 10000);
         add_window_params(p, kSingleWindow, kCouplingsWindow);
         p.integer("coarse_points", 12, "coarse grid points per axis", 2, 10000)
-            .integer("max_evaluations", 150, "Nelder-Mead budget", 0, 1000000)
-            .integer("threads", 0, "OpenMP threads (0: default)", 0, 1024);
+            .integer("max_evaluations", 150, "Nelder-Mead budget", 0, 1000000);
+        add_threads_param(p);
         add_output_params(p, "out/control_tune.csv", "coarse-grid");
-        p.flag("progress", true, "show progress on stderr");
+        add_progress_flag(p);
       },
       with_si_inputs(run_tune));
 }

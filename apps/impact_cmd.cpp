@@ -23,6 +23,7 @@
 #include "afmkit/io/quantity.hpp"
 #include "command.hpp"
 #include "commands.hpp"
+#include "described_params.hpp"
 #include "law_params.hpp"
 
 namespace afmkit::cli {
@@ -68,15 +69,9 @@ void add_impact_params(io::ParamSet& p) {
       .unit("nN")
       .real("force2", 0.0, "constant external force F2 on body 2", Range::any())
       .unit("nN")
-      .group("Numerics")
-      .text("method", "automatic", "solver: automatic (closed form for linear laws), closed_form, integrator",
-            {"automatic", "closed_form", "integrator"})
-      .real("relative_tolerance", 1e-11, "integrator relative tolerance", {0.0, 1e-2, true, false})
-      .unit("dimensionless")
-      .real("absolute_tolerance", 1e-13, "integrator absolute tolerance of the scaled state", Range::positive())
-      .unit("dimensionless")
-      .integer("points", 400, "time-history samples written with --output (>= 2; events are added)", 2, 10000000)
-      ;
+      .group("Numerics");
+  declare_fields(p, impact::ImpactOptions{});  // method, relative_tolerance, absolute_tolerance
+  p.integer("points", 400, "time-history samples written with --output (>= 2; events are added)", 2, 10000000);
   add_output_params(p, "", "time history");
   add_law_params(p, impact::LawRegistry::builtin(), "hysteresis");
 }
@@ -198,12 +193,7 @@ void print_summary(const impact::ImpactResult& r, const impact::ForceLaw& law) {
 void run_impact(const io::ParamSet& p, Captured* capture) {
   const impact::ImpactProblem problem = problem_from(p, capture);
   impact::ImpactOptions options;
-  const std::string& method = p.text("method");
-  options.method = method == "closed_form" ? impact::ImpactMethod::closed_form
-                   : method == "integrator" ? impact::ImpactMethod::integrator
-                                            : impact::ImpactMethod::automatic;
-  options.relative_tolerance = p.real("relative_tolerance");
-  options.absolute_tolerance = p.real("absolute_tolerance");
+  read_fields(p, options);  // method, tolerances
   CommandOutput out(p, capture, "impact");
   options.history_points = out.keeps_rows() ? p.integer("points") : 0;
   if (out.writes_file()) check_disk_space(out.path(), options.history_points);

@@ -17,6 +17,7 @@
 #include "afmkit/scan/gsf.hpp"
 #include "afmkit/scan/png16.hpp"
 #include "afmkit/scan/sample_generators.hpp"
+#include "control_params.hpp"
 
 namespace afmkit::cli {
 
@@ -199,12 +200,10 @@ void add_scan_params(io::ParamSet& p) {
       .integer("noise_seed", 1, "seed of the detector noise", 0, 4294967295L)
       .group("Controller (seed 2, eqs. 15, 6, 20)")
       .text("control", "on", "the harmonic-rejection controller in the loop", {"on", "off"})
-      .integer("harmonics", 10, "oscillators N of the bank (N x spindle_frequency below sample_rate / 2)", 1, 10000)
-      .real("alpha", 0.1, "coupling alpha (eq. 20)", io::Range::any())
-      .unit("Omega")
-      .real("beta", -0.1, "coupling beta (eq. 20)", io::Range::any())
-      .unit("Omega")
-      .real("gain", 0.0, "controller gain K (0: the design rule K = bandwidth)", non_negative)
+      .integer("harmonics", 10, "oscillators N of the bank (N x spindle_frequency below sample_rate / 2)", 1, 10000);
+  add_coupling_alpha(p);  // as the control commands declare them (control_params.hpp)
+  add_coupling_beta(p);
+  p.real("gain", 0.0, "controller gain K (0: the design rule K = bandwidth)", non_negative)
       .unit("rad/s")
       .follows("bandwidth")  // recorded as the gain used
       .group("Reconstruction (docs/scan.md#reconstruction)")

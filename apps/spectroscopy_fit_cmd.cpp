@@ -22,6 +22,7 @@
 #include "afmkit/spectroscopy/fit_input.hpp"
 #include "command.hpp"
 #include "commands.hpp"
+#include "described_params.hpp"
 #include "law_params.hpp"
 #include "python_launch.hpp"
 
@@ -117,15 +118,7 @@ spectroscopy::FitOptions fit_options(const io::ParamSet& p, spectroscopy::FitMod
                                                  : spectroscopy::CurveDirection::approach;
   o.amplitude_noise = p.real("amplitude_noise");
   o.phase_noise = p.real("phase_noise") * kDeg;
-  o.huber = p.real("huber");
-  o.fd_step = p.real("fd_step");
-  o.max_evaluations = static_cast<int>(p.integer("max_evaluations"));
-  o.tolerance = p.real("tolerance");
-  o.integrator_tolerance = p.real("integrator_tolerance");
-  o.shooting_tolerance = p.real("shooting_tolerance");
-  o.correlation_limit = p.real("correlation_limit");
-  o.condition_limit = p.real("condition_limit");
-  o.flat_column = p.real("flat_column");
+  read_fields(p, o);  // huber … flat_column
   o.validate();
   return o;
 }
@@ -426,33 +419,8 @@ void register_spectroscopy_fit(CLI::App& spectroscopy) {
             .unit("dimensionless")
             .real("phase_noise", 0.0, "σ of the measured phase (0: estimated from the data's scatter)",
                   io::Range::non_negative())
-            .unit("deg")
-            .real("huber", 5.0, "Huber's loss beyond this many σ: a point far off (another branch next to a jump) "
-                  "pulls linearly; 0: plain least squares", io::Range::non_negative())
-            .unit("dimensionless")
-            .real("fd_step", 1e-3, "forward-difference step of the Jacobian in the transformed parameters",
-                  io::Range::closed(1e-8, 0.1))
-            .unit("dimensionless")
-            .integer("max_evaluations", 100, "budget of forward-model evaluations (curves, Jacobian columns included)",
-                     2, 1000000)
-            .real("tolerance", 1e-4, "Levenberg–Marquardt ftol and xtol (relative reduction of the cost, relative step)",
-                  io::Range::closed(1e-15, 0.1))
-            .unit("dimensionless")
-            .real("integrator_tolerance", 1e-9, "relative tolerance of the orbits' integrator",
-                  io::Range::closed(1e-14, 1e-4))
-            .unit("dimensionless")
-            .real("shooting_tolerance", 1e-10, "tolerance of the orbits' Newton shooting",
-                  io::Range::closed(1e-14, 1e-4))
-            .unit("dimensionless")
-            .real("correlation_limit", 0.99, "warn when |correlation| of two parameters exceeds this",
-                  {0.0, 1.0, true, true})
-            .unit("dimensionless")
-            .real("condition_limit", 1e10, "warn when the condition number of the scaled JᵀWJ exceeds this",
-                  {1.0, 1e300, true, false})
-            .unit("dimensionless")
-            .real("flat_column", 1e-3, "a parameter whose weighted Jacobian column is shorter is flat (not identifiable)",
-                  io::Range::closed(0.0, 1.0))
-            .unit("dimensionless");
+            .unit("deg");
+        declare_fields(p, spectroscopy::FitOptions{});  // huber … flat_column, as the library declares them
         add_law_params(p, impact::LawRegistry::builtin(), "dmt");
         add_output_params(p, "out/spectroscopy_fit.csv", "measured and fitted curve");
         p.file("plot", "", "PNG of data vs fit (Matplotlib, through the Python package; needs output); empty: none")

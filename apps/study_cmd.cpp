@@ -109,8 +109,8 @@ void register_study(CLI::App& app) {
             .default_text("from chunk_seconds")
             .file("netcdf", "", "also write the results to this NetCDF file when the study is complete")
             .writes()
-            .default_text("none")
-            .flag("quiet", false, "no progress lines (otherwise one line per second on standard error)");
+            .default_text("none");
+        add_quiet_flag(p, "no progress lines (otherwise one line per second on standard error)");
       },
       run_study);
 }

@@ -166,7 +166,7 @@ void register_tapping_fm(CLI::App& tapping) {
         add_tapping_sim_params(p);
         add_tapping_fm_params(p);
         add_output_params(p, "out/tapping_fm.csv", "FM approach");
-        p.flag("quiet", false, "no progress output");
+        add_quiet_flag(p);
       },
       run_fm);
 }

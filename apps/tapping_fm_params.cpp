@@ -40,16 +40,9 @@ void add_tapping_fm_params(io::ParamSet& p) {
       .real("separation_max", 10.0, "largest separation, where the approach starts; > separation_min",
             io::Range::closed(-1e6, 1e6))
       .unit(kLengthUnit)
-      .integer("points", 71, "separations of the approach (>= 2)", 2, 10000000)
-      .reals("separations", {}, "explicit separations instead of the uniform grid (any order; run from the largest)",
-             io::Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .default_text("none: points on [separation_min, separation_max]")
-      .only_if_given(uniform_grid_keys())  // the record of a run gives the list or the grid it used
-      .file("separations_file", "",
-            "file with the separations instead (numbers separated by commas, spaces or lines; # comments)")
-      .only_if_given(uniform_grid_keys())
-      .text("axis", "separation",
+      .integer("points", 71, "separations of the approach (>= 2)", 2, 10000000);
+  add_separation_list_params(p, "explicit separations instead of the uniform grid (any order; run from the largest)");
+  p.text("axis", "separation",
             "what separation_min, separation_max and separations set: separation (the rest position l, stepped as an "
             "instrument's piezo) or min_gap (the tip-sample distance at the lower turning point; l is solved for)",
             {"separation", "min_gap"})

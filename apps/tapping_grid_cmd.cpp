@@ -194,8 +194,8 @@ void register_tapping_grid(CLI::App& tapping) {
             .file("store", "out/tapping_grid.zarr",
                   "Zarr store the grid is written to (a folder, complete or not at all; an existing afmkit store "
                   "there is replaced, anything else refused)")
-            .writes([](const std::string& store) { return std::vector<io::WrittenPath>{{store, true}}; })
-            .flag("quiet", false, "no progress output");
+            .writes([](const std::string& store) { return std::vector<io::WrittenPath>{{store, true}}; });
+        add_quiet_flag(p);
       },
       run_grid);
 }

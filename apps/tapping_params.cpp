@@ -79,6 +79,16 @@ namespace {
 Range below(double hi) { return {0.0, hi, true, false}; }
 }  // namespace
 
+void add_separation_list_params(io::ParamSet& p, const std::string& help) {
+  p.reals("separations", {}, help, Range::closed(-1e6, 1e6))
+      .unit(kLengthUnit)
+      .default_text("none: points on [separation_min, separation_max]")
+      .only_if_given(uniform_grid_keys())  // the record of a run gives the list or the grid it used
+      .file("separations_file", "",
+            "file with the separations instead (numbers separated by commas, spaces or lines; # comments)")
+      .only_if_given(uniform_grid_keys());
+}
+
 void add_tapping_model_params(io::ParamSet& p) {
   p.group("Model");
   p.text("units", "normalised", "unit system of the model parameters and results", {"normalised", "physical"})

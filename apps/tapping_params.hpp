@@ -17,6 +17,10 @@ inline constexpr const char* kLengthUnit = "nm (physical) or L (normalised)";
 /// a run given a list records the list, not the grid it did not use.
 inline std::vector<std::string> uniform_grid_keys() { return {"separation_min", "separation_max", "points"}; }
 
+/// `separations` (an explicit list, described by `help`) and `separations_file`, either replacing the uniform grid
+/// (uniform_grid_keys) in the records; shared by tapping sweep and tapping fm.
+void add_separation_list_params(io::ParamSet& p, const std::string& help);
+
 /// units, cantilever, drive, force law, separation.
 void add_tapping_model_params(io::ParamSet& p);
 /// The normalised model at the parameter `separation` (nm in physical units). `law_object`: the caller's law of

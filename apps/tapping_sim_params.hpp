@@ -8,7 +8,10 @@
 
 namespace afmkit::cli {
 
+/// The "Numerics" group: the fields of tapping::ShootingOptions (with its SimulationOptions) and
+/// tapping::TransientOptions, as their describe() declares them (apps/described_params.hpp).
 void add_tapping_sim_params(io::ParamSet& p);
+/// The resolved values of those fields (read_fields).
 tapping::ShootingOptions shooting_options_from(const io::ParamSet& p);
 tapping::TransientOptions transient_options_from(const io::ParamSet& p);
 

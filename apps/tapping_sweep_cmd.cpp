@@ -411,18 +411,11 @@ void register_tapping_sweep(CLI::App& tapping) {
             .unit(kLengthUnit)
             .real("separation_max", 15.0, "largest separation of the sweep, > separation_min", io::Range::any())
             .unit(kLengthUnit)
-            .integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000)
-            .reals("separations", {},
-                   "explicit separations of the instrument sweep instead of the uniform grid (any order, e.g. "
-                   "20,18,16,15.5); the continuation runs between the smallest and the largest",
-                   io::Range::closed(-1e6, 1e6))
-            .unit(kLengthUnit)
-            .default_text("none: points on [separation_min, separation_max]")
-            .only_if_given(uniform_grid_keys())  // the record of a run gives the list or the grid it used
-            .file("separations_file", "",
-                  "file with the separations instead (numbers separated by commas, spaces or lines; # comments)")
-            .only_if_given(uniform_grid_keys())
-            .text("mode", "instrument",
+            .integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000);
+        add_separation_list_params(p, "explicit separations of the instrument sweep instead of the uniform grid (any "
+                                      "order, e.g. 20,18,16,15.5); the continuation runs between the smallest and the "
+                                      "largest");
+        p.text("mode", "instrument",
                   "instrument (approach then retract, jumps and hysteresis), continuation (pseudo-arclength through "
                   "folds, unstable branches) or both",
                   {"instrument", "continuation", "both"})
@@ -446,7 +439,7 @@ void register_tapping_sweep(CLI::App& tapping) {
         for (const char* key : {"separation_min", "separation_max", "separations", "separations_file"})
           p.applies_when(key, "parameter", {"separation"});
         add_output_params(p, "out/tapping_sweep.csv", "sweep");
-        p.flag("quiet", false, "no progress output");
+        add_quiet_flag(p);
       },
       run_sweep);
 }

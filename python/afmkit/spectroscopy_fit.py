@@ -122,18 +122,23 @@ def _settings(spring_constant, resonance_frequency, quality_factor, free_amplitu
                 drive_frequency=0.0 if drive_frequency is None else float(drive_frequency))
 
 
+# The solver's settings (huber, fd_step, max_evaluations, tolerance, integrator_tolerance, shooting_tolerance,
+# correlation_limit, condition_limit, flat_column) and their defaults: declared once, by the library's
+# spectroscopy::FitOptions (the command line's `afmkit spectroscopy fit` has the same), which also checks their ranges.
+_SOLVER_DEFAULTS = _afmkit.spectroscopy_fit_solver_defaults()
+
+
 def _options(law="dmt", parameters=DEFAULT_PARAMETERS, initial=None, fixed=None, direction="approach",
-             huber=5.0, force_curve="", allow_energy_gain=False, fd_step=1e-3, max_evaluations=100, tolerance=1e-4,
-             integrator_tolerance=1e-9, shooting_tolerance=1e-10, correlation_limit=0.99, condition_limit=1e10,
-             flat_column=1e-3, parallel=True) -> dict:
+             force_curve="", allow_energy_gain=False, parallel=True, **solver) -> dict:
     """The options :func:`fit` and :func:`fit_fm` share, with their defaults (docs/fitting.md)."""
+    for key in solver:
+        if key not in _SOLVER_DEFAULTS:
+            raise TypeError(f"fit() got an unexpected keyword argument '{key}'")
+    # each setting as the type of its default (an integer count may be given as 100.0)
+    settings = {key: type(default)(solver.get(key, default)) for key, default in _SOLVER_DEFAULTS.items()}
     return dict(law=str(law), parameters=[str(p) for p in parameters], initial=dict(initial or {}),
-                fixed=dict(fixed or {}), direction=str(direction), huber=float(huber), force_curve=str(force_curve),
-                allow_energy_gain=bool(allow_energy_gain), fd_step=float(fd_step),
-                max_evaluations=int(max_evaluations), tolerance=float(tolerance),
-                integrator_tolerance=float(integrator_tolerance), shooting_tolerance=float(shooting_tolerance),
-                correlation_limit=float(correlation_limit), condition_limit=float(condition_limit),
-                flat_column=float(flat_column), parallel=bool(parallel))
+                fixed=dict(fixed or {}), direction=str(direction), force_curve=str(force_curve),
+                allow_energy_gain=bool(allow_energy_gain), parallel=bool(parallel), **settings)
 
 
 def fit(distance, amplitude, phase=None, *, spring_constant, resonance_frequency, quality_factor, free_amplitude,

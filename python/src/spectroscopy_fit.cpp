@@ -12,6 +12,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
 #include "bindings.hpp"
+#include "described_fields.hpp"
 #include "interrupts.hpp"
 #include "numpy_arrays.hpp"
 
@@ -45,15 +46,7 @@ spectroscopy::FitOptions options_of(const py::dict& d) {
   o.force_curve = get("force_curve").cast<std::string>();
   o.allow_energy_gain = get("allow_energy_gain").cast<bool>();
   o.direction = direction_of(get("direction").cast<std::string>());
-  o.huber = get("huber").cast<double>();
-  o.fd_step = get("fd_step").cast<double>();
-  o.max_evaluations = get("max_evaluations").cast<int>();
-  o.tolerance = get("tolerance").cast<double>();
-  o.integrator_tolerance = get("integrator_tolerance").cast<double>();
-  o.shooting_tolerance = get("shooting_tolerance").cast<double>();
-  o.correlation_limit = get("correlation_limit").cast<double>();
-  o.condition_limit = get("condition_limit").cast<double>();
-  o.flat_column = get("flat_column").cast<double>();
+  read_fields(d, o);  // huber … flat_column: FitOptions::describe
   o.parallel = get("parallel").cast<bool>();
   return o;
 }
@@ -222,6 +215,9 @@ void bind_spectroscopy_fit(py::module_& m) {
         py::arg("spring_constant"), py::arg("resonance_frequency"), py::arg("quality_factor"),
         py::arg("free_amplitude"), py::arg("drive_frequency"), py::arg("amplitude_noise"), py::arg("phase_noise"),
         py::arg("options"), "The law fit of `afmkit spectroscopy fit` (SI units): use afmkit.spectroscopy_fit.fit.");
+  m.def("spectroscopy_fit_solver_defaults", [] { return field_defaults(spectroscopy::FitOptions{}); },
+        "The fit's solver settings (huber … flat_column) and their defaults, as spectroscopy::FitOptions declares "
+        "them.");
   m.def("spectroscopy_predict", &predict, py::arg("distance"), py::arg("law"), py::arg("values"),
         py::arg("calibration"), py::arg("force_curve"), py::arg("allow_energy_gain"), py::arg("spring_constant"),
         py::arg("resonance_frequency"), py::arg("quality_factor"), py::arg("free_amplitude"),

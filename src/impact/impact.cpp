@@ -190,9 +190,7 @@ void require_finite_result(const ImpactResult& r) {
 }  // namespace
 
 ImpactResult simulate_impact(const ImpactProblem& problem, const ImpactOptions& options) {
-  validate::require(options.relative_tolerance > 0 && options.relative_tolerance <= 1e-2, "relative_tolerance",
-                    options.relative_tolerance, "in (0, 1e-2]");
-  validate::positive("absolute_tolerance", options.absolute_tolerance);
+  check_fields(options);  // method, tolerances: the ranges ImpactOptions::describe declares
   validate::in_range("max_steps", options.max_steps, 1L, 1'000'000'000L);
   validate::non_negative("max_time", options.max_time);
   if (options.history_points != 0) validate::in_range("history_points", options.history_points, 2L, 1'000'000'000L);

@@ -121,21 +121,6 @@ void check_toml_nesting(std::string_view text, const std::string& origin) {
 }
 }  // namespace
 
-bool Range::contains(double v) const {
-  if (!std::isfinite(v)) return false;
-  bool ok_lo = lo_open ? v > lo : v >= lo;
-  bool ok_hi = hi_open ? v < hi : v <= hi;
-  return ok_lo && ok_hi;
-}
-
-std::string Range::describe() const {
-  bool has_lo = lo > -1e307, has_hi = hi < 1e307;
-  if (has_lo && has_hi) return fmt::format("in {}{:g}, {:g}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
-  if (has_lo) return fmt::format("{} {:g} (finite)", lo_open ? ">" : ">=", lo);
-  if (has_hi) return fmt::format("{} {:g} (finite)", hi_open ? "<" : "<=", hi);
-  return "a finite number";
-}
-
 ParamSet::Entry ParamSet::make_entry(Value value, const std::string& help, Range range) {
   Entry e;
   e.value = std::move(value);
@@ -144,11 +129,13 @@ ParamSet::Entry ParamSet::make_entry(Value value, const std::string& help, Range
   return e;
 }
 
-void ParamSet::declare(const std::string& key, Entry e) {
+void ParamSet::declare(const std::string& key, Entry e, const std::source_location& where) {
   e.group = group_;
   if (const auto c = group_conditions_.find(group_); c != group_conditions_.end())
     e.applies.push_back({c->second.first, {c->second.second}});
-  if (!entries_.count(key)) order_.push_back(key);
+  if (const auto old = entries_.find(key); old == entries_.end()) order_.push_back(key);
+  else e.declared_at = old->second.declared_at;  // declared again: both places are kept (the test names them)
+  e.declared_at.push_back(fmt::format("{}:{}", where.file_name(), where.line()));
   entries_[key] = std::move(e);
   last_ = key;
 }
@@ -262,36 +249,40 @@ ParamSet& ParamSet::unit(const std::string& unit) {
   return *this;
 }
 const std::string& ParamSet::unit_of(const std::string& key) const& { return entry(key).unit; }
-ParamSet& ParamSet::real(const std::string& key, double def, const std::string& help, Range range) {
-  declare(key, make_entry(def, help, range));
+ParamSet& ParamSet::real(const std::string& key, double def, const std::string& help, Range range,
+                         std::source_location where) {
+  declare(key, make_entry(def, help, range), where);
   return *this;
 }
-ParamSet& ParamSet::integer(const std::string& key, long def, const std::string& help, long lo, long hi) {
+ParamSet& ParamSet::integer(const std::string& key, long def, const std::string& help, long lo, long hi,
+                            std::source_location where) {
   Entry e = make_entry(def, help, Range::any());
   e.unit = "count";  // a number of things, unless unit() says otherwise
   e.ilo = lo;
   e.ihi = hi;
-  declare(key, std::move(e));
+  declare(key, std::move(e), where);
   return *this;
 }
 ParamSet& ParamSet::text(const std::string& key, const std::string& def, const std::string& help,
-                         std::vector<std::string> choices) {
+                         std::vector<std::string> choices, std::source_location where) {
   Entry e = make_entry(def, help, Range::any());
   e.choices = std::move(choices);
-  declare(key, std::move(e));
+  declare(key, std::move(e), where);
   return *this;
 }
-ParamSet& ParamSet::file(const std::string& key, const std::string& def, const std::string& help) {
-  text(key, def, help);
+ParamSet& ParamSet::file(const std::string& key, const std::string& def, const std::string& help,
+                         std::source_location where) {
+  text(key, def, help, {}, where);
   entries_[key].is_file = true;
   return *this;
 }
-ParamSet& ParamSet::flag(const std::string& key, bool def, const std::string& help) {
-  declare(key, make_entry(def, help, Range::any()));
+ParamSet& ParamSet::flag(const std::string& key, bool def, const std::string& help, std::source_location where) {
+  declare(key, make_entry(def, help, Range::any()), where);
   return *this;
 }
-ParamSet& ParamSet::reals(const std::string& key, std::vector<double> def, const std::string& help, Range range) {
-  declare(key, make_entry(std::move(def), help, range));
+ParamSet& ParamSet::reals(const std::string& key, std::vector<double> def, const std::string& help, Range range,
+                          std::source_location where) {
+  declare(key, make_entry(std::move(def), help, range), where);
   return *this;
 }
 
@@ -440,7 +431,7 @@ std::vector<ParamSet::Description> ParamSet::describe() const {
   std::vector<Description> out;
   for (const auto& key : order_) {
     const Entry& e = entries_.at(key);
-    Description d{key, "", e.value, e.default_text, e.help, e.unit, "", e.group, e.choices, e.follows};
+    Description d{key, "", e.value, e.default_text, e.help, e.unit, "", e.group, e.choices, e.follows, e.declared_at};
     switch (e.value.index()) {
       case 0: d.kind = "real"; d.allowed = e.range.describe(); break;
       case 1: d.kind = "integer"; d.allowed = fmt::format("integer in [{}, {}]", e.ilo, e.ihi); break;

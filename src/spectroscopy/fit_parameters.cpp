@@ -133,19 +133,7 @@ void FitOptions::validate() const {
   validate::non_negative("phase_noise", phase_noise);
   validate::non_negative("frequency_shift_noise", frequency_shift_noise);
   validate::non_negative("dissipation_noise", dissipation_noise);
-  validate::non_negative("huber", huber);
-  validate::require(fd_step >= 1e-8 && fd_step <= 0.1, "fd_step", fd_step, "in [1e-8, 0.1]");
-  validate::require(max_evaluations >= 2 && max_evaluations <= 1000000, "max_evaluations", max_evaluations,
-                    "in [2, 1000000]");
-  validate::require(tolerance >= 1e-15 && tolerance <= 0.1, "tolerance", tolerance, "in [1e-15, 0.1]");
-  validate::require(correlation_limit > 0.0 && correlation_limit < 1.0, "correlation_limit", correlation_limit,
-                    "in (0, 1)");
-  validate::require(integrator_tolerance >= 1e-14 && integrator_tolerance <= 1e-4, "integrator_tolerance",
-                    integrator_tolerance, "in [1e-14, 1e-4]");
-  validate::require(shooting_tolerance >= 1e-14 && shooting_tolerance <= 1e-4, "shooting_tolerance",
-                    shooting_tolerance, "in [1e-14, 1e-4]");
-  validate::require(flat_column >= 0.0 && flat_column <= 1.0, "flat_column", flat_column, "in [0, 1]");
-  validate::require(condition_limit > 1.0, "condition_limit", condition_limit, "> 1");
+  check_fields(*this);  // the ranges describe() declares
 }
 
 bool is_calibration(const std::string& name, FitMode mode) {

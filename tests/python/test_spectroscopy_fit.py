@@ -1,6 +1,7 @@
 """afmkit.spectroscopy_fit on NumPy arrays (SI units): synthetic DMT + vdW data made by afmkit's own forward model
 with known parameters and noise (fixed seed) are fitted back within their standard errors; a parameter the data
 do not depend on is reported; bad input raises InvalidParameter naming the parameter; the plot is a PNG."""
+import inspect
 import os
 import subprocess
 
@@ -87,6 +88,26 @@ def test_bad_input_names_the_parameter():
         sf.fit(z, a, None, parameters=["viscosity"], **SETTINGS)
     with pytest.raises(afmkit.InvalidParameter, match="direction"):
         sf.fit(z, a, None, direction="sideways", **SETTINGS)
+
+
+def test_the_solver_settings_are_declared_once():
+    # the NumPy function and the command take the solver's settings and defaults from spectroscopy::FitOptions
+    defaults = sf._SOLVER_DEFAULTS
+    assert set(defaults) == {"huber", "fd_step", "max_evaluations", "tolerance", "integrator_tolerance",
+                             "shooting_tolerance", "correlation_limit", "condition_limit", "flat_column"}
+    signature = inspect.signature(sf.run).parameters  # the command `afmkit spectroscopy fit`
+    for key, value in defaults.items():
+        assert signature[key].default == value, key
+    assert isinstance(defaults["max_evaluations"], int)
+    # the library checks the declared range, naming the key
+    z = np.linspace(30e-9, 20e-9, 5)
+    a = np.full(5, 10e-9)
+    with pytest.raises(afmkit.InvalidParameter, match=r"huber = -1 is out of range: must be >= 0"):
+        sf.fit(z, a, None, huber=-1, **SETTINGS)
+    with pytest.raises(afmkit.InvalidParameter, match=r"max_evaluations = 1 is out of range"):
+        sf.fit(z, a, None, max_evaluations=1.0, **SETTINGS)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'hubert'"):
+        sf.fit(z, a, None, hubert=1.0, **SETTINGS)
 
 
 def test_the_command_line_plot_is_drawn_by_matplotlib(tmp_path):

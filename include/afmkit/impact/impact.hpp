@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "afmkit/core/describe.hpp"
+
 #include "afmkit/impact/force_law.hpp"
 
 namespace afmkit::impact {
@@ -102,6 +104,20 @@ struct ImpactOptions {
   /// ImpactResult::history, so memory does not grow with history_points. Without it the history is stored and
   /// simulate_impact refuses (InvalidParameter "history_points") a history larger than the available memory.
   std::function<void(const ImpactSample&)> on_sample{};
+
+  /// The settings a user chooses, declared once (core/describe.hpp): key, help, unit, range; the defaults are the
+  /// initializers above. simulate_impact checks them (check_fields) with the rest.
+  template <class Archive, class Self>
+  static void describe(Archive& a, Self& o) {
+    a.choice("method", o.method, "solver: automatic (closed form for linear laws), closed_form, integrator",
+             {{"automatic", ImpactMethod::automatic},
+              {"closed_form", ImpactMethod::closed_form},
+              {"integrator", ImpactMethod::integrator}});
+    a.real("relative_tolerance", o.relative_tolerance, "integrator relative tolerance", "dimensionless",
+           Range{0.0, 1e-2, true, false});
+    a.real("absolute_tolerance", o.absolute_tolerance, "integrator absolute tolerance of the scaled state",
+           "dimensionless", Range::positive());
+  }
 };
 
 enum class ImpactOutcome {

@@ -7,11 +7,14 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <source_location>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include <nlohmann/json_fwd.hpp>
+
+#include "afmkit/core/range.hpp"
 
 namespace CLI {
 class App;
@@ -19,19 +22,8 @@ class App;
 
 namespace afmkit::io {
 
-/// Allowed range of a numeric parameter.
-struct Range {
-  double lo = -1e308;
-  double hi = 1e308;
-  bool lo_open = false;  // true: value > lo, false: value >= lo
-  bool hi_open = false;
-  static Range positive() { return {0.0, 1e308, true, false}; }
-  static Range non_negative() { return {0.0, 1e308, false, false}; }
-  static Range any() { return {}; }
-  static Range closed(double a, double b) { return {a, b, false, false}; }
-  std::string describe() const;
-  bool contains(double v) const;
-};
+/// Allowed range of a numeric parameter (core/range.hpp: the same type the library's option descriptions use).
+using Range = afmkit::Range;
 
 /// What an output parameter's value writes (ParamSet::writes): a file, or a folder whose whole content counts as
 /// written (a store replaced as a whole).
@@ -47,16 +39,25 @@ class ParamSet {
  public:
   using Value = std::variant<double, long, std::string, bool, std::vector<double>>;
 
-  ParamSet& real(const std::string& key, double def, const std::string& help, Range range = Range::any());
-  ParamSet& integer(const std::string& key, long def, const std::string& help, long lo, long hi);
+  // Declaring a parameter. Each records where it is declared (`where`, the caller's line by default: see
+  // Description::declared_at): a key is declared in one place, shared by the commands that have it (a function
+  // such as add_tapping_model_params, or a library struct's describe(): apps/described_params.hpp);
+  // tests/cli/test_declared_once.cpp checks it over every command.
+  ParamSet& real(const std::string& key, double def, const std::string& help, Range range = Range::any(),
+                 std::source_location where = std::source_location::current());
+  ParamSet& integer(const std::string& key, long def, const std::string& help, long lo, long hi,
+                    std::source_location where = std::source_location::current());
   ParamSet& text(const std::string& key, const std::string& def, const std::string& help,
-                 std::vector<std::string> choices = {});
+                 std::vector<std::string> choices = {},
+                 std::source_location where = std::source_location::current());
   /// A file path (a text shown as FILE in --help).
-  ParamSet& file(const std::string& key, const std::string& def, const std::string& help);
-  ParamSet& flag(const std::string& key, bool def, const std::string& help);
+  ParamSet& file(const std::string& key, const std::string& def, const std::string& help,
+                 std::source_location where = std::source_location::current());
+  ParamSet& flag(const std::string& key, bool def, const std::string& help,
+                 std::source_location where = std::source_location::current());
   /// A list of reals: TOML array, or a comma-separated flag value "1,0.5,0.2".
   ParamSet& reals(const std::string& key, std::vector<double> def, const std::string& help,
-                  Range range = Range::any());
+                  Range range = Range::any(), std::source_location where = std::source_location::current());
   /// Parameters declared after this call are listed under `name` in --help (model, drive, contact law, numerics,
   /// output, …); before any call: "Options".
   ParamSet& group(const std::string& name);
@@ -142,6 +143,9 @@ class ParamSet {
     std::string group;
     std::vector<std::string> choices;
     std::string follows;  ///< not empty: not given, the parameter takes the value of this one (follows())
+    /// Where it is declared ("file:line" of the declaring call), one entry per declaration (a key declared twice
+    /// in one set has two).
+    std::vector<std::string> declared_at;
   };
   /// Every parameter in declaration order.
   std::vector<Description> describe() const;
@@ -187,6 +191,7 @@ class ParamSet {
     bool used = false;                    // value recorded by record_used
     std::vector<std::pair<std::string, std::vector<std::string>>> applies;  // (text key, values): applies_when
     std::vector<std::function<bool(const ParamSet&)>> applies_if;           // applies_if
+    std::vector<std::string> declared_at;  // "file:line" of each declaration (Description::declared_at)
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   const Entry& entry(const std::string& key) const;
@@ -200,7 +205,7 @@ class ParamSet {
   std::string group_ = "Options";
   std::string last_;  // the parameter default_text() and unit() apply to
   std::map<std::string, std::pair<std::string, std::string>> group_conditions_;  // group -> (key, value)
-  void declare(const std::string& key, Entry e);
+  void declare(const std::string& key, Entry e, const std::source_location& where);
   static Entry make_entry(Value value, const std::string& help, Range range);
 };
 

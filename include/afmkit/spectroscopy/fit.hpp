@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "afmkit/core/cancellation.hpp"
+#include "afmkit/core/describe.hpp"
 
 namespace afmkit::spectroscopy {
 
@@ -116,7 +117,35 @@ struct FitOptions {
   double shooting_tolerance = 1e-10;
   bool parallel = true;          // the orbits of a warm-started evaluation in parallel (OpenMP)
   Cancellation cancellation;
-  void validate() const;
+
+  /// The solver's settings, declared once (core/describe.hpp): key, help, unit, range; the defaults are the
+  /// initializers above. `afmkit spectroscopy fit` lists them in this order.
+  template <class Archive, class Self>
+  static void describe(Archive& a, Self& o) {
+    a.real("huber", o.huber,
+           "Huber's loss beyond this many σ: a point far off (another branch next to a jump) pulls linearly; 0: plain "
+           "least squares",
+           "dimensionless", Range::non_negative());
+    a.real("fd_step", o.fd_step, "forward-difference step of the Jacobian in the transformed parameters",
+           "dimensionless", Range::closed(1e-8, 0.1));
+    a.integer("max_evaluations", o.max_evaluations,
+              "budget of forward-model evaluations (curves, Jacobian columns included)", 2, 1000000);
+    a.real("tolerance", o.tolerance,
+           "Levenberg–Marquardt ftol and xtol (relative reduction of the cost, relative step)", "dimensionless",
+           Range::closed(1e-15, 0.1));
+    a.real("integrator_tolerance", o.integrator_tolerance, "relative tolerance of the orbits' integrator",
+           "dimensionless", Range::closed(1e-14, 1e-4));
+    a.real("shooting_tolerance", o.shooting_tolerance, "tolerance of the orbits' Newton shooting", "dimensionless",
+           Range::closed(1e-14, 1e-4));
+    a.real("correlation_limit", o.correlation_limit, "warn when |correlation| of two parameters exceeds this",
+           "dimensionless", Range::open(0.0, 1.0));
+    a.real("condition_limit", o.condition_limit, "warn when the condition number of the scaled JᵀWJ exceeds this",
+           "dimensionless", Range{1.0, 1e300, true, false});
+    a.real("flat_column", o.flat_column,
+           "a parameter whose weighted Jacobian column is shorter is flat (not identifiable)", "dimensionless",
+           Range::closed(0.0, 1.0));
+  }
+  void validate() const;  // InvalidParameter naming the key (the ranges of describe() and the noises >= 0)
 };
 
 /// How a parameter is kept in its valid range: p(u) with u the solver's coordinate.

@@ -14,11 +14,21 @@
 namespace afmkit::tapping {
 
 struct ShootingOptions {
-  double tolerance = 1e-11;        // converged when |P^n(y) − y| ≤ tolerance · max(1, |y|) (per component scale)
-  int max_iterations = 30;         // Newton iterations -> NumericalFailure when exceeded (shoot) / nullopt (try_shoot)
-  double time_budget_seconds = 5;  // wall-clock budget of one shooting solve
-  SimulationOptions simulation;    // integrator used for the map (sensitivity is switched on internally)
-  void validate() const;
+  double tolerance = 1e-11;         // converged when |P^n(y) − y| ≤ tolerance · max(1, |y|) (per component scale)
+  int max_iterations = 30;          // Newton iterations -> NumericalFailure when exceeded (shoot) / nullopt (try_shoot)
+  double time_budget_seconds = 30;  // wall-clock budget of one shooting solve -> NumericalFailure when exceeded
+  SimulationOptions simulation;     // integrator used for the map (sensitivity is switched on internally)
+
+  /// The fields a user sets, declared once (core/describe.hpp): the simulation's, then the shooting's.
+  template <class Archive, class Self>
+  static void describe(Archive& a, Self& o) {
+    SimulationOptions::describe(a, o.simulation);
+    a.real("shooting_tolerance", o.tolerance, "Newton convergence of periodic orbits |P(y) - y| / |y|",
+           "dimensionless", Range::open(0.0, 1.0));
+    a.integer("max_newton_iterations", o.max_iterations, "Newton iterations per shooting solve", 1, 1000);
+    a.real("time_budget", o.time_budget_seconds, "wall-clock budget of one shooting solve", "s", Range::positive());
+  }
+  void validate() const;  // InvalidParameter naming the key (the ranges of describe())
 };
 
 /// A periodic orbit of period n·T (T = 2π/ω), given by its state at t = 0 (drive Γ cos ωt at phase 0).

@@ -12,6 +12,8 @@
 // drive can move it; it is counted, never looped on.
 #include <Eigen/Core>
 
+#include "afmkit/core/describe.hpp"
+
 #include "afmkit/tapping/events.hpp"
 #include "afmkit/tapping/model.hpp"
 
@@ -39,7 +41,22 @@ struct SimulationOptions {
   /// Propagate ∂(x, ẋ, l)(t_end)/∂(x, ẋ, l)(t_begin) (variational equations + saltation matrices at events).
   bool sensitivity = false;
 
-  void validate() const;  // InvalidParameter on bad values
+  /// The fields a user sets, declared once: key, help, unit, range (core/describe.hpp); the defaults are the
+  /// initializers above. The command line's `--integrator`, `--relative-tolerance`, `--absolute-tolerance`.
+  template <class Archive, class Self>
+  static void describe(Archive& a, Self& o) {
+    a.choice("integrator", o.integrator,
+             "time integration: closed_form (exact, piecewise-linear laws), adaptive (DOP853, order 8, events located "
+             "on its dense output; any law) or automatic",
+             {{"automatic", Integrator::automatic},
+              {"closed_form", Integrator::closed_form},
+              {"adaptive", Integrator::adaptive}});
+    a.real("relative_tolerance", o.relative_tolerance, "adaptive integrator relative tolerance", "dimensionless",
+           Range::open(0.0, 1.0));
+    a.real("absolute_tolerance", o.absolute_tolerance, "adaptive integrator absolute tolerance of the model state",
+           "L (= nm in physical runs)", Range::positive());
+  }
+  void validate() const;  // InvalidParameter naming the key on bad values (the ranges of describe() and the rest)
 };
 
 /// Counters of one simulation.

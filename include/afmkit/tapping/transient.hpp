@@ -23,7 +23,14 @@ struct TransientOptions {
   /// Checked after every chunk of chunk_periods periods (a long transient stops within a chunk on request;
   /// core/cancellation.hpp). find_orbits and the sweeps pass their own cancellation here.
   Cancellation cancellation{};
-  void validate() const;
+
+  /// The fields a user sets, declared once (core/describe.hpp). max_periods must also be >= chunk_periods.
+  template <class Archive, class Self>
+  static void describe(Archive& a, Self& o) {
+    a.integer("max_period_multiple", o.max_period_multiple, "look for period-n responses up to this n", 1, 16);
+    a.integer("max_transient_periods", o.max_periods, "drive periods a transient may take to settle", 24, 100000000);
+  }
+  void validate() const;  // InvalidParameter naming the key
 };
 
 enum class ResponseKind { periodic, not_settled };

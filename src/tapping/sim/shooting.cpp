@@ -12,10 +12,8 @@
 namespace afmkit::tapping {
 
 void ShootingOptions::validate() const {
-  validate::require(tolerance > 0 && tolerance < 1, "tolerance", tolerance, "in (0, 1)");
-  validate::require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
-  validate::positive("time_budget_seconds", time_budget_seconds);
-  simulation.validate();
+  check_fields(*this);     // the ranges describe() declares (the simulation's included)
+  simulation.validate();  // and the simulation's internal limits
 }
 
 StroboscopicMap stroboscopic_map(const TappingModel& model, TipState start, int period_multiple,

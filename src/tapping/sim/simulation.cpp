@@ -21,11 +21,8 @@ const char* integrator_name(Integrator integrator) {
 }
 
 void SimulationOptions::validate() const {
-  // cheap when valid (called for every simulation): build messages only on failure
-  if (!(relative_tolerance > 0 && relative_tolerance < 1))
-    validate::require(false, "relative_tolerance", relative_tolerance, "in (0, 1)");
-  if (!(absolute_tolerance > 0 && std::isfinite(absolute_tolerance)))
-    validate::positive("absolute_tolerance", absolute_tolerance);
+  // cheap when valid (called for every simulation): messages are built only on failure
+  check_fields(*this);  // the ranges describe() declares
   if (!(max_step_fraction > 0 && max_step_fraction <= 0.25))
     validate::require(false, "max_step_fraction", max_step_fraction, "in (0, 0.25]");
   if (max_events < 1) validate::require(false, "max_events", static_cast<double>(max_events), ">= 1");

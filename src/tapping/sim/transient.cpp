@@ -14,9 +14,8 @@ namespace afmkit::tapping {
 
 void TransientOptions::validate() const {
   validate::require(chunk_periods >= 1, "chunk_periods", chunk_periods, ">= 1");
-  validate::require(max_periods >= chunk_periods, "max_periods", max_periods, ">= chunk_periods");
-  validate::require(max_period_multiple >= 1 && max_period_multiple <= 16, "max_period_multiple",
-                    max_period_multiple, "in [1, 16]");
+  check_fields(*this);  // the ranges describe() declares
+  validate::require(max_periods >= chunk_periods, "max_transient_periods", max_periods, ">= chunk_periods");
   validate::require(capture_distance > 0 && capture_distance < 1, "capture_distance", capture_distance, "in (0, 1)");
 }
 

@@ -1,0 +1,87 @@
+#pragma once
+// The command line's side of the library's options that describe themselves (afmkit/core/describe.hpp): one generic
+// adapter instead of a hand-written copy per struct.
+//   declare_fields(p, tapping::ShootingOptions{});   // its fields on a ParamSet: key, default, help, unit, range
+//   tapping::ShootingOptions o;  read_fields(p, o);  // the resolved values back into the struct
+// Each key is recorded as declared where the struct's describe() declares it (io::ParamSet::Description::
+// declared_at), so a key shared by several commands has one declaration (tests/cli/test_declared_once.cpp).
+#include <initializer_list>
+#include <source_location>
+#include <string>
+#include <vector>
+
+#include "afmkit/core/describe.hpp"
+#include "afmkit/io/params.hpp"
+
+namespace afmkit::cli {
+
+/// The archive of declare_fields(): each field becomes a parameter of the current group, its value the default.
+class FieldDeclarer {
+ public:
+  explicit FieldDeclarer(io::ParamSet& p) : p_(p) {}
+  void real(const char* key, double value, const char* help, const char* unit, Range range,
+            std::source_location where = std::source_location::current()) {
+    p_.real(key, value, help, range, where).unit(unit);
+  }
+  template <class Int>
+  void integer(const char* key, Int value, const char* help, long lo, long hi,
+               std::source_location where = std::source_location::current()) {
+    p_.integer(key, static_cast<long>(value), help, lo, hi, where);
+  }
+  template <class Enum>
+  void choice(const char* key, Enum value, const char* help, std::initializer_list<Choice<Enum>> choices,
+              std::source_location where = std::source_location::current()) {
+    std::vector<std::string> names;
+    std::string def;
+    for (const Choice<Enum>& c : choices) {
+      names.emplace_back(c.name);
+      if (c.value == value) def = c.name;
+    }
+    p_.text(key, def, help, std::move(names), where);
+  }
+
+ private:
+  io::ParamSet& p_;
+};
+
+/// The archive of read_fields(): each field takes its parameter's resolved value.
+class FieldReader {
+ public:
+  explicit FieldReader(const io::ParamSet& p) : p_(p) {}
+  void real(const char* key, double& field, const char*, const char*, Range,
+            std::source_location = std::source_location::current()) const {
+    field = p_.real(key);
+  }
+  template <class Int>
+  void integer(const char* key, Int& field, const char*, long, long,
+               std::source_location = std::source_location::current()) const {
+    field = static_cast<Int>(p_.integer(key));  // the declared range fits Int
+  }
+  template <class Enum>
+  void choice(const char* key, Enum& field, const char*, std::initializer_list<Choice<Enum>> choices,
+              std::source_location = std::source_location::current()) const {
+    const std::string& name = p_.text(key);
+    for (const Choice<Enum>& c : choices)
+      if (name == c.name) field = c.value;
+  }
+
+ private:
+  const io::ParamSet& p_;
+};
+
+/// Declares every field `Options::describe` lists on `p` (in its order, in the current group), with the values of
+/// `defaults` as defaults (usually `Options{}`: the library's own defaults).
+template <class Options>
+void declare_fields(io::ParamSet& p, const Options& defaults) {
+  FieldDeclarer archive(p);
+  Options::describe(archive, defaults);
+}
+
+/// Sets every described field of `options` from the resolved parameters of `p` (other fields are left as they are).
+template <class Options>
+void read_fields(const io::ParamSet& p, Options& options) {
+  FieldReader archive(p);
+  Options::describe(archive, options);
+}
+
+}  // namespace afmkit::cli

@@ -1,0 +1,198 @@
+// Every parameter is declared once (issue 26, "typed requests declared once"): over every command of the program
+// (command_specs(), the registry the command line and the Python module share), a key is declared at one place —
+// one line of a shared declaration function (add_tapping_model_params, add_output_params, …) or of a library
+// struct's describe() (afmkit/core/describe.hpp, through apps/described_params.hpp) — so that its default, range,
+// unit and help cannot drift apart between commands. io::ParamSet records where each key is declared
+// (Description::declared_at: the declaring call's file and line).
+//
+// The rule, precisely: a key declared at two or more places (over all commands, or twice within one command) fails,
+// unless it is listed below as a name that several commands use for genuinely different parameters (another
+// quantity, unit or meaning: each entry says which), or as a known duplicate still to be merged (each entry: the
+// places, and why it is not merged yet). Both lists only shrink: an entry whose key is no longer declared at two
+// places fails too, so that it is removed.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "afmkit/io/params.hpp"
+#include "command.hpp"
+
+namespace {
+
+// key -> place ("file:line", shortened to the repository) -> the commands declaring it there.
+using DeclaredOnceSites = std::map<std::string, std::map<std::string, std::set<std::string>>>;
+
+// "/…/<checkout>/apps/x.cpp:12" or "../apps/x.cpp:12" (ccache's base_dir) -> "apps/x.cpp:12": from the first
+// top-level folder of the repository in the path.
+std::string declared_once_short(const std::string& place) {
+  std::size_t from = std::string::npos;
+  for (const char* root : {"/apps/", "/include/", "/src/", "/python/", "/tests/"})
+    if (const auto at = place.find(root); at != std::string::npos && (from == std::string::npos || at < from))
+      from = at;
+  return from == std::string::npos ? place : place.substr(from + 1);
+}
+
+DeclaredOnceSites declared_once_sites(const std::vector<afmkit::cli::CommandSpec>& specs) {
+  DeclaredOnceSites sites;
+  for (const auto& spec : specs) {
+    afmkit::io::ParamSet p;
+    spec.declare(p);
+    for (const auto& d : p.describe())
+      for (const std::string& place : d.declared_at) sites[d.key][declared_once_short(place)].insert(spec.path);
+  }
+  return sites;
+}
+
+std::string declared_once_places(const std::map<std::string, std::set<std::string>>& places) {
+  std::string out;
+  for (const auto& [place, commands] : places) {
+    out += "\n    " + place + " (";
+    bool first = true;
+    for (const auto& c : commands) out += (first ? "" : ", ") + c, first = false;
+    out += ")";
+  }
+  return out;
+}
+
+// A listed key: at how many places it is declared, and why. A listed key declared at another number of places fails
+// (a new declaration of a listed key reuses one of its declarations, or the list is updated with the reason).
+struct DeclaredOnceListed {
+  std::size_t places;
+  const char* why;
+};
+using DeclaredOnceList = std::map<std::string, DeclaredOnceListed>;
+
+// Names several commands use for different parameters (key -> places, what differs).
+const DeclaredOnceList kDeclaredOnceDifferentParameters = {
+    {"absolute_tolerance", {2, "impact: of the impact integrator on the scaled state (dimensionless); tapping: of the "
+                           "adaptive DOP853 integrator on the model state (L)"}},
+    {"relative_tolerance", {2, "impact: the impact integrator's, in (0, 1e-2]; tapping: the adaptive DOP853's, "
+                               "in (0, 1)"}},
+    {"allow_energy_gain", {2, "the law's flag (accept a law that creates energy) vs spectroscopy prepare's (accept a "
+                          "prepared table whose retract force exceeds the approach force)"}},
+    {"delay", {2, "control: measurement delay in units of T; scan: actuator delay in seconds"}},
+    {"sample_rate", {2, "control export: the filter's sample rate on the target; scan: the simulated detector's, "
+                        "in Hz"}},
+    {"file", {2, "spectroscopy fit: the measured curve CSV; study run: the study's TOML file"}},
+    {"format", {2, "control export: the output format; spectroscopy prepare: the input file's format"}},
+    {"input", {2, "spectroscopy prepare: an instrument file; spectroscopy reconstruct: a prepared curve CSV"}},
+    {"output", {2, "a table's CSV (add_output_params) vs control export's C header"}},
+    {"output_dir", {2, "demo: folder of its two tables; report: folder of the HTML report"}},
+    {"plot", {2, "PNG of different figures: spectroscopy fit (data vs fit), prepare (raw and prepared curves)"}},
+    {"max_evaluations", {2, "control tune: Nelder-Mead budget; spectroscopy fit: forward-model evaluations of LM"}},
+    {"method", {3, "impact: solver; control simulate: time stepping; spectroscopy reconstruct: inversion formula"}},
+    {"store", {2, "study run: the study's Zarr store (resumed); tapping grid: the grid's Zarr store (replaced)"}},
+};
+
+// The same parameter declared at several places, not merged yet (key -> the places and why). To merge one, declare
+// it in one function the commands share (per-command defaults by set_default() or an argument) and remove it here.
+const DeclaredOnceList kDeclaredOnceNotYetMerged = {
+    {"harmonics", {2, "control: N in [1, 100 or 1000]; scan: N in [1, 10000]"}},
+    {"gain", {2, "control: K in units of Omega, default = plant_rate; scan: K in rad/s, 0 = bandwidth"}},
+    {"spring_constant", {4, "tapping (physical units), spectroscopy prepare/fit/reconstruct: defaults (40, the file's, "
+                        "required) and ranges differ"}},
+    {"resonance_frequency", {3, "tapping (physical units), spectroscopy fit/reconstruct: defaults and ranges differ"}},
+    {"quality_factor", {3, "tapping, spectroscopy fit/reconstruct: defaults (100, required, 400) and ranges differ"}},
+    {"free_amplitude", {3, "tapping (physical units), spectroscopy fit/reconstruct: defaults and ranges differ"}},
+    {"amplitude", {3, "tapping fm (nm or L), spectroscopy fit/reconstruct (FM amplitude, nm): defaults differ"}},
+    {"drive_frequency", {2, "spectroscopy fit and reconstruct: the same AM drive frequency, declared in each"}},
+    {"separation_min", {4, "tapping sweep, grid, fm and demo: defaults differ and ranges disagree (any finite vs "
+                       "[-1e6, 1e6])"}},
+    {"separation_max", {4, "tapping sweep, grid, fm and demo: as separation_min"}},
+    {"points", {7, "the separations of tapping sweep, grid, fm and demo (in [2, 1e6], [2, 1e7] or [2, 1e8]); the other "
+               "commands' points are other counts (impact's history samples, hb's q samples, control tf's grid)"}},
+    {"approach_stiffness", {2, "the hysteresis law's K_a: the law registry's (add_law_params; impact, spectroscopy "
+                               "fit) and the tapping model's normalised per-unit-mass form (add_tapping_model_params, "
+                               "which the tapping commands declare instead: add_law_params skips it there)"}},
+    {"departure_stiffness", {2, "as approach_stiffness (K_b)"}},
+    {"approach_adhesion", {2, "as approach_stiffness (F_a)"}},
+    {"departure_adhesion", {2, "as approach_stiffness (F_b)"}},
+    {"tip_radius", {2, "the laws' tip radius (add_law_params) and spectroscopy prepare's Hertz-fit radius (0: no "
+                       "modulus reported)"}},
+    {"shooting_tolerance", {2, "tapping::ShootingOptions (1e-11, in (0, 1)) and spectroscopy::FitOptions (the fit's "
+                           "orbits: 1e-10, in [1e-14, 1e-4]); FitOptions should hold the shooting options"}},
+};
+
+/// The violations of the rule above in `sites` (one message each; empty: every key is declared once).
+std::vector<std::string> declared_once_violations(const DeclaredOnceSites& sites, const DeclaredOnceList& different,
+                                                  const DeclaredOnceList& not_yet_merged) {
+  std::vector<std::string> out;
+  for (const auto& [key, places] : sites) {
+    if (places.size() < 2) continue;
+    const DeclaredOnceListed* listed = nullptr;
+    if (const auto d = different.find(key); d != different.end()) listed = &d->second;
+    if (const auto m = not_yet_merged.find(key); m != not_yet_merged.end()) listed = &m->second;
+    if (listed == nullptr) {
+      out.push_back("key '" + key + "' is declared at " + std::to_string(places.size()) +
+                    " places (declare it once, in a function or describe() the commands share):" +
+                    declared_once_places(places));
+    } else if (listed->places != places.size()) {
+      out.push_back("key '" + key + "' is declared at " + std::to_string(places.size()) + " places, listed with " +
+                    std::to_string(listed->places) + " (" + listed->why +
+                    "): reuse one of its declarations, or update the list" + declared_once_places(places));
+    }
+  }
+  for (const auto* list : {&different, &not_yet_merged})
+    for (const auto& [key, listed] : *list) {
+      const auto it = sites.find(key);
+      if (it == sites.end() || it->second.size() < 2)
+        out.push_back("key '" + key + "' is listed as declared at several places but is declared at " +
+                      std::to_string(it == sites.end() ? 0 : it->second.size()) + ": remove it from the list");
+    }
+  return out;
+}
+
+TEST(DeclaredOnce, EveryKeyOfEveryCommandIsDeclaredAtOnePlace) {
+  const auto specs = afmkit::cli::command_specs();
+  ASSERT_GT(specs.size(), 15u);
+  const DeclaredOnceSites sites = declared_once_sites(specs);
+  ASSERT_GT(sites.size(), 100u);
+  for (const std::string& v :
+       declared_once_violations(sites, kDeclaredOnceDifferentParameters, kDeclaredOnceNotYetMerged))
+    ADD_FAILURE() << v;
+}
+
+TEST(DeclaredOnce, TheLibraryStructsDeclareTheirKeysInTheirHeaders) {
+  // the converted option structs: their keys come from describe() in the library's headers, for every command
+  const DeclaredOnceSites sites = declared_once_sites(afmkit::cli::command_specs());
+  for (const auto& [key, header] : std::map<std::string, std::string>{
+           {"integrator", "include/afmkit/tapping/simulation.hpp"},
+           {"time_budget", "include/afmkit/tapping/shooting.hpp"},
+           {"max_transient_periods", "include/afmkit/tapping/transient.hpp"},
+           {"huber", "include/afmkit/spectroscopy/fit.hpp"}}) {
+    ASSERT_TRUE(sites.count(key)) << key;
+    for (const auto& [place, commands] : sites.at(key))
+      EXPECT_TRUE(place.substr(0, place.find(':')).ends_with(header)) << key << " declared at " << place;
+  }
+}
+
+TEST(DeclaredOnce, AKeyDeclaredAtTwoPlacesIsFound) {
+  // two commands declaring the same key each on its own line: the rule names both places; one shared declaration
+  // function: no violation
+  const auto shared = [](afmkit::io::ParamSet& p) { p.real("declared_once_q", 1.0, "shared").unit("dimensionless"); };
+  const std::vector<afmkit::cli::CommandSpec> twice = {
+      {"one", "", [](afmkit::io::ParamSet& p) { p.real("declared_once_q", 1.0, "here").unit("dimensionless"); }, {}},
+      {"two", "", [](afmkit::io::ParamSet& p) { p.real("declared_once_q", 2.0, "there").unit("dimensionless"); }, {}}};
+  const auto found = declared_once_violations(declared_once_sites(twice), {}, {});
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_NE(found[0].find("'declared_once_q' is declared at 2 places"), std::string::npos) << found[0];
+  EXPECT_NE(found[0].find("test_declared_once.cpp"), std::string::npos) << found[0];
+  const std::vector<afmkit::cli::CommandSpec> once = {{"one", "", shared, {}}, {"two", "", shared, {}}};
+  EXPECT_TRUE(declared_once_violations(declared_once_sites(once), {}, {}).empty());
+  // declared twice within one command (a second declaration replacing the first) counts too
+  const std::vector<afmkit::cli::CommandSpec> replaced = {{"one", "", [](afmkit::io::ParamSet& p) {
+                                                             p.real("declared_once_q", 1.0, "a").unit("dimensionless");
+                                                             p.real("declared_once_q", 2.0, "b").unit("dimensionless");
+                                                           }, {}}};
+  EXPECT_EQ(declared_once_violations(declared_once_sites(replaced), {}, {}).size(), 1u);
+  // a listed key that is no longer declared twice is reported, so the lists only shrink
+  EXPECT_EQ(declared_once_violations(declared_once_sites(once), {{"declared_once_q", {2, "stale"}}}, {}).size(), 1u);
+  // a listed key declared at one more place than listed is reported
+  EXPECT_TRUE(declared_once_violations(declared_once_sites(twice), {{"declared_once_q", {2, "two"}}}, {}).empty());
+  EXPECT_EQ(declared_once_violations(declared_once_sites(twice), {{"declared_once_q", {3, "three"}}}, {}).size(), 1u);
+}
+
+}  // namespace
