@@ -34,12 +34,15 @@ bool chunks_same_point(const HbPoint& a, const HbPoint& b) {
          a.branch == b.branch;
 }
 
-void chunks_expect_same_curve(const TappingModel& model, const HbCurveOptions& o, const std::string& what) {
+void chunks_expect_same_curve(const TappingModel& model, const HbCurveOptions& o, const std::string& what,
+                              const std::vector<std::size_t>& chunk_sizes) {
   const std::vector<HbPoint> held = harmonic_balance_curve(model, o);
   std::size_t minus = 0;
   for (const HbPoint& p : held) minus += p.branch == HbBranch::Minus ? 1 : 0;
-  if (o.include_minus && o.q_min < 0.0) EXPECT_GT(minus, 0u) << what << ": the case has a '-' block";
-  for (const std::size_t chunk : {std::size_t{1}, std::size_t{7}, std::size_t{4096}}) {
+  if (o.include_minus && o.q_min < 0.0) {
+    EXPECT_GT(minus, 0u) << what << ": the case has a '-' block";
+  }
+  for (const std::size_t chunk : chunk_sizes) {
     std::vector<HbPoint> streamed;
     std::vector<std::size_t> sizes;
     const std::size_t count = harmonic_balance_curve_chunks(
@@ -55,7 +58,9 @@ void chunks_expect_same_curve(const TappingModel& model, const HbCurveOptions& o
       ASSERT_TRUE(chunks_same_point(streamed[k], held[k])) << what << ", chunk " << chunk << ", point " << k;
     for (std::size_t k = 0; k < sizes.size(); ++k) {  // full chunks, the last one possibly shorter
       EXPECT_LE(sizes[k], chunk);
-      if (k + 1 < sizes.size()) EXPECT_EQ(sizes[k], chunk) << what;
+      if (k + 1 < sizes.size()) {
+        EXPECT_EQ(sizes[k], chunk) << what;
+      }
     }
   }
 }
@@ -70,20 +75,21 @@ TEST(CurveChunks, ClosedFormStreamsTheHeldCurve) {
       o.spacing = spacing;
       o.include_minus = minus;
       chunks_expect_same_curve(chunks_closed_form_model(), o,
-                               std::string("closed form, ") + (minus ? "with" : "without") + " minus");
+                               std::string("closed form, ") + (minus ? "with" : "without") + " minus", {1, 7, 4096});
     }
 }
 
 TEST(CurveChunks, GeneralLawStreamsTheHeldCurve) {
-  for (const HbCurveSpacing spacing : {HbCurveSpacing::Uniform, HbCurveSpacing::RefinedGrazing})
+  for (const HbCurveSpacing spacing : {HbCurveSpacing::RefinedGrazing})  // the merge of both sample kinds
     for (const bool minus : {true, false}) {
       HbCurveOptions o;
       o.q_min = -1.0;
       o.q_max = 1.5;
-      o.points = 600;
+      o.points = 90;  // each sample of a general law evaluates describing functions: few of them
       o.spacing = spacing;
       o.include_minus = minus;
-      chunks_expect_same_curve(chunks_dmt_model(), o, std::string("DMT, ") + (minus ? "with" : "without") + " minus");
+      chunks_expect_same_curve(chunks_dmt_model(), o, std::string("DMT, ") + (minus ? "with" : "without") + " minus",
+                               {7, 4096});
     }
 }
 

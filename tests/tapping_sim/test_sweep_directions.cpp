@@ -47,7 +47,9 @@ TEST(SweepDirections, ApproachOnlyIsTheApproachOfTheFullSweep) {
       own.hb_solutions = 0;
       attach_harmonic_balance(directions_loop_model(), own);
       EXPECT_EQ(own.hb_solutions, p.hb_solutions) << "l = " << p.separation;
-      if (own.hb_solutions > 0) EXPECT_NEAR(own.hb_amplitude, p.hb_amplitude, 1e-9 * std::abs(p.hb_amplitude));
+      if (own.hb_solutions > 0) {
+        EXPECT_NEAR(own.hb_amplitude, p.hb_amplitude, 1e-9 * std::abs(p.hb_amplitude));
+      }
     }
 }
 
