@@ -2,6 +2,7 @@
 // force law, issue 7.2) sampled over the penetration parameter q, as CSV (q, separation, amplitude, offset, phase,
 // branch) with a JSON sidecar holding the folds (jump points), the free amplitude and the solutions at `separation`;
 // --json prints them (with the curve when --output "" writes no file).
+#include <algorithm>
 #include <memory>
 #include <span>
 #include <string>
@@ -29,6 +30,8 @@ namespace {
 /// Memory of one row held as JSON and printed (the row's JSON array of 6 cells, the copy made for the printed
 /// document and its indented text; measured 990 bytes a row with --json --output '' at 2·10^5 rows).
 constexpr double kHeldRowBytes = 1024.0;
+/// Points of the curve in memory at once when it is streamed.
+constexpr std::size_t kChunkPoints = 4096;
 
 nlohmann::json point_json(const tapping::HbPoint& p, const TappingScales& s) {
   return {{"q", p.q},
@@ -82,10 +85,13 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   // The curve is streamed to the file in chunks (memory bounded by a chunk whatever `points`); only rows printed
   // as JSON or handed to Python are held, up to 2 per q sample (both branches).
   CommandOutput out(p, capture, "tapping hb");
+  // (the streamed chunk is checked too: a malformed AFMKIT_MEMORY_LIMIT is refused as on every run)
   if (out.holds_rows()) memory::require_fits("points", static_cast<double>(options.points), 2.0 * kHeldRowBytes);
+  else memory::require_fits("points", static_cast<double>(std::min(options.points, kChunkPoints)), sizeof(tapping::HbPoint));
   out.open(hb_columns(scales));
   const std::size_t count = tapping::harmonic_balance_curve_chunks(
-      model, options, [&](std::span<const tapping::HbPoint> chunk) { write_hb_rows(out, chunk, scales); });
+      model, options, [&](std::span<const tapping::HbPoint> chunk) { write_hb_rows(out, chunk, scales); },
+      kChunkPoints);
 
   // the model and options are checked: what is refused from here on was computed (core/computed.hpp)
   const tapping::HarmonicBalance hb = computed("harmonic balance", [&] { return tapping::HarmonicBalance(model); });

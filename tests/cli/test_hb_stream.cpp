@@ -55,24 +55,24 @@ HbStreamRun hb_stream_run(const std::vector<std::string>& args, const TempDir& d
 TEST(HbStream, PeakMemoryDoesNotGrowWithThePoints) {
   TempDir dir;
   const HbStreamRun small = hb_stream_run({"tapping", "hb", "--points", "2000", "--output", "small.csv"}, dir);
-  const HbStreamRun large = hb_stream_run({"tapping", "hb", "--points", "300000", "--output", "large.csv"}, dir);
+  const HbStreamRun large = hb_stream_run({"tapping", "hb", "--points", "150000", "--output", "large.csv"}, dir);
   ASSERT_EQ(small.status, 0);
   ASSERT_EQ(large.status, 0);
-  // the curve held in memory took 2 × 48 bytes per sample: 28 MiB more for the large run
+  // the curve held in memory took 2 × 48 bytes per sample: 14 MiB more for the large run
   EXPECT_LT(large.peak_rss_kib - small.peak_rss_kib, 4 * 1024)
-      << "peak memory " << small.peak_rss_kib << " KiB at 2000 points, " << large.peak_rss_kib << " KiB at 300000";
-  // every sample written: 300000 Plus/Free rows (the default q range ends beyond grazing), then the Minus rows
+      << "peak memory " << small.peak_rss_kib << " KiB at 2000 points, " << large.peak_rss_kib << " KiB at 150000";
+  // every sample written: 150000 Plus/Free rows (the default q range ends beyond grazing), then the Minus rows
   const std::string csv = slurp(dir.path / "large.csv");
-  EXPECT_GE(std::count(csv.begin(), csv.end(), '\n'), 300001);  // the header and a row per sample at least
+  EXPECT_GE(std::count(csv.begin(), csv.end(), '\n'), 150001);  // the header and a row per sample at least
 }
 
 TEST(HbStream, AMemoryLimitNoLongerRefusesAStreamedCurve) {
   TempDir dir;
-  // 300000 samples held would need 28.8 MB, more than half of 20 MB (the share a request may take)
-  auto r = run_shell("AFMKIT_MEMORY_LIMIT=20M afmkit tapping hb --points 300000 --output hb.csv", dir);
+  // 150000 samples held would need 14.4 MB, more than half of 20 MB (the share a request may take)
+  auto r = run_shell("AFMKIT_MEMORY_LIMIT=20M afmkit tapping hb --points 150000 --output hb.csv", dir);
   EXPECT_EQ(r.status, 0) << r.err;
   // rows printed as JSON are held: still checked
-  r = run_shell("AFMKIT_MEMORY_LIMIT=20M afmkit tapping hb --points 300000 --output '' --json", dir);
+  r = run_shell("AFMKIT_MEMORY_LIMIT=20M afmkit tapping hb --points 150000 --output '' --json", dir);
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("points = 300000 needs about"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("points = 150000 needs about"), std::string::npos) << r.err;
 }
