@@ -13,9 +13,16 @@ namespace afmkit::cli {
 CLI::App& add_command(CLI::App& parent, const std::string& name, const std::string& help, const Declare& declare,
                       Run run) {
   auto params = std::make_shared<io::ParamSet>();
-  declare(*params);
   CLI::App* cmd = parent.add_subcommand(name, help);
-  params->add_options(*cmd);
+  // The parameters and their options are built when the command's words begin to be parsed (CLI11's pre-parse
+  // callback, before any of its options or --help): a run builds only the command that runs, not the whole tree
+  // (start-up time, docs/development.md#start-up). Once: a second parse of the same app keeps them.
+  cmd->preparse_callback([params, declare, cmd, declared = false](std::size_t) mutable {
+    if (declared) return;
+    declared = true;
+    declare(*params);
+    params->add_options(*cmd);
+  });
   const CLI::App* root = cmd;
   std::string path = name;
   for (const CLI::App* up = cmd->get_parent(); up != nullptr; up = up->get_parent()) {

@@ -129,6 +129,8 @@ class CommandOutput {
   /// The rows are wanted (a file, a capture, or --json without a file): commands skip recording a history nobody
   /// will read.
   bool keeps_rows() const { return writes_file() || keep_rows_; }
+  /// The rows are held in memory (--json without a file, or a capture that wants them): their memory grows with them.
+  bool holds_rows() const { return keep_rows_; }
 
   /// The other files of the command's result (images, a series, a point cloud): staged there, they are committed
   /// with the table by finish(), all of them or none (io::OutputSet).

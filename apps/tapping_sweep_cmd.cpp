@@ -127,6 +127,23 @@ std::vector<double> sweep_separations(const io::ParamSet& p, double length_scale
   return list;
 }
 
+/// Whether the harmonic-balance solution goes beside each point (hb_* columns): hb_beside = on, off, or auto — on
+/// where it is a closed form (piecewise-linear laws: ~10 µs a point after a 0.5 ms scan), off for the other laws
+/// (a describing-function curve traced per model, 5–20 ms, then more per point than the orbits themselves: 0.84 vs
+/// 0.40 ms per DMT point with and without it, bench_sweep_options; docs/commands.md#sweep-options).
+bool hb_beside(const io::ParamSet& p, const tapping::TappingModel& base) {
+  const std::string& mode = p.text("hb_beside");
+  return mode == "on" || (mode == "auto" && base.law.piecewise_linear() != nullptr);
+}
+/// Why the hb_* columns are NaN (results "harmonic_balance") when HB is not put beside the points.
+std::string hb_not_evaluated(const io::ParamSet& p) {
+  if (p.text("hb_beside") == "off") return "not evaluated (hb_* columns nan): hb_beside = off";
+  return fmt::format("not evaluated (hb_* columns nan): hb_beside = auto and law = {} has no closed-form harmonic "
+                     "balance (its describing-function curve costs more than the orbits); hb_beside = on puts it "
+                     "beside each point",
+                     p.text("law"));
+}
+
 /// Records sorted by the value of `key`.
 nlohmann::json records_sorted_by(nlohmann::json records, const std::string& key) {
   std::stable_sort(records.begin(), records.end(), [&](const nlohmann::json& a, const nlohmann::json& b) {
@@ -143,11 +160,13 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
   const SweptParameter swept = swept_parameter_from(p, law_object_of(capture));
   const std::string& name = swept.name;
   const int points = static_cast<int>(p.integer("points"));
-  memory::require_fits("points", static_cast<double>(points), 2.0 * sizeof(tapping::SweepPoint));
+  const bool retract = p.text("directions") == "both";  // the up pass after the down pass
+  memory::require_fits("points", static_cast<double>(points), (retract ? 2.0 : 1.0) * sizeof(tapping::SweepPoint));
   const std::string& mode = p.text("mode");
   const bool instrument = mode == "instrument" || mode == "both";
   const bool continuation = mode == "continuation" || mode == "both";
   const bool quiet = p.flag("json") || p.flag("quiet");
+  const bool beside = hb_beside(p, base);
   const std::string unit = swept.unit;
   // values of the swept parameter in its own unit (none for ω/ω_n)
   const auto values_text = [&](const std::vector<double>& v) {
@@ -175,18 +194,22 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
   results["parameter"] = name;
   // HB beside each point where it is a closed form at each value (docs/commands.md#sweeps-in-another-parameter)
   results["harmonic_balance"] =
-      base.law.piecewise_linear()
+      beside && base.law.piecewise_linear()
           ? std::string("beside each point (closed form at each point's model)")
+      : !beside ? hb_not_evaluated(p)
           : fmt::format("not evaluated (hb_* columns nan): law = {} has no closed-form harmonic balance, and a "
                         "describing-function curve per point costs 7 ms to 0.3 s; use tapping hb at chosen values",
                         p.text("law"));
   std::string summary;
   const double magnitude = std::max(std::abs(swept.min), std::abs(swept.max));
   if (instrument) {
-    io::Progress progress(fmt::format("tapping sweep in {} (down + up)", name), 2L * points, !quiet);
+    io::Progress progress(fmt::format("tapping sweep in {} ({})", name, retract ? "down + up" : "down"),
+                          (retract ? 2L : 1L) * points, !quiet);
     tapping::SweepOptions options;
     options.shooting = shooting_options_from(p);
     options.transient = transient_options_from(p);
+    options.harmonic_balance = beside;
+    options.retract = retract;
     options.progress = [&progress](long n) { progress.advance(n); };
     options.cancellation = cancellation_of(capture);
     options.validate();
@@ -211,13 +234,18 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
     results["jumps"] = records_sorted_by(std::move(jumps), name);
     const double tolerance = options.jump_tolerance * magnitude;
     results["jump_tolerance"] = tolerance;
-    summary += fmt::format("instrument sweep in {}: jumps down at {}; up at {} (located to ±{})", name,
-                           values_text(r.approach_jumps), values_text(r.retract_jumps),
-                           values_text({tolerance}));
+    if (!retract) results["directions"] = "approach";
+    summary += retract ? fmt::format("instrument sweep in {}: jumps down at {}; up at {} (located to ±{})", name,
+                                     values_text(r.approach_jumps), values_text(r.retract_jumps),
+                                     values_text({tolerance}))
+                       : fmt::format("instrument sweep in {}: jumps down at {} (located to ±{}); no up pass "
+                                     "(directions = approach)",
+                                     name, values_text(r.approach_jumps), values_text({tolerance}));
   }
   if (continuation) {
     tapping::ContinuationOptions options;
     options.shooting = shooting_options_from(p);
+    options.harmonic_balance = beside;
     options.max_step = p.real("max_arclength_step") / scales.length;
     options.initial_step = std::min(options.initial_step, options.max_step);
     options.max_points = static_cast<int>(p.integer("max_continuation_points"));
@@ -281,6 +309,7 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
                       {"free_amplitude", L},
                       {"trapped_rows", "count"},
                       {"rows", "count"}};
+  if (results.contains("directions")) results["units"]["directions"] = "label";
   out.finish(results, summary);
 }
 
@@ -304,12 +333,14 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
                                                          p.real("separation_min"), p.real("separation_max")));
   }
   const int points = list.empty() ? static_cast<int>(p.integer("points")) : static_cast<int>(list.size());
+  const bool retract = p.text("directions") == "both";  // the retract pass after the approach
   // Both directions are held in memory (then streamed out).
-  memory::require_fits("points", static_cast<double>(points), 2.0 * sizeof(tapping::SweepPoint));
+  memory::require_fits("points", static_cast<double>(points), (retract ? 2.0 : 1.0) * sizeof(tapping::SweepPoint));
   const std::string& mode = p.text("mode");
   const bool instrument = mode == "instrument" || mode == "both";
   const bool continuation = mode == "continuation" || mode == "both";
   const bool quiet = p.flag("json") || p.flag("quiet");
+  const bool beside = hb_beside(p, base);
 
   CommandOutput out(p, capture, "tapping sweep");
   out.open(sweep_columns(scales));
@@ -319,19 +350,23 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     for (const tapping::SweepPoint& pt : points) trapped += tapping::tip_trapped(pt.metrics) ? 1 : 0;
   };
   nlohmann::json results = nlohmann::json::object();
+  if (!beside) results["harmonic_balance"] = hb_not_evaluated(p);
   std::string summary;
   if (instrument) {
-    io::Progress progress("tapping sweep (approach + retract)", 2L * points, !quiet);
+    io::Progress progress(retract ? "tapping sweep (approach + retract)" : "tapping sweep (approach)",
+                          (retract ? 2L : 1L) * points, !quiet);
     tapping::SweepOptions options;
     options.shooting = shooting_options_from(p);
     options.transient = transient_options_from(p);
+    options.harmonic_balance = beside;
+    options.retract = retract;
     options.progress = [&progress](long n) { progress.advance(n); };
     // a jump runs a transient of up to max_transient_periods drive periods (a response decaying at Q settles in
     // about Q of them): when one can take seconds, its periods show as well (docs/development.md#work-and-time)
     const double transient_seconds =
         kTransientPeriodSeconds * std::min(static_cast<double>(options.transient.max_periods), p.real("quality_factor"));
     io::Progress transient_progress("tapping sweep (drive periods of transients at jumps, of at most)",
-                                    2L * points * options.transient.max_periods,
+                                    (retract ? 2L : 1L) * points * options.transient.max_periods,
                                     !quiet && transient_seconds > kProgressAfterSeconds);
     options.transient.on_periods = [&transient_progress](int n) { transient_progress.advance(n); };
     options.cancellation = cancellation_of(capture);
@@ -349,14 +384,21 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     results["jumps"] = jump_records(r.jumps, scales);
     const double tolerance = options.jump_tolerance * base.free_amplitude() * scales.length;
     results["jump_tolerance"] = tolerance;
-    summary += fmt::format("instrument sweep: jumps on approach at {}; on retract at {} (located to ±{})",
-                           io::summary_values(scaled_values(r.approach_jumps, scales.length), scales.length_unit),
-                           io::summary_values(scaled_values(r.retract_jumps, scales.length), scales.length_unit),
-                           io::summary_value(tolerance, scales.length_unit, 3));
+    if (!retract) results["directions"] = "approach";
+    summary += retract
+                   ? fmt::format("instrument sweep: jumps on approach at {}; on retract at {} (located to ±{})",
+                                 io::summary_values(scaled_values(r.approach_jumps, scales.length), scales.length_unit),
+                                 io::summary_values(scaled_values(r.retract_jumps, scales.length), scales.length_unit),
+                                 io::summary_value(tolerance, scales.length_unit, 3))
+                   : fmt::format("instrument sweep: jumps on approach at {} (located to ±{}); no retract pass "
+                                 "(directions = approach)",
+                                 io::summary_values(scaled_values(r.approach_jumps, scales.length), scales.length_unit),
+                                 io::summary_value(tolerance, scales.length_unit, 3));
   }
   if (continuation) {
     tapping::ContinuationOptions options;
     options.shooting = shooting_options_from(p);
+    options.harmonic_balance = beside;
     options.max_step = p.real("max_arclength_step") / scales.length;
     options.initial_step = std::min(options.initial_step, options.max_step);
     options.max_points = static_cast<int>(p.integer("max_continuation_points"));
@@ -392,6 +434,8 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
                                               : std::string();
   if (trapped > 0) summary += fmt::format("\n{}", results["note"].get<std::string>());
   results["units"] = sweep_units(scales);
+  for (const char* key : {"harmonic_balance", "directions"})  // present only where an option turned something off
+    if (results.contains(key)) results["units"][key] = "label";
   out.finish(results, summary);
 }
 
@@ -422,6 +466,17 @@ void register_tapping_sweep(CLI::App& tapping) {
             .real("max_arclength_step", 0.2, "largest continuation step (scaled arclength)", io::Range::positive())
             .unit(kLengthUnit)
             .integer("max_continuation_points", 5000, "continuation point budget", 2, 100000000)
+            .text("directions", "both",
+                  "passes of the instrument sweep: both (approach then retract, or down then up: hysteresis and "
+                  "the jumps of both) or approach (the approach, or down, pass only: half the work)",
+                  {"both", "approach"})
+            .only_if_given()
+            .text("hb_beside", "auto",
+                  "the harmonic-balance solution beside each point (hb_* columns): on, off, or auto (on where it is "
+                  "a closed form, i.e. piecewise-linear laws, about 10 us a point; off for the other laws, whose "
+                  "describing-function curve costs more than the orbits)",
+                  {"auto", "on", "off"})
+            .only_if_given()
             .text("parameter", "separation",
                   "the parameter swept: separation (separation_min .. separation_max), drive_frequency (ω/ω_n, the "
                   "drive force held: resonance curves), or a numeric model or law key of the run (drive_amplitude, "

@@ -19,7 +19,7 @@ namespace afmkit::cli {
 std::vector<io::Column> hb_columns(const tapping::UnitScales& scales);
 /// Rows of the curve into `out` (a CommandOutput or an io::TableWriter opened with hb_columns).
 template <class Table>
-void write_hb_rows(Table& out, const std::vector<tapping::HbPoint>& curve, const tapping::UnitScales& s) {
+void write_hb_rows(Table& out, std::span<const tapping::HbPoint> curve, const tapping::UnitScales& s) {
   for (const tapping::HbPoint& pt : curve)
     out.row(pt.q, pt.separation * s.length, pt.amplitude * s.length, pt.offset * s.length, pt.phase,
             tapping::branch_name(pt.branch));

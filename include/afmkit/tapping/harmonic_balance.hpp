@@ -20,8 +20,10 @@
 // out-of-contact part of the branch that continues the free oscillation, with B ≈ Γ|L(iω)| and A ≈ 0 only
 // approximately. At one q there may be more than one Plus (or Minus) point (e.g. the S-shaped DMT curve).
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "afmkit/core/cancellation.hpp"
@@ -89,6 +91,13 @@ struct HbCurveOptions {
 std::vector<HbPoint> harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options);
 /// Same, writing into `out` (overwritten; piecewise-linear laws: no allocation when out.capacity() ≥ 2·points).
 void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out);
+/// The same points in the same order, streamed: `sink` gets them in consecutive chunks of at most `chunk` (≥ 1)
+/// points, so that memory is bounded by a chunk whatever options.points. The "−" block comes from a second pass
+/// over the samples, run only where the first found "−" points (for a general law: only over the chunks of q
+/// samples that have some). Returns the number of points.
+std::size_t harmonic_balance_curve_chunks(const TappingModel& model, const HbCurveOptions& options,
+                                          const std::function<void(std::span<const HbPoint>)>& sink,
+                                          std::size_t chunk = 4096);
 
 /// Every fold of the "+" and "−" branches (sorted by q), each located to |Δq| ≤ 1e-10 (closed form; general
 /// laws: where dl/ds = 0 along the curve, from 4th-order differences of the numerical describing functions —

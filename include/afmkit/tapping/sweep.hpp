@@ -37,6 +37,9 @@ struct SweepOptions {
   ShootingOptions shooting;
   TransientOptions transient;
   bool harmonic_balance = true;  // put the nearest HB solution beside each point (any law)
+  /// The retract pass after the approach (instrument sweeps: hysteresis, retract jumps); false: approach only
+  /// (SweepResult::retract and retract_jumps stay empty; half the work).
+  bool retract = true;
   /// Sub-step budget of follow_branch per separation step (halving / doubling the step in l).
   int max_substeps = 200;
   /// Resolution of the followed branch: a sub-step moves the scaled orbit state z = (x, ẋ/ω) by at most this times

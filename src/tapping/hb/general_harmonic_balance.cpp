@@ -1073,7 +1073,9 @@ void GeneralHarmonicBalance::sample(const std::vector<double>& qs, bool include_
       }
     }
   }
-  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) {
+  // stable: points of equal sample and amplitude keep the order of the segments, so that sampling any contiguous
+  // part of the samples gives the same points for it (the streamed curve samples chunk by chunk)
+  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) {
     return a.first != b.first ? a.first < b.first : a.second.amplitude < b.second.amplitude;
   });
   // drop duplicates (a sample on a node shared by two segments)

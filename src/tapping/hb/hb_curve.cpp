@@ -1,6 +1,7 @@
 // The parametric separation–amplitude curve (l(q), B(q), A(q), φ(q)) sampled over q (seed-1 eq. 19).
 #include <algorithm>
 #include <cmath>
+#include <exception>
 
 #include "afmkit/core/computed.hpp"
 #include "afmkit/core/validate.hpp"
@@ -101,7 +102,126 @@ void curve_of_checked(const TappingModel& model, const HbCurveOptions& options, 
   out.resize(n_plus + n_minus);
 }
 
+// Thrown through computed() when the sink failed (its own exception is kept: a write error stays the sink's,
+// never a numerical failure of the curve).
+struct SinkStopped {};
+
+// Points handed to a sink in chunks of at most `size`.
+class ChunkSink {
+ public:
+  ChunkSink(const std::function<void(std::span<const HbPoint>)>& sink, std::size_t size) : sink_(sink), size_(size) {
+    buffer_.reserve(size_);
+  }
+  void push(const HbPoint& p) {
+    buffer_.push_back(p);
+    if (buffer_.size() == size_) flush();
+  }
+  void flush() {
+    if (buffer_.empty()) return;
+    count_ += buffer_.size();
+    try {
+      sink_(std::span<const HbPoint>(buffer_));
+    } catch (...) {
+      error_ = std::current_exception();
+      throw SinkStopped{};
+    }
+    buffer_.clear();
+  }
+  std::size_t count() const { return count_; }
+  std::exception_ptr error() const { return error_; }
+
+ private:
+  const std::function<void(std::span<const HbPoint>)>& sink_;
+  std::size_t size_;
+  std::vector<HbPoint> buffer_;
+  std::size_t count_ = 0;
+  std::exception_ptr error_;
+};
+
+// Any other law, streamed: the q samples in chunks of `size`, each sampled on the traced curve (the points of a
+// sample depend on its q only: the same as one call over every sample); the Minus points of the chunks that have
+// some in a second pass.
+std::size_t general_curve_chunks(const TappingModel& model, const HbCurveOptions& options, ChunkSink& sink,
+                                 std::size_t size) {
+  const detail::GeneralHarmonicBalance hb(model, options.cancellation);
+  std::vector<double> qs;
+  qs.reserve(size);
+  std::vector<HbPoint> upper, lower;
+  std::vector<bool> has_minus;  // per chunk of samples: one bit each
+  auto run_chunks = [&](bool minus_pass) {
+    std::size_t index = 0;
+    auto sample_chunk = [&] {
+      if (qs.empty()) return;
+      if (!minus_pass || has_minus[index]) {
+        upper.clear();
+        lower.clear();
+        hb.sample(qs, options.include_minus, upper, lower, options.cancellation);
+        if (!minus_pass) has_minus.push_back(!lower.empty());
+        for (const HbPoint& p : minus_pass ? lower : upper) sink.push(p);
+      }
+      ++index;
+      qs.clear();
+    };
+    for_each_sample(options, [&](double q, double) {
+      qs.push_back(q);
+      if (qs.size() == size) sample_chunk();
+    });
+    sample_chunk();
+  };
+  run_chunks(false);
+  if (std::find(has_minus.begin(), has_minus.end(), true) != has_minus.end()) run_chunks(true);
+  sink.flush();
+  return sink.count();
+}
+
+// Piecewise-linear laws, streamed: the Plus/Free points in one pass, the Minus points in a second one where the
+// first found some (evaluate_branches_at_gap gives both roots of a sample: the same points as curve_of_checked).
+std::size_t closed_form_curve_chunks(const TappingModel& model, const HbCurveOptions& options, ChunkSink& sink) {
+  const HbCoefficients c(model);
+  const double b_free = c.free_amplitude();
+  const double phase_free = c.free_phase();
+  std::size_t n_minus = 0;
+  std::size_t visited = 0;
+  for_each_sample(options, [&](double q, double gap) {
+    if ((++visited & 4095) == 0) options.cancellation.check();
+    if (gap <= 0.0) {
+      sink.push({q, q * b_free, b_free, 0.0, phase_free, HbBranch::Free});
+      return;
+    }
+    const HbRoots roots = evaluate_branches_at_gap(c, gap, false);
+    if (roots.plus.exists) sink.push(curve_point(roots.plus, HbBranch::Plus));
+    if (options.include_minus && roots.minus.exists) ++n_minus;
+  });
+  if (n_minus > 0) {
+    for_each_sample(options, [&](double, double gap) {
+      if ((++visited & 4095) == 0) options.cancellation.check();
+      if (gap <= 0.0) return;
+      const HbRoots roots = evaluate_branches_at_gap(c, gap, false);
+      if (roots.minus.exists) sink.push(curve_point(roots.minus, HbBranch::Minus));
+    });
+  }
+  sink.flush();
+  return sink.count();
+}
+
 }  // namespace
+
+std::size_t harmonic_balance_curve_chunks(const TappingModel& model, const HbCurveOptions& options,
+                                          const std::function<void(std::span<const HbPoint>)>& sink,
+                                          std::size_t chunk) {
+  validate_options(options);
+  validate::require(chunk >= 1, "chunk", static_cast<double>(chunk), ">= 1");
+  // the options are checked: what is refused from here on was computed (core/computed.hpp)
+  ChunkSink out(sink, chunk);
+  try {
+    return computed("harmonic-balance curve", [&] {
+      return model.law.piecewise_linear() == nullptr ? general_curve_chunks(model, options, out, chunk)
+                                                     : closed_form_curve_chunks(model, options, out);
+    });
+  } catch (const SinkStopped&) {
+    std::rethrow_exception(out.error());
+  }
+}
 
 void harmonic_balance_curve(const TappingModel& model, const HbCurveOptions& options, std::vector<HbPoint>& out) {
   validate_options(options);

@@ -446,6 +446,11 @@ void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, co
                    bool harmonic_balance, bool parallel, const Cancellation& cancellation) {
   std::optional<HarmonicBalance> hb;  // branch scan once, cheap queries
   if (harmonic_balance) hb.emplace(base, cancellation);  // any law (closed form for piecewise-linear ones)
+  finish_points(base, points, simulation, hb ? &*hb : nullptr, parallel, cancellation);
+}
+
+void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
+                   const HarmonicBalance* hb, bool parallel, const Cancellation& cancellation) {
   ExceptionCollector errors;
 #pragma omp parallel for schedule(dynamic) if (parallel)
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -572,16 +577,23 @@ SweepResult sweep_checked(const TappingModel& base, const SweepParameter& parame
 
   SweepResult result;
   result.approach = run_direction(path, down, start, SweepDirection::approach, options, result.jumps);
-  SweepPoint turn = result.approach.back();
-  turn.jumped = false;
-  result.retract = run_direction(path, up, turn, SweepDirection::retract, options, result.jumps);
+  if (options.retract) {
+    SweepPoint turn = result.approach.back();
+    turn.jumped = false;
+    result.retract = run_direction(path, up, turn, SweepDirection::retract, options, result.jumps);
+  }
   for (const SweepJump& j : result.jumps)
     (j.direction == SweepDirection::approach ? result.approach_jumps : result.retract_jumps).push_back(j.parameter);
   if (parameter.is_separation()) {
-    detail::finish_points(base, result.approach, options.shooting.simulation, options.harmonic_balance,
-                          options.parallel, options.cancellation);
-    detail::finish_points(base, result.retract, options.shooting.simulation, options.harmonic_balance,
-                          options.parallel, options.cancellation);
+    // one harmonic balance of the model for both directions (for a law without closed forms its constructor
+    // traces the whole curve: 5–20 ms)
+    std::optional<HarmonicBalance> hb;
+    if (options.harmonic_balance) hb.emplace(base, options.cancellation);
+    const HarmonicBalance* beside = hb ? &*hb : nullptr;
+    detail::finish_points(base, result.approach, options.shooting.simulation, beside, options.parallel,
+                          options.cancellation);
+    detail::finish_points(base, result.retract, options.shooting.simulation, beside, options.parallel,
+                          options.cancellation);
   } else {
     detail::finish_points(path, result.approach, options.shooting.simulation, options.harmonic_balance,
                           options.parallel, options.cancellation);

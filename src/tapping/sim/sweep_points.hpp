@@ -8,6 +8,10 @@
 #include "afmkit/tapping/parameter.hpp"
 #include "afmkit/tapping/sweep.hpp"
 
+namespace afmkit::tapping {
+class HarmonicBalance;
+}
+
 namespace afmkit::tapping::detail {
 
 /// The models along the swept parameter p, and how the continuation scales p: its unknown is scale·p (1 for the
@@ -33,6 +37,9 @@ ParameterPath make_path(const TappingModel& base, const SweepParameter& paramete
 
 void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
                    bool harmonic_balance, bool parallel, const Cancellation& cancellation = {});
+/// The same with the harmonic balance of `base` built by the caller (nullptr: none), e.g. one for both directions.
+void finish_points(const TappingModel& base, std::vector<SweepPoint>& points, const SimulationOptions& simulation,
+                   const HarmonicBalance* hb, bool parallel, const Cancellation& cancellation = {});
 /// The same along any parameter: the metrics at each point's model, harmonic balance of each point's model (one
 /// HB evaluation per point) when the law is piecewise linear (closed form); else hb_* stay NaN. (The separation
 /// uses finish_points with one HB object for all points.)
