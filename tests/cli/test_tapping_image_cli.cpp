@@ -62,14 +62,15 @@ TEST(TappingImageCli, WritesEveryImageGwyddionRendersAndTheSidecarHasUnits) {
     }
   EXPECT_EQ(images, 12);
   EXPECT_TRUE(std::filesystem::exists(dir.file("out/tapping_image/image_truth.gsf")));
-  // the truth as written is the steps sample: two terraces 1 nm apart
+  // the truth as written is the steps sample: terraces 250 nm wide (the default steps_width), 1 nm apart, over the
+  // 1 µm scan centred on x = 0: floor(x / 250 nm) from -2 to 1, four terraces spanning 3 nm
   const afmkit::scan::GsfField truth = afmkit::scan::read_gsf(dir.file("out/tapping_image/image_truth.gsf"));
   double lo = 1, hi = -1;
   for (double v : truth.map.data()) {
     lo = std::min(lo, v);
     hi = std::max(hi, v);
   }
-  EXPECT_NEAR(hi - lo, 1e-9, 1e-15);
+  EXPECT_NEAR(hi - lo, 3e-9, 1e-15);
 }
 
 TEST(TappingImageCli, AFlatSampleImagesZeroHeightAtTheSetPoint) {
