@@ -74,8 +74,8 @@ void declare_tapping_image(io::ParamSet& p) {
       .default_text("the sample file's width (sample = file), else 1e-6")
       .real("scan_height", 0.0, "height of the scanned area (slow axis y; 0: scan_size)", io::Range::non_negative())
       .unit("m")
-      .integer("pixels", 256, "pixels per line", 2, 16384)
-      .integer("lines", 256, "lines (each scanned trace then retrace)", 2, 16384)
+      .integer("pixels", 128, "pixels per line", 2, 16384)
+      .integer("lines", 128, "lines (each scanned trace then retrace)", 2, 16384)
       .real("line_rate", 1.0, "lines per second (trace + retrace): tip speed 2 x scan_size x line_rate",
             io::Range::positive())
       .unit("Hz")
@@ -109,7 +109,7 @@ void declare_tapping_image(io::ParamSet& p) {
       .real("map_separation_max", 0.0, "largest separation of the map (0: 1.25 x free_amplitude)",
             io::Range::closed(-1e6, 1e6))
       .unit("nm")
-      .integer("map_points", 300, "separations of the map's approach and retract", 8, 100000)
+      .integer("map_points", 200, "separations of the map's approach and retract", 8, 100000)
       .group("Images and files")
       .file("image_output", "out/tapping_image/image",
             "prefix of the images <prefix>_<channel>_<trace|retrace>.gsf/.png and <prefix>_truth (empty: none)")

@@ -44,7 +44,8 @@ const QimgCase& qimg_case() {
   static const QimgCase c = [] {
     SweepOptions o;
     o.harmonic_balance = false;
-    o.transient.max_periods = 4000;
+    o.transient.max_periods = 1000;  // the non-periodic window below the first approach jump: 1000 periods settle the
+                                     // jumps used here as 4000 do, at half the cost
     SweepResult s = sweep_instrument(qimg_model(), 0.0, 12.0, 48, o);
     OrbitMap m = OrbitMap::from_sweep(qimg_model(), s);
     return QimgCase{std::move(s), std::move(m)};

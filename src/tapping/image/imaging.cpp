@@ -41,12 +41,13 @@ void FeedbackSpec::validate() const {
   if (!(setpoint > 0.0 && setpoint < 1.0))
     throw InvalidParameter("setpoint", fmt::format("setpoint = {} is out of range: the amplitude set-point A_sp/A0 "
                                                    "must be in (0, 1)", setpoint));
-  if (!(proportional_gain >= 0.0 && std::isfinite(proportional_gain)))
+  // upper bounds far beyond any stable loop, so that Z stays finite whatever the error
+  if (!(proportional_gain >= 0.0 && proportional_gain <= 1e6))
     throw InvalidParameter("proportional_gain", fmt::format("proportional_gain = {} is out of range: must be >= 0 "
-                                                            "(and finite)", proportional_gain));
-  if (!(integral_gain >= 0.0 && std::isfinite(integral_gain)))
+                                                            "(and <= 1e6)", proportional_gain));
+  if (!(integral_gain >= 0.0 && integral_gain <= 1e12))
     throw InvalidParameter("integral_gain", fmt::format("integral_gain = {} 1/s is out of range: must be >= 0 (and "
-                                                        "finite)", integral_gain));
+                                                        "<= 1e12 1/s)", integral_gain));
   if (!(proportional_gain > 0.0 || integral_gain > 0.0))
     throw InvalidParameter("integral_gain", "proportional_gain and integral_gain are both 0: the loop would not move Z");
   if (!(std::isfinite(z_min) && std::isfinite(z_max)))

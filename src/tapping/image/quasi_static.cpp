@@ -48,9 +48,9 @@ TipReading QuasiStaticEngine::advance(const scan::Surface& surface, double z, do
   const double h = surface(0.5 * (x0 + x1), y);
   r.separation = z - h;
   double l = r.separation / metres_;
-  if (l < map_.separation_min() || l > map_.separation_max()) {
+  if (!(l >= map_.separation_min() && l <= map_.separation_max())) {  // NaN too
     r.beyond_map = true;
-    l = std::min(std::max(l, map_.separation_min()), map_.separation_max());
+    l = l > map_.separation_max() ? map_.separation_max() : map_.separation_min();
   }
   branch_ = map_.follow(branch_, l);
   const SteadyState s = map_.at(branch_, l, hints_[static_cast<std::size_t>(branch_)]);
