@@ -1,9 +1,10 @@
 // AM-AFM imaging with Z feedback, quasi-static engine (docs/theory-tapping.md#quasi-static-imaging). The
 // expectations come from the instrument sweep's own points and jumps (sweep_instrument), interpolated here, not
 // from the orbit map's branches, tracks or engagement: a flat sample holds the set-point and images zero height; a
-// step is imaged with its height on one branch, and with its height minus the separation between the branches where
-// the step pushes the tip off the attractive branch; at a set-point inside the bistable window the regime is the one
-// the approach reaches, and it switches where the attractive branch ends.
+// step is imaged with its height on one branch; at a set-point inside the bistable window a step higher than the
+// attractive branch's margin (from the set-point's separation down to the approach's located jump) switches the tip
+// to the repulsive branch and is imaged lower by the separation between the branches (test_orbit_map_branches.cpp
+// checks the engagement across a jump and the hysteresis rule in closed form).
 #include <algorithm>
 #include <cmath>
 #include <numbers>
