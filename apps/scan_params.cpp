@@ -131,7 +131,7 @@ scan::HeightMap sample_from_file(const io::ParamSet& p) {
 
 }  // namespace
 
-void add_scan_params(io::ParamSet& p) {
+void add_sample_params(io::ParamSet& p) {
   const auto positive = io::Range::positive();
   const auto non_negative = io::Range::non_negative();
   p.group("Sample")
@@ -141,7 +141,7 @@ void add_scan_params(io::ParamSet& p) {
       .real("sample_size", 0.0, "sample width (generators: square side; png/ASCII files: image width)",
             non_negative)
       .unit("m")
-      .default_text("generators: 2.04 x end_radius")
+      .default_text("generators: scan 2.04 x end_radius, tapping image the larger side of the scan")
       .real("sample_z_scale", 1.0, "height per file unit: ASCII values x scale; png: height of grey 65535", positive)
       .unit("m")
       .integer("sample_resolution", 2048, "pixels per side of a generated sample", 16, 16384)
@@ -166,8 +166,14 @@ void add_scan_params(io::ParamSet& p) {
       .real("tilt_angle", 0.05, "tilt of the sample normal from the spindle axis, in [0, 90)", non_negative)
       .unit("deg")
       .real("tilt_azimuth", 0.0, "direction of the tilt in the sample plane", io::Range::any())
-      .unit("deg")
-      .group("Spiral")
+      .unit("deg");
+}
+
+void add_scan_params(io::ParamSet& p) {
+  const auto positive = io::Range::positive();
+  const auto non_negative = io::Range::non_negative();
+  add_sample_params(p);
+  p.group("Spiral")
       .real("spindle_frequency", 50.0, "spindle rotation frequency f_rot (Omega = 2 pi f_rot)", positive)
       .unit("Hz")
       .real("start_radius", 0.0, "radius where the scan starts", non_negative)
@@ -272,6 +278,8 @@ double sample_bytes(const io::ParamSet& p) {
 }
 }  // namespace
 
+double require_sample_memory(const io::ParamSet& p) { return sample_bytes(p); }
+
 void require_scan_memory(const io::ParamSet& p, bool recorded) {
   const double sample = recorded ? 0.0 : sample_bytes(p);
   memory::require_fits_square("image_resolution", static_cast<double>(p.integer("image_resolution")),
@@ -291,6 +299,10 @@ const std::vector<std::string>& simulation_only_keys() {
 
 void record_only_what_applies(io::ParamSet& p) {
   for (const std::string& key : simulation_only_keys()) p.applies_when(key, "recorded", {""});
+  record_only_sample_keys_that_apply(p);
+}
+
+void record_only_sample_keys_that_apply(io::ParamSet& p) {
   p.applies_when("sample_file", "sample", {"file"})
       .applies_when("sample_z_scale", "sample", {"file"})
       .applies_when("sample_resolution", "sample", {"grating", "steps", "particles", "rough", "flat"})
@@ -350,13 +362,17 @@ scan::Surface surface_from(const io::ParamSet& p) {
                     "deg for this end_radius (or end_radius <= {:.6g} m for this tilt_angle)",
                     tilt_angle, end_radius, tilt_height, kMaxHeight, kMaxHeight,
                     std::atan(kMaxHeight / end_radius) / kDegree, kMaxHeight / std::tan(tilt.angle)));
+  return scan::Surface(sample_map_from(p, generated_sample_size(p)), tilt);
+}
+
+scan::HeightMap sample_map_from(const io::ParamSet& p, double generated_size) {
   const std::string kind = p.text("sample");
-  if (kind == "file") return scan::Surface(sample_from_file(p), tilt);
+  if (kind == "file") return sample_from_file(p);
   if (p.was_set("sample_file"))
     throw InvalidParameter("sample_file", fmt::format("sample_file is given but sample = {}: set sample = file to "
                                                       "scan the file, or leave sample_file out", kind));
 
-  const double size = generated_sample_size(p);
+  const double size = generated_size;
   if (!(size > 0.0))
     throw InvalidParameter("sample_size", fmt::format("sample_size = {} m is out of range: must be > 0", size));
   const long n = p.integer("sample_resolution");
@@ -378,7 +394,7 @@ scan::Surface surface_from(const io::ParamSet& p) {
                                             : "sample";
   require_map_heights(map.data(), n, key, fmt::format("sample = {} with {} = {} m", kind, key,
                                                       kind == "flat" ? 0.0 : p.real(key)));
-  return scan::Surface(std::move(map), tilt);
+  return map;
 }
 
 }  // namespace afmkit::cli

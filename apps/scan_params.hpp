@@ -12,6 +12,17 @@
 namespace afmkit::cli {
 
 void add_scan_params(io::ParamSet& p);
+/// The "Sample" group alone (the generators, the file, the tilt): the one declaration of the samples every scanning
+/// command shares (`scan`, `tapping image`); a command sets its own defaults with ParamSet::set_default.
+void add_sample_params(io::ParamSet& p);
+/// The sample's topography without tilt, centred on (0, 0): a file (GSF, ASCII matrix, 16-bit PNG) or a generator
+/// on a square of side `generated_size` [m] (InvalidParameter naming the parameter).
+scan::HeightMap sample_map_from(const io::ParamSet& p, double generated_size);
+/// The bytes the sample map needs; InvalidParameter (sample_resolution or sample_file) when it alone does not fit.
+double require_sample_memory(const io::ParamSet& p);
+/// The applies_when declarations of the sample's keys (each generator's keys for that generator, the file's for
+/// sample = file).
+void record_only_sample_keys_that_apply(io::ParamSet& p);
 /// The instrument given (validated: InvalidParameter naming the parameter).
 scan::InstrumentSpec instrument_from(const io::ParamSet& p);
 /// The side [m] of a generated sample: sample_size when given, else 2.04 x end_radius.

@@ -33,7 +33,7 @@ using cli::CommandSpec;
 
 /// The commands whose law comes from law_from_params with the caller's law object (cli::law_object_of).
 bool takes_law_object(const std::string& path) {
-  for (const char* p : {"tapping orbit", "tapping hb", "tapping sweep", "tapping fm", "demo", "impact"})
+  for (const char* p : {"tapping orbit", "tapping hb", "tapping sweep", "tapping fm", "tapping image", "demo", "impact"})
     if (path == p) return true;
   return false;
 }

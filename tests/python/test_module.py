@@ -34,6 +34,7 @@ def test_every_command_of_the_program_is_a_function_with_its_toml_keys():
     functions = {"impact": afmkit.impact, "scan": afmkit.scan, "demo": afmkit.demo,
                  "tapping orbit": afmkit.tapping.orbit, "tapping hb": afmkit.tapping.hb,
                  "tapping sweep": afmkit.tapping.sweep, "tapping fm": afmkit.tapping.fm,
+                 "tapping image": afmkit.tapping.image,
                  "control tf": afmkit.control.tf,
                  "control roots": afmkit.control.roots, "control margin": afmkit.control.margin,
                  "control chart": afmkit.control.chart, "control tune": afmkit.control.tune,
@@ -45,6 +46,7 @@ def test_every_command_of_the_program_is_a_function_with_its_toml_keys():
     assert paths - {"spectroscopy fit"} == set(functions)
     for path, fn in functions.items():
         help_text = cli(*path.split(), "--help").stdout + cli(*path.split(), "--units", "physical", "--help").stdout
+        help_text += cli(*path.split(), "--units", "normalised", "--help").stdout  # tapping image: physical by default
         keys = [p for p in inspect.signature(fn).parameters if p != "config"]
         for key in keys:  # every keyword is an option of the command line (key with '-' for '_')
             assert "--" + key.replace("_", "-") in help_text, (path, key)
