@@ -11,6 +11,7 @@ void register_tapping(CLI::App& app) {
   register_tapping_sweep(tapping);
   register_tapping_grid(tapping);
   register_tapping_fm(tapping);
+  register_tapping_modes(tapping);
 }
 
 }  // namespace afmkit::cli

@@ -17,6 +17,7 @@ FAST = {
     "tapping sweep": dict(free_amplitude=10.0, separation_min=7.0, separation_max=9.0, points=3, mode="instrument",
                           quiet=True),
     "tapping fm": dict(separation_min=7.0, separation_max=9.0, points=3, quiet=True),
+    "tapping modes": dict(separation_min=10.0, separation_max=12.0, points=2, settle_periods=20, lockin_periods=4, quiet=True),
     "control tf": dict(harmonics=3, points=20),
     "control roots": dict(harmonics=3),
     "control margin": dict(harmonics=3),
@@ -44,6 +45,7 @@ FILES = {"demo": lambda d: dict(output_dir=str(d / "demo")), "control export": l
 FUNCTIONS = {
     "impact": afmkit.impact, "tapping hb": afmkit.tapping.hb, "tapping orbit": afmkit.tapping.orbit,
     "tapping sweep": afmkit.tapping.sweep, "tapping fm": afmkit.tapping.fm, "control tf": afmkit.control.tf, "control roots": afmkit.control.roots,
+    "tapping modes": afmkit.tapping.modes,
     "control margin": afmkit.control.margin, "control chart": afmkit.control.chart,
     "control tune": afmkit.control.tune, "control simulate": afmkit.control.simulate, "scan": afmkit.scan,
     "demo": afmkit.demo, "control export": afmkit.control.export, "spectroscopy fit": spectroscopy_fit.run,
