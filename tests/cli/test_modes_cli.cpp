@@ -29,6 +29,7 @@ double modes_cli_cell(const nlohmann::json& doc, std::size_t row, const std::str
   for (std::size_t i = 0; i < columns.size(); ++i)
     if (columns[i]["name"] == column) {
       const auto& cell = doc["table"]["rows"][row][i];
+      if (cell.is_boolean()) return cell.get<bool>() ? 1.0 : 0.0;
       return cell.is_null() ? std::nan("") : cell.get<double>();
     }
   ADD_FAILURE() << "no column " << column;
@@ -58,7 +59,7 @@ TEST(TappingModesCli, FarFromTheSampleEveryModeIsItsFreeLinearResponse) {
 
 TEST(TappingModesCli, InTappingTheSecondModePhaseMovesAndEveryModeBalancesItsEnergy) {
   const auto doc = modes_cli_document(
-      "--quality-factor 20 --separation-min 12 --separation-max 30 --points 2 --settle-periods 40 "
+      "--quality-factor 20 --separation-min 3 --separation-max 30 --points 2 --settle-periods 40 "
       "--lockin-periods 10 --second-free-amplitude 0.5");
   ASSERT_EQ(doc["table"]["rows"].size(), 2u);
   EXPECT_NEAR(modes_cli_cell(doc, 0, "phase_2"), std::numbers::pi / 2, 1e-3);
@@ -73,8 +74,8 @@ TEST(TappingModesCli, InTappingTheSecondModePhaseMovesAndEveryModeBalancesItsEne
 
 TEST(TappingModesCli, ThePeriodicOrbitIsWhereALongTransientSettles) {
   // one drive (commensurate): Newton's orbit after a short settling against 300 periods of settling at Q = 20
-  // (transients decay by exp(−π·300/20) ≈ 3e-21)
-  const std::string common = "--quality-factor 20 --separation-min 12 --separation-max 12 --points 1 --lockin-periods 4";
+  // (free amplitude ΓQ = 4; transients decay by exp(−π·300/20) ≈ 3e-21)
+  const std::string common = "--quality-factor 20 --separation-min 3 --separation-max 3 --points 1 --lockin-periods 4";
   const auto orbit = modes_cli_document(common + " --settle-periods 20 --periodic");
   const auto settled = modes_cli_document(common + " --settle-periods 300");
   ASSERT_EQ(modes_cli_cell(orbit, 0, "periodic"), 1.0);

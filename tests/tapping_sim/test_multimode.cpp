@@ -158,6 +158,27 @@ TEST(MultiMode, EnergyBalanceOfEveryModeInTapping) {
   EXPECT_LT(tip_total, 0.0);  // a dissipative law takes energy from the cantilever
 }
 
+TEST(MultiMode, StickingHoldsTheTipWhileTheModesMoveOnAndBalancesTheirEnergy) {
+  // the repulsive–attractive law (26) with adhesion holds the tip at rest in contact (seed-1 eq. 4, both branches
+  // pushing back onto ẋ = 0); with two modes the tip stays put while the modes exchange energy through the
+  // holding force, which does no work on the tip but works on each mode
+  const TappingModel single = testing::make_model(10, 8, 0.5, 1.0, 9.0);
+  const auto modes = euler_bernoulli_modes(single.cantilever, 2);
+  const MultiModeModel m(modes, {single.drive}, Excitation::base, Medium{}, single.law, single.separation);
+  ModalResponseOptions o;
+  o.settle_periods = 10;
+  o.lockin_periods = 10;
+  o.simulation = multimode_tight();
+  const ModalResponse r = modal_response(m, 0.0, free_steady_state(m, 0.0), o);
+  ASSERT_GT(r.stats.sticking_count, 0);
+  EXPECT_GT(r.stats.sticking_duration, 0.0);
+  for (int i = 0; i < 2; ++i) {
+    const ModeEnergy& e = r.energy[i];
+    const double scale = std::max({std::abs(e.drive_work), e.damping_loss, std::abs(e.tip_work)});
+    EXPECT_NEAR(e.residual(), 0.0, 1e-7 * scale) << "mode " << i + 1;
+  }
+}
+
 TEST(MultiMode, SecondModePhaseMovesWithTheSeparation) {
   // bimodal AM-AFM: far away the second mode's phase is its free phase at resonance (π/2); in tapping it shifts
   const TappingModel single = multimode_dmt_single(20.0, 30.0);

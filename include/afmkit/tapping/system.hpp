@@ -90,8 +90,10 @@ class TappingSystem {
   /// Shortest period of the drives and modes other than drive 1 and mode 1 (infinity for a TappingModel).
   double shortest_extra_period() const { return modal_ ? modal_->shortest_period : afmkit_infinity(); }
   /// Multi-mode: the modal accelerations q̈_i (`out`, mode_count() values, may be null) in `branch` and `region`
-  /// at (t, s); returns the tip's ẍ = ÿ_b + Σ q̈_i.
-  double modal_accelerations(ContactBranch branch, int region, double t, const TipState& s, double* out) const;
+  /// at (t, s); returns the tip's ẍ = ÿ_b + Σ q̈_i. Sticking: the tip is held (ẍ = 0 returned) by the contact force
+  /// h = (ÿ_b + Σ (F_i − 2ξ_i'ω_i' q̇_i − ω_i'² q_i)) / Σ ρβ_i, and the modes move on under it. `force`: h used.
+  double modal_accelerations(ContactBranch branch, int region, double t, const TipState& s, double* out,
+                             double* force = nullptr) const;
   /// Multi-mode: the modal coordinates q_i, q̇_i of s at t (mode 1 = the tip minus the base motion and the others).
   void modal_coordinates(double t, const TipState& s, double* q, double* v) const;
   /// Multi-mode: the modal forcing F_i(t) (`out`, mode_count() values) and the base motion (y_b, ẏ_b, ÿ_b, y_b⃛).
@@ -142,6 +144,7 @@ class TappingSystem {
   };
   std::optional<ModalTerms> modal_;
   double modal_jerk(const Mode& mode, double t, const TipState& s) const;
+  double modal_release_rate(double t, const TipState& s, int region) const;
 };
 
 }  // namespace afmkit::tapping

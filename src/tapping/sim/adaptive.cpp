@@ -95,7 +95,7 @@ struct ModalField {
   void operator()(const std::array<double, N>& y, std::array<double, N>& dy, double t) const {
     double a[kMaxEigenmodes];
     dy[0] = y[1];
-    dy[1] = sys->modal_accelerations(mode.branch, mode.region, t, tip_of(y), a);
+    dy[1] = sys->modal_accelerations(mode.branch, mode.region, t, tip_of(y), a);  // 0 while sticking
     for (std::size_t j = 1; 2 * j < N; ++j) {
       dy[2 * j] = y[2 * j + 1];
       dy[2 * j + 1] = a[j];
@@ -197,10 +197,12 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
   State y{}, tmp{};
   double dt = std::min(max_dt, 1e-3 * drive_period);
   while (rs.t < t_end) {
-    if (rs.mode.branch == ContactBranch::sticking) {
+    // one mode: the tip rests (run_sticking); more modes: the modes move on with the tip held (ModalField)
+    if (rs.mode.branch == ContactBranch::sticking && !sys.modal()) {
       run_sticking(sys, rs, t_end, options, observer);
       continue;
     }
+    const double segment_begin = rs.t;
     const Mode mode = rs.mode;
     y.fill(0.0);
     y[0] = rs.y.position;
@@ -244,6 +246,7 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
       seg << tmp[2], tmp[4], tmp[6], tmp[3], tmp[5], tmp[7], 0.0, 0.0, 1.0;
       rs.jacobian = seg * rs.jacobian;
     }
+    if (mode.branch == ContactBranch::sticking) rs.stats.sticking_duration += t_stop - segment_begin;
     if (hit) {
       handle_event(sys, rs, guards[hit->guard], t_stop, y1, options, observer);
     } else {

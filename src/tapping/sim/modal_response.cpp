@@ -102,7 +102,11 @@ void ModalLockIn::integrate(const TappingSystem& system, const Segment& segment,
       const double t = mid + half * kModalGaussNodes[k], w = half * kModalGaussWeights[k];
       const TipState s = segment.state(t);
       modal_state(t, s, q, v, f);
-      const double h = system.interaction(mode.branch, s.position, s.velocity, mode.region);
+      double h = 0.0;  // the tip force on the modes (while a multi-mode tip sticks: the force that holds it)
+      if (system.modal())
+        system.modal_accelerations(mode.branch, mode.region, t, s, nullptr, &h);
+      else
+        h = system.interaction(mode.branch, s.position, s.velocity, mode.region);
       for (int d = 0; d < nd; ++d) {
         if (middle < begin_[d]) continue;
         const std::complex<double> e = std::polar(w, -model_.drives[d].frequency * t);

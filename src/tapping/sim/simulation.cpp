@@ -169,11 +169,6 @@ class StaticSegment final : public Segment {
 
 void run_sticking(const TappingSystem& sys, RunState& rs, double t_end, const SimulationOptions& options,
                   TrajectoryObserver* observer) {
-  if (sys.modal())
-    throw NumericalFailure(fmt::format(
-        "tapping simulation (modes): the tip sticks at t = {:.9g} (x = {:.9g}: both branches of the law push it back "
-        "onto zero velocity); sticking is modelled for one eigenmode only (docs/theory-tapping.md)",
-        rs.t, rs.y.position));
   std::array<Guard, 3> guards;
   const int n = sys.guards(rs.mode, guards);
   const TipState rest{rs.y.position, 0.0};

@@ -96,21 +96,50 @@ void TappingSystem::modal_coordinates(double t, const TipState& s, double* q, do
 }
 
 double TappingSystem::modal_accelerations(ContactBranch branch, int region, double t, const TipState& s,
-                                          double* out) const {
+                                          double* out, double* force) const {
   // q̈_i = F_i(t) − 2ξ_i'ω_i' q̇_i − ω_i'² q_i − ρβ_i h(x, ẋ);  ẍ = ÿ_b + Σ q̈_i   (modes.hpp)
   const ModalTerms& m = *modal_;
   double f[kMaxEigenmodes], q[kMaxEigenmodes], v[kMaxEigenmodes];
   std::array<double, 4> base{};
   modal_forcing(t, f, base);
   coordinates_given_base(m.modes, s, base, q, v);
-  const double h = interaction(branch, s.position, s.velocity, region);
+  double h;
+  if (branch == ContactBranch::sticking) {
+    // the tip held at rest: the contact force is what keeps ẍ = ÿ_b + Σ q̈_i = 0 (the modes move on)
+    double free_tip = base[2], coupling = 0.0;
+    for (int i = 0; i < m.modes; ++i) {
+      free_tip += f[i] - m.damping[i] * v[i] - m.stiffness[i] * q[i];
+      coupling += m.coupling[i];
+    }
+    h = free_tip / coupling;
+  } else {
+    h = interaction(branch, s.position, s.velocity, region);
+  }
   double tip = base[2];
   for (int i = 0; i < m.modes; ++i) {
     const double a = f[i] - m.damping[i] * v[i] - m.stiffness[i] * q[i] - m.coupling[i] * h;
     if (out) out[i] = a;
     tip += a;
   }
-  return tip;
+  if (force) *force = h;
+  return branch == ContactBranch::sticking ? 0.0 : tip;
+}
+
+double TappingSystem::modal_release_rate(double t, const TipState& s, int region) const {
+  // g = ÿ_b + Σ (F_i − 2ξ_i'ω_i' q̇_i − ω_i'² q_i) − Σ ρβ_i h_branch(x) with x held: ġ = y_b⃛ + Σ (Ḟ_i − … q̈_i − … q̇_i)
+  const ModalTerms& m = *modal_;
+  double a[kMaxEigenmodes], f[kMaxEigenmodes], q[kMaxEigenmodes], v[kMaxEigenmodes];
+  std::array<double, 4> base{};
+  modal_forcing(t, f, base);
+  coordinates_given_base(m.modes, s, base, q, v);
+  modal_accelerations(ContactBranch::sticking, region, t, s, a);
+  double rate = base[3];
+  for (int i = 0; i < m.modes; ++i) {
+    double f_rate = 0.0;
+    for (int d = 0; d < m.drives; ++d) f_rate -= m.forcing[i][d] * m.omega[d] * std::sin(m.omega[d] * t);
+    rate += f_rate - m.damping[i] * a[i] - m.stiffness[i] * v[i];
+  }
+  return rate;
 }
 
 double TappingSystem::modal_jerk(const Mode& mode, double t, const TipState& s) const {
@@ -356,7 +385,7 @@ double TappingSystem::witness_rate(const Guard& guard, const Mode& mode, double 
     case GuardKind::gap: return s.velocity;
     case GuardKind::velocity: return acceleration(mode, t, s);
     case GuardKind::release_departure:
-    case GuardKind::release_approach: return drive_rate(t);
+    case GuardKind::release_approach: return modal_ ? modal_release_rate(t, s, mode.region) : drive_rate(t);
   }
   return 0.0;
 }
@@ -373,7 +402,7 @@ double TappingSystem::witness_rate_derivative(const Guard& guard, const Mode& mo
              (stiffness_ + interaction_slope(mode.branch, s.position, s.velocity, mode.region)) * s.velocity;
     }
     case GuardKind::release_departure:
-    case GuardKind::release_approach: return -omega_ * omega_ * drive(t);
+    case GuardKind::release_approach: return modal_ ? 0.0 : -omega_ * omega_ * drive(t);  // modal: unused (bisection)
   }
   return 0.0;
 }
