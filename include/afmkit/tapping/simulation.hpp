@@ -69,8 +69,9 @@ SimulationResult simulate(const TappingModel& model, double t_begin, TipState st
 
 /// The same for a multi-mode cantilever (modes.hpp): `start` holds the tip's x, ẋ and the higher modal
 /// coordinates (TipState::modal). A MultiModeModel::single_mode() model is simulated as its TappingModel (the
-/// same bits); otherwise by the adaptive integrator, with the same guards and events seen at the tip. Not
-/// available for more than one mode: sensitivity and closed_form (InvalidParameter), sticking (NumericalFailure).
+/// same bits); otherwise by the adaptive integrator, with the same guards and events seen at the tip (sticking holds
+/// the tip while the modes move on). Not available for more than one mode: sensitivity and closed_form
+/// (InvalidParameter).
 SimulationResult simulate(const MultiModeModel& model, double t_begin, TipState start, double t_end,
                           const SimulationOptions& options = {}, TrajectoryObserver* observer = nullptr);
 
