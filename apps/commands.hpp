@@ -14,6 +14,7 @@ void register_tapping_sweep(CLI::App& tapping); // tapping_sweep_cmd.cpp: afmkit
 void register_tapping_grid(CLI::App& tapping);  // tapping_grid_cmd.cpp:  afmkit tapping grid (OpenMP, Zarr)
 void register_tapping_fm(CLI::App& tapping);    // tapping_fm_cmd.cpp:    afmkit tapping fm (FM-AFM)
 void register_tapping_image(CLI::App& tapping); // tapping_image_cmd.cpp: afmkit tapping image (AM imaging)
+void register_tapping_modes(CLI::App& tapping); // tapping_modes_cmd.cpp: afmkit tapping modes (2-3 eigenmodes)
 void register_control(CLI::App& app);           // control_cmd.cpp:       afmkit control …
 void register_control_tf(CLI::App& control);        // control_tf_cmd.cpp:       control tf
 void register_control_analysis(CLI::App& control);  // control_analysis_cmd.cpp: control roots|margin|chart|tune

@@ -12,6 +12,7 @@ void register_tapping(CLI::App& app) {
   register_tapping_grid(tapping);
   register_tapping_fm(tapping);
   register_tapping_image(tapping);
+  register_tapping_modes(tapping);
 }
 
 }  // namespace afmkit::cli

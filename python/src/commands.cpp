@@ -33,7 +33,8 @@ using cli::CommandSpec;
 
 /// The commands whose law comes from law_from_params with the caller's law object (cli::law_object_of).
 bool takes_law_object(const std::string& path) {
-  for (const char* p : {"tapping orbit", "tapping hb", "tapping sweep", "tapping fm", "tapping image", "demo", "impact"})
+  for (const char* p : {"tapping orbit", "tapping hb", "tapping sweep", "tapping fm", "tapping image", "tapping modes",
+                        "demo", "impact"})
     if (path == p) return true;
   return false;
 }

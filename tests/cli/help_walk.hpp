@@ -16,7 +16,7 @@ inline const std::vector<std::string> kCommands = {
     "demo",          "impact",         "tapping orbit", "tapping hb",    "tapping sweep", "tapping grid",
     "control tf",    "control roots",  "control margin", "control chart", "control tune",  "control simulate",
     "control export", "scan",          "report",         "study run",     "tapping fm",
-    "spectroscopy prepare", "spectroscopy reconstruct", "spectroscopy fit", "tapping image"};
+    "spectroscopy prepare", "spectroscopy reconstruct", "spectroscopy fit", "tapping image", "tapping modes"};
 
 /// Whether this build has the Python module (`afmkit report` and `afmkit study run` need it; the sanitizer build has
 /// none).

@@ -35,6 +35,7 @@ def test_every_command_of_the_program_is_a_function_with_its_toml_keys():
                  "tapping orbit": afmkit.tapping.orbit, "tapping hb": afmkit.tapping.hb,
                  "tapping sweep": afmkit.tapping.sweep, "tapping fm": afmkit.tapping.fm,
                  "tapping image": afmkit.tapping.image,
+                 "tapping modes": afmkit.tapping.modes,
                  "control tf": afmkit.control.tf,
                  "control roots": afmkit.control.roots, "control margin": afmkit.control.margin,
                  "control chart": afmkit.control.chart, "control tune": afmkit.control.tune,

@@ -34,6 +34,8 @@ CASES = {
     "tapping sweep": lambda d: dict(separation_min=7.0, separation_max=9.0, points=3, mode="instrument", quiet=True),
     "tapping fm": lambda d: dict(separation_min=7.0, separation_max=9.0, points=3, quiet=True),
     "tapping image": lambda d: dict(pixels=8, lines=4, map_points=40, sample="steps", image_output="", quiet=True),
+    "tapping modes": lambda d: dict(units="physical", law="dmt", quality_factor=20.0, separation_min=16.0,
+                                    separation_max=18.0, points=2, settle_periods=20, lockin_periods=4, quiet=True),
     "control tf": lambda d: dict(harmonics=3, points=20, plant_rate=7.0),
     "control roots": lambda d: dict(harmonics=3),
     "control margin": lambda d: dict(harmonics=3, controller="smith"),

@@ -1,5 +1,6 @@
 #pragma once
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -28,6 +29,9 @@ struct TipState {
   double position = 0.0;  // x
   double velocity = 0.0;  // ẋ
   bool contact = false;   // memory of contact (contact-aware laws)
+  /// A multi-mode cantilever (modes.hpp): the higher modal coordinates (q_2, q̇_2, q_3, q̇_3); x and ẋ stay the
+  /// tip's, so the guards are those of one mode. Zero (unused) for a single-mode cantilever.
+  std::array<double, 4> modal{};
 };
 
 /// Which force branch is active (seed-1 eq. 4 as corrected in docs/theory-tapping.md#impact).

@@ -16,6 +16,7 @@
 
 #include "afmkit/tapping/events.hpp"
 #include "afmkit/tapping/model.hpp"
+#include "afmkit/tapping/modes.hpp"
 
 namespace afmkit::tapping {
 
@@ -81,6 +82,14 @@ struct SimulationResult {
 /// TappingSystem::initial_mode). Throws NumericalFailure when an event or step budget is exhausted and
 /// InvalidParameter for a non-finite state, t_end < t_begin, or closed_form with a non piecewise-linear law.
 SimulationResult simulate(const TappingModel& model, double t_begin, TipState start, double t_end,
+                          const SimulationOptions& options = {}, TrajectoryObserver* observer = nullptr);
+
+/// The same for a multi-mode cantilever (modes.hpp): `start` holds the tip's x, ẋ and the higher modal
+/// coordinates (TipState::modal). A MultiModeModel::single_mode() model is simulated as its TappingModel (the
+/// same bits); otherwise by the adaptive integrator, with the same guards and events seen at the tip (sticking holds
+/// the tip while the modes move on). Not available for more than one mode: sensitivity and closed_form
+/// (InvalidParameter).
+SimulationResult simulate(const MultiModeModel& model, double t_begin, TipState start, double t_end,
                           const SimulationOptions& options = {}, TrajectoryObserver* observer = nullptr);
 
 /// Integrator actually used for `model` under `requested` (resolves automatic; validates closed_form).

@@ -4,12 +4,14 @@
 //   ẍ = Γ cos(ωt) − 2ξω_n ẋ − ω_n² x − h_branch(x),   h_branch(x) = −H_branch(x + l)   (seed-1 eq. 8)
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
 
 #include "afmkit/tapping/events.hpp"
 #include "afmkit/tapping/model.hpp"
+#include "afmkit/tapping/modes.hpp"
 
 namespace afmkit::tapping {
 
@@ -18,6 +20,10 @@ namespace afmkit::tapping {
 class TappingSystem {
  public:
   explicit TappingSystem(TappingModel model);
+  /// The system of a multi-mode cantilever (modes.hpp): the same modes, guards and events, seen at the tip
+  /// (TipState::modal carries the higher modal coordinates). A MultiModeModel::single_mode() model gives exactly
+  /// the system of its TappingModel. model() is then mode 1 with drive 1 (the law unscaled by the medium).
+  explicit TappingSystem(const MultiModeModel& model);
 
   const TappingModel& model() const& { return model_; }
   TappingModel model() && { return std::move(model_); }
@@ -77,6 +83,26 @@ class TappingSystem {
   /// Mode after the crossing of `guard` out of `mode` (s may be adjusted: ẋ = 0 on sticking / release).
   Mode after_event(const Mode& mode, const Guard& guard, double t, TipState& s) const;
 
+  /// Whether this is the system of a multi-mode model other than a TappingModel (more modes, two drives, base
+  /// excitation or a liquid): the tip acceleration is then the sum of the modal ones.
+  bool modal() const { return modal_.has_value(); }
+  int mode_count() const { return modal_ ? modal_->modes : 1; }
+  /// Shortest period of the drives and modes other than drive 1 and mode 1 (infinity for a TappingModel).
+  double shortest_extra_period() const { return modal_ ? modal_->shortest_period : afmkit_infinity(); }
+  /// Multi-mode: the modal accelerations q̈_i (`out`, mode_count() values, may be null) in `branch` and `region`
+  /// at (t, s); returns the tip's ẍ = ÿ_b + Σ q̈_i. Sticking: the tip is held (ẍ = 0 returned) by the contact force
+  /// h = (ÿ_b + Σ (F_i − 2ξ_i'ω_i' q̇_i − ω_i'² q_i)) / Σ ρβ_i, and the modes move on under it. `force`: h used.
+  double modal_accelerations(ContactBranch branch, int region, double t, const TipState& s, double* out,
+                             double* force = nullptr) const;
+  /// Multi-mode: the modal coordinates q_i, q̇_i of s at t (mode 1 = the tip minus the base motion and the others).
+  void modal_coordinates(double t, const TipState& s, double* q, double* v) const;
+  /// Multi-mode: the modal forcing F_i(t) (`out`, mode_count() values) and the base motion (y_b, ẏ_b, ÿ_b, y_b⃛).
+  void modal_forcing(double t, double* out, std::array<double, 4>& base) const;
+  /// Multi-mode: the effective coefficients of mode i: ω_i'², 2ξ_i'ω_i', and ρβ_i (the tip force's coupling).
+  double modal_stiffness(int i) const { return modal_->stiffness[i]; }
+  double modal_damping(int i) const { return modal_->damping[i]; }
+  double modal_coupling(int i) const { return modal_->coupling[i]; }
+
   /// Guards that can end `mode` (at most 3). Returns their number.
   int guards(const Mode& mode, std::array<Guard, 3>& out) const;
   /// Value of a guard's witness function at (t, s) in `mode`.
@@ -107,6 +133,18 @@ class TappingSystem {
   double gamma_;      // Γ
   double region_lo(int region) const;
   double region_hi(int region) const;
+  static double afmkit_infinity() { return std::numeric_limits<double>::infinity(); }
+  /// The terms of a multi-mode model (modes.hpp), effective (medium applied).
+  struct ModalTerms {
+    int modes = 1, drives = 1;
+    std::array<double, kMaxEigenmodes> stiffness{}, damping{}, coupling{};
+    std::array<std::array<double, 2>, kMaxEigenmodes> forcing{};  // [mode][drive]
+    std::array<double, 2> omega{}, base{};                        // ω_d, Y_d
+    double shortest_period = 0.0;
+  };
+  std::optional<ModalTerms> modal_;
+  double modal_jerk(const Mode& mode, double t, const TipState& s) const;
+  double modal_release_rate(double t, const TipState& s, int region) const;
 };
 
 }  // namespace afmkit::tapping

@@ -50,6 +50,7 @@ struct ModeField {
   const TappingSystem* sys = nullptr;
   Mode mode;
   DriveClock clock;
+  static ModeField make(const TappingSystem& s, const Mode& m) { return {&s, m, DriveClock(s.drive_frequency())}; }
   void begin_step(double t0) { clock.begin(t0); }
   void operator()(const std::array<double, N>& y, std::array<double, N>& dy, double t) const {
     const TipState s{y[0], y[1]};
@@ -74,13 +75,41 @@ struct ModeField {
   }
 };
 
+/// The tip state of an integrated state: (x, ẋ) first; a multi-mode state (N = 4, 6) carries the higher modal
+/// coordinates next (N = 8 is the single-mode state with its sensitivities).
+template <std::size_t N>
+TipState tip_of(const std::array<double, N>& y) {
+  TipState s{y[0], y[1]};
+  if constexpr (N == 4 || N == 6)
+    for (std::size_t i = 2; i < N; ++i) s.modal[i - 2] = y[i];
+  return s;
+}
+
+/// Vector field of one mode (region, branch) of a multi-mode cantilever: y = (x, ẋ, q_2, q̇_2, q_3, q̇_3), N = 2M.
+template <std::size_t N>
+struct ModalField {
+  const TappingSystem* sys = nullptr;
+  Mode mode;
+  static ModalField make(const TappingSystem& s, const Mode& m) { return {&s, m}; }
+  void begin_step(double /*t0*/) {}  // the modal forcing is evaluated where needed
+  void operator()(const std::array<double, N>& y, std::array<double, N>& dy, double t) const {
+    double a[kMaxEigenmodes];
+    dy[0] = y[1];
+    dy[1] = sys->modal_accelerations(mode.branch, mode.region, t, tip_of(y), a);  // 0 while sticking
+    for (std::size_t j = 1; 2 * j < N; ++j) {
+      dy[2 * j] = y[2 * j + 1];
+      dy[2 * j + 1] = a[j];
+    }
+  }
+};
+
 template <class Dense, std::size_t N>
 class DenseSegment final : public Segment {
  public:
   DenseSegment(double a, double b, Mode m, const Dense& dense) : Segment(a, b, m), dense_(&dense) {}
   TipState state(double t) const override {
     dense_->calc_state(t, buffer_);
-    return {buffer_[0], buffer_[1]};
+    return tip_of(buffer_);
   }
 
  private:
@@ -149,38 +178,43 @@ class Dopri5 {
   State y_{};
 };
 
-template <std::size_t N, template <class, std::size_t> class StepperFor>
+template <std::size_t N, template <class, std::size_t> class StepperFor, class Field = ModeField<N>>
 void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationOptions& options,
          TrajectoryObserver* observer) {
   using State = std::array<double, N>;
   const double drive_period = sys.model().period();
   // Shortest natural period of the cantilever (contact stiffening shortens it; the error control handles it).
   const double max_dt = scan_step(sys, 2.0 * 3.141592653589793 / sys.model().cantilever.natural_frequency, options);
-  using Stepper = StepperFor<ModeField<N>, N>;
+  using Stepper = StepperFor<Field, N>;
   // the sensitivities are controlled relative to the identity they start from, not to their own (possibly tiny)
   // entries: their right-hand side jumps with the law's slope at a switching gap, just where a step must reach
   State floor{};
-  for (std::size_t i = 2; i < N; ++i) floor[i] = 1.0;
+  if constexpr (N == 8)
+    for (std::size_t i = 2; i < N; ++i) floor[i] = 1.0;
   Stepper dense(options.absolute_tolerance, options.relative_tolerance, max_dt, floor);
   std::array<Guard, 3> guards;
   GuardSamples a, b;
   State y{}, tmp{};
   double dt = std::min(max_dt, 1e-3 * drive_period);
   while (rs.t < t_end) {
-    if (rs.mode.branch == ContactBranch::sticking) {
+    // one mode: the tip rests (run_sticking); more modes: the modes move on with the tip held (ModalField)
+    if (rs.mode.branch == ContactBranch::sticking && !sys.modal()) {
       run_sticking(sys, rs, t_end, options, observer);
       continue;
     }
+    const double segment_begin = rs.t;
     const Mode mode = rs.mode;
     y.fill(0.0);
     y[0] = rs.y.position;
     y[1] = rs.y.velocity;
     if constexpr (N == 8) y[2] = y[5] = 1.0;  // per-segment state-transition matrix starts at I
-    dense.initialize(ModeField<N>{&sys, mode, DriveClock(sys.drive_frequency())}, y, rs.t, dt);
+    if constexpr (N == 4 || N == 6)
+      for (std::size_t i = 2; i < N; ++i) y[i] = rs.y.modal[i - 2];
+    dense.initialize(Field::make(sys, mode), y, rs.t, dt);
     const int n = sys.guards(mode, guards);
     auto state = [&](double t) {
       dense.calc_state(t, tmp);
-      return TipState{tmp[0], tmp[1]};
+      return tip_of(tmp);
     };
     sample_guards(sys, mode, guards, n, rs.t, rs.y, a);
     start_on_pre_side(guards, n,
@@ -194,7 +228,7 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
                                            "t = {:.9g}", options.max_steps, dense.current_time()));
       const auto [t_old, t_new] = dense.do_step(t_end);
       const State& y_new = dense.current_state();
-      sample_guards(sys, mode, guards, n, t_new, {y_new[0], y_new[1]}, b);
+      sample_guards(sys, mode, guards, n, t_new, tip_of(y_new), b);
       hit = first_crossing(sys, mode, guards, n, t_old, t_new, a, b, state);
       if (!hit) a = b;
       const double seg_end = hit ? hit->time : t_new;
@@ -206,12 +240,13 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
     }
     dt = std::min(max_dt, dense.current_time_step());
     dense.calc_state(t_stop, tmp);
-    const TipState y1{tmp[0], tmp[1]};
+    const TipState y1 = tip_of(tmp);
     if constexpr (N == 8) {
       Eigen::Matrix3d seg = Eigen::Matrix3d::Identity();
       seg << tmp[2], tmp[4], tmp[6], tmp[3], tmp[5], tmp[7], 0.0, 0.0, 1.0;
       rs.jacobian = seg * rs.jacobian;
     }
+    if (mode.branch == ContactBranch::sticking) rs.stats.sticking_duration += t_stop - segment_begin;
     if (hit) {
       handle_event(sys, rs, guards[hit->guard], t_stop, y1, options, observer);
     } else {
@@ -226,6 +261,19 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
 void run_adaptive(const TappingSystem& sys, RunState& rs, double t_end, const SimulationOptions& options,
                   TrajectoryObserver* observer) {
   const bool smooth = sys.model().law.smooth();
+  if (sys.modal()) {  // the same engine on the modal state (x, ẋ, q_2, q̇_2, q_3, q̇_3)
+    switch (sys.mode_count()) {
+      case 1:
+        return smooth ? run<2, Dop853, ModalField<2>>(sys, rs, t_end, options, observer)
+                      : run<2, Dopri5, ModalField<2>>(sys, rs, t_end, options, observer);
+      case 2:
+        return smooth ? run<4, Dop853, ModalField<4>>(sys, rs, t_end, options, observer)
+                      : run<4, Dopri5, ModalField<4>>(sys, rs, t_end, options, observer);
+      default:
+        return smooth ? run<6, Dop853, ModalField<6>>(sys, rs, t_end, options, observer)
+                      : run<6, Dopri5, ModalField<6>>(sys, rs, t_end, options, observer);
+    }
+  }
   if (options.sensitivity)
     smooth ? run<8, Dop853>(sys, rs, t_end, options, observer) : run<8, Dopri5>(sys, rs, t_end, options, observer);
   else

@@ -1,5 +1,6 @@
 #include "afmkit/tapping/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -75,11 +76,48 @@ SimulationResult simulate(const TappingModel& model, double t_begin, TipState st
   return out;
 }
 
+SimulationResult simulate(const MultiModeModel& model, double t_begin, TipState start, double t_end,
+                          const SimulationOptions& options, TrajectoryObserver* observer) {
+  if (model.single_mode()) return simulate(model.first_mode(), t_begin, start, t_end, options, observer);
+  options.validate();
+  if (options.sensitivity)
+    throw InvalidParameter("sensitivity", "sensitivity (variational equations) is available for one eigenmode only");
+  if (options.integrator == Integrator::closed_form)
+    throw InvalidParameter("integrator", "integrator = closed_form is available for one eigenmode only (the modes "
+                                         "are integrated by the adaptive integrator)");
+  if (!std::isfinite(t_begin)) validate::finite("t_begin", t_begin);
+  if (!std::isfinite(t_end)) validate::finite("t_end", t_end);
+  if (!(t_end >= t_begin)) validate::require(false, "t_end", t_end, fmt::format(">= t_begin = {}", t_begin));
+  if (!std::isfinite(start.position)) validate::finite("position", start.position);
+  if (!std::isfinite(start.velocity)) validate::finite("velocity", start.velocity);
+  for (double c : start.modal)
+    if (!std::isfinite(c)) validate::finite("modal coordinate", c);
+  const TappingSystem sys(model);
+  detail::RunState rs;
+  rs.t = t_begin;
+  rs.y = start;
+  rs.mode = sys.initial_mode(t_begin, rs.y);
+  if (rs.mode.branch == ContactBranch::sticking) ++rs.stats.sticking_count;
+  detail::run_adaptive(sys, rs, t_end, options, observer);
+  if (!std::isfinite(rs.y.position) || !std::isfinite(rs.y.velocity))
+    throw NumericalFailure(fmt::format("tapping simulation (modes): the motion diverges (state x = {}, dx/dt = {} at "
+                                       "t = {:.9g})",
+                                       rs.y.position, rs.y.velocity, rs.t));
+  SimulationResult out;
+  out.time = rs.t;
+  out.state = rs.y;
+  out.state.contact = rs.mode.contact;
+  out.mode = rs.mode;
+  out.stats = rs.stats;
+  return out;
+}
+
 namespace detail {
 
 double scan_step(const TappingSystem& sys, double mode_period, const SimulationOptions& options) {
   const double drive_period = sys.model().period();
-  return options.max_step_fraction * std::min(drive_period, mode_period);
+  // a multi-mode system: also the other drives' and modes' periods (infinity for a TappingModel)
+  return options.max_step_fraction * std::min({drive_period, mode_period, sys.shortest_extra_period()});
 }
 
 void handle_event(const TappingSystem& sys, RunState& rs, const Guard& guard, double te, TipState pre_state,

@@ -32,6 +32,136 @@ TappingSystem::TappingSystem(TappingModel model)
   }
 }
 
+namespace {
+/// The TappingModel a multi-mode system carries: the model itself when single_mode() (bit for bit), else mode 1
+/// (medium applied) with drive 1 and the law unscaled (the modal equations apply ρβ_i to its force).
+TappingModel modal_carrier(const MultiModeModel& m) {
+  if (m.single_mode()) return m.first_mode();
+  return {Cantilever(m.frequency(0), m.quality_factor(0)), m.drives[0], m.law, m.separation};
+}
+}  // namespace
+
+TappingSystem::TappingSystem(const MultiModeModel& m) : TappingSystem(modal_carrier(m)) {
+  if (m.single_mode()) return;
+  ModalTerms t;
+  t.modes = m.mode_count();
+  t.drives = m.drive_count();
+  t.shortest_period = m.shortest_mode_period();
+  for (int i = 0; i < t.modes; ++i) {
+    t.stiffness[i] = m.frequency(i) * m.frequency(i);
+    t.damping[i] = m.damping(i);
+    t.coupling[i] = m.coupling(i);
+    for (int d = 0; d < t.drives; ++d) t.forcing[i][d] = m.forcing(i, d);
+  }
+  for (int d = 0; d < t.drives; ++d) {
+    t.omega[d] = m.drives[d].frequency;
+    t.base[d] = m.base_amplitude(d);
+    t.shortest_period = std::min(t.shortest_period, m.drives[d].period());
+  }
+  modal_ = t;
+}
+
+void TappingSystem::modal_forcing(double t, double* out, std::array<double, 4>& base) const {
+  const ModalTerms& m = *modal_;
+  for (int i = 0; i < m.modes; ++i) out[i] = 0.0;
+  base = {0.0, 0.0, 0.0, 0.0};
+  for (int d = 0; d < m.drives; ++d) {
+    const double w = m.omega[d], c = std::cos(w * t), sn = std::sin(w * t), y = m.base[d];
+    for (int i = 0; i < m.modes; ++i) out[i] += m.forcing[i][d] * c;
+    base[0] += y * c;
+    base[1] -= y * w * sn;
+    base[2] -= y * w * w * c;
+    base[3] += y * w * w * w * sn;
+  }
+}
+
+namespace {
+void coordinates_given_base(int modes, const TipState& s, const std::array<double, 4>& base, double* q, double* v) {
+  q[0] = s.position - base[0];
+  v[0] = s.velocity - base[1];
+  for (int j = 1; j < modes; ++j) {
+    q[j] = s.modal[2 * (j - 1)];
+    v[j] = s.modal[2 * (j - 1) + 1];
+    q[0] -= q[j];
+    v[0] -= v[j];
+  }
+}
+}  // namespace
+
+void TappingSystem::modal_coordinates(double t, const TipState& s, double* q, double* v) const {
+  double f[kMaxEigenmodes];
+  std::array<double, 4> base{};
+  modal_forcing(t, f, base);
+  coordinates_given_base(modal_->modes, s, base, q, v);
+}
+
+double TappingSystem::modal_accelerations(ContactBranch branch, int region, double t, const TipState& s,
+                                          double* out, double* force) const {
+  // q̈_i = F_i(t) − 2ξ_i'ω_i' q̇_i − ω_i'² q_i − ρβ_i h(x, ẋ);  ẍ = ÿ_b + Σ q̈_i   (modes.hpp)
+  const ModalTerms& m = *modal_;
+  double f[kMaxEigenmodes], q[kMaxEigenmodes], v[kMaxEigenmodes];
+  std::array<double, 4> base{};
+  modal_forcing(t, f, base);
+  coordinates_given_base(m.modes, s, base, q, v);
+  double h;
+  if (branch == ContactBranch::sticking) {
+    // the tip held at rest: the contact force is what keeps ẍ = ÿ_b + Σ q̈_i = 0 (the modes move on)
+    double free_tip = base[2], coupling = 0.0;
+    for (int i = 0; i < m.modes; ++i) {
+      free_tip += f[i] - m.damping[i] * v[i] - m.stiffness[i] * q[i];
+      coupling += m.coupling[i];
+    }
+    h = free_tip / coupling;
+  } else {
+    h = interaction(branch, s.position, s.velocity, region);
+  }
+  double tip = base[2];
+  for (int i = 0; i < m.modes; ++i) {
+    const double a = f[i] - m.damping[i] * v[i] - m.stiffness[i] * q[i] - m.coupling[i] * h;
+    if (out) out[i] = a;
+    tip += a;
+  }
+  if (force) *force = h;
+  return branch == ContactBranch::sticking ? 0.0 : tip;
+}
+
+double TappingSystem::modal_release_rate(double t, const TipState& s, int region) const {
+  // g = ÿ_b + Σ (F_i − 2ξ_i'ω_i' q̇_i − ω_i'² q_i) − Σ ρβ_i h_branch(x) with x held: ġ = y_b⃛ + Σ (Ḟ_i − … q̈_i − … q̇_i)
+  const ModalTerms& m = *modal_;
+  double a[kMaxEigenmodes], f[kMaxEigenmodes], q[kMaxEigenmodes], v[kMaxEigenmodes];
+  std::array<double, 4> base{};
+  modal_forcing(t, f, base);
+  coordinates_given_base(m.modes, s, base, q, v);
+  modal_accelerations(ContactBranch::sticking, region, t, s, a);
+  double rate = base[3];
+  for (int i = 0; i < m.modes; ++i) {
+    double f_rate = 0.0;
+    for (int d = 0; d < m.drives; ++d) f_rate -= m.forcing[i][d] * m.omega[d] * std::sin(m.omega[d] * t);
+    rate += f_rate - m.damping[i] * a[i] - m.stiffness[i] * v[i];
+  }
+  return rate;
+}
+
+double TappingSystem::modal_jerk(const Mode& mode, double t, const TipState& s) const {
+  if (mode.branch == ContactBranch::sticking) return 0.0;
+  // d/dt ẍ = y_b⃛ + Σ [Ḟ_i − 2ξ_i'ω_i' q̈_i − ω_i'² q̇_i − ρβ_i (h_x ẋ + h_ẋ ẍ)]
+  const ModalTerms& m = *modal_;
+  double a[kMaxEigenmodes], f[kMaxEigenmodes], q[kMaxEigenmodes], v[kMaxEigenmodes];
+  std::array<double, 4> base{};
+  modal_forcing(t, f, base);
+  coordinates_given_base(m.modes, s, base, q, v);
+  const double tip = modal_accelerations(mode.branch, mode.region, t, s, a);
+  const double h_rate = interaction_slope(mode.branch, s.position, s.velocity, mode.region) * s.velocity +
+                        interaction_rate_slope(mode.branch, s.position, mode.region) * tip;
+  double jerk = base[3];
+  for (int i = 0; i < m.modes; ++i) {
+    double f_rate = 0.0;
+    for (int d = 0; d < m.drives; ++d) f_rate -= m.forcing[i][d] * m.omega[d] * std::sin(m.omega[d] * t);
+    jerk += f_rate - m.damping[i] * a[i] - m.stiffness[i] * v[i] - m.coupling[i] * h_rate;
+  }
+  return jerk;
+}
+
 int TappingSystem::region_of(double gap) const {
   return static_cast<int>(std::upper_bound(switching().begin(), switching().end(), gap) - switching().begin());
 }
@@ -131,6 +261,7 @@ double TappingSystem::interaction_with_slope(ContactBranch branch, double x, dou
 }
 
 double TappingSystem::acceleration(ContactBranch branch, int region, double t, TipState s) const {
+  if (modal_) return modal_accelerations(branch, region, t, s, nullptr);
   return acceleration_given_drive({region, branch}, drive(t), s);
 }
 
@@ -170,7 +301,8 @@ Mode TappingSystem::enter_region(int region, double t, TipState& s, bool contact
 }
 
 Mode TappingSystem::after_velocity_zero(int region, ContactBranch from, double t, TipState& s) const {
-  TipState rest{s.position, 0.0};
+  TipState rest = s;  // at rest: the tip's velocity 0 (a multi-mode state keeps its higher modal coordinates)
+  rest.velocity = 0.0;
   const double aa = acceleration(ContactBranch::approach, region, t, rest);
   const double ab = acceleration(ContactBranch::departure, region, t, rest);
   // (a velocity guard exists only in velocity-switched modes: in contact for a contact-aware law)
@@ -239,9 +371,11 @@ double TappingSystem::witness(const Guard& guard, const Mode& mode, double t, Ti
     case GuardKind::gap: return gap(s.position) - guard.level;
     case GuardKind::velocity: return s.velocity;
     case GuardKind::release_departure:
-      return acceleration(ContactBranch::departure, mode.region, t, {s.position, 0.0});
+      s.velocity = 0.0;  // at rest (a multi-mode state keeps its higher modal coordinates)
+      return acceleration(ContactBranch::departure, mode.region, t, s);
     case GuardKind::release_approach:
-      return acceleration(ContactBranch::approach, mode.region, t, {s.position, 0.0});
+      s.velocity = 0.0;
+      return acceleration(ContactBranch::approach, mode.region, t, s);
   }
   return 0.0;
 }
@@ -251,7 +385,7 @@ double TappingSystem::witness_rate(const Guard& guard, const Mode& mode, double 
     case GuardKind::gap: return s.velocity;
     case GuardKind::velocity: return acceleration(mode, t, s);
     case GuardKind::release_departure:
-    case GuardKind::release_approach: return drive_rate(t);
+    case GuardKind::release_approach: return modal_ ? modal_release_rate(t, s, mode.region) : drive_rate(t);
   }
   return 0.0;
 }
@@ -261,13 +395,14 @@ double TappingSystem::witness_rate_derivative(const Guard& guard, const Mode& mo
     case GuardKind::gap: return acceleration(mode, t, s);
     case GuardKind::velocity: {
       if (mode.branch == ContactBranch::sticking) return 0.0;
+      if (modal_) return modal_jerk(mode, t, s);
       // jerk: d/dt (Γ cos ωt − cẋ − ω_n² x − h(x, ẋ)) = −Γω sin ωt − (c + h_ẋ) ẍ − (ω_n² + h_x) ẋ
       const double a = acceleration(mode, t, s);
       return drive_rate(t) - (damping_ + interaction_rate_slope(mode.branch, s.position, mode.region)) * a -
              (stiffness_ + interaction_slope(mode.branch, s.position, s.velocity, mode.region)) * s.velocity;
     }
     case GuardKind::release_departure:
-    case GuardKind::release_approach: return -omega_ * omega_ * drive(t);
+    case GuardKind::release_approach: return modal_ ? 0.0 : -omega_ * omega_ * drive(t);  // modal: unused (bisection)
   }
   return 0.0;
 }
