@@ -115,7 +115,7 @@ void declare_tapping_image(io::ParamSet& p) {
             "prefix of the images <prefix>_<channel>_<trace|retrace>.gsf/.png and <prefix>_truth (empty: none)")
       .writes(tapping_image_files);
   add_output_params(p, "out/tapping_image/lines.csv", "per-line metrics (regime switches, jumps, peak force)");
-  p.flag("quiet", false, "no progress output");
+  add_quiet_flag(p);
 }
 
 std::vector<io::Column> tapping_image_line_columns() {

@@ -304,7 +304,7 @@ void register_tapping_modes(CLI::App& tapping) {
         add_tapping_model_params(p);
         add_modes_params(p);
         add_output_params(p, "out/tapping_modes.csv", "multi-mode approach");
-        p.flag("quiet", false, "no progress output");
+        add_quiet_flag(p);
       },
       run_modes);
 }

@@ -85,6 +85,8 @@ const DeclaredOnceList kDeclaredOnceDifferentParameters = {
     {"max_evaluations", {2, "control tune: Nelder-Mead budget; spectroscopy fit: forward-model evaluations of LM"}},
     {"method", {3, "impact: solver; control simulate: time stepping; spectroscopy reconstruct: inversion formula"}},
     {"store", {2, "study run: the study's Zarr store (resumed); tapping grid: the grid's Zarr store (replaced)"}},
+    {"image_output", {2, "scan: the prefix of the rotational scan's images; tapping image: the prefix of the raster "
+                         "images (trace, retrace, truth), other files"}},
 };
 
 // The same parameter declared at several places, not merged yet (key -> the places and why). To merge one, declare
@@ -99,10 +101,10 @@ const DeclaredOnceList kDeclaredOnceNotYetMerged = {
     {"free_amplitude", {3, "tapping (physical units), spectroscopy fit/reconstruct: defaults and ranges differ"}},
     {"amplitude", {3, "tapping fm (nm or L), spectroscopy fit/reconstruct (FM amplitude, nm): defaults differ"}},
     {"drive_frequency", {2, "spectroscopy fit and reconstruct: the same AM drive frequency, declared in each"}},
-    {"separation_min", {4, "tapping sweep, grid, fm and demo: defaults differ and ranges disagree (any finite vs "
-                       "[-1e6, 1e6])"}},
-    {"separation_max", {4, "tapping sweep, grid, fm and demo: as separation_min"}},
-    {"points", {7, "the separations of tapping sweep, grid, fm and demo (in [2, 1e6], [2, 1e7] or [2, 1e8]); the other "
+    {"separation_min", {5, "tapping sweep, grid, fm, modes and demo: defaults differ and ranges disagree (any finite "
+                       "vs [-1e6, 1e6])"}},
+    {"separation_max", {5, "tapping sweep, grid, fm, modes and demo: as separation_min"}},
+    {"points", {8, "the separations of tapping sweep, grid, fm, modes and demo (in [1 or 2, 1e6, 1e7 or 1e8]); the other "
                "commands' points are other counts (impact's history samples, hb's q samples, control tf's grid)"}},
     {"approach_stiffness", {2, "the hysteresis law's K_a: the law registry's (add_law_params; impact, spectroscopy "
                                "fit) and the tapping model's normalised per-unit-mass form (add_tapping_model_params, "
