@@ -77,9 +77,9 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   // The curve is held in memory (both branches: 2 points per q sample) before it is streamed out.
   memory::require_fits("points", static_cast<double>(options.points), 2.0 * sizeof(tapping::HbPoint));
   CommandOutput out(p, capture, "tapping hb");
-  out.open(hb_columns(scales));
+  auto rows = out.open(hb_table(scales));
   const std::vector<tapping::HbPoint> curve = tapping::harmonic_balance_curve(model, options);
-  write_hb_rows(out, curve, scales);
+  rows.add_all(curve);
 
   // the model and options are checked: what is refused from here on was computed (core/computed.hpp)
   const tapping::HarmonicBalance hb = computed("harmonic balance", [&] { return tapping::HarmonicBalance(model); });

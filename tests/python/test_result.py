@@ -104,6 +104,26 @@ def test_to_xarray_of_a_chart_is_the_long_table_regridded(chart):
     assert ds.attrs["command"] == "control chart"
 
 
+def test_a_chart_declares_its_grid_in_the_result_and_the_sidecar(chart, tmp_path):
+    import json
+    g = chart.grid
+    assert g["dims"] == ["delay", "beta", "alpha"] and g["columns"] == ["delay", "y", "x"] and g["shape"] == [3, 4, 5]
+    # independently: the coordinates are the columns' distinct values (delays in the order given)
+    np.testing.assert_array_equal(g["coords"]["delay"], [0.3, 0.1, 0.2])
+    np.testing.assert_array_equal(g["coords"]["alpha"], np.unique(chart.x))
+    np.testing.assert_array_equal(g["coords"]["beta"], np.unique(chart.y))
+    # and the rows are that grid in row-major order (x fastest)
+    np.testing.assert_array_equal(chart.x, np.tile(np.unique(chart.x), 12))
+    np.testing.assert_array_equal(chart.delay, np.repeat([0.3, 0.1, 0.2], 20))
+    assert pickle.loads(pickle.dumps(chart)).grid == g
+    path = tmp_path / "chart.csv"
+    afmkit.control.chart(harmonics=2, x_points=5, y_points=4, delays=[0.3, 0.1, 0.2], boundaries_output="",
+                         progress=False, output=str(path))
+    with open(f"{path}.json") as f:
+        assert json.load(f)["grid"] == g
+    assert afmkit.control.tf(harmonics=3, points=7).grid is None  # a table along one variable declares none
+
+
 def test_to_xarray_of_a_margin_map_and_of_tables():
     m = afmkit.control.chart(controller="single", harmonics=2, x_points=3, y_points=2, quantity="margin",
                              boundaries_output="", progress=False).to_xarray()
