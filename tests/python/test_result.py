@@ -158,3 +158,14 @@ def test_the_module_imports_without_pandas_and_xarray_and_says_what_is_missing()
             "    try:\n        f()\n    except ImportError as e:\n        print(e)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert "to_pandas() needs pandas" in out and "to_xarray() needs xarray" in out
+
+
+def test_a_sweep_in_another_parameter_describes_each_column_by_its_name():
+    # the columns used to be renamed by position after the swept parameter was put first: direction had the
+    # separation's meaning and amplitude the directions' (fixed by declaring each column with its value)
+    r = afmkit.tapping.sweep(parameter="drive_frequency", parameter_min=0.95, parameter_max=1.05, points=3, quiet=True)
+    assert r.columns[:4] == ["drive_frequency", "separation", "direction", "amplitude"]
+    assert "fixed: the sweep moves drive_frequency" in r.meaning["separation"]
+    assert r.meaning["direction"].startswith("down (from parameter_max")
+    assert r.meaning["amplitude"] == "first-harmonic amplitude B of the periodic orbit"
+    assert set(r.direction) <= {"down", "up", "continuation"}
