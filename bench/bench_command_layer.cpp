@@ -81,6 +81,22 @@ void Command(benchmark::State& state) {
 }
 BENCHMARK(Command)->Unit(benchmark::kMicrosecond);
 
+// The part of Command that builds the ParamSet (declare, defaults, resolve, values, checks).
+void Params(benchmark::State& state) {
+  for (auto _ : state) {
+    const io::ParamSet p = orbit_params("");
+    benchmark::DoNotOptimize(p);
+  }
+}
+BENCHMARK(Params)->Unit(benchmark::kMicrosecond);
+
+// The part that records the parameters as run (what every sidecar and r.params hold).
+void ParamsRecord(benchmark::State& state) {
+  const io::ParamSet p = orbit_params("");
+  for (auto _ : state) benchmark::DoNotOptimize(p.to_json());
+}
+BENCHMARK(ParamsRecord)->Unit(benchmark::kMicrosecond);
+
 void CommandFiles(benchmark::State& state) {
   const cli::CommandSpec& spec = orbit_spec();
   const std::string path = (std::filesystem::temp_directory_path() / "afmkit_bench_command_layer.csv").string();
