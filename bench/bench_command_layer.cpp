@@ -90,6 +90,46 @@ void Params(benchmark::State& state) {
 }
 BENCHMARK(Params)->Unit(benchmark::kMicrosecond);
 
+// The command's run alone on a ParamSet built once (no rows kept: only the summary document is made).
+void RunOnly(benchmark::State& state) {
+  const cli::CommandSpec& spec = orbit_spec();
+  const io::ParamSet p = orbit_params("");
+  for (auto _ : state) {
+    cli::Captured captured;
+    captured.want_rows = false;
+    spec.run(p, &captured);
+    benchmark::DoNotOptimize(captured);
+  }
+}
+BENCHMARK(RunOnly)->Unit(benchmark::kMicrosecond);
+
+// The library call with the model built from the ParamSet on each call (as the command does).
+void LibraryWithModel(benchmark::State& state) {
+  const io::ParamSet p = orbit_params("");
+  for (auto _ : state) {
+    const tapping::TappingModel model = cli::tapping_model_from(p);
+    tapping::OrbitSearchOptions options;
+    options.shooting = cli::shooting_options_from(p);
+    options.transient = cli::transient_options_from(p);
+    benchmark::DoNotOptimize(tapping::find_orbits(model, options));
+  }
+}
+BENCHMARK(LibraryWithModel)->Unit(benchmark::kMicrosecond);
+
+// The library call with the progress callback the command installs (a no-op here).
+void LibraryWithProgress(benchmark::State& state) {
+  const io::ParamSet p = orbit_params("");
+  const tapping::TappingModel model = cli::tapping_model_from(p);
+  tapping::OrbitSearchOptions options;
+  options.shooting = cli::shooting_options_from(p);
+  options.transient = cli::transient_options_from(p);
+  long periods = 0;
+  options.transient.on_periods = [&periods](int n) { periods += n; };
+  for (auto _ : state) benchmark::DoNotOptimize(tapping::find_orbits(model, options));
+  benchmark::DoNotOptimize(periods);
+}
+BENCHMARK(LibraryWithProgress)->Unit(benchmark::kMicrosecond);
+
 // The part that records the parameters as run (what every sidecar and r.params hold).
 void ParamsRecord(benchmark::State& state) {
   const io::ParamSet p = orbit_params("");
