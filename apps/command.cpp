@@ -68,10 +68,17 @@ void CommandOutput::open(std::vector<io::Column> columns) {
 }
 
 void CommandOutput::finish(const nlohmann::json& results, const std::string& summary) {
-  if (file_) file_->stage(io::make_sidecar(command_, params_, results), outputs_);
+  // a table declared as a grid: its dimensions and coordinates (checked against the rows written)
+  const nlohmann::json grid = grid_.empty() ? nlohmann::json() : grid_.json();
+  if (file_) {
+    nlohmann::json sidecar = io::make_sidecar(command_, params_, results);
+    if (!grid.is_null()) sidecar["grid"] = grid;
+    file_->stage(sidecar, outputs_);
+  }
   outputs_.commit();
   if (capture_ != nullptr) {
     capture_->results = results;
+    capture_->grid = grid;
     capture_->columns = columns_;
     capture_->rows = std::move(rows_);
     capture_->parameters = params_.to_json();
@@ -80,7 +87,10 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
   try {
     if (json_) {
       nlohmann::json document = results;
-      if (keep_rows_) document["table"] = {{"columns", io::columns_json(columns_)}, {"rows", rows_}};
+      if (keep_rows_) {
+        document["table"] = {{"columns", io::columns_json(columns_)}, {"rows", rows_}};
+        if (!grid.is_null()) document["table"]["grid"] = grid;
+      }
       else if (!path_.empty()) document["output"] = path_;
       fmt::print("{}\n", io::json_text(document));
     } else {

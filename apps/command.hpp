@@ -22,6 +22,7 @@
 #include "afmkit/core/cancellation.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/params.hpp"
+#include "afmkit/io/table.hpp"
 
 namespace CLI {
 class App;
@@ -43,6 +44,8 @@ struct Captured {
   /// Stop request of the caller (Python: Ctrl-C); the long computations check it once per point. The command line
   /// has no capture and keeps its signal handling.
   Cancellation cancellation;
+  /// The table's grid (io::GridRecord::json: dims, shape, coords) when it declares one (io::TableOf::grid); else null.
+  nlohmann::json grid;
   /// The parameters as run (what the sidecar records: computed defaults filled in); null until the command finishes.
   nlohmann::json parameters;
   /// law = python: the force law the caller gave as an object (afmkit.laws.Python), built into the run's law.
@@ -114,7 +117,39 @@ class CommandOutput {
   CommandOutput(io::ParamSet&& params, Captured* capture, std::string command,
                 const std::string& output_key = "output") = delete;
 
-  /// Opens the table (file or memory) with its columns; call once before adding rows.
+  /// The rows of a table opened with its declaration (open(io::TableOf<Row>)): each row's cells are read by the
+  /// columns' own accessors, so the values cannot go out of step with the columns.
+  template <class Row>
+  class Rows {
+   public:
+    void add(const Row& row) { out_->add_row(table_, row); }
+    template <class Range>
+    void add_all(const Range& rows) {
+      for (const auto& row : rows) add(row);
+    }
+
+   private:
+    friend class CommandOutput;
+    Rows(CommandOutput& out, io::TableOf<Row> table) : out_(&out), table_(std::move(table)) {}
+    CommandOutput* out_;
+    io::TableOf<Row> table_;
+  };
+
+  /// Opens the table (file or memory) with its declared columns (io::TableOf: name, unit, description and the
+  /// value of each in a row); call once, then add rows through the handle returned. A table declared as a grid
+  /// (io::TableOf::grid) is recorded as such (the sidecar's and the capture's "grid").
+  template <class Row>
+  [[nodiscard]] Rows<Row> open(io::TableOf<Row> table) {
+    open(table.columns());
+    grid_ = io::GridRecord(table.grid());
+    for (const io::GridDimension& d : table.grid()) {
+      const auto& entries = table.entries();
+      for (std::size_t c = 0; c < entries.size(); ++c)
+        if (entries[c].column.name == d.column) grid_columns_.push_back(c);
+    }
+    return Rows<Row>(*this, std::move(table));
+  }
+  /// Opens the table (file or memory) with its columns; call once before adding rows with row().
   void open(std::vector<io::Column> columns);
   /// Adds one row; cells as io::TableWriter::row.
   template <class... Cells>
@@ -143,6 +178,27 @@ class CommandOutput {
   void finish(const nlohmann::json& results, const std::string& summary);
 
  private:
+  template <class Row>
+  void add_row(const io::TableOf<Row>& table, const Row& row) {
+    nlohmann::json cells = keep_rows_ ? nlohmann::json::array() : nlohmann::json();
+    const auto& entries = table.entries();
+    for (std::size_t c = 0; c < entries.size(); ++c) {
+      const io::Cell cell = entries[c].value(row);
+      if (file_) io::write_cell(*file_, cell);
+      if (keep_rows_) cells.push_back(io::cell_json(cell));
+      for (std::size_t d = 0; d < grid_columns_.size(); ++d)
+        if (grid_columns_[d] == c) grid_.value(d, grid_coordinate(cell));
+    }
+    if (file_) file_->end_row();
+    if (keep_rows_) rows_.push_back(std::move(cells));
+    if (!grid_.empty()) grid_.end_row();
+    ++count_;
+  }
+  static double grid_coordinate(const io::Cell& cell) {
+    if (const double* x = std::get_if<double>(&cell)) return *x;
+    if (const long* n = std::get_if<long>(&cell)) return static_cast<double>(*n);
+    throw std::logic_error("a grid dimension's column must hold numbers");
+  }
   template <class T>
   static auto cell_value(const T& v) {
     if constexpr (std::is_convertible_v<T, std::string_view> && !std::is_arithmetic_v<T>) return std::string(v);
@@ -155,6 +211,8 @@ class CommandOutput {
   bool json_ = false;
   bool keep_rows_ = false;
   std::vector<io::Column> columns_;
+  io::GridRecord grid_;                    // of a table declared as a grid (else empty)
+  std::vector<std::size_t> grid_columns_;  // the column of each grid dimension
   std::optional<io::TableWriter> file_;
   io::OutputSet outputs_;
   nlohmann::json rows_ = nlohmann::json::array();

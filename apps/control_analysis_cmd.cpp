@@ -3,6 +3,7 @@
 // Units follow control_params.hpp: rates, roots and frequencies in units of Ω, delays in units of T = 2π/Ω; every
 // CSV column and JSON value below uses them (the sidecar's "columns" and the results' "units" name each one).
 #include <cmath>
+#include <complex>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "afmkit/control/spectrum.hpp"
 #include "afmkit/control/stability_tau0.hpp"
 #include "afmkit/core/error.hpp"
+#include "afmkit/io/table.hpp"
 #include "command.hpp"
 #include "commands.hpp"
 #include "control_analysis.hpp"
@@ -98,6 +100,28 @@ nlohmann::json tau0_summary(const control::ControlSettings& c) {
 }
 
 // ------------------------------------------------------------------------------------------------ roots
+// A row of `control roots`: a root s [rad/s] found in the box, near the chain or structural.
+struct RootRow {
+  std::complex<double> value;
+  long multiplicity;
+  bool certified;
+  double correction;  // rad/s
+  const char* kind;
+};
+
+io::TableOf<RootRow> roots_table(const control::RotationUnits& u) {
+  using R = RootRow;
+  return {{"real", "Omega", "Re s of the root", [u](const R& r) { return u.in_omega(r.value.real()); }},
+          {"imag", "Omega", "Im s of the root", [u](const R& r) { return u.in_omega(r.value.imag()); }},
+          {"multiplicity", "count", "argument-principle count in a box isolating the root", &R::multiplicity},
+          {"certified", "boolean (0/1)", "multiplicity confirmed by that count (1) or not counted (0)", &R::certified},
+          {"correction", "Omega", "last Newton correction |ds|", [u](const R& r) { return u.in_omega(r.correction); }},
+          {"kind", "label",
+           "root (in the certified box) | near_chain (N = inf, left of the box, Newton from the chain "
+           "asymptotics) | structural (docs/theory-control.md#neutral-realisation; neutral realisation only)",
+           &R::kind}};
+}
+
 void run_roots(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   const control::LoopSpec loop = control::loop_from(c);
@@ -141,24 +165,15 @@ void run_roots(const io::ParamSet& p, Captured* capture) {
   res["units"] = {{"box", "Omega"}, {"box_count", "count"}, {"spectral_abscissa", "Omega"}, {"decay_rate", "Omega"},
                   {"unstable_roots", "count"}, {"neutral_bound", "Omega"},
                   {"structural_roots", {{"real", "Omega"}, {"imag", "Omega"}, {"multiplicity", "count"}}}};
-  out.open({{"real", "Omega", "Re s of the root"},
-            {"imag", "Omega", "Im s of the root"},
-            {"multiplicity", "count", "argument-principle count in a box isolating the root"},
-            {"certified", "boolean (0/1)", "multiplicity confirmed by that count (1) or not counted (0)"},
-            {"correction", "Omega", "last Newton correction |ds|"},
-            {"kind", "label",
-             "root (in the certified box) | near_chain (N = inf, left of the box, Newton from the chain "
-             "asymptotics) | structural (docs/theory-control.md#neutral-realisation; neutral realisation only)"}});
+  auto rows = out.open(roots_table(u));
   for (const auto& r : sp.roots)
-    out.row(u.in_omega(r.value.real()), u.in_omega(r.value.imag()), static_cast<long>(r.multiplicity), r.certified,
-            u.in_omega(r.correction), "root");
+    rows.add({r.value, static_cast<long>(r.multiplicity), r.certified, r.correction, "root"});
   for (const auto& s : sp.near_chain) {
-    out.row(u.in_omega(s.real()), u.in_omega(s.imag()), 1L, false, 0.0, "near_chain");
-    if (s.imag() != 0.0) out.row(u.in_omega(s.real()), -u.in_omega(s.imag()), 1L, false, 0.0, "near_chain");
+    rows.add({s, 1L, false, 0.0, "near_chain"});
+    if (s.imag() != 0.0) rows.add({std::conj(s), 1L, false, 0.0, "near_chain"});
   }
   for (const auto& s : sp.structural)
-    out.row(u.in_omega(s.value.real()), u.in_omega(s.value.imag()), static_cast<long>(s.multiplicity), true, 0.0,
-            "structural");
+    rows.add({s.value, static_cast<long>(s.multiplicity), true, 0.0, "structural"});
   out.finish(res, fmt::format("{} roots in the box (argument principle: {}{}); spectral abscissa {}, {} unstable",
                               sp.roots.size(), sp.box_count, sp.complete ? ", complete" : ", INCOMPLETE",
                               rate_summary(sp.spectral_abscissa, u, 10), sp.unstable_count));
@@ -186,20 +201,35 @@ const nlohmann::json& margin_units() {
   return units;
 }
 
+// A row of `control margin --compare`: a variant of the loop and its delay margin.
+struct MarginVariant {
+  const std::string& name;
+  const control::DelayMargin& margin;
+};
+
+io::TableOf<MarginVariant> margin_compare_table(const control::RotationUnits& u) {
+  using V = MarginVariant;
+  return {{"variant", "label", "controller of the row", [](const V& v) { return v.name; }},
+          {"critical_delay", "T", "upper end tau_c of the stability interval of delays (inf: no crossing)",
+           [u](const V& v) { return u.in_periods(v.margin.upper); }},
+          {"crossing_frequency", "Omega", "crossing frequency nu at the critical delay (roots at +-i nu)",
+           [u](const V& v) { return u.in_omega(v.margin.upper_frequency); }},
+          {"lower_delay", "T", "lower end of the stability interval (0 plain loop; Smith: below the model delay)",
+           [u](const V& v) { return u.in_periods(v.margin.lower); }},
+          {"stable_at_reference", "boolean (0/1)", "stable at the reference delay",
+           [](const V& v) { return v.margin.stable_at_reference; }}};
+}
+
 // τ_c of variants of the loop (beyond the paper): other rejected harmonics, N = ∞, Smith predictor.
 void run_margin_compare(const io::ParamSet& p, const control::ControlSettings& base, Captured* capture) {
   const control::RotationUnits u = base.units();
   const io::ParamSet as_run = params_as_run(p, base);
   CommandOutput out(as_run, capture, "control margin --compare");
-  out.open({{"variant", "label", "controller of the row"},
-            {"critical_delay", "T", "upper end tau_c of the stability interval of delays (inf: no crossing)"},
-            {"crossing_frequency", "Omega", "crossing frequency nu at the critical delay (roots at +-i nu)"},
-            {"lower_delay", "T", "lower end of the stability interval (0 plain loop; Smith: below the model delay)"},
-            {"stable_at_reference", "boolean (0/1)", "stable at the reference delay"}});
+  auto table = out.open(margin_compare_table(u));
   nlohmann::json rows = nlohmann::json::array();
   const auto add = [&](const std::string& name, const control::ControlSettings& c) {
     const control::DelayMargin m = control::delay_margin(control::loop_from(c));
-    out.row(name, u.in_periods(m.upper), u.in_omega(m.upper_frequency), u.in_periods(m.lower), m.stable_at_reference);
+    table.add({name, m});
     nlohmann::json j = margin_json(m, u);
     j["variant"] = name;
     rows.push_back(j);
@@ -238,6 +268,16 @@ void run_margin_compare(const io::ParamSet& p, const control::ControlSettings& b
   out.finish(res, fmt::format("delay margins of {} variants", out.rows()));
 }
 
+io::TableOf<control::DelayCrossing> crossings_table(const control::RotationUnits& u) {
+  using X = control::DelayCrossing;
+  return {{"frequency", "Omega", "crossing frequency nu (roots at +-i nu)",
+           [u](const X& x) { return u.in_omega(x.frequency); }},
+          {"first_delay", "T", "smallest delay with these roots on the imaginary axis",
+           [u](const X& x) { return u.in_periods(x.first_delay); }},
+          {"delay_period", "T", "2 pi/nu: the crossings repeat at first_delay + m delay_period",
+           [u](const X& x) { return u.in_periods(x.delay_period); }}};
+}
+
 void run_margin(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   if (p.flag("compare")) return run_margin_compare(p, c, capture);
@@ -262,11 +302,7 @@ void run_margin(const io::ParamSet& p, Captured* capture) {
   res["settings_si"] = settings_si_json(c);
   res["tau0"] = tau0_summary(c);
   res["units"] = margin_units();
-  out.open({{"frequency", "Omega", "crossing frequency nu (roots at +-i nu)"},
-            {"first_delay", "T", "smallest delay with these roots on the imaginary axis"},
-            {"delay_period", "T", "2 pi/nu: the crossings repeat at first_delay + m delay_period"}});
-  for (const auto& x : m.crossings)
-    out.row(u.in_omega(x.frequency), u.in_periods(x.first_delay), u.in_periods(x.delay_period));
+  out.open(crossings_table(u)).add_all(m.crossings);
   out.finish(res, m.stable_at_reference
                       ? fmt::format("critical delay tau_c = {} (crossing at {}, method {})",
                                     delay_summary(m.upper, u, 6), rate_summary(m.upper_frequency, u, 6), m.method)

@@ -14,6 +14,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/output.hpp"
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/table.hpp"
 #include "command.hpp"
 #include "control_analysis.hpp"
 #include "control_params.hpp"
@@ -58,6 +59,56 @@ std::string axis_text(const control::LoopFamily& f, char axis) {
   return single ? "coupling b (eq. 5) of the grid point" : "coupling beta (eq. 20) of the grid point";
 }
 
+// A point of the delay-margin map: (x[i], y[j]).
+struct MarginMapPoint {
+  const control::MarginMap& map;
+  int i, j;
+  std::size_t k() const { return static_cast<std::size_t>(j) * map.x.size() + static_cast<std::size_t>(i); }
+};
+
+// The margin map's table: the rows are the (y, x) grid, x fastest.
+io::TableOf<MarginMapPoint> margin_map_table(const control::LoopFamily& family, const control::RotationUnits& u,
+                                             int nx, int ny) {
+  using P = MarginMapPoint;
+  io::TableOf<P> table{
+      {"x", "Omega", axis_text(family, 'x'), [u](const P& p) { return u.in_omega(p.map.x[p.i]); }},
+      {"y", "Omega", axis_text(family, 'y'), [u](const P& p) { return u.in_omega(p.map.y[p.j]); }},
+      {"critical_delay", "T", "delay margin tau_c (inf: no crossing, nan: unstable at tau = 0)",
+       [u](const P& p) { return u.in_periods(p.map.critical_delay[p.k()]); }},
+      {"crossing_frequency", "Omega", "crossing frequency nu at tau_c",
+       [u](const P& p) { return u.in_omega(p.map.crossing_frequency[p.k()]); }}};
+  table.grid({{"y", family.y_name(), static_cast<std::size_t>(ny)}, {"x", family.x_name(), static_cast<std::size_t>(nx)}});
+  return table;
+}
+
+// A point of one stability chart: (x[i], y[j]) at its delay.
+struct ChartPoint {
+  const control::StabilityChart& chart;
+  int i, j;
+  double delay;
+  std::size_t k() const { return static_cast<std::size_t>(j) * chart.x.size() + static_cast<std::size_t>(i); }
+};
+
+// The charts' table: the rows are the (delay, y, x) grid, x fastest (one chart after the other).
+io::TableOf<ChartPoint> chart_table(const control::LoopFamily& family, const control::RotationUnits& u,
+                                    std::size_t delays, int nx, int ny) {
+  using P = ChartPoint;
+  io::TableOf<P> table{
+      {"x", "Omega", axis_text(family, 'x'), [u](const P& p) { return u.in_omega(p.chart.x[p.i]); }},
+      {"y", "Omega", axis_text(family, 'y'), [u](const P& p) { return u.in_omega(p.chart.y[p.j]); }},
+      {"spectral_abscissa", "Omega", "largest real part of the closed-loop roots (= -decay rate)",
+       [u](const P& p) { return u.in_omega(p.chart.abscissa[p.k()]); }},
+      {"unstable_roots", "count", "roots with Re s > 0 (region label, argument-principle count; -1: infinitely many)",
+       [](const P& p) { return static_cast<long>(p.chart.unstable_roots[p.k()]); }},
+      {"region", "label", "region id (connected set of grid points with equal counts, within its delay)",
+       [](const P& p) { return static_cast<long>(p.chart.region[p.k()]); }},
+      {"delay", "T", "measurement delay tau of the chart", &P::delay}};
+  table.grid({{"delay", "delay", delays},
+              {"y", family.y_name(), static_cast<std::size_t>(ny)},
+              {"x", family.x_name(), static_cast<std::size_t>(nx)}});
+  return table;
+}
+
 void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, const Window& win, Captured* capture) {
   const control::RotationUnits u = c.units();
   const control::LoopFamily family = control::LoopFamily::from_loop(control::loop_from(c));
@@ -65,10 +116,7 @@ void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, co
   const io::ParamSet as_run = params_as_run(p, c, window_values(win));
   CommandOutput out(as_run, capture, "control chart --quantity margin");
   require_memory("x_points", static_cast<double>(nx), static_cast<double>(ny) * (out.writes_file() ? 64.0 : 320.0));
-  out.open({{"x", "Omega", axis_text(family, 'x')},
-            {"y", "Omega", axis_text(family, 'y')},
-            {"critical_delay", "T", "delay margin tau_c (inf: no crossing, nan: unstable at tau = 0)"},
-            {"crossing_frequency", "Omega", "crossing frequency nu at tau_c"}});
+  auto rows = out.open(margin_map_table(family, u, nx, ny));
   io::Progress progress("control chart (grid points)", static_cast<long>(nx) * ny, p.flag("progress"));
   const control::MarginMap m =
       control::delay_margin_map(family, u.rate(win.x_min), u.rate(win.x_max), nx, u.rate(win.y_min), u.rate(win.y_max),
@@ -76,11 +124,7 @@ void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, co
                                 [&progress](long n, long) { progress.advance(n); }, cancellation_of(capture));
   progress.finish();
   for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const std::size_t k = static_cast<std::size_t>(j) * nx + i;
-      out.row(u.in_omega(m.x[i]), u.in_omega(m.y[j]), u.in_periods(m.critical_delay[k]),
-              u.in_omega(m.crossing_frequency[k]));
-    }
+    for (int i = 0; i < nx; ++i) rows.add({m, i, j});
   nlohmann::json res;
   res["family"] = describe_family(family);
   res["x"] = family.x_name();
@@ -91,6 +135,23 @@ void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, co
   res["settings"] = settings_json(c);
   res["settings_si"] = settings_si_json(c);
   out.finish(res, fmt::format("the {}x{} delay-margin map", nx, ny));
+}
+
+// A point of a D-subdivision boundary curve (curve: its id within its delay).
+struct BoundaryRow {
+  long curve;
+  const control::BoundaryPoint& point;
+  double delay;
+};
+
+io::TableOf<BoundaryRow> boundaries_table(const control::LoopFamily& family, const control::RotationUnits& u) {
+  using B = BoundaryRow;
+  return {{"curve", "label", "polyline id (within its delay)", &B::curve},
+          {"frequency", "Omega", "crossing frequency nu of the imaginary-axis roots on the curve (0: root at s = 0)",
+           [u](const B& b) { return u.in_omega(b.point.frequency); }},
+          {"x", "Omega", axis_text(family, 'x'), [u](const B& b) { return u.in_omega(b.point.x); }},
+          {"y", "Omega", axis_text(family, 'y'), [u](const B& b) { return u.in_omega(b.point.y); }},
+          {"delay", "T", "measurement delay tau of the chart", &B::delay}};
 }
 
 void run_chart(const io::ParamSet& p, Captured* capture) {
@@ -122,22 +183,11 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
                        static_cast<double>(nx) * ny * static_cast<double>(runs.size()), c.harmonics,
                        "x_points x y_points per delay");
   }
-  const std::vector<io::Column> boundary_columns = {
-      {"curve", "label", "polyline id (within its delay)"},
-      {"frequency", "Omega", "crossing frequency nu of the imaginary-axis roots on the curve (0: root at s = 0)"},
-      {"x", "Omega", axis_text(first, 'x')},
-      {"y", "Omega", axis_text(first, 'y')},
-      {"delay", "T", "measurement delay tau of the chart"}};
+  const io::TableOf<BoundaryRow> boundary_table = boundaries_table(first, u);
   std::optional<io::TableWriter> boundaries;
-  if (!bout.empty()) boundaries.emplace(bout, boundary_columns);
+  if (!bout.empty()) boundaries.emplace(bout, boundary_table.columns());
   nlohmann::json boundary_rows = nlohmann::json::array();  // --json without a boundaries file
-  out.open({{"x", "Omega", axis_text(first, 'x')},
-            {"y", "Omega", axis_text(first, 'y')},
-            {"spectral_abscissa", "Omega", "largest real part of the closed-loop roots (= -decay rate)"},
-            {"unstable_roots", "count",
-             "roots with Re s > 0 (region label, argument-principle count; -1: infinitely many)"},
-            {"region", "label", "region id (connected set of grid points with equal counts, within its delay)"},
-            {"delay", "T", "measurement delay tau of the chart"}});
+  auto rows = out.open(chart_table(first, u, runs.size(), nx, ny));
   io::Progress progress("control chart (grid points)", static_cast<long>(nx) * ny * static_cast<long>(runs.size()),
                         p.flag("progress"));
   nlohmann::json charts = nlohmann::json::array();
@@ -157,18 +207,17 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
     const control::StabilityChart chart =
         control::stability_chart(spec, [&progress](long n, long) { progress.advance(n); });
     for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const std::size_t k = static_cast<std::size_t>(j) * nx + i;
-        out.row(u.in_omega(chart.x[i]), u.in_omega(chart.y[j]), u.in_omega(chart.abscissa[k]),
-                static_cast<long>(chart.unstable_roots[k]), static_cast<long>(chart.region[k]), at.delay);
-      }
+      for (int i = 0; i < nx; ++i) rows.add({chart, i, j, at.delay});
     for (std::size_t ci = 0; ci < chart.boundaries.size(); ++ci)
-      for (const auto& q : chart.boundaries[ci]) {
-        if (boundaries)
-          boundaries->row(static_cast<long>(ci), u.in_omega(q.frequency), u.in_omega(q.x), u.in_omega(q.y), at.delay);
-        else if (json)
-          boundary_rows.push_back({static_cast<long>(ci), u.in_omega(q.frequency), u.in_omega(q.x), u.in_omega(q.y),
-                                   at.delay});
+      for (const control::BoundaryPoint& q : chart.boundaries[ci]) {
+        const BoundaryRow row{static_cast<long>(ci), q, at.delay};
+        if (boundaries) {
+          io::write_row(*boundaries, boundary_table, row);
+        } else if (json) {
+          nlohmann::json cells = nlohmann::json::array();
+          for (const auto& c : boundary_table.entries()) cells.push_back(io::cell_json(c.value(row)));
+          boundary_rows.push_back(std::move(cells));
+        }
       }
     curves += static_cast<long>(chart.boundaries.size());
     nlohmann::json regions = nlohmann::json::array();
@@ -210,7 +259,7 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
     bres["grid_file"] = out.path();
     boundaries->stage(io::make_sidecar("control chart (D-subdivision boundaries)", as_run, bres), out.outputs());
   } else if (json) {
-    res["boundaries"] = {{"columns", io::columns_json(boundary_columns)}, {"rows", boundary_rows}};
+    res["boundaries"] = {{"columns", io::columns_json(boundary_table.columns())}, {"rows", boundary_rows}};
   }
   out.finish(res, fmt::format("{} {}x{} chart{} ({} boundary curves{})", runs.size(), nx, ny, runs.size() > 1 ? "s" : "",
                               curves, bout.empty() ? "" : " in " + bout));

@@ -23,6 +23,7 @@
 #include "afmkit/io/curves/text_column.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/table.hpp"
 #include "command.hpp"
 #include "commands.hpp"
 #include "control_params.hpp"
@@ -153,6 +154,18 @@ nlohmann::json report_json(const control::SimulationReport& r, const control::Cl
   return j;
 }
 
+/// The time series' table, one row per recorded step (u: the rotation units of the run).
+io::TableOf<control::TimeSample> simulate_table(const control::RotationUnits& u) {
+  using S = control::TimeSample;
+  const double w = u.rotation_frequency();
+  return {{"t", "T", "time", [u](const S& r) { return u.in_periods(r.t); }},
+          {"y", "signal", "plant output y", &S::y},
+          {"u", "signal*Omega", "control u", [w](const S& r) { return r.u / w; }},
+          {"m", "signal", "measurement y(t - tau)", &S::m},
+          {"target", "signal", "steady state to reach: uncontrolled output without the rejected harmonics", &S::target},
+          {"f_minus_f1", "signal", "disturbance f without its first harmonic", &S::f_minus_first}};
+}
+
 void run_simulate(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   if (c.controller == ControllerKind::Smith)
@@ -231,17 +244,9 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
   const control::Plant plant(c.plant, si.plant_rate, si.rotation_frequency, si.delay, disturbance,
                              u.delay(p.real("delay_variation")), u.rate(p.real("delay_variation_frequency")));
   const control::ClosedLoopSimulation sim(plant, control::bank_from(c), o);
-  out.open({{"t", "T", "time"},
-            {"y", "signal", "plant output y"},
-            {"u", "signal*Omega", "control u"},
-            {"m", "signal", "measurement y(t - tau)"},
-            {"target", "signal", "steady state to reach: uncontrolled output without the rejected harmonics"},
-            {"f_minus_f1", "signal", "disturbance f without its first harmonic"}});
+  auto rows = out.open(simulate_table(u));
   // the time series is streamed as it is computed (memory bounded by a row, not by the run)
-  const double w = u.rotation_frequency();
-  const auto sink = [&out, &u, w](const control::TimeSample& r) {
-    out.row(u.in_periods(r.t), r.y, r.u / w, r.m, r.target, r.f_minus_first);
-  };
+  const auto sink = [&rows](const control::TimeSample& r) { rows.add(r); };
   io::Progress progress("control simulate (periods)", o.periods, true, 1.0);
   const auto res = o.record_every > 0 ? sim.run([&](long, long) { progress.advance(); }, sink)
                                       : sim.run([&](long, long) { progress.advance(); });

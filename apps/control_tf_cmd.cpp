@@ -14,6 +14,7 @@
 #include "afmkit/control/frequency_response.hpp"
 #include "afmkit/control/stability_tau0.hpp"
 #include "afmkit/core/error.hpp"
+#include "afmkit/io/table.hpp"
 #include "command.hpp"
 #include "commands.hpp"
 #include "control_params.hpp"
@@ -132,6 +133,27 @@ nlohmann::json summary(const control::ControlSettings& c, const control::LoopSpe
   return j;
 }
 
+/// One frequency of the response: ω [rad/s], G(iω), |G| and the phase unwrapped along the grid.
+struct TfPoint {
+  double omega;
+  std::complex<double> g;
+  double magnitude = 0.0, phase = 0.0;
+};
+
+/// The response's table in `frequency_unit` (w: Ω [rad/s]) and the system's unit.
+io::TableOf<TfPoint> tf_table(const std::string& frequency_unit, double w, const ResponseUnit& unit) {
+  const double factor = unit.factor;
+  return {{"frequency", frequency_unit,
+           frequency_unit == "Hz" ? "frequency omega/(2 pi) of the grid point (k Omega/(2 pi) at harmonic k)"
+                                  : "angular frequency omega of the grid point (omega = k Omega at harmonic k)",
+           [frequency_unit, w](const TfPoint& p) { return frequency_in(frequency_unit, p.omega, w); }},
+          {"magnitude", unit.unit, "|G(i omega)| of the system",
+           [factor](const TfPoint& p) { return p.magnitude * factor; }},
+          {"phase", "rad", "arg G(i omega), unwrapped along the grid", &TfPoint::phase},
+          {"real", unit.unit, "Re G(i omega)", [factor](const TfPoint& p) { return p.g.real() * factor; }},
+          {"imag", unit.unit, "Im G(i omega)", [factor](const TfPoint& p) { return p.g.imag() * factor; }}};
+}
+
 void run_tf(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
   const control::LoopSpec loop = control::loop_from(c);
@@ -164,13 +186,7 @@ void run_tf(const io::ParamSet& p, Captured* capture) {
   res["system"] = system;
   res["rows"] = points;
   res["cost"] = "O(N) per frequency (sum over the oscillators); rows streamed to the file";
-  out.open({{"frequency", frequency_unit,
-             frequency_unit == "Hz" ? "frequency omega/(2 pi) of the grid point (k Omega/(2 pi) at harmonic k)"
-                                    : "angular frequency omega of the grid point (omega = k Omega at harmonic k)"},
-            {"magnitude", unit.unit, "|G(i omega)| of the system"},
-            {"phase", "rad", "arg G(i omega), unwrapped along the grid"},
-            {"real", unit.unit, "Re G(i omega)"},
-            {"imag", unit.unit, "Im G(i omega)"}});
+  auto rows = out.open(tf_table(frequency_unit, w, unit));
   // each frequency is computed and its row written at once: memory is bounded by a row, not by the file
   control::PhaseUnwrapper unwrap;
   io::Progress progress("control tf (frequencies)", points, estimate > kProgressAfterSeconds && !p.flag("json"));
@@ -178,9 +194,10 @@ void run_tf(const io::ParamSet& p, Captured* capture) {
     if ((i & 1023) == 1023) progress.advance(1024);
     const double omega = control::frequency_grid_point(fmin * w, fmax * w, points, log_spacing, i);
     const std::complex<double> g = control::evaluate(loop, which, {0.0, omega});
-    double magnitude, phase;
-    control::magnitude_phase(g, magnitude, phase);
-    out.row(frequency_in(frequency_unit, omega, w), magnitude * unit.factor, unwrap(phase), g.real() * unit.factor, g.imag() * unit.factor);
+    TfPoint point{omega, g};
+    control::magnitude_phase(g, point.magnitude, point.phase);
+    point.phase = unwrap(point.phase);
+    rows.add(point);
   }
   progress.finish();
   out.finish(res, fmt::format("{} frequencies of the {} ({})", points, system, res["loop"].get<std::string>()));

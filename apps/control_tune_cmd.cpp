@@ -9,6 +9,7 @@
 #include "afmkit/control/tuning.hpp"
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/progress.hpp"
+#include "afmkit/io/table.hpp"
 #include "command.hpp"
 #include "control_analysis.hpp"
 #include "control_params.hpp"
@@ -30,6 +31,29 @@ constexpr Window kSingleWindow{0.01, 2.0, -2.0, 0.9};
 constexpr Window kCouplingsWindow{0.01, 0.6, -0.24, 0.3};
 
 using io::Range;
+
+// A point (x[i], y[j]) of the tuning's coarse grid.
+struct CoarsePoint {
+  const control::RobustTuning& tuning;
+  int i, j;
+};
+
+// The coarse grid's table: the rows are the (y, x) grid of n x n points, x fastest.
+io::TableOf<CoarsePoint> coarse_grid_table(const control::LoopFamily& family, const control::RotationUnits& u, int n) {
+  using P = CoarsePoint;
+  io::TableOf<P> table{
+      {"x", "Omega", std::string(family.x_name()) + " of the coarse grid point",
+       [u](const P& p) { return u.in_omega(p.tuning.coarse_x[p.i]); }},
+      {"y", "Omega", std::string(family.y_name()) + " of the coarse grid point",
+       [u](const P& p) { return u.in_omega(p.tuning.coarse_y[p.j]); }},
+      {"worst_decay_rate", "Omega",
+       "objective: smallest decay rate -max Re s over the delays and gain ratios (tracked spectra)",
+       [u, n](const P& p) {
+         return u.in_omega(p.tuning.coarse_worst_decay[static_cast<std::size_t>(p.j) * n + p.i]);
+       }}};
+  table.grid({{"y", family.y_name(), static_cast<std::size_t>(n)}, {"x", family.x_name(), static_cast<std::size_t>(n)}});
+  return table;
+}
 
 void run_tune(const io::ParamSet& p, Captured* capture) {
   const control::ControlSettings c = control_settings_from(p);
@@ -78,19 +102,14 @@ void run_tune(const io::ParamSet& p, Captured* capture) {
                              "{:.2g} s per evaluation",
                              s.gain_points, c.harmonics, evaluation));
   }
-  out.open({{"x", "Omega", std::string(s.family.x_name()) + " of the coarse grid point"},
-            {"y", "Omega", std::string(s.family.y_name()) + " of the coarse grid point"},
-            {"worst_decay_rate", "Omega",
-             "objective: smallest decay rate -max Re s over the delays and gain ratios (tracked spectra)"}});
+  auto rows = out.open(coarse_grid_table(s.family, u, s.coarse_points));
   io::Progress progress("control tune (objective evaluations)",
                         static_cast<long>(s.coarse_points) * s.coarse_points + s.max_evaluations, p.flag("progress"));
   const control::RobustTuning r = control::robust_tuning(s, [&progress](long n, long) { progress.advance(n); });
   progress.finish();
   const int n = s.coarse_points;
   for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i)
-      out.row(u.in_omega(r.coarse_x[i]), u.in_omega(r.coarse_y[j]),
-              u.in_omega(r.coarse_worst_decay[static_cast<std::size_t>(j) * n + i]));
+    for (int i = 0; i < n; ++i) rows.add({r, i, j});
   nlohmann::json res;
   res["family"] = describe_family(s.family);
   res["x"] = s.family.x_name();

@@ -100,11 +100,13 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
                                   {"sweep_jumps", jumps},
                                   {"free_amplitude", model.free_amplitude() * scales.length},
                                   {"units", {{"length", scales.length_unit}}}};
-  io::TableWriter hb(dir + "/demo_hb.csv", hb_columns(scales));
-  write_hb_rows(hb, curve, scales);
-  io::TableWriter table(dir + "/demo_sweep.csv", sweep_columns(scales));
-  write_sweep_rows(table, sweep.approach, scales);
-  write_sweep_rows(table, sweep.retract, scales);
+  const io::TableOf<tapping::HbPoint> hb_rows = hb_table(scales);
+  io::TableWriter hb(dir + "/demo_hb.csv", hb_rows.columns());
+  for (const tapping::HbPoint& pt : curve) io::write_row(hb, hb_rows, pt);
+  const io::TableOf<tapping::SweepPoint> sweep_rows = sweep_table(scales);
+  io::TableWriter table(dir + "/demo_sweep.csv", sweep_rows.columns());
+  for (const auto* points : {&sweep.approach, &sweep.retract})
+    for (const tapping::SweepPoint& pt : *points) io::write_row(table, sweep_rows, pt);
   io::OutputSet set;  // both tables and their sidecars, or none
   hb.stage(io::make_sidecar("demo (harmonic balance)", p, results), set);
   table.stage(io::make_sidecar("demo (sweep)", p, results), set);

@@ -39,28 +39,57 @@ struct FmUnits {
   double energy_factor() const { return physical ? s.energy * kJoulePerAttojoule : 1.0; }
 };
 
-std::vector<io::Column> fm_columns(const FmUnits& u) {
+/// A value of the orbit at a point, nan where Newton found none.
+template <class F>
+auto of_orbit(F value) {
+  return [value](const tapping::FmPoint& pt) { return pt.orbit ? value(*pt.orbit) : kNan; };
+}
+
+/// The FM table, one row per target (`wn`: ω_n of the model; `at_gap`: the targets are gaps at the lower turning
+/// point): a point without an orbit has its target in its column, nan elsewhere and no flags.
+io::TableOf<tapping::FmPoint> fm_table(const FmUnits& u, double wn, bool at_gap) {
+  using P = tapping::FmPoint;
+  using O = tapping::FmOrbit;
   const std::string L = u.s.length_unit;
-  return {{"separation", L, "separation l: rest position of the tip above the sample surface"},
-          {"min_gap", L, "tip-sample distance at the lower turning point (smallest gap x + l over the cycle)"},
-          {"frequency_shift", u.frequency(), "frequency shift Δf = f − f0 of the oscillation (f0: the free resonance)"},
-          {"relative_frequency_shift", "dimensionless", "Δf/f0"},
-          {"frequency", u.frequency(), "oscillation frequency f held by the phase-locked loop"},
-          {"drive_ratio", "dimensionless", "drive amplitude over the free cantilever's drive at the same amplitude"},
-          {"dissipation", u.energy(), "energy taken by the tip-sample force per cycle (−∫ F dz; = drive work − viscous loss)"},
-          {"dissipation_ev", "eV", "the same in eV (nan in normalised units)"},
-          {"peak_force", u.s.force_unit, "largest tip-sample force over the cycle (positive: repulsive)"},
-          {"offset", L, "mean deflection of the tip over the cycle"},
-          {"amplitude", L, "first-harmonic amplitude of the deflection (= the setpoint A at convergence)"},
-          {"harmonic_2", L, "amplitude of the 2nd harmonic of the deflection"},
-          {"contact_fraction", "dimensionless", "fraction of the cycle with the gap below the law's contact gap"},
-          {"floquet_max", "dimensionless", "largest Floquet multiplier modulus with the drive frozen (loops held)"},
-          {"stable", "boolean (0/1)", "1: floquet_max < 1"},
+  const double l = u.s.length, force = u.s.force, ff = u.frequency_factor(), ef = u.energy_factor();
+  const bool physical = u.physical;
+  return {{"separation", L, "separation l: rest position of the tip above the sample surface",
+           [l, at_gap](const P& p) { return p.orbit ? p.orbit->separation * l : at_gap ? kNan : p.separation * l; }},
+          {"min_gap", L, "tip-sample distance at the lower turning point (smallest gap x + l over the cycle)",
+           [l, at_gap](const P& p) { return p.orbit ? p.orbit->metrics.min_gap * l : at_gap ? p.separation * l : kNan; }},
+          {"frequency_shift", u.frequency(), "frequency shift Δf = f − f0 of the oscillation (f0: the free resonance)",
+           of_orbit([ff](const O& o) { return o.frequency_shift() * ff; })},
+          {"relative_frequency_shift", "dimensionless", "Δf/f0",
+           of_orbit([wn](const O& o) { return o.frequency_shift() / wn; })},
+          {"frequency", u.frequency(), "oscillation frequency f held by the phase-locked loop",
+           of_orbit([ff](const O& o) { return o.state.frequency * ff; })},
+          {"drive_ratio", "dimensionless", "drive amplitude over the free cantilever's drive at the same amplitude",
+           of_orbit([](const O& o) { return o.drive_ratio(); })},
+          {"dissipation", u.energy(), "energy taken by the tip-sample force per cycle (−∫ F dz; = drive work − viscous loss)",
+           of_orbit([ef](const O& o) { return o.tip_dissipation() * ef; })},
+          {"dissipation_ev", "eV", "the same in eV (nan in normalised units)",
+           of_orbit([ef, physical](const O& o) { return physical ? o.tip_dissipation() * ef / kElectronvolt : kNan; })},
+          {"peak_force", u.s.force_unit, "largest tip-sample force over the cycle (positive: repulsive)",
+           of_orbit([force](const O& o) { return o.metrics.peak_force * force; })},
+          {"offset", L, "mean deflection of the tip over the cycle", of_orbit([l](const O& o) { return o.metrics.offset * l; })},
+          {"amplitude", L, "first-harmonic amplitude of the deflection (= the setpoint A at convergence)",
+           of_orbit([l](const O& o) { return o.metrics.amplitude * l; })},
+          {"harmonic_2", L, "amplitude of the 2nd harmonic of the deflection",
+           of_orbit([l](const O& o) { return o.metrics.harmonics[0] * l; })},
+          {"contact_fraction", "dimensionless", "fraction of the cycle with the gap below the law's contact gap",
+           of_orbit([](const O& o) { return o.metrics.contact_fraction; })},
+          {"floquet_max", "dimensionless", "largest Floquet multiplier modulus with the drive frozen (loops held)",
+           of_orbit([](const O& o) { return o.floquet_max; })},
+          {"stable", "boolean (0/1)", "1: floquet_max < 1", [](const P& p) { return p.orbit && p.orbit->stable; }},
           {"jumped", "boolean (0/1)", "1: reached past a fold of the branch in the separation (another branch, as an "
-                                      "instrument's loops would jump)"},
-          {"newton_iterations", "count", "Newton iterations of the FM orbit"},
-          {"residual", "dimensionless", "largest scaled residual of the four FM conditions"},
-          {"status", "label", "ok, or no_orbit: Newton found no FM orbit here (values nan)"}};
+                                      "instrument's loops would jump)",
+           [](const P& p) { return p.orbit && p.jumped; }},
+          {"newton_iterations", "count", "Newton iterations of the FM orbit",
+           [](const P& p) { return p.orbit ? static_cast<long>(p.orbit->iterations) : 0L; }},
+          {"residual", "dimensionless", "largest scaled residual of the four FM conditions",
+           of_orbit([](const O& o) { return o.residual; })},
+          {"status", "label", "ok, or no_orbit: Newton found no FM orbit here (values nan)",
+           [](const P& p) { return tapping::fm_status_name(p.status); }}};
 }
 
 void run_fm(const io::ParamSet& p, Captured* capture) {
@@ -86,24 +115,9 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
   progress.finish();
 
   CommandOutput out(p, capture, "tapping fm");
-  out.open(fm_columns(u));
+  out.open(fm_table(u, base.cantilever.natural_frequency, at_gap)).add_all(r.points);
   const double ff = u.frequency_factor(), ef = u.energy_factor();
   const double wn = base.cantilever.natural_frequency;
-  for (const tapping::FmPoint& pt : r.points) {
-    if (!pt.orbit) {
-      const double target = pt.separation * u.s.length;
-      out.row(at_gap ? kNan : target, at_gap ? target : kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan, kNan,
-              kNan, kNan, kNan, false, false, 0L, kNan, tapping::fm_status_name(pt.status));
-      continue;
-    }
-    const tapping::FmOrbit& o = *pt.orbit;
-    const auto& m = o.metrics;
-    const double e = o.tip_dissipation() * ef;
-    out.row(o.separation * u.s.length, m.min_gap * u.s.length, o.frequency_shift() * ff, o.frequency_shift() / wn,
-            o.state.frequency * ff, o.drive_ratio(), e, u.physical ? e / kElectronvolt : kNan, m.peak_force * u.s.force,
-            m.offset * u.s.length, m.amplitude * u.s.length, m.harmonics[0] * u.s.length, m.contact_fraction,
-            o.floquet_max, o.stable, pt.jumped, static_cast<long>(o.iterations), o.residual, tapping::fm_status_name(pt.status));
-  }
   const long n = static_cast<long>(r.points.size()), converged = r.converged();
   nlohmann::json results;
   results["amplitude"] = setting.amplitude * u.s.length;

@@ -88,10 +88,9 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   // (the streamed chunk is checked too: a malformed AFMKIT_MEMORY_LIMIT is refused as on every run)
   if (out.holds_rows()) memory::require_fits("points", static_cast<double>(options.points), 2.0 * kHeldRowBytes);
   else memory::require_fits("points", static_cast<double>(std::min(options.points, kChunkPoints)), sizeof(tapping::HbPoint));
-  out.open(hb_columns(scales));
+  auto rows = out.open(hb_table(scales));
   const std::size_t count = tapping::harmonic_balance_curve_chunks(
-      model, options, [&](std::span<const tapping::HbPoint> chunk) { write_hb_rows(out, chunk, scales); },
-      kChunkPoints);
+      model, options, [&](std::span<const tapping::HbPoint> chunk) { rows.add_all(chunk); }, kChunkPoints);
 
   // the model and options are checked: what is refused from here on was computed (core/computed.hpp)
   const tapping::HarmonicBalance hb = computed("harmonic balance", [&] { return tapping::HarmonicBalance(model); });

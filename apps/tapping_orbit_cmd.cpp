@@ -16,6 +16,7 @@
 #include "afmkit/tapping/orbit.hpp"
 #include "afmkit/io/progress.hpp"
 #include "afmkit/io/quantity.hpp"
+#include "afmkit/io/table.hpp"
 #include "command.hpp"
 #include "work_budget.hpp"
 #include "commands.hpp"
@@ -130,6 +131,51 @@ nlohmann::json orbit_units(const TappingScales& s) {
           {"shooting_residual", "dimensionless"}};
 }
 
+/// The table: one row per orbit found.
+io::TableOf<tapping::FoundOrbit> orbit_table(const TappingScales& s) {
+  using F = tapping::FoundOrbit;
+  const std::string L = s.length_unit, velocity = L + "/" + s.time_unit;
+  const double l = s.length, force = s.force, energy = s.energy, time = s.time;
+  return {
+      {"source", "label", "how the orbit was found first (harmonic_balance, transient, grid, contact, continuation)",
+       [](const F& f) { return tapping::orbit_source_name(f.source); }},
+      {"period_multiple", "count", "n of a period-n orbit (1: the drive period)",
+       [](const F& f) { return f.orbit.period_multiple; }},
+      {"stable", "boolean (0/1)", "1: all Floquet multipliers inside the unit circle",
+       [](const F& f) { return f.orbit.stable; }},
+      {"amplitude", L, "first-harmonic amplitude B", [l](const F& f) { return f.metrics.amplitude * l; }},
+      {"offset", L, "mean deflection A", [l](const F& f) { return f.metrics.offset * l; }},
+      {"phase", "rad", "phase lag φ of the first harmonic behind the drive (docs/conventions.md), in (-π, π]",
+       [](const F& f) { return f.metrics.phase; }},
+      {"harmonic_2", L, "amplitude of the 2nd harmonic", [l](const F& f) { return f.metrics.harmonics[0] * l; }},
+      {"harmonic_3", L, "amplitude of the 3rd harmonic", [l](const F& f) { return f.metrics.harmonics[1] * l; }},
+      {"harmonic_4", L, "amplitude of the 4th harmonic", [l](const F& f) { return f.metrics.harmonics[2] * l; }},
+      {"harmonic_5", L, "amplitude of the 5th harmonic", [l](const F& f) { return f.metrics.harmonics[3] * l; }},
+      {"contact_fraction", "dimensionless", "fraction of the period with the gap below the law's contact gap",
+       [](const F& f) { return f.metrics.contact_fraction; }},
+      {"peak_force", s.force_unit, "largest tip-sample force (positive: repulsive)",
+       [force](const F& f) { return f.metrics.peak_force * force; }},
+      {"min_gap", L, "smallest gap x + l", [l](const F& f) { return f.metrics.min_gap * l; }},
+      {"energy_dissipated", s.energy_unit, "energy dissipated per drive period (viscous + contact)",
+       [energy](const F& f) { return f.metrics.energy_dissipated() * energy; }},
+      {"viscous_dissipation", s.energy_unit, "viscous (cantilever damping) part per drive period",
+       [energy](const F& f) { return f.metrics.viscous_dissipation * energy; }},
+      {"contact_dissipation", s.energy_unit, "tip-sample (hysteresis) part per drive period",
+       [energy](const F& f) { return f.metrics.contact_dissipation * energy; }},
+      {"floquet_max", "dimensionless", "largest Floquet multiplier modulus",
+       [](const F& f) { return f.orbit.floquet_max; }},
+      {"sticking_time", s.time_unit, "time spent sticking to the sample per orbit",
+       [time](const F& f) { return f.metrics.sticking_duration * time; }},
+      {"initial_position", L, "tip position x at drive phase 0 on the orbit",
+       [l](const F& f) { return f.orbit.initial.position * l; }},
+      {"initial_velocity", velocity, "tip velocity at drive phase 0 on the orbit",
+       [l, time](const F& f) { return f.orbit.initial.velocity * l / time; }},
+      {"trapped", "boolean (0/1)",
+       "1: the tip sticks to the sample or stays in contact over the whole period (no tapping; "
+       "docs/conventions.md#statuses)",
+       [](const F& f) { return tapping::tip_trapped(f.metrics); }}};
+}
+
 void run_orbit(const io::ParamSet& p, Captured* capture) {
   const tapping::TappingModel model = tapping_model_from(p, law_object_of(capture));
   const TappingScales scales = tapping_scales_from(p);
@@ -187,38 +233,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
                     {"seeds", {{"initial_position", length}, {"initial_velocity", velocity}, {"orbits", "count"},
                                {"grid_phase", "rad"}, {"grid_amplitude", length}}}}}}}};
   CommandOutput out(p, capture, "tapping orbit");
-  out.open({{"source", "label", "how the orbit was found first (harmonic_balance, transient, grid, contact, continuation)"},
-            {"period_multiple", "count", "n of a period-n orbit (1: the drive period)"},
-            {"stable", "boolean (0/1)", "1: all Floquet multipliers inside the unit circle"},
-            {"amplitude", length, "first-harmonic amplitude B"},
-            {"offset", length, "mean deflection A"},
-            {"phase", "rad", "phase lag φ of the first harmonic behind the drive (docs/conventions.md), in (-π, π]"},
-            {"harmonic_2", length, "amplitude of the 2nd harmonic"},
-            {"harmonic_3", length, "amplitude of the 3rd harmonic"},
-            {"harmonic_4", length, "amplitude of the 4th harmonic"},
-            {"harmonic_5", length, "amplitude of the 5th harmonic"},
-            {"contact_fraction", "dimensionless", "fraction of the period with the gap below the law's contact gap"},
-            {"peak_force", scales.force_unit, "largest tip-sample force (positive: repulsive)"},
-            {"min_gap", length, "smallest gap x + l"},
-            {"energy_dissipated", scales.energy_unit, "energy dissipated per drive period (viscous + contact)"},
-            {"viscous_dissipation", scales.energy_unit, "viscous (cantilever damping) part per drive period"},
-            {"contact_dissipation", scales.energy_unit, "tip-sample (hysteresis) part per drive period"},
-            {"floquet_max", "dimensionless", "largest Floquet multiplier modulus"},
-            {"sticking_time", scales.time_unit, "time spent sticking to the sample per orbit"},
-            {"initial_position", length, "tip position x at drive phase 0 on the orbit"},
-            {"initial_velocity", velocity, "tip velocity at drive phase 0 on the orbit"},
-            {"trapped", "boolean (0/1)", "1: the tip sticks to the sample or stays in contact over the whole period (no "
-                                         "tapping; docs/conventions.md#statuses)"}});
-  for (const tapping::FoundOrbit& f : r.orbits) {
-    const auto& m = f.metrics;
-    const double l = scales.length;
-    out.row(tapping::orbit_source_name(f.source), f.orbit.period_multiple, f.orbit.stable, m.amplitude * l,
-            m.offset * l, m.phase, m.harmonics[0] * l, m.harmonics[1] * l, m.harmonics[2] * l, m.harmonics[3] * l,
-            m.contact_fraction, m.peak_force * scales.force, m.min_gap * l, m.energy_dissipated() * scales.energy,
-            m.viscous_dissipation * scales.energy, m.contact_dissipation * scales.energy, f.orbit.floquet_max,
-            m.sticking_duration * scales.time, f.orbit.initial.position * l, f.orbit.initial.velocity * l / scales.time,
-            tapping::tip_trapped(m));
-  }
+  out.open(orbit_table(scales)).add_all(r.orbits);
   if (p.flag("json")) {
     out.finish(summary, "");
     return;

@@ -177,17 +177,19 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
   };
 
   CommandOutput out(p, capture, "tapping sweep");
-  std::vector<io::Column> columns{{name, unit,
-                                   name == "drive_frequency"
-                                       ? std::string("drive frequency over natural frequency ω/ω_n (the drive force held)")
-                                       : fmt::format("value of the swept parameter {}", name)}};
-  for (io::Column& c : sweep_columns(scales)) columns.push_back(std::move(c));
-  columns[2].description = "separation l of the orbit (fixed: the sweep moves " + name + ")";
-  columns[3].description = "down (from parameter_max to parameter_min), up (back) or continuation";
-  out.open(columns);
+  io::TableOf<tapping::SweepPoint> table = sweep_table(scales, false);
+  table
+      .prepend({name, unit,
+                name == "drive_frequency"
+                    ? std::string("drive frequency over natural frequency ω/ω_n (the drive force held)")
+                    : fmt::format("value of the swept parameter {}", name),
+                &tapping::SweepPoint::parameter})
+      .describe("separation", "separation l of the orbit (fixed: the sweep moves " + name + ")")
+      .describe("direction", "down (from parameter_max to parameter_min), up (back) or continuation");
+  auto rows = out.open(std::move(table));
   long trapped = 0;
   const auto write_rows = [&](const std::vector<tapping::SweepPoint>& pts) {
-    write_sweep_rows(out, pts, scales, 1.0);
+    rows.add_all(pts);
     for (const tapping::SweepPoint& pt : pts) trapped += tapping::tip_trapped(pt.metrics) ? 1 : 0;
   };
   nlohmann::json results = nlohmann::json::object();
@@ -343,10 +345,10 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
   const bool beside = hb_beside(p, base);
 
   CommandOutput out(p, capture, "tapping sweep");
-  out.open(sweep_columns(scales));
+  auto rows = out.open(sweep_table(scales));
   long trapped = 0;  // rows on which the tip does not tap (column trapped)
   const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) {
-    write_sweep_rows(out, points, scales);
+    rows.add_all(points);
     for (const tapping::SweepPoint& pt : points) trapped += tapping::tip_trapped(pt.metrics) ? 1 : 0;
   };
   nlohmann::json results = nlohmann::json::object();

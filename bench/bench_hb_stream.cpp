@@ -50,7 +50,7 @@ std::vector<io::Column> hbs_columns() {
           {"offset", "L", "A"},       {"phase", "rad", "phase"}, {"branch", "label", "branch"}};
 }
 
-void hbs_rows(io::TableWriter& out, std::span<const HbPoint> points) {  // as apps/tapping_tables.hpp write_hb_rows
+void hbs_rows(io::TableWriter& out, std::span<const HbPoint> points) {  // the cells of apps/tapping_tables.cpp hb_table
   for (const HbPoint& p : points)
     out.row(p.q, p.separation, p.amplitude, p.offset, p.phase, branch_name(p.branch));
 }

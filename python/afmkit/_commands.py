@@ -35,11 +35,6 @@ def _summary(value):
     return value
 
 
-# Gridded results: the columns that span the grid (slowest first) of a table whose rows are every point of a
-# Cartesian grid; to_xarray() gives the other columns on these dimensions. Renamed: a dimension named after the
-# axis the summary gives ("x" -> results["x"]: alpha, a, ...).
-_GRIDS = {"control chart": ("delay", "y", "x"), "control tune": ("y", "x")}
-_AXIS_NAMES = {"x": "x", "y": "y"}  # the summary keys naming the x and y axes of a chart
 # Tables along one independent variable: its column is the dimension (when its values are distinct).
 _INDEX = {"control tf": "frequency", "control simulate": "t", "impact": "t", "tapping fm": "separation"}
 
@@ -74,6 +69,9 @@ class Result(dict):
         self.units: dict[str, str] = {c[0]: c[1] for c in raw["columns"]}
         self.meaning: dict[str, str] = {c[0]: c[2] for c in raw["columns"]}
         self._raw_columns = [tuple(c) for c in raw["columns"]]
+        #: The grid the command declares its rows to be (its sidecar's "grid": dims, columns, shape, coords), or
+        #: None: to_xarray() shapes the table on it.
+        self.grid: dict | None = raw.get("grid")
 
     # ---- the mapping (read-only)
     @property
@@ -101,7 +99,8 @@ class Result(dict):
     clear = pop = popitem = setdefault = update = _read_only
 
     def __reduce__(self):  # copy, pickle (Dask, multiprocessing)
-        raw = {"results": self.results, "params": self.params, "columns": self._raw_columns, "table": dict(self)}
+        raw = {"results": self.results, "params": self.params, "columns": self._raw_columns, "table": dict(self),
+               "grid": self.grid}
         return (Result, (self.command, raw))
 
     def __getattr__(self, name: str):
@@ -184,24 +183,14 @@ class Result(dict):
         def attrs(c):
             return {"units": self.units[c], "long_name": self.meaning[c]}
 
-        grid = self._grid()
-        if grid is not None:
-            axes, coords, where, dims = grid
-            shape = tuple(len(v) for v in coords)
-            data_vars = {}
-            for c in self.columns:
-                if c in axes:
-                    continue
-                col = self[c]
-                if col.dtype.kind == "f":
-                    full = np.full(shape, np.nan)
-                elif col.dtype.kind == "b":
-                    full = np.zeros(shape, bool)
-                else:
-                    full = np.empty(shape, col.dtype)
-                full[where] = col
-                data_vars[c] = (dims, full, attrs(c))
-            coord_vars = {d: (d, v, attrs(a)) for d, a, v in zip(dims, axes, coords)}
+        grid = self.grid
+        if grid is not None and len(self) == int(np.prod(grid["shape"], dtype=np.int64)):
+            # the rows are the declared grid in row-major order (the command checks it): reshaped, not searched
+            dims, shape = list(grid["dims"]), tuple(grid["shape"])
+            axes = set(grid["columns"])
+            data_vars = {c: (dims, self[c].reshape(shape), attrs(c)) for c in self.columns if c not in axes}
+            coord_vars = {d: (d, np.asarray(grid["coords"][d], dtype=float), attrs(a))
+                          for d, a in zip(dims, grid["columns"])}
         else:
             dim = _INDEX.get(self.command)
             if dim not in self.keys() or len(np.unique(self[dim])) != len(self):
@@ -209,34 +198,13 @@ class Result(dict):
             data_vars = {c: (dim, self[c], attrs(c)) for c in self.columns if c != dim}
             coord_vars = {dim: (dim, self[dim], attrs(dim))} if dim != "row" else {"row": ("row", np.arange(len(self)))}
         ds = xr.Dataset(data_vars, coords=coord_vars)
+        if grid is not None:  # coordinates in increasing order (a chart's delays are in the order given)
+            unsorted = [d for d in ds.dims if d in coord_vars and not ds.indexes[d].is_monotonic_increasing]
+            if unsorted:
+                ds = ds.sortby(unsorted)
         ds.attrs.update(command=self.command, results=json.dumps(self.results, default=str),
                         params=json.dumps(self.params, default=str))
         return ds
-
-    def _grid(self):
-        """(axis columns, sorted values per axis, index tuple of each row, dimension names) when the rows are every
-        point of a grid exactly once, else None."""
-        axes = [a for a in _GRIDS.get(self.command, ()) if a in self.keys()]
-        if not axes or len(self) == 0:
-            return None
-        coords, index = [], []
-        for a in axes:
-            col = self[a]
-            if col.dtype.kind != "f" or not np.all(np.isfinite(col)):
-                return None
-            values, inverse = np.unique(col, return_inverse=True)
-            coords.append(values)
-            index.append(inverse)
-        shape = tuple(len(v) for v in coords)
-        flat = np.ravel_multi_index(index, shape)
-        if int(np.prod(shape)) != len(self) or len(np.unique(flat)) != len(self):
-            return None
-        dims = []
-        for a in axes:
-            name = self.results.get(_AXIS_NAMES[a]) if a in _AXIS_NAMES else None
-            ok = isinstance(name, str) and name.isidentifier() and name not in self.keys()
-            dims.append(name if ok else a)
-        return axes, coords, tuple(index), dims
 
 
 def _cell(x) -> str:

@@ -196,6 +196,8 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   }
   out["columns"] = columns;
   out["table"] = table;
+  // a table declared as a grid (io::TableOf::grid): its dims, shape and coordinates (None otherwise)
+  out["grid"] = json_to_python(captured.grid);
   // the parameters as the run used them (computed defaults filled in), as its sidecar records them
   nlohmann::json params = captured.parameters.is_null() ? p.to_json() : captured.parameters;
   params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)

@@ -104,6 +104,26 @@ def test_to_xarray_of_a_chart_is_the_long_table_regridded(chart):
     assert ds.attrs["command"] == "control chart"
 
 
+def test_a_chart_declares_its_grid_in_the_result_and_the_sidecar(chart, tmp_path):
+    import json
+    g = chart.grid
+    assert g["dims"] == ["delay", "beta", "alpha"] and g["columns"] == ["delay", "y", "x"] and g["shape"] == [3, 4, 5]
+    # independently: the coordinates are the columns' distinct values (delays in the order given)
+    np.testing.assert_array_equal(g["coords"]["delay"], [0.3, 0.1, 0.2])
+    np.testing.assert_array_equal(g["coords"]["alpha"], np.unique(chart.x))
+    np.testing.assert_array_equal(g["coords"]["beta"], np.unique(chart.y))
+    # and the rows are that grid in row-major order (x fastest)
+    np.testing.assert_array_equal(chart.x, np.tile(np.unique(chart.x), 12))
+    np.testing.assert_array_equal(chart.delay, np.repeat([0.3, 0.1, 0.2], 20))
+    assert pickle.loads(pickle.dumps(chart)).grid == g
+    path = tmp_path / "chart.csv"
+    afmkit.control.chart(harmonics=2, x_points=5, y_points=4, delays=[0.3, 0.1, 0.2], boundaries_output="",
+                         progress=False, output=str(path))
+    with open(f"{path}.json") as f:
+        assert json.load(f)["grid"] == g
+    assert afmkit.control.tf(harmonics=3, points=7).grid is None  # a table along one variable declares none
+
+
 def test_to_xarray_of_a_margin_map_and_of_tables():
     m = afmkit.control.chart(controller="single", harmonics=2, x_points=3, y_points=2, quantity="margin",
                              boundaries_output="", progress=False).to_xarray()
@@ -138,3 +158,14 @@ def test_the_module_imports_without_pandas_and_xarray_and_says_what_is_missing()
             "    try:\n        f()\n    except ImportError as e:\n        print(e)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert "to_pandas() needs pandas" in out and "to_xarray() needs xarray" in out
+
+
+def test_a_sweep_in_another_parameter_describes_each_column_by_its_name():
+    # the columns used to be renamed by position after the swept parameter was put first: direction had the
+    # separation's meaning and amplitude the directions' (fixed by declaring each column with its value)
+    r = afmkit.tapping.sweep(parameter="drive_frequency", parameter_min=0.95, parameter_max=1.05, points=3, quiet=True)
+    assert r.columns[:4] == ["drive_frequency", "separation", "direction", "amplitude"]
+    assert "fixed: the sweep moves drive_frequency" in r.meaning["separation"]
+    assert r.meaning["direction"].startswith("down (from parameter_max")
+    assert r.meaning["amplitude"] == "first-harmonic amplitude B of the periodic orbit"
+    assert set(r.direction) <= {"down", "up", "continuation"}
