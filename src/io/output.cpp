@@ -191,8 +191,11 @@ OutputSet::Staged write_temporary(const std::string& path, const std::string& co
   return t;
 }
 
-/// The folders of `staged`, each opened and locked (flock, exclusive) in name order, unlocked at destruction: two
-/// afmkit processes (or threads) committing into the same folder take turns. A file system without locks: no lock.
+/// The folders of `staged`, each opened and locked (flock, exclusive) once, unlocked at destruction: two afmkit
+/// processes (or threads) committing into the same folder take turns. A folder is known by its device and inode,
+/// not by how its path is spelt ("/abs/dir" and "." from inside it, "a/../a"): a second lock on a second opening of
+/// a folder this run already holds would wait for itself forever. Locked in (device, inode) order, the same in
+/// every process. A file system without locks: no lock.
 class FolderLocks {
  public:
   explicit FolderLocks(const std::vector<OutputSet::Staged>& staged) {
@@ -203,12 +206,32 @@ class FolderLocks {
     }
     std::sort(folders.begin(), folders.end());
     folders.erase(std::unique(folders.begin(), folders.end()), folders.end());
+    struct Opened {
+      dev_t device;
+      ino_t inode;
+      int fd;
+    };
+    std::vector<Opened> opened;
     for (const std::string& f : folders) {
       const int fd = ::open(f.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
       if (fd < 0) continue;
-      while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+      struct stat st {};
+      const bool known = ::fstat(fd, &st) == 0;
+      if (!known || std::any_of(opened.begin(), opened.end(), [&](const Opened& o) {
+            return o.device == st.st_dev && o.inode == st.st_ino;
+          })) {
+        ::close(fd);  // the same folder by another path (or not to be identified): locked once
+        continue;
       }
-      fds_.push_back(fd);
+      opened.push_back({st.st_dev, st.st_ino, fd});
+    }
+    std::sort(opened.begin(), opened.end(), [](const Opened& a, const Opened& b) {
+      return a.device != b.device ? a.device < b.device : a.inode < b.inode;
+    });
+    for (const Opened& o : opened) {
+      while (::flock(o.fd, LOCK_EX) != 0 && errno == EINTR) {
+      }
+      fds_.push_back(o.fd);
     }
   }
   ~FolderLocks() {

@@ -270,6 +270,32 @@ TEST(OutputSafety, TwoThreadsWritingOneOutputEachLeaveAWholeTableAndItsOwnSideca
     EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
 }
 
+// One folder named two ways in one set (as `control chart --output /abs/dir/t.csv --boundaries-output b.csv` from
+// inside /abs/dir): locked once, so the commit does not wait for its own lock (it hung before). Run in a child
+// with an alarm, so that a regression fails in seconds instead of hanging the suite.
+TEST(OutputSafety, OneFolderSpeltTwoWaysIsLockedOnce) {
+  const Folder dir("spelt");
+  fs::create_directories(dir.path / "sub");
+  const std::string plain = (dir.path / "sub" / "a.csv").string();
+  const std::string detour = (dir.path / "sub" / ".." / "sub" / "b.csv").string();
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::alarm(10);
+    afmkit::io::OutputSet set;
+    set.add(plain, "a");
+    set.add(detour, "b");
+    set.commit();
+    std::_Exit(0);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "the commit did not finish (killed by signal " << WTERMSIG(status) << ")";
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_TRUE(fs::exists(dir.path / "sub" / "a.csv"));
+  EXPECT_TRUE(fs::exists(dir.path / "sub" / "b.csv"));
+}
+
 TEST(OutputSafety, ASetIsCommittedWholeOrNotAtAll) {
   const Folder dir("set");
   for (const char* name : {"a.gsf", "b.png", "c.csv"}) dir.write(name, "old");
