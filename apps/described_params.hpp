@@ -6,7 +6,7 @@
 // Each key is recorded as declared where the struct's describe() declares it (io::ParamSet::Description::
 // declared_at), so a key shared by several commands has one declaration (tests/cli/test_declared_once.cpp).
 #include <initializer_list>
-#include <source_location>
+#include "afmkit/core/source_location.hpp"
 #include <string>
 #include <vector>
 
@@ -20,17 +20,17 @@ class FieldDeclarer {
  public:
   explicit FieldDeclarer(io::ParamSet& p) : p_(p) {}
   void real(const char* key, double value, const char* help, const char* unit, Range range,
-            std::source_location where = std::source_location::current()) {
+            afmkit::SourceLocation where = afmkit::SourceLocation::current()) {
     p_.real(key, value, help, range, where).unit(unit);
   }
   template <class Int>
   void integer(const char* key, Int value, const char* help, long lo, long hi,
-               std::source_location where = std::source_location::current()) {
+               afmkit::SourceLocation where = afmkit::SourceLocation::current()) {
     p_.integer(key, static_cast<long>(value), help, lo, hi, where);
   }
   template <class Enum>
   void choice(const char* key, Enum value, const char* help, std::initializer_list<Choice<Enum>> choices,
-              std::source_location where = std::source_location::current()) {
+              afmkit::SourceLocation where = afmkit::SourceLocation::current()) {
     std::vector<std::string> names;
     std::string def;
     for (const Choice<Enum>& c : choices) {
@@ -49,17 +49,17 @@ class FieldReader {
  public:
   explicit FieldReader(const io::ParamSet& p) : p_(p) {}
   void real(const char* key, double& field, const char*, const char*, Range,
-            std::source_location = std::source_location::current()) const {
+            afmkit::SourceLocation = afmkit::SourceLocation::current()) const {
     field = p_.real(key);
   }
   template <class Int>
   void integer(const char* key, Int& field, const char*, long, long,
-               std::source_location = std::source_location::current()) const {
+               afmkit::SourceLocation = afmkit::SourceLocation::current()) const {
     field = static_cast<Int>(p_.integer(key));  // the declared range fits Int
   }
   template <class Enum>
   void choice(const char* key, Enum& field, const char*, std::initializer_list<Choice<Enum>> choices,
-              std::source_location = std::source_location::current()) const {
+              afmkit::SourceLocation = afmkit::SourceLocation::current()) const {
     const std::string& name = p_.text(key);
     for (const Choice<Enum>& c : choices)
       if (name == c.name) field = c.value;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
-#include <source_location>
+#include "afmkit/core/source_location.hpp"
 #include <string>
 #include <vector>
 
@@ -29,7 +29,7 @@ class DescribedRangeProbe {
   std::vector<std::string> defaults_outside;  // keys whose default is outside their own range
 
   void real(const char* key, double& field, const char*, const char*, afmkit::Range r,
-            std::source_location = std::source_location::current()) {
+            afmkit::SourceLocation = afmkit::SourceLocation::current()) {
     double* f = &field;
     const double keep = field;
     if (!r.contains(keep)) defaults_outside.emplace_back(key);
@@ -43,7 +43,7 @@ class DescribedRangeProbe {
   }
   template <class Int>
   void integer(const char* key, Int& field, const char*, long lo, long hi,
-               std::source_location = std::source_location::current()) {
+               afmkit::SourceLocation = afmkit::SourceLocation::current()) {
     Int* f = &field;
     const Int keep = field;
     if (keep < lo || keep > hi) defaults_outside.emplace_back(key);
@@ -54,7 +54,7 @@ class DescribedRangeProbe {
   }
   template <class Enum>
   void choice(const char*, Enum&, const char*, std::initializer_list<afmkit::Choice<Enum>>,
-              std::source_location = std::source_location::current()) {}
+              afmkit::SourceLocation = afmkit::SourceLocation::current()) {}
 };
 
 /// Checks the one layer of ranges of `options` (its described fields) with `check` (usually validate()).

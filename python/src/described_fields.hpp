@@ -4,7 +4,7 @@
 // defaults as a dict, so that a Python function takes its defaults from the struct's one declaration (and the
 // library checks the declared ranges: InvalidParameter naming the key).
 #include <initializer_list>
-#include <source_location>
+#include "afmkit/core/source_location.hpp"
 #include <string>
 
 #include <pybind11/pybind11.h>
@@ -19,17 +19,17 @@ class DictFieldReader {
  public:
   explicit DictFieldReader(const pybind11::dict& d) : d_(d) {}
   void real(const char* key, double& field, const char*, const char*, Range,
-            std::source_location = std::source_location::current()) const {
+            afmkit::SourceLocation = afmkit::SourceLocation::current()) const {
     if (d_.contains(key)) field = d_[key].cast<double>();
   }
   template <class Int>
   void integer(const char* key, Int& field, const char*, long, long,
-               std::source_location = std::source_location::current()) const {
+               afmkit::SourceLocation = afmkit::SourceLocation::current()) const {
     if (d_.contains(key)) field = d_[key].cast<Int>();
   }
   template <class Enum>
   void choice(const char* key, Enum& field, const char*, std::initializer_list<Choice<Enum>> choices,
-              std::source_location = std::source_location::current()) const {
+              afmkit::SourceLocation = afmkit::SourceLocation::current()) const {
     if (!d_.contains(key)) return;
     const auto name = d_[key].cast<std::string>();
     std::string names;
@@ -52,17 +52,17 @@ class DictFieldWriter {
  public:
   explicit DictFieldWriter(pybind11::dict& d) : d_(d) {}
   void real(const char* key, double value, const char*, const char*, Range,
-            std::source_location = std::source_location::current()) {
+            afmkit::SourceLocation = afmkit::SourceLocation::current()) {
     d_[key] = value;
   }
   template <class Int>
   void integer(const char* key, Int value, const char*, long, long,
-               std::source_location = std::source_location::current()) {
+               afmkit::SourceLocation = afmkit::SourceLocation::current()) {
     d_[key] = value;
   }
   template <class Enum>
   void choice(const char* key, Enum value, const char*, std::initializer_list<Choice<Enum>> choices,
-              std::source_location = std::source_location::current()) {
+              afmkit::SourceLocation = afmkit::SourceLocation::current()) {
     for (const Choice<Enum>& c : choices)
       if (c.value == value) d_[key] = std::string(c.name);
   }

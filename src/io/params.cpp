@@ -129,7 +129,7 @@ ParamSet::Entry ParamSet::make_entry(Value value, const std::string& help, Range
   return e;
 }
 
-void ParamSet::declare(const std::string& key, Entry e, const std::source_location& where) {
+void ParamSet::declare(const std::string& key, Entry e, const afmkit::SourceLocation& where) {
   e.group = group_;
   if (const auto c = group_conditions_.find(group_); c != group_conditions_.end())
     e.applies.push_back({c->second.first, {c->second.second}});
@@ -250,12 +250,12 @@ ParamSet& ParamSet::unit(const std::string& unit) {
 }
 const std::string& ParamSet::unit_of(const std::string& key) const& { return entry(key).unit; }
 ParamSet& ParamSet::real(const std::string& key, double def, const std::string& help, Range range,
-                         std::source_location where) {
+                         afmkit::SourceLocation where) {
   declare(key, make_entry(def, help, range), where);
   return *this;
 }
 ParamSet& ParamSet::integer(const std::string& key, long def, const std::string& help, long lo, long hi,
-                            std::source_location where) {
+                            afmkit::SourceLocation where) {
   Entry e = make_entry(def, help, Range::any());
   e.unit = "count";  // a number of things, unless unit() says otherwise
   e.ilo = lo;
@@ -264,24 +264,24 @@ ParamSet& ParamSet::integer(const std::string& key, long def, const std::string&
   return *this;
 }
 ParamSet& ParamSet::text(const std::string& key, const std::string& def, const std::string& help,
-                         std::vector<std::string> choices, std::source_location where) {
+                         std::vector<std::string> choices, afmkit::SourceLocation where) {
   Entry e = make_entry(def, help, Range::any());
   e.choices = std::move(choices);
   declare(key, std::move(e), where);
   return *this;
 }
 ParamSet& ParamSet::file(const std::string& key, const std::string& def, const std::string& help,
-                         std::source_location where) {
+                         afmkit::SourceLocation where) {
   text(key, def, help, {}, where);
   entries_[key].is_file = true;
   return *this;
 }
-ParamSet& ParamSet::flag(const std::string& key, bool def, const std::string& help, std::source_location where) {
+ParamSet& ParamSet::flag(const std::string& key, bool def, const std::string& help, afmkit::SourceLocation where) {
   declare(key, make_entry(def, help, Range::any()), where);
   return *this;
 }
 ParamSet& ParamSet::reals(const std::string& key, std::vector<double> def, const std::string& help, Range range,
-                          std::source_location where) {
+                          afmkit::SourceLocation where) {
   declare(key, make_entry(std::move(def), help, range), where);
   return *this;
 }

@@ -12,7 +12,7 @@
 //
 // giving the key (the TOML key, flag and Python keyword), the help, the unit (docs/units.md) and the allowed range;
 // the default is the member's initializer. An archive is any type with these members (all take the declaring call's
-// std::source_location as a defaulted last argument, so that a front end can tell where a key is declared):
+// afmkit::SourceLocation as a defaulted last argument, so that a front end can tell where a key is declared):
 //   real(key, double& field, help, unit, Range)
 //   integer(key, int-or-long& field, help, long lo, long hi)
 //   choice(key, Enum& field, help, std::initializer_list<Choice<Enum>>)    (a text with a closed list of values)
@@ -20,7 +20,7 @@
 // command line declares the fields on its parameter sets and reads them back (apps/described_params.hpp), so that
 // a default, a range or a help text lives in one place.
 #include <initializer_list>
-#include <source_location>
+#include "afmkit/core/source_location.hpp"
 #include <string>
 
 #include "afmkit/core/error.hpp"
@@ -45,18 +45,18 @@ namespace detail {
 class FieldChecker {
  public:
   void real(const char* key, double value, const char*, const char*, Range range,
-            std::source_location = std::source_location::current()) const {
+            afmkit::SourceLocation = afmkit::SourceLocation::current()) const {
     if (!range.contains(value)) detail::throw_out_of_range(key, value, range);
   }
   template <class Int>
   void integer(const char* key, Int value, const char*, long lo, long hi,
-               std::source_location = std::source_location::current()) const {
+               afmkit::SourceLocation = afmkit::SourceLocation::current()) const {
     if (static_cast<long>(value) < lo || static_cast<long>(value) > hi)
       detail::throw_out_of_range(key, static_cast<long>(value), lo, hi);
   }
   template <class Enum>
   void choice(const char*, Enum, const char*, std::initializer_list<Choice<Enum>>,
-              std::source_location = std::source_location::current()) const {}
+              afmkit::SourceLocation = afmkit::SourceLocation::current()) const {}
 };
 
 /// Checks every described field of `options` against its declared range (InvalidParameter naming the key).

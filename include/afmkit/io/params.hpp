@@ -7,7 +7,7 @@
 #include <functional>
 #include <map>
 #include <optional>
-#include <source_location>
+#include "afmkit/core/source_location.hpp"
 #include <string>
 #include <variant>
 #include <vector>
@@ -44,20 +44,20 @@ class ParamSet {
   // such as add_tapping_model_params, or a library struct's describe(): apps/described_params.hpp);
   // tests/cli/test_declared_once.cpp checks it over every command.
   ParamSet& real(const std::string& key, double def, const std::string& help, Range range = Range::any(),
-                 std::source_location where = std::source_location::current());
+                 afmkit::SourceLocation where = afmkit::SourceLocation::current());
   ParamSet& integer(const std::string& key, long def, const std::string& help, long lo, long hi,
-                    std::source_location where = std::source_location::current());
+                    afmkit::SourceLocation where = afmkit::SourceLocation::current());
   ParamSet& text(const std::string& key, const std::string& def, const std::string& help,
                  std::vector<std::string> choices = {},
-                 std::source_location where = std::source_location::current());
+                 afmkit::SourceLocation where = afmkit::SourceLocation::current());
   /// A file path (a text shown as FILE in --help).
   ParamSet& file(const std::string& key, const std::string& def, const std::string& help,
-                 std::source_location where = std::source_location::current());
+                 afmkit::SourceLocation where = afmkit::SourceLocation::current());
   ParamSet& flag(const std::string& key, bool def, const std::string& help,
-                 std::source_location where = std::source_location::current());
+                 afmkit::SourceLocation where = afmkit::SourceLocation::current());
   /// A list of reals: TOML array, or a comma-separated flag value "1,0.5,0.2".
   ParamSet& reals(const std::string& key, std::vector<double> def, const std::string& help,
-                  Range range = Range::any(), std::source_location where = std::source_location::current());
+                  Range range = Range::any(), afmkit::SourceLocation where = afmkit::SourceLocation::current());
   /// Parameters declared after this call are listed under `name` in --help (model, drive, contact law, numerics,
   /// output, …); before any call: "Options".
   ParamSet& group(const std::string& name);
@@ -205,7 +205,7 @@ class ParamSet {
   std::string group_ = "Options";
   std::string last_;  // the parameter default_text() and unit() apply to
   std::map<std::string, std::pair<std::string, std::string>> group_conditions_;  // group -> (key, value)
-  void declare(const std::string& key, Entry e, const std::source_location& where);
+  void declare(const std::string& key, Entry e, const afmkit::SourceLocation& where);
   static Entry make_entry(Value value, const std::string& help, Range range);
 };
 
