@@ -144,6 +144,24 @@ std::string hb_not_evaluated(const io::ParamSet& p) {
                      p.text("law"));
 }
 
+/// The sweep's status and note from its trapped rows (docs/conventions.md#statuses): every row with the tip
+/// trapped is no tapping anywhere in the range ("tip_trapped"); some trapped rows are said in the note and summary.
+/// `what`: what one row is a value of ("separation", or "value" for a sweep in another parameter).
+void record_trapped(nlohmann::json& results, std::string& summary, std::size_t rows, long trapped,
+                    const char* what) {
+  const bool all_trapped = rows > 0 && trapped == static_cast<long>(rows);
+  results["status"] = all_trapped ? "tip_trapped" : "ok";
+  results["note"] = all_trapped ? fmt::format("tip trapped: the tip sticks to the sample or stays in contact over "
+                                              "the whole period at every {} of the sweep ({} rows; column "
+                                              "trapped): no tapping",
+                                              what, rows)
+                                : trapped > 0 ? fmt::format("{} of {} rows with the tip trapped (stuck to the sample or "
+                                                            "in contact over the whole period; column trapped)",
+                                                            trapped, rows)
+                                              : std::string();
+  if (trapped > 0) summary += fmt::format("\n{}", results["note"].get<std::string>());
+}
+
 /// Records sorted by the value of `key`.
 nlohmann::json records_sorted_by(nlohmann::json records, const std::string& key) {
   std::stable_sort(records.begin(), records.end(), [&](const nlohmann::json& a, const nlohmann::json& b) {
@@ -281,17 +299,7 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
   results["free_amplitude"] = base.free_amplitude() * scales.length;
   results["rows"] = out.rows();
   results["trapped_rows"] = trapped;
-  const bool all_trapped = out.rows() > 0 && trapped == static_cast<long>(out.rows());
-  results["status"] = all_trapped ? "tip_trapped" : "ok";
-  results["note"] = all_trapped ? fmt::format("tip trapped: the tip sticks to the sample or stays in contact over "
-                                              "the whole period at every value of the sweep ({} rows; column "
-                                              "trapped): no tapping",
-                                              out.rows())
-                                : trapped > 0 ? fmt::format("{} of {} rows with the tip trapped (stuck to the sample or "
-                                                            "in contact over the whole period; column trapped)",
-                                                            trapped, out.rows())
-                                              : std::string();
-  if (trapped > 0) summary += fmt::format("\n{}", results["note"].get<std::string>());
+  record_trapped(results, summary, out.rows(), trapped, "value");
   const std::string L = scales.length_unit;
   results["units"] = {{"length", L},
                       {"energy", scales.energy_unit},
@@ -423,18 +431,7 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
   results["free_amplitude"] = base.free_amplitude() * scales.length;
   results["rows"] = out.rows();
   results["trapped_rows"] = trapped;
-  // every row with the tip trapped: no tapping anywhere in the range (docs/conventions.md#statuses)
-  const bool all_trapped = out.rows() > 0 && trapped == static_cast<long>(out.rows());
-  results["status"] = all_trapped ? "tip_trapped" : "ok";
-  results["note"] = all_trapped ? fmt::format("tip trapped: the tip sticks to the sample or stays in contact over "
-                                              "the whole period at every separation of the sweep ({} rows; column "
-                                              "trapped): no tapping",
-                                              out.rows())
-                                : trapped > 0 ? fmt::format("{} of {} rows with the tip trapped (stuck to the sample or "
-                                                            "in contact over the whole period; column trapped)",
-                                                            trapped, out.rows())
-                                              : std::string();
-  if (trapped > 0) summary += fmt::format("\n{}", results["note"].get<std::string>());
+  record_trapped(results, summary, out.rows(), trapped, "separation");
   results["units"] = sweep_units(scales);
   for (const char* key : {"harmonic_balance", "directions"})  // present only where an option turned something off
     if (results.contains(key)) results["units"][key] = "label";
