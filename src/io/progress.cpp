@@ -37,8 +37,10 @@ void Progress::print(const std::string& line) {
 void Progress::advance(long n) {
   long done = done_.fetch_add(n) + n;
   if (!enabled_) return;
-  auto now = std::chrono::steady_clock::now();
   std::lock_guard<std::mutex> lock(mutex_);
+  // The clock is read under the lock: read before it, a thread that waited could see a `now` older than the last
+  // line's and drop its own line (interval 0: a line per advance, as promised).
+  auto now = std::chrono::steady_clock::now();
   if (std::chrono::duration<double>(now - last_).count() < interval_) return;
   last_ = now;
   print(fmt::format("{}: {}/{} ({:.0f}%)", label_, done, total_,
