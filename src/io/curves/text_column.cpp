@@ -27,7 +27,11 @@ std::vector<double> read_text_column(const std::string& path, const std::string&
   if (!in) throw InputError(fmt::format("{}: cannot be read (no such file, or no permission)", path));
   std::ostringstream text;
   text << in.rdbuf();
-  const detail::TextTable t = detail::parse_text_table(text.str(), path);
+  return parse_text_column(text.str(), path, column);
+}
+
+std::vector<double> parse_text_column(const std::string& text, const std::string& path, const std::string& column) {
+  const detail::TextTable t = detail::parse_text_table(text, path);
   const std::size_t ncol = t.columns.size();
   std::size_t index = 0;
   const bool by_position = !column.empty() && column.find_first_not_of("0123456789") == std::string::npos;
@@ -36,8 +40,11 @@ std::vector<double> read_text_column(const std::string& path, const std::string&
       throw InputError(fmt::format("{}: the file has {} columns: choose one by header name or 1-based position",
                                    path, ncol));
   } else if (by_position) {
-    const long position = std::stol(column);
-    if (position < 1 || static_cast<std::size_t>(position) > ncol)
+    // Digits only: a position too long for a number is simply beyond the columns (std::stoul would throw).
+    const std::size_t digits = column.find_first_not_of('0');
+    const bool beyond = digits != std::string::npos && column.size() - digits > 9;
+    const long position = beyond ? 0 : std::stol(column);
+    if (beyond || position < 1 || static_cast<std::size_t>(position) > ncol)
       throw InputError(fmt::format("{}: column {} is chosen, but the file has {} column{}", path, column, ncol,
                                    ncol == 1 ? "" : "s"));
     index = static_cast<std::size_t>(position - 1);

@@ -12,4 +12,7 @@ namespace afmkit::io::curves {
 /// the file (and the line): unreadable file, no such column, several columns and none chosen, an empty or NaN cell.
 std::vector<double> read_text_column(const std::string& path, const std::string& column);
 
+/// The same from the file's bytes `text`; `origin` names it in errors (the file's path).
+std::vector<double> parse_text_column(const std::string& text, const std::string& origin, const std::string& column);
+
 }  // namespace afmkit::io::curves
