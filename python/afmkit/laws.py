@@ -82,6 +82,11 @@ class Law:
         """The command keywords this law stands for: ``law`` and the values given."""
         return {"law": self.name, **self.values}
 
+    def si_values(self) -> dict:
+        """The values given, in SI units (m, N, Pa, J, ...: the units of the spectroscopy fit and its results)."""
+        factor = {k["key"]: k["si_factor"] for k in _SPECS[self.name]["keys"]}
+        return {key: float(value) * factor[key] for key, value in self.values.items()}
+
     def __eq__(self, other):
         return type(self) is type(other) and self.kwargs() == other.kwargs()
 

@@ -128,6 +128,28 @@ def _settings(spring_constant, resonance_frequency, quality_factor, free_amplitu
 _SOLVER_DEFAULTS = _afmkit.spectroscopy_fit_solver_defaults()
 
 
+def _law_arguments(law, values, force_curve, values_name: str):
+    """A law given as a string, or as an :mod:`afmkit.laws` object: its name, its values (SI) joined to ``values``
+    (a key in both is refused) and, for ``laws.Table``, its file as the force curve."""
+    from . import laws
+    if not isinstance(law, laws.Law):
+        return law, values, force_curve
+    if isinstance(law, laws.Python):
+        raise TypeError("law: a law written in Python (afmkit.laws.Python) cannot be fitted: the fit adjusts the "
+                        "parameters of a built-in law (law='dmt', afmkit.laws.DMT(...), ...) or of a table")
+    if isinstance(law, laws.Table):
+        if force_curve:
+            raise ValueError("force_curve is given besides law=afmkit.laws.Table(...), which is a force curve: "
+                             "give one of them")
+        return "table", values, law.path()
+    merged = dict(values or {})
+    for key, value in law.si_values().items():
+        if key in merged:
+            raise ValueError(f"{key} is given both in the law ({law!r}) and in {values_name}: give it once")
+        merged[key] = value
+    return law.name, merged, force_curve
+
+
 def _options(law="dmt", parameters=DEFAULT_PARAMETERS, initial=None, fixed=None, direction="approach",
              force_curve="", allow_energy_gain=False, parallel=True, **solver) -> dict:
     """The options :func:`fit` and :func:`fit_fm` share, with their defaults (docs/fitting.md)."""
@@ -136,6 +158,7 @@ def _options(law="dmt", parameters=DEFAULT_PARAMETERS, initial=None, fixed=None,
             raise TypeError(f"fit() got an unexpected keyword argument '{key}'")
     # each setting as the type of its default (an integer count may be given as 100.0)
     settings = {key: type(default)(solver.get(key, default)) for key, default in _SOLVER_DEFAULTS.items()}
+    law, fixed, force_curve = _law_arguments(law, fixed, force_curve, "fixed")
     return dict(law=str(law), parameters=[str(p) for p in parameters], initial=dict(initial or {}),
                 fixed=dict(fixed or {}), direction=str(direction), force_curve=str(force_curve),
                 allow_energy_gain=bool(allow_energy_gain), parallel=bool(parallel), **settings)
@@ -148,7 +171,8 @@ def fit(distance, amplitude, phase=None, *, spring_constant, resonance_frequency
     distance [m], amplitude [m], phase [rad] (phase lag, pi/2 at resonance; None: amplitude only): 1-D arrays.
     spring_constant [N/m], resonance_frequency [Hz], quality_factor, free_amplitude [m], drive_frequency [Hz] (None:
     at resonance). amplitude_noise (A/A0) and phase_noise [rad]: 0 estimates them from the data. Options (keyword):
-    law ("dmt"); parameters: the fitted names (law keys, distance_offset [m], amplitude_scale, phase_offset [rad];
+    law ("dmt", or a law object such as ``afmkit.laws.DMT(tip_radius=8)`` or ``afmkit.laws.Table(...)``: its values
+    are fixed values, or initial values of the fitted ones); parameters: the fitted names (law keys, distance_offset [m], amplitude_scale, phase_offset [rad];
     default hamaker, effective_modulus, distance_offset, phase_offset); initial: initial values of fitted parameters
     and fixed calibration values (SI); fixed: the law's other values (SI: hamaker J, effective_modulus Pa,
     tip_radius m, ...); direction ("approach" or "retract"); huber (5: Huber's loss beyond this many σ, 0: least
@@ -205,26 +229,29 @@ def fit_fm(distance, frequency_shift, dissipation=None, *, spring_constant, reso
     return _result(raw)
 
 
-def predict(distance, *, law: str = "dmt", values=None, calibration=None, spring_constant, resonance_frequency,
+def predict(distance, *, law="dmt", values=None, calibration=None, spring_constant, resonance_frequency,
             quality_factor, free_amplitude, drive_frequency=None, direction: str = "approach",
             force_curve: str = "", allow_energy_gain: bool = False) -> dict:
     """The fit's forward model: amplitude [m] and phase [rad] at each distance [m] (in the order given), for the law
-    values ``values`` (SI) and the calibration (distance_offset [m], amplitude_scale, phase_offset [rad])."""
+    values ``values`` (SI) and the calibration (distance_offset [m], amplitude_scale, phase_offset [rad]). ``law``: a
+    name or an :mod:`afmkit.laws` object (its values join ``values``)."""
+    law, values, force_curve = _law_arguments(law, values, force_curve, "values")
     return _afmkit.spectroscopy_predict(
-        np.asarray(distance, dtype=float), law, dict(values or {}), dict(calibration or {}), force_curve,
+        np.asarray(distance, dtype=float), str(law), dict(values or {}), dict(calibration or {}), force_curve,
         bool(allow_energy_gain),
         **_settings(spring_constant, resonance_frequency, quality_factor, free_amplitude, drive_frequency),
         direction=direction)
 
 
-def predict_fm(distance, *, law: str = "dmt", values=None, calibration=None, spring_constant, resonance_frequency,
+def predict_fm(distance, *, law="dmt", values=None, calibration=None, spring_constant, resonance_frequency,
                quality_factor, amplitude, direction: str = "approach", force_curve: str = "",
                allow_energy_gain: bool = False) -> dict:
     """The FM fit's forward model: frequency shift [Hz] (+ frequency_shift_offset) and dissipation [J per cycle] at
     each distance [m] (in the order given), for the law values ``values`` (SI) and the calibration
     (distance_offset [m], frequency_shift_offset [Hz])."""
+    law, values, force_curve = _law_arguments(law, values, force_curve, "values")
     return _afmkit.spectroscopy_predict_fm(
-        np.asarray(distance, dtype=float), law, dict(values or {}), dict(calibration or {}), force_curve,
+        np.asarray(distance, dtype=float), str(law), dict(values or {}), dict(calibration or {}), force_curve,
         bool(allow_energy_gain), spring_constant=float(spring_constant),
         resonance_frequency=float(resonance_frequency), quality_factor=float(quality_factor),
         amplitude=float(amplitude), direction=direction)

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "afmkit/impact/law_registry.hpp"
+#include "afmkit/spectroscopy/fit.hpp"
 #include "bindings.hpp"
 
 namespace py = pybind11;
@@ -24,6 +25,8 @@ py::list laws() {
       py::dict d;
       d["key"] = k.key;
       d["unit"] = k.unit;
+      d["si_unit"] = spectroscopy::law_si_unit(k.unit);     // the unit of the fit's SI values
+      d["si_factor"] = spectroscopy::law_unit_to_si(k.unit);  // value in `unit` × si_factor = value in si_unit
       d["default"] = k.default_value;
       d["help"] = k.help;
       d["lower"] = k.lower;
@@ -49,7 +52,7 @@ py::list laws() {
 
 void bind_laws(py::module_& m) {
   m.def("laws", &laws,
-        "The built-in force laws (docs/force-laws.md): name, summary, the keys each reads (unit, default, range, "
+        "The built-in force laws (docs/force-laws.md): name, summary, the keys each reads (unit, its SI unit and factor, default, range, "
         "help, followed key), whether it reads a force-curve file and whether it is piecewise linear (any "
         "consistent units).");
 }

@@ -124,3 +124,22 @@ def test_the_command_line_plot_is_drawn_by_matplotlib(tmp_path):
     assert "hamaker = " in out.stdout and "wrote the plot" in out.stdout
     with open(tmp_path / "fit.png", "rb") as f:
         assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_law_object_stands_for_its_name_and_its_values_in_si():
+    # afmkit.laws.DMT takes the units of docs/force-laws.md (GPa, nm, J); the fit's values are SI, written here by hand
+    z = np.linspace(22e-9, 14e-9, 5)
+    law = afmkit.laws.DMT(effective_modulus=2.0, tip_radius=8.0, hamaker=1e-19)
+    by_object = sf.predict(z, law=law, **SETTINGS)
+    by_hand = sf.predict(z, law="dmt", values={"effective_modulus": 2e9, "tip_radius": 8e-9, "hamaker": 1e-19},
+                         **SETTINGS)
+    default = sf.predict(z, law="dmt", **SETTINGS)
+    np.testing.assert_array_equal(by_object["amplitude"], by_hand["amplitude"])
+    np.testing.assert_array_equal(by_object["phase"], by_hand["phase"])
+    assert not np.array_equal(by_object["amplitude"], default["amplitude"])  # the values were used
+    with pytest.raises(ValueError, match="tip_radius is given both in the law"):
+        sf.predict(z, law=law, values={"tip_radius": 8e-9}, **SETTINGS)
+    with pytest.raises(ValueError, match="tip_radius is given both in the law"):
+        sf.fit(z, by_hand["amplitude"], law=law, fixed={"tip_radius": 8e-9}, **SETTINGS)
+    with pytest.raises(TypeError, match="law: a law written in Python"):
+        sf.fit(z, by_hand["amplitude"], law=afmkit.laws.Python(approach=lambda d: 0 * d), **SETTINGS)
