@@ -307,12 +307,17 @@ def _scan(r, ax=None, *, channel="topography", colorbar=True):
             "scan: this result holds no image (image_output was empty, or a recorded spiral without images); the "
             f"scan view draws an image channel ({', '.join(_CHANNELS)}) of a run with image_output=PREFIX; the "
             "per-turn table is r.radius, r.deflection_first_harmonic, ...")
+    return _gsf_image(ax, image, mask, channel, "scan", colorbar)
+
+
+def _gsf_image(ax, image: str, mask, channel: str, command: str, colorbar: bool):
+    """Draws one GSF image a run wrote (pixels where `mask` < 0.5 blank) on its real extent, units from its header."""
     try:
         z, h = _read_gsf(image)
         m = _read_gsf(mask)[0] if mask is not None else None
     except OSError as e:
-        raise FileNotFoundError(f"scan: the image this run wrote cannot be read ({e.filename or image}: "
-                                f"{e.strerror or e}); run the scan again with image_output=PREFIX") from None
+        raise FileNotFoundError(f"{command}: the image this run wrote cannot be read ({e.filename or image}: "
+                                f"{e.strerror or e}); run the {command} again with image_output=PREFIX") from None
     if m is not None:
         z = np.where(m > 0.5, z, np.nan)
     x0, y0 = float(h.get("XOffset", 0)), float(h.get("YOffset", 0))
@@ -329,8 +334,51 @@ def _scan(r, ax=None, *, channel="topography", colorbar=True):
     return out
 
 
+# ------------------------------------------------------------------------------------------ tapping image
+_IMAGE_CHANNELS = ("height", "error", "phase", "power", "peak_force", "regime", "truth")
+
+
+def _image(r, ax=None, *, channel="height", direction="trace", colorbar=True):
+    """one image of the virtual tapping-mode AFM (channel height — what the instrument shows —, error, phase, power,
+    peak_force, regime, or the sample's truth; direction trace or retrace), from the GSF files it wrote."""
+    if channel not in _IMAGE_CHANNELS:
+        raise ValueError(f"channel = {channel!r} is not allowed: must be one of {', '.join(_IMAGE_CHANNELS)}")
+    if direction not in ("trace", "retrace"):
+        raise ValueError(f"direction = {direction!r} is not allowed: must be 'trace' or 'retrace'")
+    suffix = "_truth.gsf" if channel == "truth" else f"_{channel}_{direction}.gsf"
+    image = next((str(f) for f in r.results.get("files", []) if str(f).endswith(suffix)), None)
+    if image is None:
+        raise NotImplementedError(
+            "tapping image: this result holds no image (image_output was empty); the view draws an image "
+            f"({', '.join(_IMAGE_CHANNELS)}) of a run with image_output=PREFIX; the per-line metrics are "
+            "r.regime_switches, r.max_peak_force, ...")
+    return _gsf_image(ax, image, None, channel, "tapping image", colorbar)
+
+
+# ------------------------------------------------------------------------------------------ tapping modes
+def _modes(r, ax=None, *, phase=None, degrees=False):
+    """amplitude and phase of each eigenmode against separation (the bimodal observable: mode 2's phase)."""
+    axes, out = _axes(ax, 2)
+    x = np.asarray(r["separation"], float)
+    for k in (1, 2, 3):
+        amplitude = np.asarray(r[f"amplitude_{k}"], float)
+        if not np.isfinite(amplitude).any():
+            continue  # a mode the run did not have
+        panels = [(amplitude, _label(r, f"amplitude_{k}", "amplitude")),
+                  _phase(r, f"phase_{k}", phase, "lag", degrees)]
+        for a, (y, ylabel) in zip(axes, panels):
+            a.plot(x, y, ".-", lw=1.2, ms=3, label=f"mode {k}")
+            a.set_ylabel(ylabel)
+    for a in axes:
+        a.grid(alpha=0.3)
+    axes[-1].set_xlabel(_label(r, "separation"))
+    axes[0].legend(fontsize=8)
+    return out
+
+
 _VIEWS = {"tapping sweep": _sweep, "tapping fm": _fm, "tapping hb": _hb, "control chart": _chart,
-          "control tf": _tf, "control simulate": _simulate, "impact": _impact, "scan": _scan}
+          "control tf": _tf, "control simulate": _simulate, "impact": _impact, "scan": _scan,
+          "tapping image": _image, "tapping modes": _modes}
 
 
 def plot(r, ax=None, **kwargs):
@@ -345,6 +393,6 @@ def plot(r, ax=None, **kwargs):
     if unknown:
         raise TypeError(f"{r.command}: plot() got the keyword {unknown[0]!r}, which this view does not take "
                         f"(keywords: {', '.join(['ax'] + allowed)})")
-    if len(r) == 0 and r.command != "scan":
+    if len(r) == 0 and r.command not in ("scan", "tapping image"):
         raise ValueError(f"{r.command}: the result has no rows: nothing to plot")
     return view(r, ax, **kwargs)

@@ -206,3 +206,45 @@ def test_an_empty_result_is_refused_not_drawn_blank(instrument):
     empty = afmkit.Result("tapping sweep", raw)
     with pytest.raises(ValueError, match="tapping sweep: the result has no rows: nothing to plot"):
         empty.plot()
+
+
+def _gsf_by_hand(path):
+    """A GSF file read here, independently of the module: header up to NUL, padding to 4 bytes, float32 LE."""
+    raw = open(path, "rb").read()
+    end = raw.index(b"\0")
+    head = dict(line.split(" = ", 1) for line in raw[:end].decode().splitlines()[1:] if " = " in line)
+    nx, ny = int(head["XRes"]), int(head["YRes"])
+    start = end + (4 - end % 4)
+    return np.frombuffer(raw[start:start + 4 * nx * ny], "<f4").reshape(ny, nx), head
+
+
+def test_tapping_image_draws_the_channel_and_direction_asked_for(tmp_path):
+    r = afmkit.tapping.image(sample="steps", pixels=12, lines=4, map_points=40, image_output=str(tmp_path / "i"),
+                             output="", quiet=True)
+    for channel, direction in [("height", "trace"), ("peak_force", "retrace"), ("truth", "trace")]:
+        ax = r.plot(channel=channel, direction=direction)
+        (im,) = ax.get_images()
+        name = "i_truth.gsf" if channel == "truth" else f"i_{channel}_{direction}.gsf"
+        z, head = _gsf_by_hand(tmp_path / name)
+        np.testing.assert_array_equal(np.ma.filled(im.get_array(), np.nan), z.astype(float))
+        assert ax.figure.axes[-1].get_ylabel() == f"{channel} [{head['ZUnits']}]"  # the colour bar
+        width = float(head["XReal"])
+        np.testing.assert_allclose(abs(im.get_extent()[1] - im.get_extent()[0]), width, rtol=1e-12)
+        plt.close("all")
+    with pytest.raises(ValueError, match="channel = 'topography' is not allowed: must be one of height"):
+        r.plot(channel="topography")
+    none = afmkit.tapping.image(pixels=4, lines=2, map_points=20, image_output="", output="", quiet=True)
+    with pytest.raises(NotImplementedError, match="tapping image: this result holds no image"):
+        none.plot()
+
+
+def test_tapping_modes_draws_each_mode_it_has():
+    r = afmkit.tapping.modes(modes=2, points=4, settle_periods=40, lockin_periods=4, output="", quiet=True)
+    amplitude, phase = r.plot(degrees=True)
+    for k in (1, 2):
+        x, y = _line(amplitude, f"mode {k}")
+        np.testing.assert_array_equal(x, r.separation)
+        np.testing.assert_array_equal(y, r[f"amplitude_{k}"])
+        np.testing.assert_allclose(_line(phase, f"mode {k}")[1], np.degrees(r[f"phase_{k}"]), rtol=1e-15)
+    assert [ln.get_label() for ln in amplitude.get_lines()] == ["mode 1", "mode 2"]  # no third mode drawn
+    assert phase.get_ylabel() == "phase lag [deg]"
