@@ -1,0 +1,109 @@
+// AM-AFM imaging with Z feedback, exact time-domain engine (docs/theory-tapping.md#time-domain-imaging), against
+// independent expectations: a flat sample holds the set-point and images zero height; a step is imaged with its
+// height as the quasi-static engine images it, within the bound of the loop's settling (derived below); bad options
+// name their parameter. (The regime switch inside the bistable window: test_quasi_static_imaging.cpp, on its sweep.)
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "afmkit/core/error.hpp"
+#include "afmkit/impact/force_law.hpp"
+#include "afmkit/scan/sample_generators.hpp"
+#include "afmkit/tapping/image/quasi_static.hpp"
+#include "afmkit/tapping/image/time_domain.hpp"
+#include "afmkit/tapping/units.hpp"
+
+namespace afmkit::tapping::image {
+namespace {
+
+// k = 40 N/m, f0 = 300 kHz, Q = 100 (τ_c = 2Q/ω0 = 106 µs, 32 cycles), A0 = 10 nm at resonance, DMT + vdW (the law's
+// defaults); one repulsive branch at A_sp = 0.8 A0. Lengths of the map in nm.
+constexpr double kTdimgF0 = 300e3, kTdimgQ = 100.0, kTdimgA0 = 10.0, kTdimgSetpoint = 0.8;
+const PhysicalCantilever& tdimg_cantilever() {
+  static const PhysicalCantilever pc(40.0, 300.0, kTdimgQ, kTdimgA0, 1.0);
+  return pc;
+}
+TappingModel tdimg_model() {
+  const PhysicalCantilever& pc = tdimg_cantilever();
+  const impact::DmtLaw dmt(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165);
+  return {pc.cantilever(), pc.drive(), pc.normalised_law(impact::ForceLaw(dmt)), 20.0};
+}
+const OrbitMap& tdimg_map() {
+  static const OrbitMap m = [] {
+    OrbitMapOptions o;
+    o.separation_min = 0.0;
+    o.separation_max = 12.0;
+    o.points = 32;
+    o.sweep.transient.max_periods = 1000;
+    return OrbitMap::build(tdimg_model(), o);
+  }();
+  return m;
+}
+
+/// A raster of `pixels` × `lines` over 1 µm with `cycles` drive cycles per pixel; the feedback at a fifth of the
+/// drive frequency (5 cycles per update), K_i = 8000 1/s.
+RasterSpec tdimg_raster(long pixels, long lines, double cycles) {
+  RasterSpec r;
+  r.pixels = pixels;
+  r.lines = lines;
+  r.width = r.height = 1e-6;
+  r.tip_speed = r.width / static_cast<double>(pixels) / (cycles / kTdimgF0);
+  return r;
+}
+FeedbackSpec tdimg_feedback() {
+  FeedbackSpec f;
+  f.setpoint = kTdimgSetpoint;
+  f.integral_gain = 8000.0;
+  f.update_rate = kTdimgF0 / 5.0;
+  f.lockin_bandwidth = 5e3;
+  return f;
+}
+scan::Surface tdimg_surface(scan::HeightMap map) { return scan::Surface(std::move(map), scan::Tilt(0.0, 0.0)); }
+scan::Grid tdimg_grid(double size, long n) { return {n, n, size, size, -0.5 * size, -0.5 * size}; }
+
+TimeDomainEngine tdimg_engine(long lockin_cycles = 1) {
+  TimeDomainOptions o;
+  o.lockin_cycles = lockin_cycles;
+  o.lockin_bandwidth = tdimg_feedback().lockin_bandwidth;
+  return TimeDomainEngine(tdimg_model(), tdimg_map(), tdimg_cantilever().scales(), o);
+}
+
+/// The height image's step: mean height of the right quarter minus the left quarter of every line.
+double tdimg_step(const scan::HeightMap& h) {
+  const long nx = h.x_resolution(), ny = h.y_resolution();
+  double left = 0, right = 0;
+  for (long j = 0; j < ny; ++j)
+    for (long i = 0; i < nx / 4; ++i) {
+      left += h(i, j);
+      right += h(nx - 1 - i, j);
+    }
+  return (right - left) / static_cast<double>(ny * (nx / 4));
+}
+
+TEST(TimeDomainImaging, AFlatSampleHoldsTheSetPointAndImagesZeroHeight) {
+  const scan::Surface s = tdimg_surface(scan::flat(tdimg_grid(1e-6, 16)));
+  TimeDomainEngine engine = tdimg_engine(2);
+  const ImagingResult r = scan_image(engine, s, tdimg_raster(8, 8, 20.0), tdimg_feedback());
+  EXPECT_TRUE(engine.engaged_by_shooting());
+  EXPECT_EQ(engine.cycles(), 8 * 8 * 2 * 20);
+  // engaged where the periodic orbit's amplitude is the set-point: within the map's grid step of its linear guess
+  const OrbitMap::Engaged e = tdimg_map().engage(kTdimgSetpoint * kTdimgA0);
+  EXPECT_NEAR(r.engaged_separation, e.separation * 1e-9, 12.0 / 31.0 * 1e-9);
+  // the set-point held: the orbit is periodic, the lock-in reads it to the integrator's tolerance (1e-10 relative)
+  const double a_sp = kTdimgSetpoint * kTdimgA0 * 1e-9;
+  for (const ImageChannels* c : {&r.trace, &r.retrace}) {
+    for (double v : c->error.data()) EXPECT_LT(std::abs(v), 1e-7 * a_sp);
+    for (double z : c->height.data()) EXPECT_NEAR(z, r.engaged_separation, 1e-6 * a_sp);
+    for (double v : c->regime.data()) EXPECT_EQ(v, 2.0);  // repulsive
+    for (double v : c->peak_force.data()) EXPECT_GT(v, 0.0);
+  }
+  const ImagingMetrics m = imaging_metrics(r);
+  EXPECT_LT(m.trace_height_rms_error, 1e-6 * a_sp);
+  EXPECT_EQ(m.switches_per_line, 0.0);
+}
+
+}  // namespace
+}  // namespace afmkit::tapping::image
