@@ -105,5 +105,62 @@ TEST(TimeDomainImaging, AFlatSampleHoldsTheSetPointAndImagesZeroHeight) {
   EXPECT_EQ(m.switches_per_line, 0.0);
 }
 
+TEST(TimeDomainImaging, AStepIsImagedAsTheQuasiStaticEngineImagesIt) {
+  // one step up of 1 nm at x = 0 (terraces 0.6 µm wide, the sample map's pixel 2 nm), on the repulsive branch
+  const double height = 1e-9;
+  const scan::Surface s = tdimg_surface(scan::steps(tdimg_grid(1.2e-6, 600), {0.6e-6, height, 0.0}));
+  const long pixels = 16;
+  const double cycles = 80.0;
+  const RasterSpec raster = tdimg_raster(pixels, 1, cycles);
+  FeedbackSpec f = tdimg_feedback();
+  f.integral_gain = 4000.0;
+  TimeDomainEngine td = tdimg_engine();
+  const ImagingResult r = scan_image(td, s, raster, f);
+  const double tau_c = 2.0 * kTdimgQ / (2.0 * std::numbers::pi * kTdimgF0);
+  QuasiStaticEngine qs(tdimg_map(), tdimg_cantilever().scales(), tau_c, f.lockin_bandwidth);
+  const ImagingResult q = scan_image(qs, s, raster, f);
+  // The bound. Both engines hold A = A_sp on each terrace once settled, at the same separation on both terraces
+  // (the map's interpolation moves the quasi-static engine's separation by the same offset on both: it cancels in
+  // the step); what differs is how they settle after the edge. The loop's time constant is τ_L = 1/(K_i S), S the
+  // slope dA/dl at the set-point (from the map); the cantilever (τ_c) and the lock-in (τ_li) delay it. The right
+  // quarter starts t_s = (pixels/4) · cycles · T after the edge (the left one as long after the engagement or the
+  // line's turn): each engine's residual there is below h e^{−(t_s − τ_c − τ_li)/τ_L}, their difference below twice
+  // that.
+  const OrbitMap& m = tdimg_map();
+  const OrbitMap::Engaged e = m.engage(kTdimgSetpoint * kTdimgA0);
+  const double dl = 0.25;  // nm
+  const double slope = (m.at(e.branch, e.separation + dl).amplitude - m.at(e.branch, e.separation - dl).amplitude) /
+                       (2.0 * dl);
+  const double tau_loop = 1.0 / (f.integral_gain * slope);
+  const double t_s = static_cast<double>(pixels / 4) * cycles / kTdimgF0;
+  const double tau_li = 1.0 / (2.0 * std::numbers::pi * f.lockin_bandwidth);
+  const double bound = 2.0 * height * std::exp(-(t_s - tau_c - tau_li) / tau_loop);
+  ASSERT_LT(bound, 0.1 * height);  // the case resolves the step
+  for (const auto& [t, qq] : {std::pair{&r.trace, &q.trace}, std::pair{&r.retrace, &q.retrace}}) {
+    const double td_step = tdimg_step(t->height), qs_step = tdimg_step(qq->height);
+    EXPECT_NEAR(td_step, qs_step, bound);
+    EXPECT_NEAR(td_step, height, bound);
+  }
+  for (double v : r.trace.regime.data()) EXPECT_EQ(v, 2.0);
+}
+
+TEST(TimeDomainImaging, BadLockInOptionsNameTheirParameter) {
+  const auto tdimg_name_of = [](const TimeDomainOptions& o) {
+    try {
+      o.validate();
+    } catch (const InvalidParameter& e) {
+      return e.parameter();
+    }
+    return std::string("none");
+  };
+  TimeDomainOptions o;
+  EXPECT_EQ(tdimg_name_of(o), "none");
+  o.lockin_cycles = 0;
+  EXPECT_EQ(tdimg_name_of(o), "lockin_cycles");
+  o = {};
+  o.lockin_bandwidth = -1.0;
+  EXPECT_EQ(tdimg_name_of(o), "lockin_bandwidth");
+}
+
 }  // namespace
 }  // namespace afmkit::tapping::image
