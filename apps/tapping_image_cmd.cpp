@@ -161,13 +161,13 @@ void require_whole_cycles(const io::ParamSet& p, const ti::RasterSpec& r, const 
   const std::string speed_key = p.real("tip_speed") > 0.0 ? "tip_speed" : "line_rate";
   if (!(cycles_per_pixel >= 1.0))
     throw InvalidParameter(speed_key, fmt::format("engine = time-domain: a pixel lasts {:.4g} drive cycles ({} at tip "
-                                                  "speed {} m/s, drive {} Hz): it must last at least 1 cycle (lower "
+                                                  "speed {:.6g} m/s, drive {:.6g} Hz): it must last at least 1 cycle (lower "
                                                   "{} or the pixels)",
                                                   cycles_per_pixel, io::quantity(r.pixel_time(), "s"), r.tip_speed,
                                                   f_drive, speed_key));
   const long cycles = p.integer("lockin_cycles");
   if (static_cast<double>(cycles) > cycles_per_pixel * (1.0 + 1e-9))
-    throw InvalidParameter("lockin_cycles", fmt::format("lockin_cycles = {} is more than the {:.4g} drive cycles of one "
+    throw InvalidParameter("lockin_cycles", fmt::format("lockin_cycles = {} is more than the {:.6g} drive cycles of one "
                                                         "pixel: the lock-in would average over the neighbouring "
                                                         "pixels; must be in [1, {}]",
                                                         cycles, cycles_per_pixel,
@@ -234,6 +234,10 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
   require_sample_covers_scan(p, map, raster);
   const bool time_domain = p.text("engine") == "time-domain";
   if (time_domain) require_whole_cycles(p, raster, fb, f_drive);
+  if (!time_domain && p.was_set("lockin_cycles"))
+    throw InvalidParameter("lockin_cycles", fmt::format("lockin_cycles does not apply to engine = {}: the lock-in "
+                                                        "window of whole cycles is the time-domain engine's",
+                                                        p.text("engine")));
   const double tilt_angle = p.real("tilt_angle");
   if (!(tilt_angle < 90.0))
     throw InvalidParameter("tilt_angle", fmt::format("tilt_angle = {} deg is out of range: must be in [0, 90) deg",
