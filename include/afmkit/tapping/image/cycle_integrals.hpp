@@ -1,8 +1,8 @@
 #pragma once
 // What the time-domain imaging engine needs of one drive cycle [t_a, t_b] (model units), integrated on the
-// trajectory's smooth segments: the lock-in's ∫ x e^{−iωt} dt and ∫ ẋ² dt by 5-point Gauss–Legendre panels no
-// longer than a 16th of the drive period (exact for the degree-7 dense output of DOP853 times e^{−iωt} to about
-// (ωh)^10/10!), the smallest gap and the largest tip–sample force (at the segments' ends and where ẋ rises through
+// trajectory's smooth segments: the lock-in's ∫ x e^{−iωt} dt and ∫ ẋ² dt by 7-point Gauss–Legendre panels no
+// longer than a 16th of the drive period (exact for polynomials of degree 13: the degree-7 dense output of DOP853
+// times e^{−iωt} to about (ωh)^7/7!), the largest tip–sample force (at the segments' ends and where ẋ rises through
 // 0: the bottom of the motion). Lighter than OrbitIntegrals (observer.hpp), which evaluates the force law and six
 // harmonics at 20 nodes per panel: the energy the sample takes follows from the energy balance of eq. 8 instead,
 //   ∫ h ẋ dt = Γ ∫ cos(ωt) ẋ dt − 2ξω_n ∫ ẋ² dt − [½ẋ² + ½ω_n² x²]_a^b,
