@@ -1,11 +1,13 @@
 // afmkit tapping image: the virtual tapping-mode AFM — amplitude-modulation imaging with Z feedback
 // (docs/commands.md#afmkit-tapping-image, docs/theory-tapping.md#quasi-static-imaging). A sample topography (the
 // samples of `afmkit scan`) is scanned in raster lines, trace and retrace; a PI controller moves the base height Z
-// to hold the lock-in amplitude at the set-point. Engine: quasi-static (the steady-state orbit map of the law,
-// computed once by an instrument sweep, seen through the cantilever's and the lock-in's lags).
+// to hold the lock-in amplitude at the set-point. Engines: quasi-static (the steady-state orbit map of the law,
+// computed once by an instrument sweep, seen through the cantilever's and the lock-in's lags) or time-domain (the
+// cantilever ODE stepped cycle by cycle under the moving tip, a lock-in over whole cycles; engaged on the map).
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,7 @@
 #include "afmkit/scan/gsf.hpp"
 #include "afmkit/scan/levelling.hpp"
 #include "afmkit/tapping/image/quasi_static.hpp"
+#include "afmkit/tapping/image/time_domain.hpp"
 #include "command.hpp"
 #include "commands.hpp"
 #include "scan_outputs.hpp"
@@ -82,8 +85,12 @@ void declare_tapping_image(io::ParamSet& p) {
       .real("tip_speed", 0.0, "tip speed along the fast axis (0: from line_rate)", io::Range::non_negative())
       .unit("m/s")
       .group("Amplitude feedback")
-      .text("engine", "quasi-static", "imaging engine: the steady-state orbit map with the loop's lags",
-            {"quasi-static"})
+      .text("engine", "quasi-static",
+            "imaging engine: quasi-static (the steady-state orbit map with the loop's lags) or time-domain (the "
+            "cantilever ODE stepped cycle by cycle under the moving tip, demodulated by a lock-in)",
+            {"quasi-static", "time-domain"})
+      .integer("lockin_cycles", 1, "time-domain engine: drive cycles the lock-in averages (boxcar), at most the "
+               "cycles of one pixel", 1, 1000000)
       .real("setpoint", 0.8, "amplitude set-point A_sp / A0, in (0, 1)", io::Range::any())
       .unit("dimensionless")
       .reals("setpoint_sweep", {}, "more set-points A_sp/A0 imaged with the same orbit map (results: setpoint_sweep)",
@@ -103,7 +110,7 @@ void declare_tapping_image(io::ParamSet& p) {
       .real("lockin_bandwidth", 5e3, "-3 dB bandwidth of the lock-in's first-order output filter (< f_drive / 2)",
             io::Range::non_negative())
       .unit("Hz")
-      .group("Orbit map (the steady states of the law, computed once)")
+      .group("Orbit map (the steady states of the law, computed once; the time-domain engine engages on it)")
       .real("map_separation_min", 0.0, "smallest separation of the map", io::Range::closed(-1e6, 1e6))
       .unit("nm")
       .real("map_separation_max", 0.0, "largest separation of the map (0: 1.25 x free_amplitude)",
@@ -116,6 +123,7 @@ void declare_tapping_image(io::ParamSet& p) {
       .writes(tapping_image_files);
   add_output_params(p, "out/tapping_image/lines.csv", "per-line metrics (regime switches, jumps, peak force)");
   add_quiet_flag(p);
+  p.applies_when("lockin_cycles", "engine", {"time-domain"});
 }
 
 std::vector<io::Column> tapping_image_line_columns() {
@@ -144,6 +152,32 @@ void require_sample_covers_scan(const io::ParamSet& p, const scan::HeightMap& ma
     throw InvalidParameter(p.was_set("scan_height") ? "scan_height" : key,
                            fmt::format("the scan height {} m is taller than the sample: {}; the scan must lie on the "
                                        "sample", r.height, what));
+}
+
+/// The time-domain engine demodulates whole drive cycles: a pixel must last at least one cycle, and the lock-in's
+/// window (lockin_cycles) at most one pixel (else each pixel reads its neighbours).
+void require_whole_cycles(const io::ParamSet& p, const ti::RasterSpec& r, const ti::FeedbackSpec& fb, double f_drive) {
+  const double cycles_per_pixel = r.pixel_time() * f_drive;
+  const std::string speed_key = p.real("tip_speed") > 0.0 ? "tip_speed" : "line_rate";
+  if (!(cycles_per_pixel >= 1.0))
+    throw InvalidParameter(speed_key, fmt::format("engine = time-domain: a pixel lasts {:.4g} drive cycles ({} at tip "
+                                                  "speed {:.6g} m/s, drive {:.6g} Hz): it must last at least 1 cycle (lower "
+                                                  "{} or the pixels)",
+                                                  cycles_per_pixel, io::quantity(r.pixel_time(), "s"), r.tip_speed,
+                                                  f_drive, speed_key));
+  const long cycles = p.integer("lockin_cycles");
+  if (static_cast<double>(cycles) > cycles_per_pixel * (1.0 + 1e-9))
+    throw InvalidParameter("lockin_cycles", fmt::format("lockin_cycles = {} is more than the {:.6g} drive cycles of one "
+                                                        "pixel: the lock-in would average over the neighbouring "
+                                                        "pixels; must be in [1, {}]",
+                                                        cycles, cycles_per_pixel,
+                                                        static_cast<long>(std::floor(cycles_per_pixel * (1.0 + 1e-9)))));
+  // the controller samples the lock-in's output once per update: its bandwidth must be below the Nyquist frequency
+  if (!(fb.lockin_bandwidth < 0.5 * fb.update_rate))
+    throw InvalidParameter("lockin_bandwidth",
+                           fmt::format("engine = time-domain: lockin_bandwidth = {} Hz aliases in the controller, "
+                                       "which samples the lock-in at feedback_rate = {} Hz: it must be below {} Hz",
+                                       fb.lockin_bandwidth, fb.update_rate, 0.5 * fb.update_rate));
 }
 
 void run_tapping_image(const io::ParamSet& p, Captured* capture) {
@@ -198,6 +232,12 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
   raster.tip_speed = p.real("tip_speed") > 0.0 ? p.real("tip_speed") : 2.0 * raster.width * p.real("line_rate");
   raster.validate();
   require_sample_covers_scan(p, map, raster);
+  const bool time_domain = p.text("engine") == "time-domain";
+  if (time_domain) require_whole_cycles(p, raster, fb, f_drive);
+  if (!time_domain && p.was_set("lockin_cycles"))
+    throw InvalidParameter("lockin_cycles", fmt::format("lockin_cycles does not apply to engine = {}: the lock-in "
+                                                        "window of whole cycles is the time-domain engine's",
+                                                        p.text("engine")));
   const double tilt_angle = p.real("tilt_angle");
   if (!(tilt_angle < 90.0))
     throw InvalidParameter("tilt_angle", fmt::format("tilt_angle = {} deg is out of range: must be in [0, 90) deg",
@@ -222,12 +262,24 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
   map_progress.finish();
 
   const double time_constant = 2.0 * q / (2.0 * std::numbers::pi * f0);  // τ_c = 2Q/ω0
-  ti::QuasiStaticEngine engine(orbit_map, scales, time_constant, fb.lockin_bandwidth);
+  ti::TimeDomainOptions td;
+  if (time_domain) {
+    td.lockin_cycles = p.integer("lockin_cycles");
+    td.lockin_bandwidth = fb.lockin_bandwidth;
+    td.shooting = shooting_options_from(p);
+    td.validate();
+  }
+  // a new engine for each scan (the main one and every set-point of the sweep)
+  const auto make_engine = [&]() -> std::unique_ptr<ti::TipEngine> {
+    if (time_domain) return std::make_unique<ti::TimeDomainEngine>(model, orbit_map, scales, td);
+    return std::make_unique<ti::QuasiStaticEngine>(orbit_map, scales, time_constant, fb.lockin_bandwidth);
+  };
+  const std::unique_ptr<ti::TipEngine> engine = make_engine();
   io::Progress progress("tapping image", raster.lines, !quiet);
   ti::ImagingOptions io_options;
   io_options.progress = [&progress](long n) { progress.advance(n); };
   io_options.cancellation = cancellation_of(capture);
-  const ti::ImagingResult r = ti::scan_image(engine, surface, raster, fb, io_options);
+  const ti::ImagingResult r = ti::scan_image(*engine, surface, raster, fb, io_options);
   progress.finish();
   const ti::ImagingMetrics m = ti::imaging_metrics(r);
   // the set-point sweep: the same sample and map at each set-point (the height of the features against the truth's)
@@ -241,12 +293,12 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
   for (double sp : p.reals("setpoint_sweep")) {
     ti::FeedbackSpec at = fb;
     at.setpoint = sp;
-    ti::QuasiStaticEngine e(orbit_map, scales, time_constant, fb.lockin_bandwidth);
+    const std::unique_ptr<ti::TipEngine> e = make_engine();
     ti::ImagingOptions o;
     o.cancellation = io_options.cancellation;
     const ti::ImagingResult rs = [&] {
       try {
-        return ti::scan_image(e, surface, raster, at, o);
+        return ti::scan_image(*e, surface, raster, at, o);
       } catch (const InvalidParameter& error) {  // the approach does not reach it: name the list
         throw InvalidParameter("setpoint_sweep", fmt::format("setpoint_sweep contains {}: {}", sp, error.what()));
       }
@@ -327,7 +379,10 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
     }
   const double a_sp = r.setpoint_amplitude;
   const nlohmann::json results = {
-      {"engine", "quasi-static"},
+      {"engine", p.text("engine")},
+      {"cycles_per_pixel", raster.pixel_time() * f_drive},
+      {"drive_cycles", time_domain ? static_cast<double>(dynamic_cast<const ti::TimeDomainEngine&>(*engine).cycles())
+                                   : 2.0 * static_cast<double>(raster.pixels * raster.lines) * raster.pixel_time() * f_drive},
       {"free_amplitude", a0_nm * nm},
       {"setpoint_amplitude", a_sp},
       {"drive_frequency", f_drive},
@@ -362,6 +417,7 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
       {"units",
        {{"free_amplitude", "m"}, {"setpoint_amplitude", "m"}, {"drive_frequency", "Hz"},
         {"cantilever_time_constant", "s"}, {"lockin_time_constant", "s"}, {"tip_speed", "m/s"}, {"pixel_time", "s"},
+        {"cycles_per_pixel", "count"}, {"drive_cycles", "count"},
         {"updates", "count"}, {"engaged_separation", "m"}, {"trace_height_rms_error", "m"},
         {"retrace_height_rms_error", "m"}, {"truth_rms_height", "m"}, {"fraction_free", "dimensionless"},
         {"fraction_attractive", "dimensionless"}, {"fraction_repulsive", "dimensionless"},
@@ -382,12 +438,12 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
                                  r.beyond_map_updates, r.updates, io::quantity(orbit_map.separation_min() * scales.length * nm, "m"),
                                  io::quantity(orbit_map.separation_max() * scales.length * nm, "m")));
   const std::string summary = fmt::format(
-      "afmkit tapping image: {} x {} pixels, trace and retrace, set-point {} ({}), engaged at {}; height RMS error "
+      "afmkit tapping image ({} engine): {} x {} pixels, trace and retrace, set-point {} ({}), engaged at {}; height RMS error "
       "{} (trace) / {} (retrace) against the truth's {} after plane levelling; regime: {:.3g} % attractive, "
       "{:.3g} % repulsive, {:.3g} % free; {:.3g} regime switches per line; largest peak force {}; orbit map {} "
       "branches, {} jumps; scan {:.3g} s{}",
-      raster.pixels, raster.lines, fb.setpoint, io::quantity(a_sp, "m"), io::quantity(r.engaged_separation, "m"),
-      io::quantity(m.trace_height_rms_error, "m"), io::quantity(m.retrace_height_rms_error, "m"),
+      p.text("engine"), raster.pixels, raster.lines, fb.setpoint, io::quantity(a_sp, "m"),
+      io::quantity(r.engaged_separation, "m"), io::quantity(m.trace_height_rms_error, "m"), io::quantity(m.retrace_height_rms_error, "m"),
       io::quantity(m.truth_rms_height, "m"), 100.0 * m.fraction_attractive, 100.0 * m.fraction_repulsive,
       100.0 * m.fraction_free, m.switches_per_line, io::quantity(m.max_peak_force, "N"),
       orbit_map.branches().size(), orbit_map.jumps(), r.seconds,
@@ -401,7 +457,8 @@ void register_tapping_image(CLI::App& tapping) {
   add_command(tapping, "image",
               "virtual tapping-mode AFM: a sample scanned in raster lines (trace, retrace) with the amplitude held at "
               "the set-point by a PI loop on Z; height, amplitude error, phase, dissipated power, peak force and "
-              "regime images (GSF, PNG); quasi-static engine on the orbit map of the law",
+              "regime images (GSF, PNG); quasi-static engine on the orbit map of the law, or the exact time-domain "
+              "engine (--engine time-domain)",
               declare_tapping_image, run_tapping_image);
 }
 

@@ -18,6 +18,7 @@
 #include "afmkit/scan/levelling.hpp"
 #include "afmkit/scan/sample_generators.hpp"
 #include "afmkit/tapping/image/quasi_static.hpp"
+#include "afmkit/tapping/image/time_domain.hpp"
 #include "afmkit/tapping/units.hpp"
 
 namespace afmkit::tapping::image {
@@ -175,6 +176,48 @@ void qimg_check_step_switching_branch() {
   EXPECT_GE(r.trace.regime_switches[0], 1);
 }
 
+void qimg_check_time_domain_switch() {
+  // the same step, scanned by the time-domain engine (on this sweep's map for the engagement only): the tip meets
+  // the edge on the attractive branch; below the approach's jump (where the map says the attractive branch ends) the
+  // orbit can only land on the repulsive branch. 24 pixels of 48 drive cycles (the loop, K_i = 2000 1/s, and the
+  // cantilever, τ_c = 2Q/ω0 = 127 cycles, settle over the following pixels)
+  const double a_sp = kQimgSetpoint * kQimgA0;
+  const double l_att = *qimg_crossing(qimg_case().sweep.approach, a_sp);
+  const double margin = l_att - qimg_first_jump(SweepDirection::approach).separation;
+  const double height = 1.5 * margin * 1e-9;
+  const scan::Surface s = qimg_surface(scan::steps(qimg_grid(1.2e-6, 600), {0.6e-6, height, 0.0}));
+  FeedbackSpec f;
+  f.setpoint = kQimgSetpoint;
+  const long pixels = 24;
+  const double cycles = 48.0;
+  TimeDomainOptions o;
+  o.lockin_bandwidth = f.lockin_bandwidth;
+  TimeDomainEngine engine(qimg_model(), qimg_case().map, qimg_cantilever().scales(), o);
+  const ImagingResult r =
+      scan_image(engine, s, qimg_raster(pixels, 1, 1e-6, 1e-6 / static_cast<double>(pixels) * kQimgF0 / cycles), f);
+  // the edge is between pixels 11 and 12: attractive before it, repulsive at once in the edge's pixel (the regime
+  // follows the force's first harmonic cycle by cycle), and repulsive once the loop has settled on the upper terrace
+  // (in between, while the loop lifts Z by several nm per pixel, the orbit is between the branches)
+  for (long i = 0; i < pixels / 2; ++i) EXPECT_EQ(r.trace.regime(i, 0), 1.0) << "pixel " << i;
+  EXPECT_EQ(r.trace.regime(pixels / 2, 0), 2.0);
+  for (long i = 3 * pixels / 4; i < pixels; ++i) EXPECT_EQ(r.trace.regime(i, 0), 2.0) << "pixel " << i;
+  // settled on the repulsive branch: the upper terrace imaged lower by l_att − l_rep, as the quasi-static engine
+  // images it (qimg_check_step_switching_branch). Bound: the loop's residual at the last pixel, t = 12 pixels after
+  // the edge, e^{−(t − τ_c − τ_li)/τ_L} of the change, τ_L = 1/(K_i S) with S = dA/dl of the repulsive branch at l_rep
+  const std::optional<double> l_rep = qimg_crossing(qimg_case().sweep.retract, a_sp);
+  ASSERT_TRUE(l_rep.has_value());
+  const double expected = height - (l_att - *l_rep) * 1e-9;
+  const OrbitMap& m = qimg_case().map;
+  const int rep = m.retract_branch(*l_rep);
+  const double dl = 0.1;
+  const double slope = (m.at(rep, *l_rep + dl).amplitude - m.at(rep, *l_rep - dl).amplitude) / (2.0 * dl);
+  const double tau_c = 2.0 * kQimgQ / (2.0 * std::numbers::pi * kQimgF0), tau_li = 1.0 / (2.0 * std::numbers::pi * 5e3);
+  const double t = static_cast<double>(pixels / 2) * cycles / kQimgF0;
+  const double bound = std::abs(expected) * std::exp(-(t - tau_c - tau_li) * f.integral_gain * slope);
+  ASSERT_LT(bound, 0.1 * height);
+  EXPECT_NEAR(r.trace.height(pixels - 1, 0) - r.trace.height(0, 0), expected, bound);
+}
+
 // One test (one process under ctest): the sweep, about 1 s of CPU, is computed once.
 TEST(QuasiStaticImaging, ADmtSampleIsImagedAsTheSweepPredicts) {
   {
@@ -192,6 +235,10 @@ TEST(QuasiStaticImaging, ADmtSampleIsImagedAsTheSweepPredicts) {
   {
     SCOPED_TRACE("a step that pushes the tip off the attractive branch is imaged lower by the branches' separation");
     qimg_check_step_switching_branch();
+  }
+  {
+    SCOPED_TRACE("the time-domain engine switches to the repulsive branch at the edge, as the map says");
+    qimg_check_time_domain_switch();
   }
 }
 

@@ -21,6 +21,7 @@
 namespace afmkit::tapping {
 
 class TrajectoryObserver;
+class TappingSystem;
 
 /// How the flow between events is computed.
 enum class Integrator {
@@ -82,6 +83,11 @@ struct SimulationResult {
 /// TappingSystem::initial_mode). Throws NumericalFailure when an event or step budget is exhausted and
 /// InvalidParameter for a non-finite state, t_end < t_begin, or closed_form with a non piecewise-linear law.
 SimulationResult simulate(const TappingModel& model, double t_begin, TipState start, double t_end,
+                          const SimulationOptions& options = {}, TrajectoryObserver* observer = nullptr);
+
+/// The same on a system already built (a single-mode TappingSystem, e.g. one whose separation an imaging engine
+/// moves with TappingSystem::set_separation): no model copy, no allocation by the engine itself.
+SimulationResult simulate(const TappingSystem& system, double t_begin, TipState start, double t_end,
                           const SimulationOptions& options = {}, TrajectoryObserver* observer = nullptr);
 
 /// The same for a multi-mode cantilever (modes.hpp): `start` holds the tip's x, ẋ and the higher modal

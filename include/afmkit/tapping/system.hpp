@@ -28,6 +28,10 @@ class TappingSystem {
   const TappingModel& model() const& { return model_; }
   TappingModel model() && { return std::move(model_); }
   double separation() const { return separation_; }
+  /// Moves the sample to the separation l (finite) in place: no rebuilt system, no allocation (an imaging engine
+  /// steps cycle by cycle with the height under the moving tip). A single-mode system only (the modal carrier's
+  /// separation is that of the multi-mode model).
+  void set_separation(double l) { model_.separation = separation_ = l; }
   double gap(double x) const { return x + separation_; }  // d = x + l
   /// Number of gap regions (switching gaps + 1). Region r: s_{r−1} ≤ gap < s_r.
   int region_count() const { return static_cast<int>(switching().size()) + 1; }

@@ -23,22 +23,28 @@ QuasiStaticEngine::QuasiStaticEngine(const OrbitMap& map, const UnitScales& scal
   if (!(lockin_bandwidth >= 0.0 && std::isfinite(lockin_bandwidth)))
     throw InvalidParameter("lockin_bandwidth",
                            fmt::format("lockin_bandwidth = {} Hz is out of range: must be >= 0", lockin_bandwidth));
-  time_constant_ = time_constant;
-  lockin_time_constant_ = lockin_bandwidth > 0.0 ? 1.0 / (2.0 * std::numbers::pi * lockin_bandwidth) : 0.0;
+  cantilever_ = PhasorLag(time_constant);
+  lockin_ = PhasorLag(lockin_time_constant(lockin_bandwidth));
 }
 
-double QuasiStaticEngine::engage(double amplitude) {
-  const OrbitMap::Engaged e = map_.engage(amplitude / metres_);
+OrbitMap::Engaged engage_on(const OrbitMap& map, double amplitude, double metres) {
+  const OrbitMap::Engaged e = map.engage(amplitude / metres);
   if (e.branch < 0)
     throw InvalidParameter(
         "setpoint", fmt::format("the approach from map_separation_max = {:.6g} m down to map_separation_min = {:.6g} m "
                                 "never brings the amplitude down to the set-point {:.6g} m: raise the setpoint or "
                                 "lower map_separation_min",
-                                map_.separation_max() * metres_, map_.separation_min() * metres_, amplitude));
+                                map.separation_max() * metres, map.separation_min() * metres, amplitude));
+  return e;
+}
+
+double QuasiStaticEngine::engage(double amplitude) {
+  const OrbitMap::Engaged e = engage_on(map_, amplitude, metres_);
   branch_ = e.branch;
   const SteadyState s = map_.at(branch_, e.separation);
-  cantilever_re_ = lockin_re_ = s.amplitude * metres_ * s.cos_phase;
-  cantilever_im_ = lockin_im_ = s.amplitude * metres_ * s.sin_phase;
+  const std::complex<double> settled(s.amplitude * metres_ * s.cos_phase, s.amplitude * metres_ * s.sin_phase);
+  cantilever_.reset(settled);
+  lockin_.reset(settled);
   return e.separation * metres_;
 }
 
@@ -54,20 +60,13 @@ TipReading QuasiStaticEngine::advance(const scan::Surface& surface, double z, do
   }
   branch_ = map_.follow(branch_, l);
   const SteadyState s = map_.at(branch_, l, hints_[static_cast<std::size_t>(branch_)]);
-  if (dt != last_dt_) {  // exact first-order lags over a step with the input held (zero-order hold)
-    last_dt_ = dt;
-    decay_c_ = time_constant_ > 0.0 ? std::exp(-dt / time_constant_) : 0.0;
-    decay_li_ = lockin_time_constant_ > 0.0 ? std::exp(-dt / lockin_time_constant_) : 0.0;
-  }
+  // the lags act on X + iY = B e^{iφ}, the input held over the step (zero-order hold)
   const double a = s.amplitude * metres_;
-  const double target_re = a * s.cos_phase, target_im = a * s.sin_phase;  // X + iY = B e^{iφ}
-  cantilever_re_ = target_re + decay_c_ * (cantilever_re_ - target_re);
-  cantilever_im_ = target_im + decay_c_ * (cantilever_im_ - target_im);
-  lockin_re_ = cantilever_re_ + decay_li_ * (lockin_re_ - cantilever_re_);
-  lockin_im_ = cantilever_im_ + decay_li_ * (lockin_im_ - cantilever_im_);
-  r.amplitude = std::sqrt(lockin_re_ * lockin_re_ + lockin_im_ * lockin_im_);
-  r.in_phase = lockin_re_;
-  r.quadrature = lockin_im_;
+  const std::complex<double> target(a * s.cos_phase, a * s.sin_phase);
+  const std::complex<double> out = lockin_.step(cantilever_.step(target, dt), dt);
+  r.amplitude = std::sqrt(out.real() * out.real() + out.imag() * out.imag());
+  r.in_phase = out.real();
+  r.quadrature = out.imag();
   r.peak_force = s.peak_force * newtons_;
   r.power = s.contact_dissipation * watts_;
   r.regime = static_cast<int>(regime_of(s.in_phase_force, map_.drive_amplitude()));

@@ -6,9 +6,9 @@
 #include <complex>
 #include <type_traits>
 
-#include <boost/math/quadrature/gauss.hpp>
 
 #include "afmkit/core/validate.hpp"
+#include "afmkit/tapping/gauss_panels.hpp"
 #include "afmkit/tapping/system.hpp"
 #include "small_angle.hpp"
 
@@ -57,9 +57,6 @@ void OrbitIntegrals::extremum(const TappingSystem& system, const Segment& segmen
 }
 
 void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segment) {
-  using Rule = boost::math::quadrature::gauss<double, 20>;
-  const auto& nodes = Rule::abscissa();
-  const auto& weights = Rule::weights();
   const double t0 = segment.t_begin(), t1 = segment.t_end();
   if (!(t1 > t0)) return;
   const Mode mode = segment.mode();
@@ -69,8 +66,6 @@ void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segm
   const bool in_contact_region = exact_contact && mode.region == 0;
   duration += t1 - t0;
   if (in_contact_region) contact_time += t1 - t0;
-  const int panels = std::max(1, static_cast<int>(std::ceil((t1 - t0) / max_panel_)));
-  const double width = (t1 - t0) / panels;
   auto accumulate = [&](double t, double w, std::complex<double> e1) {  // e1 = e^{−iωt}
     const TipState s = segment.state(t);
     const double x = s.position, v = s.velocity;
@@ -87,24 +82,8 @@ void OrbitIntegrals::on_segment(const TappingSystem& system, const Segment& segm
     peak_force = std::max(peak_force, 0.0 - h);
     min_gap = std::min(min_gap, system.gap(x));
   };
-  // e^{−iωt} at the nodes mid ± half·ξ_i: e^{−iω mid} (one sincos per panel) times the rotations e^{∓iω half ξ_i},
-  // the same for every panel of the segment (equal widths; the last one's rounding difference is below 1e-16)
-  std::array<std::complex<double>, std::tuple_size_v<std::decay_t<decltype(nodes)>>> rotation{};
-  for (std::size_t i = 0; i < nodes.size(); ++i) rotation[i] = small_phasor(-omega * 0.5 * width * nodes[i]);
-  for (int p = 0; p < panels; ++p) {
-    const double a = t0 + p * width, b = (p + 1 == panels) ? t1 : a + width;
-    const double mid = 0.5 * (a + b), half = 0.5 * (b - a);
-    const std::complex<double> e_mid = std::polar(1.0, -omega * mid);
-    for (std::size_t i = 0; i < nodes.size(); ++i) {
-      if (nodes[i] == 0.0) {
-        accumulate(mid, half * weights[i], e_mid);
-      } else {
-        accumulate(mid - half * nodes[i], half * weights[i], e_mid * std::conj(rotation[i]));
-        accumulate(mid + half * nodes[i], half * weights[i], e_mid * rotation[i]);
-      }
-    }
-    extremum(system, segment, a, b);
-  }
+  gauss_panels<20>(t0, t1, max_panel_, omega, small_phasor, accumulate,
+                   [&](double a, double b) { extremum(system, segment, a, b); });
   for (double t : {t0, t1}) {
     const TipState s = segment.state(t);
     min_gap = std::min(min_gap, system.gap(s.position));

@@ -40,16 +40,17 @@ Integrator resolve_integrator(const TappingModel& model, Integrator requested) {
   return requested;
 }
 
-SimulationResult simulate(const TappingModel& model, double t_begin, TipState start, double t_end,
-                          const SimulationOptions& options, TrajectoryObserver* observer) {
-  options.validate();
+namespace {
+void check_run(double t_begin, const TipState& start, double t_end) {
   if (!std::isfinite(t_begin)) validate::finite("t_begin", t_begin);
   if (!std::isfinite(t_end)) validate::finite("t_end", t_end);
   if (!(t_end >= t_begin)) validate::require(false, "t_end", t_end, fmt::format(">= t_begin = {}", t_begin));
   if (!std::isfinite(start.position)) validate::finite("position", start.position);
   if (!std::isfinite(start.velocity)) validate::finite("velocity", start.velocity);
-  const Integrator integrator = resolve_integrator(model, options.integrator);
-  const TappingSystem sys(model);
+}
+
+SimulationResult run_system(const TappingSystem& sys, Integrator integrator, double t_begin, TipState start,
+                            double t_end, const SimulationOptions& options, TrajectoryObserver* observer) {
   detail::RunState rs;
   rs.t = t_begin;
   rs.y = start;
@@ -74,6 +75,27 @@ SimulationResult simulate(const TappingModel& model, double t_begin, TipState st
   out.stats = rs.stats;
   out.sensitivity = rs.jacobian;
   return out;
+}
+}  // namespace
+
+SimulationResult simulate(const TappingModel& model, double t_begin, TipState start, double t_end,
+                          const SimulationOptions& options, TrajectoryObserver* observer) {
+  options.validate();
+  check_run(t_begin, start, t_end);
+  const Integrator integrator = resolve_integrator(model, options.integrator);
+  const TappingSystem sys(model);
+  return run_system(sys, integrator, t_begin, start, t_end, options, observer);
+}
+
+SimulationResult simulate(const TappingSystem& system, double t_begin, TipState start, double t_end,
+                          const SimulationOptions& options, TrajectoryObserver* observer) {
+  if (system.modal())
+    throw InvalidParameter("system", "simulate(TappingSystem): a single-mode system only (multi-mode models: "
+                                     "simulate(MultiModeModel))");
+  options.validate();
+  check_run(t_begin, start, t_end);
+  const Integrator integrator = resolve_integrator(system.model(), options.integrator);
+  return run_system(system, integrator, t_begin, start, t_end, options, observer);
 }
 
 SimulationResult simulate(const MultiModeModel& model, double t_begin, TipState start, double t_end,

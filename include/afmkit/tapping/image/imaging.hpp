@@ -5,8 +5,8 @@
 //
 // The loop is the same for every engine; the engine (TipEngine) is what answers "which amplitude and phase does the
 // lock-in read, and what does the tip do to the sample" while the base is at Z and the tip moves over the sample.
-// The quasi-static engine (quasi_static.hpp) answers from the steady-state orbit map; an exact time-domain engine
-// plugs in through the same interface.
+// The quasi-static engine (quasi_static.hpp) answers from the steady-state orbit map; the exact time-domain engine
+// (time_domain.hpp) by stepping the cantilever ODE cycle by cycle under the moving tip.
 //
 // SI units throughout: m, s, N, W, rad.
 #include <cstdint>

@@ -6,10 +6,15 @@
 // (OrbitMap::follow). Valid while the separation changes little within τ_c (scan speed × slope × τ_c ≪ the width
 // of the features of the amplitude curve) and the orbit does not come near a bifurcation.
 #include "afmkit/tapping/image/imaging.hpp"
+#include "afmkit/tapping/image/lockin.hpp"
 #include "afmkit/tapping/image/orbit_map.hpp"
 #include "afmkit/tapping/units.hpp"
 
 namespace afmkit::tapping::image {
+
+/// Where the map's approach from separation_max() first reaches `amplitude` [m] (`metres`: m per model length):
+/// the engagement of both engines. InvalidParameter("setpoint") when it never does.
+OrbitMap::Engaged engage_on(const OrbitMap& map, double amplitude, double metres);
 
 class QuasiStaticEngine final : public TipEngine {
  public:
@@ -21,7 +26,7 @@ class QuasiStaticEngine final : public TipEngine {
   double drive_frequency() const override { return 1.0 / (map_.drive_period() * scales_.time); }
   double engage(double amplitude) override;
   TipReading advance(const scan::Surface& surface, double z, double x0, double x1, double y, double dt) override;
-  double time_constant() const { return time_constant_; }
+  double time_constant() const { return cantilever_.time_constant(); }
 
  private:
   const OrbitMap& map_;
@@ -29,12 +34,10 @@ class QuasiStaticEngine final : public TipEngine {
   double metres_;        // m per model length
   double newtons_;       // N per model force
   double watts_;         // W per model energy per model period
-  double time_constant_, lockin_time_constant_;
   int branch_ = 0;
   std::vector<std::size_t> hints_;
-  double cantilever_re_ = 0, cantilever_im_ = 0;  // B e^{iφ} of the cantilever [m] (X, Y)
-  double lockin_re_ = 0, lockin_im_ = 0;          // what the lock-in outputs
-  double last_dt_ = -1, decay_c_ = 0, decay_li_ = 0;
+  PhasorLag cantilever_;  // B e^{iφ} of the cantilever [m] (X + iY)
+  PhasorLag lockin_;      // what the lock-in outputs
 };
 
 }  // namespace afmkit::tapping::image
