@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "afmkit/core/units.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/tapping/model.hpp"
 #include "afmkit/tapping/units.hpp"
@@ -30,5 +31,18 @@ tapping::TappingModel tapping_model_from(const io::ParamSet& p,
 using TappingScales = tapping::UnitScales;
 /// Factors converting model quantities to the user's units (all 1 for normalised units).
 TappingScales tapping_scales_from(const io::ParamSet& p);
+
+/// The units of the tapping commands' results, each converting a model quantity into the user's unit and naming it
+/// (nm, nN, aJ, s in physical runs; L, L/t^2, L^2/t^2, t in normalised ones): the one edge from the model's
+/// normalised units to the user's (afmkit/core/units.hpp, docs/units.md).
+struct TappingUnits {
+  units::Unit length, force, energy, time, velocity;
+  explicit TappingUnits(const TappingScales& s)
+      : length{s.length_unit, s.length},
+        force{s.force_unit, s.force},
+        energy{s.energy_unit, s.energy},
+        time{s.time_unit, s.time},
+        velocity(length.per(time)) {}
+};
 
 }  // namespace afmkit::cli
