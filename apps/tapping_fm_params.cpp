@@ -58,7 +58,7 @@ void reject_keys_not_for_fm(const io::ParamSet& p) {
     if (p.was_set(key)) throw InvalidParameter(key, fmt::format("{} does not apply to tapping fm: {}", key, why));
 }
 
-std::vector<double> fm_separations(const io::ParamSet& p, double length_scale) {
+std::vector<double> fm_separations(const io::ParamSet& p, const units::Unit& length) {
   if (p.was_set("separations") && p.was_set("separations_file"))
     throw InvalidParameter("separations", "give either separations or separations_file, not both");
   std::vector<double> list;
@@ -81,11 +81,11 @@ std::vector<double> fm_separations(const io::ParamSet& p, double length_scale) {
     const long n = p.integer("points");
     for (long i = 0; i < n; ++i) list.push_back(lo + (hi - lo) * static_cast<double>(i) / static_cast<double>(n - 1));
   }
-  for (double& l : list) l /= length_scale;
+  for (double& l : list) l = length.internal(l);
   std::sort(list.begin(), list.end(), std::greater<>());
   return list;
 }
 
-double fm_amplitude(const io::ParamSet& p, double length_scale) { return p.real("amplitude") / length_scale; }
+double fm_amplitude(const io::ParamSet& p, const units::Unit& length) { return length.internal(p.real("amplitude")); }
 
 }  // namespace afmkit::cli
