@@ -94,8 +94,8 @@ inline double real_si(const io::ParamSet& p, const std::string& key) {
 
 /// Records the value a run used for the numeric parameter `key` (ParamSet::record_used) from its SI value, in the
 /// unit `key` is declared in: the way out of the same edge.
-inline void record_used_si(io::ParamSet& p, const std::string& key, double si_value) {
-  p.record_used(key, units::from_si(p.unit_of(key))(si_value));
+inline void record_used_si(io::ParamSet& p, const std::string& key, double value_in_si) {
+  p.record_used(key, units::from_si(p.unit_of(key))(value_in_si));
 }
 
 }  // namespace afmkit::cli
