@@ -25,6 +25,7 @@
 #include "described_params.hpp"
 #include "law_params.hpp"
 #include "python_launch.hpp"
+#include "spectroscopy_params.hpp"
 #include "unit_tagged.hpp"
 
 namespace afmkit::cli {
@@ -382,11 +383,9 @@ void register_spectroscopy_fit(CLI::App& spectroscopy) {
             .real("amplitude", 0.0, "FM: oscillation amplitude A held by the amplitude loop (required)",
                   io::Range::non_negative())
             .unit("nm")
-            .default_text("required")
-            .real("drive_frequency", 0.0, "AM: drive frequency", io::Range::non_negative())
-            .unit("kHz")
-            .follows("resonance_frequency")
-            .text("direction", "approach", "the branch the curve is: approach (from the largest distance down) or "
+            .default_text("required");
+        add_drive_frequency_param(p);
+        p.text("direction", "approach", "the branch the curve is: approach (from the largest distance down) or "
                                            "retract (after the approach down to the smallest distance)",
                   {"approach", "retract"});
         p.group("Fit")

@@ -19,6 +19,7 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "described_params.hpp"
+#include "spectroscopy_params.hpp"
 #include "unit_tagged.hpp"
 
 namespace afmkit::cli {
@@ -295,9 +296,8 @@ void register_spectroscopy_reconstruct(CLI::App& spectroscopy) {
                   "quality factor Q (AM: required; FM: of the cantilever of the exact round trip, which Δf hardly "
                   "depends on)",
                   positive_below(1e9))
-            .unit("dimensionless")
-            .real("drive_frequency", 0.0, "AM: drive frequency (0: f0)", io::Range::closed(0.0, 1e7))
-            .unit("kHz");
+            .unit("dimensionless");
+        add_drive_frequency_param(p);
         p.group("Reconstruction")
             .integer("noise_realisations", 8, "FM: synthetic noise realisations for the force uncertainty (0: none)",
                      0, 1000)
