@@ -33,14 +33,9 @@ void add_tapping_fm_params(io::ParamSet& p) {
       .real("amplitude", 5.0, "oscillation amplitude A held by the amplitude controller (first harmonic of the "
                               "deflection)",
             {0.0, 1e6, true, false})
-      .unit(kLengthUnit)
-      .real("separation_min", 3.0, "smallest separation (rest position to surface) of the approach",
-            io::Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .real("separation_max", 10.0, "largest separation, where the approach starts; > separation_min",
-            io::Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .integer("points", 71, "separations of the approach (>= 2)", 2, 10000000);
+      .unit(kLengthUnit);
+  add_separation_range_params(p, 3.0, 10.0);
+  p.integer("points", 71, "separations of the approach (>= 2)", 2, 10000000);
   add_separation_list_params(p, "explicit separations instead of the uniform grid (any order; run from the largest)");
   p.text("axis", "separation",
             "what separation_min, separation_max and separations set: separation (the rest position l, stepped as an "

@@ -183,13 +183,9 @@ void register_tapping_grid(CLI::App& tapping) {
       [](io::ParamSet& p) {
         add_tapping_model_params(p);
         add_tapping_sim_params(p);
-        p.group("Grid")
-            .real("separation_min", 5.0, "smallest separation of the grid", io::Range::closed(-1e6, 1e6))
-            .unit(kLengthUnit)
-            .real("separation_max", 15.0, "largest separation of the grid, > separation_min",
-                  io::Range::closed(-1e6, 1e6))
-            .unit(kLengthUnit)
-            .integer("points", 41, "separations, equally spaced from separation_min to separation_max", 2, 100000000);
+        p.group("Grid");
+        add_separation_range_params(p, 5.0, 15.0);
+        p.integer("points", 41, "separations, equally spaced from separation_min to separation_max", 2, 100000000);
         p.group("Output")
             .file("store", "out/tapping_grid.zarr",
                   "Zarr store the grid is written to (a folder, complete or not at all; an existing afmkit store "

@@ -66,14 +66,9 @@ void add_modes_params(io::ParamSet& p) {
             "liquid: quality factor of mode 1 from the fluid damping alone (0: no fluid damping)",
             Range::closed(0.0, 1e9))
       .unit("dimensionless")
-      .group("Approach")
-      .real("separation_min", 5.0, "smallest separation (rest position to surface) of the approach",
-            Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .real("separation_max", 12.0, "largest separation, where the approach starts; >= separation_min",
-            Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .integer("points", 8, "separations of the approach (1: separation_max only)", 1, 10000000)
+      .group("Approach");
+  add_separation_range_params(p, 5.0, 12.0);
+  p.integer("points", 8, "separations of the approach (1: separation_max only)", 1, 10000000)
       .integer("settle_periods", 0,
                "drive periods simulated at each separation before the lock-in (0: automatic, 2 Q_i f_drive/f_i at "
                "least: every transient decays by exp(-2 pi))",

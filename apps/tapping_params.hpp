@@ -22,6 +22,10 @@ inline std::vector<std::string> uniform_grid_keys() { return {"separation_min", 
 /// (uniform_grid_keys) in the records; shared by tapping sweep and tapping fm.
 void add_separation_list_params(io::ParamSet& p, const std::string& help);
 
+/// separation_min and separation_max of the commands that visit a range of separations (tapping sweep, grid, fm,
+/// modes), each with its defaults; in [-1e6, 1e6] like every separation (each command checks their order).
+void add_separation_range_params(io::ParamSet& p, double min_default, double max_default);
+
 /// units, cantilever, drive, force law, separation.
 void add_tapping_model_params(io::ParamSet& p);
 /// The normalised model at the parameter `separation` (nm in physical units). `law_object`: the caller's law of

@@ -449,12 +449,9 @@ void register_tapping_sweep(CLI::App& tapping) {
       [](io::ParamSet& p) {
         add_tapping_model_params(p);
         add_tapping_sim_params(p);
-        p.group("Sweep")
-            .real("separation_min", 5.0, "smallest separation of the sweep", io::Range::any())
-            .unit(kLengthUnit)
-            .real("separation_max", 15.0, "largest separation of the sweep, > separation_min", io::Range::any())
-            .unit(kLengthUnit)
-            .integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000);
+        p.group("Sweep");
+        add_separation_range_params(p, 5.0, 15.0);
+        p.integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000);
         add_separation_list_params(p, "explicit separations of the instrument sweep instead of the uniform grid (any "
                                       "order, e.g. 20,18,16,15.5); the continuation runs between the smallest and the "
                                       "largest");

@@ -110,10 +110,9 @@ const DeclaredOnceList kDeclaredOnceNotYetMerged = {
     {"quality_factor", {3, "tapping, spectroscopy fit/reconstruct: defaults (100, required, 400) and ranges differ"}},
     {"free_amplitude", {3, "tapping (physical units), spectroscopy fit/reconstruct: defaults and ranges differ"}},
     {"amplitude", {3, "tapping fm (nm or L), spectroscopy fit/reconstruct (FM amplitude, nm): defaults differ"}},
-    {"drive_frequency", {2, "spectroscopy fit and reconstruct: the same AM drive frequency, declared in each"}},
-    {"separation_min", {5, "tapping sweep, grid, fm, modes and demo: defaults differ and ranges disagree (any finite "
-                       "vs [-1e6, 1e6])"}},
-    {"separation_max", {5, "tapping sweep, grid, fm, modes and demo: as separation_min"}},
+    {"separation_min", {2, "tapping sweep, grid, fm and modes (add_separation_range_params) and demo, whose defaults "
+                       "are the demonstration case scaled to free_amplitude (any finite value)"}},
+    {"separation_max", {2, "as separation_min"}},
     {"points", {8, "the separations of tapping sweep, grid, fm, modes and demo (in [1 or 2, 1e6, 1e7 or 1e8]); the other "
                "commands' points are other counts (impact's history samples, hb's q samples, control tf's grid)"}},
     {"approach_stiffness", {2, "the hysteresis law's K_a: the law registry's (add_law_params; impact, spectroscopy "
