@@ -64,7 +64,7 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
     throw InvalidParameter("separation_max",
                            fmt::format("separation_max = {} is out of range: must be > separation_min = {}", l_max, l_min));
   const tapping::TappingModel model = tapping_model_from(p, law_object_of(capture));
-  const TappingScales scales = tapping_scales_from(p);
+  const TappingUnits u(tapping_scales_from(p));
   const std::string dir = p.text("output_dir");
   const int points = static_cast<int>(p.integer("points"));
   // Both directions are held in memory (then streamed out).
@@ -82,7 +82,7 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
   const tapping::HarmonicBalance balance =
       computed("demo: harmonic balance", [&] { return tapping::HarmonicBalance(model); });
   const nlohmann::json folds =  // sorted by separation, as `tapping hb`
-      computed("demo: the harmonic-balance folds", [&] { return hb_fold_records(balance, scales); });
+      computed("demo: the harmonic-balance folds", [&] { return hb_fold_records(balance, u); });
 
   // 2. Approach–retract sweep, each orbit continued from the previous one (shooting).
   io::Progress progress("demo sweep", 2L * points, true, 1.0);
@@ -95,15 +95,15 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
 
   nlohmann::json jumps = {{"approach", sweep.approach_jumps}, {"retract", sweep.retract_jumps}};
   for (auto& side : {"approach", "retract"})
-    for (auto& v : jumps[side]) v = v.get<double>() * scales.length;
+    for (auto& v : jumps[side]) v = u.length(v.get<double>());
   const nlohmann::json results = {{"hb_folds", folds},
                                   {"sweep_jumps", jumps},
-                                  {"free_amplitude", model.free_amplitude() * scales.length},
-                                  {"units", {{"length", scales.length_unit}}}};
-  const io::TableOf<tapping::HbPoint> hb_rows = hb_table(scales);
+                                  {"free_amplitude", u.length(model.free_amplitude())},
+                                  {"units", {{"length", u.length.name}}}};
+  const io::TableOf<tapping::HbPoint> hb_rows = hb_table(u);
   io::TableWriter hb(dir + "/demo_hb.csv", hb_rows.columns());
   for (const tapping::HbPoint& pt : curve) io::write_row(hb, hb_rows, pt);
-  const io::TableOf<tapping::SweepPoint> sweep_rows = sweep_table(scales);
+  const io::TableOf<tapping::SweepPoint> sweep_rows = sweep_table(u);
   io::TableWriter table(dir + "/demo_sweep.csv", sweep_rows.columns());
   for (const auto* points : {&sweep.approach, &sweep.retract})
     for (const tapping::SweepPoint& pt : *points) io::write_row(table, sweep_rows, pt);
@@ -117,10 +117,10 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
   }
 
   // lengths by magnitude in physical units, said to be normalised otherwise (docs/units.md#summaries)
-  const std::string unit = scales.length_unit;
+  const std::string& unit = u.length.name;
   fmt::print("afmkit demo: tapping cantilever, law '{}', Q = {}, drive at {} x resonance ({} units)\n",
              model.law.name(), model.cantilever.quality_factor, p.real("frequency_ratio"), p.text("units"));
-  fmt::print("  free amplitude {}\n", io::summary_value(model.free_amplitude() * scales.length, unit, 6));
+  fmt::print("  free amplitude {}\n", io::summary_value(u.length(model.free_amplitude()), unit, 6));
   for (const auto& f : folds)
     fmt::print("  harmonic balance fold (jump point) at separation {}, amplitude {}\n",
                io::summary_value(f["separation"].get<double>(), unit, 6),

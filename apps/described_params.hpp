@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "afmkit/core/describe.hpp"
+#include "afmkit/core/units.hpp"
 #include "afmkit/io/params.hpp"
 
 namespace afmkit::cli {
@@ -82,6 +83,19 @@ template <class Options>
 void read_fields(const io::ParamSet& p, Options& options) {
   FieldReader archive(p);
   Options::describe(archive, options);
+}
+
+/// The numeric parameter `key` in SI: its value read in the unit it is declared in (ParamSet::unit, e.g. "nm") and
+/// converted here, the one edge where a user's number becomes the library's (afmkit/core/units.hpp). A key declared
+/// in a unit without an SI conversion is a programming error (std::logic_error).
+inline double real_si(const io::ParamSet& p, const std::string& key) {
+  return units::to_si(p.real(key), p.unit_of(key));
+}
+
+/// Records the value a run used for the numeric parameter `key` (ParamSet::record_used) from its SI value, in the
+/// unit `key` is declared in: the way out of the same edge.
+inline void record_used_si(io::ParamSet& p, const std::string& key, double value_in_si) {
+  p.record_used(key, units::from_si(p.unit_of(key))(value_in_si));
 }
 
 }  // namespace afmkit::cli

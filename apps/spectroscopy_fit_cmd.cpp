@@ -25,13 +25,13 @@
 #include "described_params.hpp"
 #include "law_params.hpp"
 #include "python_launch.hpp"
+#include "spectroscopy_params.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
-constexpr double kElectronvolt = 1.602176634e-19;  // J
 constexpr const char* kFmParameters = "hamaker,effective_modulus,distance_offset";  // FM default of `parameters`
 
 /// The keys of one mode that the other does not read (refused when given).
@@ -79,11 +79,11 @@ std::vector<std::string> parameter_list(const std::string& text) {
   return out;
 }
 
-double required(const io::ParamSet& p, const std::string& key, const std::string& unit) {
-  const double v = p.real(key);
-  if (!(v > 0.0))
+/// A required measured setting (> 0), in SI.
+double required_si(const io::ParamSet& p, const std::string& key, const std::string& unit) {
+  if (!(p.real(key) > 0.0))
     throw InvalidParameter(key, fmt::format("{} is required (the measured setting, {}): must be > 0", key, unit));
-  return v;
+  return real_si(p, key);
 }
 
 /// Every parameter of the run in the options of the library (SI).
@@ -105,34 +105,30 @@ spectroscopy::FitOptions fit_options(const io::ParamSet& p, spectroscopy::FitMod
     if (reads && (p.was_set(k.key) || (k.follows.empty() && !k.only_if_given)))
       o.law_values[k.key] = p.real(k.key) * spectroscopy::law_unit_to_si(k.unit);
   }
-  o.initial["distance_offset"] = p.real("distance_offset") * 1e-9;
+  o.initial["distance_offset"] = real_si(p, "distance_offset");
   if (fm) {
     o.initial["frequency_shift_offset"] = p.real("frequency_shift_offset");
     o.frequency_shift_noise = p.real("frequency_shift_noise");
-    o.dissipation_noise = p.real("dissipation_noise") * kElectronvolt;
+    o.dissipation_noise = real_si(p, "dissipation_noise");
   } else {
     o.initial["amplitude_scale"] = p.real("amplitude_scale");
-    o.initial["phase_offset"] = p.real("phase_offset") * kDeg;
+    o.initial["phase_offset"] = real_si(p, "phase_offset");
   }
   o.direction = p.text("direction") == "retract" ? spectroscopy::CurveDirection::retract
                                                  : spectroscopy::CurveDirection::approach;
   o.amplitude_noise = p.real("amplitude_noise");
-  o.phase_noise = p.real("phase_noise") * kDeg;
+  o.phase_noise = real_si(p, "phase_noise");
   read_fields(p, o);  // huber … flat_column
   o.validate();
   return o;
 }
 
-/// A parameter's value in the units of the command's output (m -> nm, rad -> deg, Pa -> GPa, others SI).
-struct Shown {
-  double factor;
-  std::string unit;
-};
-Shown shown(const std::string& si_unit) {
-  if (si_unit == "m") return {1e9, "nm"};
-  if (si_unit == "rad") return {1.0 / kDeg, "deg"};
-  if (si_unit == "Pa") return {1e-9, "GPa"};  // the registry's unit of moduli
-  return {1.0, si_unit};
+/// The unit a fitted parameter is shown in (m -> nm, rad -> deg, Pa -> GPa, others SI).
+units::Unit shown(const std::string& si_unit) {
+  if (si_unit == "m") return units::from_si("nm");
+  if (si_unit == "rad") return units::degrees_from_radians();
+  if (si_unit == "Pa") return units::from_si("GPa");  // the registry's unit of moduli
+  return units::as_is(si_unit);
 }
 
 /// The summary's and the sidecar's account of the estimates, shared by the modes; returns the summary's lines.
@@ -142,16 +138,16 @@ std::string estimates_of(const spectroscopy::FitResult& r, nlohmann::json& resul
   std::string summary;
   for (std::size_t j = 0; j < r.parameters.size(); ++j) {
     const auto& info = r.parameters[j];
-    const Shown sh = shown(info.unit);
+    const units::Unit u = shown(info.unit);
     names.push_back(info.name);
-    estimates[info.name] = {{"value", r.estimates[j] * sh.factor},
-                            {"standard_error", r.standard_errors[j] * sh.factor},
-                            {"initial", info.initial * sh.factor},
+    estimates[info.name] = {{"value", u(r.estimates[j])},
+                            {"standard_error", u(r.standard_errors[j])},
+                            {"initial", u(info.initial)},
                             {"identifiable", r.identifiable[j]},
                             {"transform", spectroscopy::transform_name(info.transform)}};
-    units[info.name] = sh.unit;
-    summary += fmt::format("\n  {} = {} ± {}", info.name, io::quantity(r.estimates[j] * sh.factor, sh.unit),
-                           io::quantity(r.standard_errors[j] * sh.factor, sh.unit));
+    units[info.name] = u.name;
+    summary += fmt::format("\n  {} = {} ± {}", info.name, io::quantity(u(r.estimates[j]), u.name),
+                           io::quantity(u(r.standard_errors[j]), u.name));
   }
   results["mode"] = spectroscopy::fit_mode_name(r.mode);
   results["status"] = spectroscopy::fit_status_name(r.status);
@@ -206,10 +202,10 @@ std::string closing_lines(const spectroscopy::FitResult& r) {
 /// The FM fit: settings, table and summary of a frequency-shift curve.
 void run_fm_fit(const io::ParamSet& p, Captured* capture, const spectroscopy::FmFitCurve& curve) {
   spectroscopy::FmFitSettings s;
-  s.spring_constant = required(p, "spring_constant", "N/m");
-  s.resonance_frequency = required(p, "resonance_frequency", "kHz") * 1e3;
-  s.quality_factor = required(p, "quality_factor", "dimensionless");
-  s.amplitude = required(p, "amplitude", "nm, the oscillation amplitude held by the amplitude loop") * 1e-9;
+  s.spring_constant = required_si(p, "spring_constant", "N/m");
+  s.resonance_frequency = required_si(p, "resonance_frequency", "kHz");
+  s.quality_factor = required_si(p, "quality_factor", "dimensionless");
+  s.amplitude = required_si(p, "amplitude", "nm, the oscillation amplitude held by the amplitude loop");
   s.validate();
   spectroscopy::FitOptions options = fit_options(p, spectroscopy::FitMode::fm);
   spectroscopy::fit_parameter_info(options, spectroscopy::FitMode::fm);
@@ -221,29 +217,30 @@ void run_fm_fit(const io::ParamSet& p, Captured* capture, const spectroscopy::Fm
   if (!p.was_set("parameters")) as_run.record_used("parameters", std::string(kFmParameters));
   CommandOutput out(as_run, capture, "spectroscopy fit");
   const bool diss = !r.dissipation.empty();
-  std::vector<io::Column> columns = {
-      {"distance", "nm", "measured distance (piezo separation; model separation = distance + distance_offset)"},
-      {"frequency_shift", "Hz", "measured frequency shift Δf"},
-      {"fitted_frequency_shift", "Hz", "model frequency shift at the estimates + frequency_shift_offset"},
-      {"frequency_shift_residual", "Hz", "measured − fitted frequency shift"}};
+  // SI results shown in nm and eV (the output edge: each column's unit converts its values); rows: point indices
+  const units::Unit nm = units::from_si("nm"), Hz = units::from_si("Hz"), eV = units::from_si("eV");
+  using I = std::size_t;
+  std::vector<io::ColumnOf<I>> columns = {
+      {"distance", nm, "measured distance (piezo separation; model separation = distance + distance_offset)",
+       [&r](I i) { return r.distance[i]; }},
+      {"frequency_shift", Hz, "measured frequency shift Δf", [&r](I i) { return r.frequency_shift[i]; }},
+      {"fitted_frequency_shift", Hz, "model frequency shift at the estimates + frequency_shift_offset",
+       [&r](I i) { return r.fitted_frequency_shift[i]; }},
+      {"frequency_shift_residual", Hz, "measured − fitted frequency shift",
+       [&r](I i) { return r.frequency_shift[i] - r.fitted_frequency_shift[i]; }}};
   if (diss) {
-    columns.push_back({"dissipation", "eV", "measured energy dissipated per cycle"});
-    columns.push_back({"fitted_dissipation", "eV", "model energy taken by the tip–sample force per cycle"});
-    columns.push_back({"dissipation_residual", "eV", "measured − fitted dissipation"});
+    columns.push_back({"dissipation", eV, "measured energy dissipated per cycle", [&r](I i) { return r.dissipation[i]; }});
+    columns.push_back({"fitted_dissipation", eV, "model energy taken by the tip–sample force per cycle",
+                       [&r](I i) { return r.fitted_dissipation[i]; }});
+    columns.push_back({"dissipation_residual", eV, "measured − fitted dissipation",
+                       [&r](I i) { return r.dissipation[i] - r.fitted_dissipation[i]; }});
   }
-  columns.push_back({"contact", "boolean (0/1)", "the orbit reaches the law's contact gap"});
-  columns.push_back({"jumped", "boolean (0/1)", "the FM orbit was reached past a fold of the branch"});
-  out.open(columns);
-  for (std::size_t i = 0; i < r.distance.size(); ++i) {
-    const double rf = r.frequency_shift[i] - r.fitted_frequency_shift[i];
-    if (diss) {
-      out.row(r.distance[i] * 1e9, r.frequency_shift[i], r.fitted_frequency_shift[i], rf,
-              r.dissipation[i] / kElectronvolt, r.fitted_dissipation[i] / kElectronvolt,
-              (r.dissipation[i] - r.fitted_dissipation[i]) / kElectronvolt, r.contact[i], r.jumped[i]);
-    } else {
-      out.row(r.distance[i] * 1e9, r.frequency_shift[i], r.fitted_frequency_shift[i], rf, r.contact[i], r.jumped[i]);
-    }
-  }
+  columns.push_back({"contact", "boolean (0/1)", "the orbit reaches the law's contact gap",
+                     [&r](I i) { return static_cast<bool>(r.contact[i]); }});
+  columns.push_back({"jumped", "boolean (0/1)", "the FM orbit was reached past a fold of the branch",
+                     [&r](I i) { return static_cast<bool>(r.jumped[i]); }});
+  auto rows = out.open(io::TableOf<I>(std::move(columns)));
+  for (I i = 0; i < r.distance.size(); ++i) rows.add(i);
   nlohmann::json results = nlohmann::json::object(), units = nlohmann::json::object();
   std::string summary = fmt::format("fit of law {} to {} points (FM-AFM frequency shift{}, {}): status {} ({})",
                                     options.law, r.distance.size(), diss ? " and dissipation" : "",
@@ -251,21 +248,21 @@ void run_fm_fit(const io::ParamSet& p, Captured* capture, const spectroscopy::Fm
   summary += estimates_of(r, results, units);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   results["rms_frequency_shift"] = r.rms_frequency_shift;
-  results["rms_dissipation"] = diss ? r.rms_dissipation / kElectronvolt : nan;
+  results["rms_dissipation"] = diss ? eV(r.rms_dissipation) : nan;
   results["frequency_shift_noise"] = r.frequency_shift_noise;
-  results["dissipation_noise"] = diss ? r.dissipation_noise / kElectronvolt : nan;
+  results["dissipation_noise"] = diss ? eV(r.dissipation_noise) : nan;
   results["noise_estimated"] = {{"frequency_shift", r.noise_estimated_frequency_shift},
                                 {"dissipation", r.noise_estimated_dissipation}};
   units["rms_frequency_shift"] = "Hz";
-  units["rms_dissipation"] = "eV";
+  units["rms_dissipation"] = eV.name;
   units["frequency_shift_noise"] = "Hz";
-  units["dissipation_noise"] = "eV";
+  units["dissipation_noise"] = eV.name;
   results["units"] = units;
   summary += fmt::format("\n  residual RMS: {}{}; noise σ: {}{}{}", io::quantity(r.rms_frequency_shift, "Hz"),
-                         diss ? ", " + io::quantity(r.rms_dissipation / kElectronvolt, "eV") : std::string(),
+                         diss ? ", " + io::quantity(eV(r.rms_dissipation), eV.name) : std::string(),
                          io::quantity(r.frequency_shift_noise, "Hz"),
                          r.noise_estimated_frequency_shift ? " (estimated)" : "",
-                         diss ? fmt::format(", {}{}", io::quantity(r.dissipation_noise / kElectronvolt, "eV"),
+                         diss ? fmt::format(", {}{}", io::quantity(eV(r.dissipation_noise), eV.name),
                                             r.noise_estimated_dissipation ? " (estimated)" : "")
                               : std::string());
   summary += closing_lines(r);
@@ -287,11 +284,11 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
   refuse_other_mode(p, file.mode);
   if (file.mode == spectroscopy::FitMode::fm) return run_fm_fit(p, capture, file.fm);
   spectroscopy::FitSettings s;
-  s.spring_constant = required(p, "spring_constant", "N/m");
-  s.resonance_frequency = required(p, "resonance_frequency", "kHz") * 1e3;
-  s.quality_factor = required(p, "quality_factor", "dimensionless");
-  s.free_amplitude = required(p, "free_amplitude", "nm") * 1e-9;
-  s.drive_frequency = p.real("drive_frequency") * 1e3;
+  s.spring_constant = required_si(p, "spring_constant", "N/m");
+  s.resonance_frequency = required_si(p, "resonance_frequency", "kHz");
+  s.quality_factor = required_si(p, "quality_factor", "dimensionless");
+  s.free_amplitude = required_si(p, "free_amplitude", "nm");
+  s.drive_frequency = real_si(p, "drive_frequency");
   s.validate();
   const spectroscopy::FitOptions options = fit_options(p, spectroscopy::FitMode::am);
   spectroscopy::fit_parameter_info(options);  // refuses unknown names before the fit
@@ -304,48 +301,50 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
   const io::ParamSet as_run = record_of(p, spectroscopy::FitMode::am);  // CommandOutput keeps a reference
   CommandOutput out(as_run, capture, "spectroscopy fit");
   const bool phase = !r.phase.empty();
-  std::vector<io::Column> columns = {
-      {"distance", "nm", "measured distance (piezo separation; model separation = distance + distance_offset)"},
-      {"amplitude", "nm", "measured amplitude"},
-      {"fitted_amplitude", "nm", "model amplitude at the estimates, as measured (A_model / amplitude_scale)"},
-      {"amplitude_residual", "dimensionless", "(measured − fitted) amplitude / free_amplitude"}};
+  // SI results shown in nm and deg (the output edge: each column's unit converts its values); rows: point indices
+  const units::Unit nm = units::from_si("nm"), deg = units::degrees_from_radians();
+  using I = std::size_t;
+  std::vector<io::ColumnOf<I>> columns = {
+      {"distance", nm, "measured distance (piezo separation; model separation = distance + distance_offset)",
+       [&r](I i) { return r.distance[i]; }},
+      {"amplitude", nm, "measured amplitude", [&r](I i) { return r.amplitude[i]; }},
+      {"fitted_amplitude", nm, "model amplitude at the estimates, as measured (A_model / amplitude_scale)",
+       [&r](I i) { return r.fitted_amplitude[i]; }},
+      {"amplitude_residual", "dimensionless", "(measured − fitted) amplitude / free_amplitude",
+       [&r, &s](I i) { return (r.amplitude[i] - r.fitted_amplitude[i]) / s.free_amplitude; }}};
   if (phase) {
-    columns.push_back({"phase", "deg", "measured phase"});
-    columns.push_back({"fitted_phase", "deg", "model phase at the estimates + phase_offset"});
-    columns.push_back({"phase_residual", "deg", "measured − fitted phase, wrapped to (−180, 180]"});
+    columns.push_back({"phase", deg, "measured phase", [&r](I i) { return r.phase[i]; }});
+    columns.push_back({"fitted_phase", deg, "model phase at the estimates + phase_offset",
+                       [&r](I i) { return r.fitted_phase[i]; }});
+    columns.push_back({"phase_residual", deg, "measured − fitted phase, wrapped to (−180, 180]", [&r](I i) {
+                         return std::remainder(r.phase[i] - r.fitted_phase[i], 2.0 * 3.14159265358979323846);
+                       }});
   }
-  columns.push_back({"contact", "boolean (0/1)", "the orbit reaches the law's contact gap"});
-  columns.push_back({"jumped", "boolean (0/1)", "the response jumped to another branch before this point"});
-  out.open(columns);
-  for (std::size_t i = 0; i < r.distance.size(); ++i) {
-    const double ra = (r.amplitude[i] - r.fitted_amplitude[i]) / s.free_amplitude;
-    if (phase) {
-      const double rp = std::remainder(r.phase[i] - r.fitted_phase[i], 2.0 * 3.14159265358979323846);
-      out.row(r.distance[i] * 1e9, r.amplitude[i] * 1e9, r.fitted_amplitude[i] * 1e9, ra, r.phase[i] / kDeg,
-              r.fitted_phase[i] / kDeg, rp / kDeg, r.contact[i], r.jumped[i]);
-    } else {
-      out.row(r.distance[i] * 1e9, r.amplitude[i] * 1e9, r.fitted_amplitude[i] * 1e9, ra, r.contact[i], r.jumped[i]);
-    }
-  }
+  columns.push_back({"contact", "boolean (0/1)", "the orbit reaches the law's contact gap",
+                     [&r](I i) { return static_cast<bool>(r.contact[i]); }});
+  columns.push_back({"jumped", "boolean (0/1)", "the response jumped to another branch before this point",
+                     [&r](I i) { return static_cast<bool>(r.jumped[i]); }});
+  auto rows = out.open(io::TableOf<I>(std::move(columns)));
+  for (I i = 0; i < r.distance.size(); ++i) rows.add(i);
 
   nlohmann::json results = nlohmann::json::object(), units = nlohmann::json::object();
   std::string summary = fmt::format("fit of law {} to {} points ({}): status {} ({})", options.law, r.distance.size(),
                                     p.text("direction"), spectroscopy::fit_status_name(r.status), r.solver_status);
   summary += estimates_of(r, results, units);
   results["rms_amplitude"] = r.rms_amplitude;
-  results["rms_phase"] = phase ? r.rms_phase / kDeg : std::numeric_limits<double>::quiet_NaN();
+  results["rms_phase"] = phase ? deg(r.rms_phase) : std::numeric_limits<double>::quiet_NaN();
   results["amplitude_noise"] = r.amplitude_noise;
-  results["phase_noise"] = phase ? r.phase_noise / kDeg : std::numeric_limits<double>::quiet_NaN();
+  results["phase_noise"] = phase ? deg(r.phase_noise) : std::numeric_limits<double>::quiet_NaN();
   results["noise_estimated"] = {{"amplitude", r.noise_estimated_amplitude}, {"phase", r.noise_estimated_phase}};
   units["rms_amplitude"] = "dimensionless (A/A0)";
-  units["rms_phase"] = "deg";
+  units["rms_phase"] = deg.name;
   units["amplitude_noise"] = "dimensionless (A/A0)";
-  units["phase_noise"] = "deg";
+  units["phase_noise"] = deg.name;
   results["units"] = units;
   summary += fmt::format("\n  residual RMS: {:.4g} (A/A0){}; noise σ: {:.3g} (A/A0{}){}", r.rms_amplitude,
-                         phase ? fmt::format(", {:.4g} deg", r.rms_phase / kDeg) : std::string(), r.amplitude_noise,
+                         phase ? fmt::format(", {:.4g} deg", deg(r.rms_phase)) : std::string(), r.amplitude_noise,
                          r.noise_estimated_amplitude ? ", estimated" : "",
-                         phase ? fmt::format(", {:.3g} deg{}", r.phase_noise / kDeg,
+                         phase ? fmt::format(", {:.3g} deg{}", deg(r.phase_noise),
                                              r.noise_estimated_phase ? " (estimated)" : "")
                                : std::string());
   summary += closing_lines(r);
@@ -384,11 +383,9 @@ void register_spectroscopy_fit(CLI::App& spectroscopy) {
             .real("amplitude", 0.0, "FM: oscillation amplitude A held by the amplitude loop (required)",
                   io::Range::non_negative())
             .unit("nm")
-            .default_text("required")
-            .real("drive_frequency", 0.0, "AM: drive frequency", io::Range::non_negative())
-            .unit("kHz")
-            .follows("resonance_frequency")
-            .text("direction", "approach", "the branch the curve is: approach (from the largest distance down) or "
+            .default_text("required");
+        add_drive_frequency_param(p);
+        p.text("direction", "approach", "the branch the curve is: approach (from the largest distance down) or "
                                            "retract (after the approach down to the smallest distance)",
                   {"approach", "retract"});
         p.group("Fit")

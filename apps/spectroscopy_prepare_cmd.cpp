@@ -27,6 +27,7 @@
 #include "afmkit/spectroscopy/prepare.hpp"
 #include "command.hpp"
 #include "commands.hpp"
+#include "described_params.hpp"
 #include "python_launch.hpp"
 #include "spectroscopy_prepare.hpp"
 
@@ -157,39 +158,42 @@ io::curves::ReadOptions read_options(const io::ParamSet& p) {
 sp::PrepareOptions prepare_options(const io::ParamSet& p) {
   sp::PrepareOptions o;
   o.calibration.spring_constant = p.was_set("spring_constant") ? p.real("spring_constant") : std::nan("");
-  o.calibration.invols = p.was_set("invols") ? p.real("invols") * 1e-9 : std::nan("");
+  o.calibration.invols = p.was_set("invols") ? real_si(p, "invols") : std::nan("");
   o.baseline_fraction = p.real("baseline_fraction");
   const std::string& m = p.text("contact_method");
   o.contact.method = m == "dmt" ? sp::ContactMethod::dmt
                      : m == "threshold" ? sp::ContactMethod::threshold
                                         : sp::ContactMethod::hertz;
   o.contact.noise_multiple = p.real("noise_multiple");
-  o.contact.fit.tip_radius = p.real("tip_radius") > 0 ? p.real("tip_radius") * 1e-9 : std::nan("");
+  o.contact.fit.tip_radius = p.real("tip_radius") > 0 ? real_si(p, "tip_radius") : std::nan("");
   o.contact.fit.poisson_ratio = p.real("poisson_ratio");
-  o.bin_width = p.real("bin_width") * 1e-9;
+  o.bin_width = real_si(p, "bin_width");
   o.trim_baseline = !p.flag("keep_baseline");
   return o;
 }
 
-const nlohmann::json kUnits = {{"position", "nm"},          {"distance", "nm"},  {"force", "nN"},
-                               {"spring_constant", "N/m"},   {"invols", "nm/V"},  {"baseline_slope", "N/m"},
+// SI results shown in nm, nN, nm/V (the output edge: each unit converts its values and names the unit)
+const units::Unit kNm = units::from_si("nm"), kNn = units::from_si("nN"), kNmPerVolt = units::from_si("nm/V");
+
+const nlohmann::json kUnits = {{"position", kNm.name},       {"distance", kNm.name},     {"force", kNn.name},
+                               {"spring_constant", "N/m"},   {"invols", kNmPerVolt.name}, {"baseline_slope", "N/m"},
                                {"youngs_modulus", "Pa"},     {"hertz_coefficient", "N/m^1.5"},
-                               {"noise", "nN"},              {"bin_width", "nm"}, {"height", "nm"}};
+                               {"noise", kNn.name},          {"bin_width", kNm.name},    {"height", kNm.name}};
 
 nlohmann::json fit_json(const sp::HertzFit& f) {
   return {{"model", sp::to_string(f.model)},
-          {"contact_point", f.contact_point * 1e9},
-          {"contact_point_error", f.contact_point_error * 1e9},
+          {"contact_point", kNm(f.contact_point)},
+          {"contact_point_error", kNm(f.contact_point_error)},
           {"hertz_coefficient", f.coefficient},
           {"hertz_coefficient_error", f.coefficient_error},
-          {"adhesion_offset", f.offset * 1e9},
-          {"adhesion_offset_error", f.offset_error * 1e9},
+          {"adhesion_offset", kNn(f.offset)},
+          {"adhesion_offset_error", kNn(f.offset_error)},
           {"youngs_modulus", f.youngs_modulus},
           {"youngs_modulus_error", f.youngs_modulus_error},
-          {"residual_rms", f.residual_rms * 1e9},
+          {"residual_rms", kNn(f.residual_rms)},
           {"points", f.points},
-          {"position_from", f.position_from * 1e9},
-          {"position_to", f.position_to * 1e9},
+          {"position_from", kNm(f.position_from)},
+          {"position_to", kNm(f.position_to)},
           {"evaluations", f.evaluations},
           {"solver_status", f.solver_status}};
 }
@@ -199,33 +203,33 @@ nlohmann::json curve_json(const sp::CurvePreparation& c) {
       {"origin", c.origin},
       {"spring_constant", c.spring_constant},
       {"spring_constant_source", c.spring_constant_source},
-      {"invols", c.invols * 1e9},
+      {"invols", kNmPerVolt(c.invols)},
       {"invols_source", c.invols_source},
       {"approach_samples", c.approach_samples},
       {"retract_samples", c.retract_samples},
       {"baseline",
-       {{"offset", c.baseline.offset * 1e9},
+       {{"offset", kNn(c.baseline.offset)},
         {"slope", c.baseline.slope},
-        {"noise", c.baseline.residual_rms * 1e9},
-        {"level_error", c.baseline.level_error * 1e9},
+        {"noise", kNn(c.baseline.residual_rms)},
+        {"level_error", kNn(c.baseline.level_error)},
         {"slope_error", c.baseline.slope_error},
-        {"mean_height", c.baseline.mean_height * 1e9},
+        {"mean_height", kNm(c.baseline.mean_height)},
         {"points", c.baseline.points},
-        {"height_from", c.baseline.height_from * 1e9},
-        {"height_to", c.baseline.height_to * 1e9}}},
+        {"height_from", kNm(c.baseline.height_from)},
+        {"height_to", kNm(c.baseline.height_to)}}},
       {"contact",
        {{"method", sp::to_string(c.contact.method)},
-        {"position", c.contact.position * 1e9},
-        {"error", c.contact.error * 1e9},
-        {"baseline_error", c.contact.baseline_error * 1e9},
-        {"threshold_position", c.contact.threshold_position * 1e9}}},
+        {"position", kNm(c.contact.position)},
+        {"error", kNm(c.contact.error)},
+        {"baseline_error", kNm(c.contact.baseline_error)},
+        {"threshold_position", kNm(c.contact.threshold_position)}}},
       {"notes", c.notes}};
   if (c.contact.fit) j["contact"]["fit"] = fit_json(*c.contact.fit);
   return j;
 }
 
 nlohmann::json event_json(const sp::CurveEvent& e) {
-  return {{"detected", e.detected}, {"distance", e.distance * 1e9}, {"force", e.force * 1e9}};
+  return {{"detected", e.detected}, {"distance", kNm(e.distance)}, {"force", kNn(e.force)}};
 }
 
 /// The law file's text, as the table writer writes it (shortest round-trip numbers, empty cells past a branch).
@@ -316,7 +320,7 @@ std::string summary_text(const sp::PreparedCurve& r, const nlohmann::json& resul
   for (const auto& c : r.curves) {
     s += fmt::format("  {}: k = {:.6g} N/m ({}), InvOLS = {}\n", c.origin, c.spring_constant, c.spring_constant_source,
                      std::isnan(c.invols) ? std::string("not needed")
-                                          : fmt::format("{:.6g} nm/V ({})", c.invols * 1e9, c.invols_source));
+                                          : fmt::format("{:.6g} {} ({})", kNmPerVolt(c.invols), kNmPerVolt.name, c.invols_source));
     s += fmt::format("    baseline: offset {} at z = 0, tilt {:.4g} N/m, noise sigma {} ({} samples)\n",
                      q(c.baseline.offset, "N"), c.baseline.slope, q(c.baseline.residual_rms, "N"), c.baseline.points);
     s += fmt::format("    contact point ({}): tip position {} +- {}\n", sp::to_string(c.contact.method),
@@ -369,7 +373,7 @@ void run_prepare_curves(const io::ParamSet& p, const std::vector<io::curves::Raw
       pick > 0 ? sp::prepare({curves[static_cast<std::size_t>(pick - 1)]}, prepare_options(p))
                : sp::prepare(curves, prepare_options(p));
   io::ParamSet as_run = p;  // the sidecar records the values used (computed defaults filled in)
-  as_run.record_used("bin_width", r.bin_width * 1e9);
+  record_used_si(as_run, "bin_width", r.bin_width);
   // k and InvOLS taken from the file: recorded when every curve used the same (else each curve's are in the results)
   const auto same = [&](auto value) {
     return std::all_of(r.curves.begin(), r.curves.end(), [&](const auto& c) { return value(c) == value(r.curves[0]); });
@@ -378,7 +382,7 @@ void run_prepare_curves(const io::ParamSet& p, const std::vector<io::curves::Raw
     if (!p.was_set("spring_constant") && same([](const auto& c) { return c.spring_constant; }))
       as_run.record_used("spring_constant", r.curves[0].spring_constant);
     if (!p.was_set("invols") && std::isfinite(r.curves[0].invols) && same([](const auto& c) { return c.invols; }))
-      as_run.record_used("invols", r.curves[0].invols * 1e9);
+      record_used_si(as_run, "invols", r.curves[0].invols);
   }
 
   // the check: the table as written, read back by the table law's reader and law
@@ -403,11 +407,11 @@ void run_prepare_curves(const io::ParamSet& p, const std::vector<io::curves::Raw
   for (const auto& c : r.curves) curves_json.push_back(curve_json(c));
   nlohmann::json results = {{"status", status},
                             {"curves", curves_json},
-                            {"noise", r.noise * 1e9},
-                            {"bin_width", r.bin_width * 1e9},
+                            {"noise", kNn(r.noise)},
+                            {"bin_width", kNm(r.bin_width)},
                             {"approach_points", r.approach.size()},
                             {"retract_points", r.retract.size()},
-                            {"trimmed_at", r.trimmed_at * 1e9},
+                            {"trimmed_at", kNm(r.trimmed_at)},
                             {"snap_in", event_json(r.snap_in)},
                             {"pull_off", event_json(r.pull_off)},
                             {"units", kUnits}};

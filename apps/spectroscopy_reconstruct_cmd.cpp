@@ -18,6 +18,9 @@
 #include "afmkit/spectroscopy/reconstruct_law.hpp"
 #include "command.hpp"
 #include "commands.hpp"
+#include "described_params.hpp"
+#include "spectroscopy_params.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -47,6 +50,11 @@ nlohmann::json notes_json(const std::vector<std::string>& notes) {
   return j;
 }
 
+/// A column read from the i-th element of `values` (a curve's per-point results; rows are point indices).
+auto element_of(const std::vector<double>& values) {
+  return [&values](std::size_t i) { return values[i]; };
+}
+
 std::string notes_text(const std::vector<std::string>& notes) {
   std::string s;
   for (const auto& n : notes) s += "\nnote: " + n;
@@ -56,8 +64,8 @@ std::string notes_text(const std::vector<std::string>& notes) {
 void run_fm(const io::ParamSet& p, Captured* capture, const spectroscopy::MeasuredCurve& m) {
   std::string method = p.text("method");
   if (method == "auto") method = "sader_jarvis";
-  const spectroscopy::FmSettings s(p.real("spring_constant"), p.real("resonance_frequency") * 1e3,
-                                   p.real("amplitude") * 1e-9);
+  const spectroscopy::FmSettings s(real_si(p, "spring_constant"), real_si(p, "resonance_frequency"),
+                                   real_si(p, "amplitude"));
   spectroscopy::FmOptions o;
   o.method = spectroscopy::fm_method_from(method);
   o.tail = spectroscopy::tail_model_from(p.text("tail"));
@@ -67,43 +75,46 @@ void run_fm(const io::ParamSet& p, Captured* capture, const spectroscopy::Measur
   o.quality_factor = p.real("quality_factor");
   const auto r = spectroscopy::reconstruct_fm({m.distance, m.frequency_shift}, s, o);
 
+  // SI results shown in nm, nN, aJ (the output edge: each column's unit converts its values)
+  const units::Unit nm = units::from_si("nm"), nN = units::from_si("nN"), aJ = units::from_si("aJ"),
+                    Hz = units::from_si("Hz");
   CommandOutput out(p, capture, "spectroscopy reconstruct");
-  out.open({{"distance", "nm", "closest tip–sample distance of the oscillation"},
-            {"frequency_shift", "Hz", "measured frequency shift"},
-            {"force", "nN", "reconstructed tip–sample force (positive repulsive)"},
-            {"force_uncertainty", "nN", "1σ of the force from the noise estimated in the frequency shift"},
-            {"energy", "aJ", "interaction energy U(z) = ∫_z^∞ F dt"},
-            {"round_trip_frequency_shift", "Hz",
-             "frequency shift of the reconstructed law by the first-order large-amplitude formula"},
-            {"residual", "Hz", "round trip − measured"}});
-  for (std::size_t i = 0; i < r.distance.size(); ++i)
-    out.row(r.distance[i] * 1e9, r.frequency_shift[i], r.force[i] * 1e9, r.force_uncertainty[i] * 1e9,
-            r.energy[i] * 1e18, r.round_trip_frequency_shift[i], r.residual[i]);
+  auto rows = out.open(io::TableOf<std::size_t>{
+      {"distance", nm, "closest tip–sample distance of the oscillation", element_of(r.distance)},
+      {"frequency_shift", Hz, "measured frequency shift", element_of(r.frequency_shift)},
+      {"force", nN, "reconstructed tip–sample force (positive repulsive)", element_of(r.force)},
+      {"force_uncertainty", nN, "1σ of the force from the noise estimated in the frequency shift",
+       element_of(r.force_uncertainty)},
+      {"energy", aJ, "interaction energy U(z) = ∫_z^∞ F dt", element_of(r.energy)},
+      {"round_trip_frequency_shift", Hz,
+       "frequency shift of the reconstructed law by the first-order large-amplitude formula",
+       element_of(r.round_trip_frequency_shift)},
+      {"residual", Hz, "round trip − measured", element_of(r.residual)}});
+  for (std::size_t i = 0; i < r.distance.size(); ++i) rows.add(i);
   const std::string law_path = p.text("law_output");
   if (!law_path.empty())
     add_law_file(out, law_path, r.law, fmt::format("force reconstructed by afmkit spectroscopy reconstruct ({}, FM) "
                                                    "from {}", r.method, p.text("input")), "any (a conservative law: both branches equal)");
   double f_min = 0.0;
   for (double f : r.force) f_min = std::min(f_min, f);
-  nlohmann::json results = {{"mode", "fm"},
-                            {"method", r.method},
-                            {"tail", spectroscopy::to_string(r.tail.active ? spectroscopy::TailModel::exponential
-                                                                           : spectroscopy::TailModel::zero)},
-                            {"points", r.distance.size()},
-                            {"largest_attraction", f_min * 1e9},
-                            {"noise", r.noise},
-                            {"interaction_length", r.interaction_length * 1e9},
-                            {"tail_sensitivity", r.tail_sensitivity * 1e9},
-                            {"residual_rms", r.residual_rms},
-                            {"residual_max", r.residual_max},
-                            {"round_trip_model", r.round_trip_model},
-                            {"law_output", law_path},
-                            {"status", "ok"},
-                            {"notes", notes_json(r.notes)},
-                            {"units",
-                             {{"largest_attraction", "nN"}, {"noise", "Hz"}, {"interaction_length", "nm"},
-                              {"tail_sensitivity", "nN"}, {"residual_rms", "Hz"}, {"residual_max", "Hz"},
-                              {"points", "count"}}}};
+  UnitTagged tagged;
+  tagged.add("mode", "fm")
+      .add("method", r.method)
+      .add("tail", spectroscopy::to_string(r.tail.active ? spectroscopy::TailModel::exponential
+                                                         : spectroscopy::TailModel::zero))
+      .add("points", r.distance.size(), "count")
+      .add("largest_attraction", f_min, nN)
+      .add("noise", r.noise, Hz)
+      .add("interaction_length", r.interaction_length, nm)
+      .add("tail_sensitivity", r.tail_sensitivity, nN)
+      .add("residual_rms", r.residual_rms, Hz)
+      .add("residual_max", r.residual_max, Hz)
+      .add("round_trip_model", r.round_trip_model)
+      .add("law_output", law_path)
+      .add("status", "ok")
+      .add("notes", notes_json(r.notes));
+  nlohmann::json results = tagged.values();
+  results["units"] = tagged.units();
   const std::string summary = fmt::format(
       "FM reconstruction ({}, {} points): largest attraction {}; round trip ({}): residual {} rms, {} max; noise "
       "{}{}",
@@ -116,6 +127,9 @@ void run_fm(const io::ParamSet& p, Captured* capture, const spectroscopy::Measur
 void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurve m) {
   const std::string& file = p.text("input");
   const bool mirrored = p.text("phase_convention") == "mirrored";
+  // SI results shown in nm, nN, aJ, deg (the output edge: each column's unit converts its values)
+  const units::Unit nm = units::from_si("nm"), nN = units::from_si("nN"), aJ = units::from_si("aJ"),
+                    deg = units::degrees_from_radians(), rad = units::from_si("rad");
   for (std::size_t i = 0; i < m.phase.size(); ++i) {
     if (mirrored) m.phase[i] = std::numbers::pi - m.phase[i];
     if (!(m.amplitude[i] > 0.0))
@@ -124,14 +138,13 @@ void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurv
     if (!(m.phase[i] > 0.0 && m.phase[i] < std::numbers::pi))
       throw InputError(fmt::format("{}:{}: column phase: {}° ({}) is out of range: must be in (0°, 180°), the lag "
                                    "of the response behind the drive (phase_convention = lag; docs/conventions.md)",
-                                   file, m.lines[i], m.phase[i] * 180.0 / std::numbers::pi,
-                                   mirrored ? "after mirroring" : "as given"));
+                                   file, m.lines[i], deg(m.phase[i]), mirrored ? "after mirroring" : "as given"));
   }
   std::string method = p.text("method");
   if (method == "auto") method = "payam";
-  const double f0 = p.real("resonance_frequency") * 1e3;
-  const spectroscopy::AmSettings s(p.real("spring_constant"), f0, p.real("quality_factor"),
-                                   p.real("free_amplitude") * 1e-9, p.real("drive_frequency") * 1e3);
+  const spectroscopy::AmSettings s(real_si(p, "spring_constant"), real_si(p, "resonance_frequency"),
+                                   p.real("quality_factor"), real_si(p, "free_amplitude"),
+                                   real_si(p, "drive_frequency"));
   spectroscopy::AmOptions o;
   o.method = spectroscopy::am_method_from(method);
   if (o.method == spectroscopy::AmMethod::katan)  // Katan's equivalent oscillator needs 1 + 2 Ω_eq > 0
@@ -140,40 +153,54 @@ void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurv
         throw InputError(fmt::format("{}:{}: column phase: {}° with amplitude {} nm has no equivalent oscillator for "
                                      "method katan: 1 + (A0/(Q A)) cos φ must be > 0 (use payam or hoelscher; "
                                      "docs/reconstruction.md#am-sources)",
-                                     file, m.lines[i], m.phase[i] * 180.0 / std::numbers::pi, m.amplitude[i] * 1e9));
+                                     file, m.lines[i], deg(m.phase[i]), nm(m.amplitude[i])));
   o.tail = spectroscopy::tail_model_from(p.text("tail"));
   o.round_trip_points = static_cast<int>(p.integer("round_trip_points"));
   const auto r = spectroscopy::reconstruct_am({m.distance, m.amplitude, m.phase}, s, o);
 
-  CommandOutput out(p, capture, "spectroscopy reconstruct");
-  out.open({{"separation", "nm", "measured separation l (rest position of the tip above the sample)"},
-            {"amplitude_ratio", "dimensionless", "measured A/A0"},
-            {"phase", "rad", "measured phase lag (afmkit's convention)"},
-            {"dissipation", "aJ", "energy dissipated per cycle (first-harmonic balance)"},
-            {"gap", "nm", "lower turning point D = l − A (empty: point not used)"},
-            {"force", "nN", "reconstructed conservative force at D"},
-            {"force_uncertainty", "nN", "1σ of the force from the noise estimated in amplitude and phase"},
-            {"approach_force", "nN", "approach branch of the law at D"},
-            {"retract_force", "nN", "retract branch of the law at D"},
-            {"round_trip_amplitude_ratio", "dimensionless", "A/A0 of the law's exact orbit (approach sweep)"},
-            {"round_trip_phase", "rad", "phase of the law's exact orbit"},
-            {"residual_amplitude_ratio", "dimensionless", "round trip − measured"},
-            {"residual_phase", "rad", "round trip − measured"}});
-  // the per-point force lives on the points used (ascending D = ascending l among them)
-  std::size_t k = 0;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (std::size_t i = 0; i < r.separation.size(); ++i) {
+  // the per-point force lives on the points used (ascending D = ascending l among them): row i, and k of the force
+  struct AmRow {
+    std::size_t i;
+    std::size_t k;
+    bool used;
+  };
+  std::vector<AmRow> am_rows;
+  for (std::size_t i = 0, k = 0; i < r.separation.size(); ++i) {
     const double d = r.separation[i] - r.amplitude[i];
     const bool used = k < r.gap.size() && std::abs(r.gap[k] - d) <= 1e-15;
-    out.row(r.separation[i] * 1e9, r.amplitude[i] / s.free_amplitude, r.phase[i], r.dissipation[i] * 1e18,
-            used ? d * 1e9 : nan, used ? r.force[k] * 1e9 : nan, used ? r.force_uncertainty[k] * 1e9 : nan,
-            used ? r.approach_force[k] * 1e9 : nan,
-            used ? r.retract_force[k] * 1e9 : nan, r.round_trip_amplitude_ratio.empty() ? nan : r.round_trip_amplitude_ratio[i],
-            r.round_trip_phase.empty() ? nan : r.round_trip_phase[i],
-            r.residual_amplitude_ratio.empty() ? nan : r.residual_amplitude_ratio[i],
-            r.residual_phase.empty() ? nan : r.residual_phase[i]);
+    am_rows.push_back({i, k, used});
     if (used) ++k;
   }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto at_used = [nan](const std::vector<double>& v) {
+    return [&v, nan](const AmRow& w) { return w.used ? v[w.k] : nan; };
+  };
+  const auto round_trip = [nan](const std::vector<double>& v) {
+    return [&v, nan](const AmRow& w) { return v.empty() ? nan : v[w.i]; };
+  };
+  CommandOutput out(p, capture, "spectroscopy reconstruct");
+  out.open(io::TableOf<AmRow>{
+               {"separation", nm, "measured separation l (rest position of the tip above the sample)",
+                [&r](const AmRow& w) { return r.separation[w.i]; }},
+               {"amplitude_ratio", "dimensionless", "measured A/A0",
+                [&r, &s](const AmRow& w) { return r.amplitude[w.i] / s.free_amplitude; }},
+               {"phase", rad, "measured phase lag (afmkit's convention)", [&r](const AmRow& w) { return r.phase[w.i]; }},
+               {"dissipation", aJ, "energy dissipated per cycle (first-harmonic balance)",
+                [&r](const AmRow& w) { return r.dissipation[w.i]; }},
+               {"gap", nm, "lower turning point D = l − A (empty: point not used)",
+                [&r, nan](const AmRow& w) { return w.used ? r.separation[w.i] - r.amplitude[w.i] : nan; }},
+               {"force", nN, "reconstructed conservative force at D", at_used(r.force)},
+               {"force_uncertainty", nN, "1σ of the force from the noise estimated in amplitude and phase",
+                at_used(r.force_uncertainty)},
+               {"approach_force", nN, "approach branch of the law at D", at_used(r.approach_force)},
+               {"retract_force", nN, "retract branch of the law at D", at_used(r.retract_force)},
+               {"round_trip_amplitude_ratio", "dimensionless", "A/A0 of the law's exact orbit (approach sweep)",
+                round_trip(r.round_trip_amplitude_ratio)},
+               {"round_trip_phase", rad, "phase of the law's exact orbit", round_trip(r.round_trip_phase)},
+               {"residual_amplitude_ratio", "dimensionless", "round trip − measured",
+                round_trip(r.residual_amplitude_ratio)},
+               {"residual_phase", rad, "round trip − measured", round_trip(r.residual_phase)}})
+      .add_all(am_rows);
   const std::string law_path = p.text("law_output");
   if (!law_path.empty())
     add_law_file(out, law_path, r.law, fmt::format("force reconstructed by afmkit spectroscopy reconstruct ({}, AM) "
@@ -181,28 +208,27 @@ void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurv
   double f_min = 0.0, e_max = 0.0;
   for (double f : r.force) f_min = std::min(f_min, f);
   for (double e : r.dissipation) e_max = std::max(e_max, e);
-  nlohmann::json results = {{"mode", "am"},
-                            {"method", r.method},
-                            {"points", r.separation.size()},
-                            {"points_used", r.gap.size()},
-                            {"largest_attraction", f_min * 1e9},
-                            {"largest_dissipation", e_max * 1e18},
-                            {"contact_gap", r.contact_gap * 1e9},
-                            {"rms_amplitude_ratio", r.rms_amplitude_ratio},
-                            {"rms_phase", r.rms_phase},
-                            {"round_trip_model", r.round_trip_model},
-                            {"law_output", law_path},
-                            {"status", "ok"},
-                            {"notes", notes_json(r.notes)},
-                            {"units",
-                             {{"largest_attraction", "nN"}, {"largest_dissipation", "aJ"}, {"contact_gap", "nm"},
-                              {"rms_amplitude_ratio", "dimensionless"}, {"rms_phase", "rad"}, {"points", "count"},
-                              {"points_used", "count"}}}};
+  UnitTagged tagged;
+  tagged.add("mode", "am")
+      .add("method", r.method)
+      .add("points", r.separation.size(), "count")
+      .add("points_used", r.gap.size(), "count")
+      .add("largest_attraction", f_min, nN)
+      .add("largest_dissipation", e_max, aJ)
+      .add("contact_gap", r.contact_gap, nm)
+      .add("rms_amplitude_ratio", r.rms_amplitude_ratio, "dimensionless")
+      .add("rms_phase", r.rms_phase, rad)
+      .add("round_trip_model", r.round_trip_model)
+      .add("law_output", law_path)
+      .add("status", "ok")
+      .add("notes", notes_json(r.notes));
+  nlohmann::json results = tagged.values();
+  results["units"] = tagged.units();
   const std::string summary = fmt::format(
       "AM reconstruction ({}, {} of {} points used): largest attraction {}, largest dissipation {} per cycle; round "
       "trip (exact orbits): A/A0 {:.2g} rms, phase {:.3g}° rms{}",
       r.method, r.gap.size(), r.separation.size(), io::quantity(f_min, "N"), io::quantity(e_max, "J"),
-      r.rms_amplitude_ratio, r.rms_phase * 180.0 / std::numbers::pi, notes_text(r.notes));
+      r.rms_amplitude_ratio, deg(r.rms_phase), notes_text(r.notes));
   out.finish(results, summary);
 }
 
@@ -270,9 +296,8 @@ void register_spectroscopy_reconstruct(CLI::App& spectroscopy) {
                   "quality factor Q (AM: required; FM: of the cantilever of the exact round trip, which Δf hardly "
                   "depends on)",
                   positive_below(1e9))
-            .unit("dimensionless")
-            .real("drive_frequency", 0.0, "AM: drive frequency (0: f0)", io::Range::closed(0.0, 1e7))
-            .unit("kHz");
+            .unit("dimensionless");
+        add_drive_frequency_param(p);
         p.group("Reconstruction")
             .integer("noise_realisations", 8, "FM: synthetic noise realisations for the force uncertainty (0: none)",
                      0, 1000)

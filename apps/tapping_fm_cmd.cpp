@@ -26,17 +26,20 @@ namespace afmkit::cli {
 namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
-constexpr double kJoulePerAttojoule = 1e-18;
-constexpr double kElectronvolt = 1.602176634e-19;  // J
-
-/// The FM table's units: physical (nm, Hz, J, nN) or normalised (L, cycles per t, L²/t², L/t²).
+/// The FM table's units: physical (nm, Hz, J, nN) or normalised (L, cycles per t, L²/t², L/t²), each converting
+/// a model quantity into the user's unit (afmkit/core/units.hpp).
 struct FmUnits {
   bool physical;
-  TappingScales s;
-  std::string frequency() const { return physical ? "Hz" : "1/t"; }
-  std::string energy() const { return physical ? "J" : s.energy_unit; }
-  double frequency_factor() const { return 1.0 / (2.0 * std::numbers::pi * s.time); }  // ω [rad/t] -> f
-  double energy_factor() const { return physical ? s.energy * kJoulePerAttojoule : 1.0; }
+  TappingUnits t;         // length, force
+  units::Unit frequency;  // ω [rad/t] -> f
+  units::Unit energy;     // the model's energy -> J (aJ per model unit, in J) or L^2/t^2
+  units::Unit energy_ev;  // the same in eV
+  FmUnits(bool physical_units, const TappingScales& s)
+      : physical(physical_units),
+        t(s),
+        frequency{physical ? "Hz" : "1/t", 1.0 / (2.0 * std::numbers::pi * s.time)},
+        energy{physical ? "J" : s.energy_unit, physical ? s.energy * units::si_unit("aJ").to_si : 1.0},
+        energy_ev{"eV", energy.multiply, units::si_unit("eV").to_si} {}
 };
 
 /// A value of the orbit at a point, nan where Newton found none.
@@ -50,32 +53,31 @@ auto of_orbit(F value) {
 io::TableOf<tapping::FmPoint> fm_table(const FmUnits& u, double wn, bool at_gap) {
   using P = tapping::FmPoint;
   using O = tapping::FmOrbit;
-  const std::string L = u.s.length_unit;
-  const double l = u.s.length, force = u.s.force, ff = u.frequency_factor(), ef = u.energy_factor();
+  const units::Unit& L = u.t.length;
   const bool physical = u.physical;
   return {{"separation", L, "separation l: rest position of the tip above the sample surface",
-           [l, at_gap](const P& p) { return p.orbit ? p.orbit->separation * l : at_gap ? kNan : p.separation * l; }},
+           [at_gap](const P& p) { return p.orbit ? p.orbit->separation : at_gap ? kNan : p.separation; }},
           {"min_gap", L, "tip-sample distance at the lower turning point (smallest gap x + l over the cycle)",
-           [l, at_gap](const P& p) { return p.orbit ? p.orbit->metrics.min_gap * l : at_gap ? p.separation * l : kNan; }},
-          {"frequency_shift", u.frequency(), "frequency shift Δf = f − f0 of the oscillation (f0: the free resonance)",
-           of_orbit([ff](const O& o) { return o.frequency_shift() * ff; })},
+           [at_gap](const P& p) { return p.orbit ? p.orbit->metrics.min_gap : at_gap ? p.separation : kNan; }},
+          {"frequency_shift", u.frequency, "frequency shift Δf = f − f0 of the oscillation (f0: the free resonance)",
+           of_orbit([](const O& o) { return o.frequency_shift(); })},
           {"relative_frequency_shift", "dimensionless", "Δf/f0",
            of_orbit([wn](const O& o) { return o.frequency_shift() / wn; })},
-          {"frequency", u.frequency(), "oscillation frequency f held by the phase-locked loop",
-           of_orbit([ff](const O& o) { return o.state.frequency * ff; })},
+          {"frequency", u.frequency, "oscillation frequency f held by the phase-locked loop",
+           of_orbit([](const O& o) { return o.state.frequency; })},
           {"drive_ratio", "dimensionless", "drive amplitude over the free cantilever's drive at the same amplitude",
            of_orbit([](const O& o) { return o.drive_ratio(); })},
-          {"dissipation", u.energy(), "energy taken by the tip-sample force per cycle (−∫ F dz; = drive work − viscous loss)",
-           of_orbit([ef](const O& o) { return o.tip_dissipation() * ef; })},
-          {"dissipation_ev", "eV", "the same in eV (nan in normalised units)",
-           of_orbit([ef, physical](const O& o) { return physical ? o.tip_dissipation() * ef / kElectronvolt : kNan; })},
-          {"peak_force", u.s.force_unit, "largest tip-sample force over the cycle (positive: repulsive)",
-           of_orbit([force](const O& o) { return o.metrics.peak_force * force; })},
-          {"offset", L, "mean deflection of the tip over the cycle", of_orbit([l](const O& o) { return o.metrics.offset * l; })},
+          {"dissipation", u.energy, "energy taken by the tip-sample force per cycle (−∫ F dz; = drive work − viscous loss)",
+           of_orbit([](const O& o) { return o.tip_dissipation(); })},
+          {"dissipation_ev", u.energy_ev, "the same in eV (nan in normalised units)",
+           of_orbit([physical](const O& o) { return physical ? o.tip_dissipation() : kNan; })},
+          {"peak_force", u.t.force, "largest tip-sample force over the cycle (positive: repulsive)",
+           of_orbit([](const O& o) { return o.metrics.peak_force; })},
+          {"offset", L, "mean deflection of the tip over the cycle", of_orbit([](const O& o) { return o.metrics.offset; })},
           {"amplitude", L, "first-harmonic amplitude of the deflection (= the setpoint A at convergence)",
-           of_orbit([l](const O& o) { return o.metrics.amplitude * l; })},
+           of_orbit([](const O& o) { return o.metrics.amplitude; })},
           {"harmonic_2", L, "amplitude of the 2nd harmonic of the deflection",
-           of_orbit([l](const O& o) { return o.metrics.harmonics[0] * l; })},
+           of_orbit([](const O& o) { return o.metrics.harmonics[0]; })},
           {"contact_fraction", "dimensionless", "fraction of the cycle with the gap below the law's contact gap",
            of_orbit([](const O& o) { return o.metrics.contact_fraction; })},
           {"floquet_max", "dimensionless", "largest Floquet multiplier modulus with the drive frozen (loops held)",
@@ -95,10 +97,10 @@ io::TableOf<tapping::FmPoint> fm_table(const FmUnits& u, double wn, bool at_gap)
 void run_fm(const io::ParamSet& p, Captured* capture) {
   reject_keys_not_for_fm(p);
   const tapping::TappingModel base = tapping_model_from(p, law_object_of(capture));
-  const FmUnits u{p.text("units") == "physical", tapping_scales_from(p)};
-  const std::vector<double> separations = fm_separations(p, u.s.length);
+  const FmUnits u(p.text("units") == "physical", tapping_scales_from(p));
+  const std::vector<double> separations = fm_separations(p, u.t.length);
   memory::require_fits("points", static_cast<double>(separations.size()), sizeof(tapping::FmPoint));
-  const tapping::FmSetting setting(base.cantilever, base.law, fm_amplitude(p, u.s.length));
+  const tapping::FmSetting setting(base.cantilever, base.law, fm_amplitude(p, u.t.length));
   tapping::FmSweepOptions options;
   options.fm.shooting = shooting_options_from(p);
   options.max_bisections = static_cast<int>(p.integer("max_bisections"));
@@ -116,12 +118,11 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
 
   CommandOutput out(p, capture, "tapping fm");
   out.open(fm_table(u, base.cantilever.natural_frequency, at_gap)).add_all(r.points);
-  const double ff = u.frequency_factor(), ef = u.energy_factor();
   const double wn = base.cantilever.natural_frequency;
   const long n = static_cast<long>(r.points.size()), converged = r.converged();
   nlohmann::json results;
-  results["amplitude"] = setting.amplitude * u.s.length;
-  results["resonance_frequency"] = wn * ff;
+  results["amplitude"] = u.t.length(setting.amplitude);
+  results["resonance_frequency"] = u.frequency(wn);
   results["rows"] = n;
   results["converged_rows"] = converged;
   results["jumped_rows"] = std::count_if(r.points.begin(), r.points.end(), [](const auto& q) { return q.jumped; });
@@ -138,8 +139,7 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
                     : converged < n ? fmt::format("no FM orbit at {} of {} separations (rows with status no_orbit)",
                                                   n - converged, n)
                                     : std::string();
-  const std::string L = u.s.length_unit;
-  results["units"] = {{"amplitude", L}, {"resonance_frequency", u.frequency()}, {"rows", "count"},
+  results["units"] = {{"amplitude", u.t.length.name}, {"resonance_frequency", u.frequency.name}, {"rows", "count"},
                       {"converged_rows", "count"}, {"jumped_rows", "count"}, {"no_orbit_rows", "count"}, {"evaluations", "count"},
                       {"failed_attempts", "count"}, {"seconds", "s"}, {"seconds_per_separation", "s"}};
   // summary: the closest point reached
@@ -147,7 +147,7 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
   const tapping::FmPoint* last = nullptr;
   for (const auto& pt : r.points)
     if (pt.orbit) last = &pt;
-  auto length = [&](double v) { return u.physical ? io::quantity(v * u.s.length, "nm") : fmt::format("{:.6g} L", v); };
+  auto length = [&](double v) { return u.physical ? io::quantity(u.t.length(v), u.t.length.name) : fmt::format("{:.6g} L", v); };
   if (last) {
     const auto& o = *last->orbit;
     summary = fmt::format(
@@ -155,11 +155,12 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
         "closest: separation {}, turning point {}: Δf = {} (Δf/f0 = {:.4g}), drive ratio {:.6g}, dissipation {}",
         length(setting.amplitude), converged, n, r.evaluations, io::quantity(results["seconds_per_separation"], "s"),
         length(o.separation), length(o.metrics.min_gap),
-        u.physical ? io::quantity(o.frequency_shift() * ff, "Hz") : fmt::format("{:.6g} 1/t", o.frequency_shift() * ff),
+        u.physical ? io::quantity(u.frequency(o.frequency_shift()), u.frequency.name)
+                   : fmt::format("{:.6g} {}", u.frequency(o.frequency_shift()), u.frequency.name),
         o.frequency_shift() / wn, o.drive_ratio(),
-        u.physical ? fmt::format("{} ({:.4g} eV)", io::quantity(o.tip_dissipation() * ef, "J"),
-                                 o.tip_dissipation() * ef / kElectronvolt)
-                   : fmt::format("{:.6g} {}", o.tip_dissipation(), u.energy()));
+        u.physical ? fmt::format("{} ({:.4g} {})", io::quantity(u.energy(o.tip_dissipation()), u.energy.name),
+                                 u.energy_ev(o.tip_dissipation()), u.energy_ev.name)
+                   : fmt::format("{:.6g} {}", u.energy(o.tip_dissipation()), u.energy.name));
   }
   if (const std::string note = results["note"].get<std::string>(); !note.empty()) {
     if (!summary.empty()) summary += '\n';

@@ -33,14 +33,9 @@ void add_tapping_fm_params(io::ParamSet& p) {
       .real("amplitude", 5.0, "oscillation amplitude A held by the amplitude controller (first harmonic of the "
                               "deflection)",
             {0.0, 1e6, true, false})
-      .unit(kLengthUnit)
-      .real("separation_min", 3.0, "smallest separation (rest position to surface) of the approach",
-            io::Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .real("separation_max", 10.0, "largest separation, where the approach starts; > separation_min",
-            io::Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .integer("points", 71, "separations of the approach (>= 2)", 2, 10000000);
+      .unit(kLengthUnit);
+  add_separation_range_params(p, 3.0, 10.0);
+  p.integer("points", 71, "separations of the approach (>= 2)", 2, 10000000);
   add_separation_list_params(p, "explicit separations instead of the uniform grid (any order; run from the largest)");
   p.text("axis", "separation",
             "what separation_min, separation_max and separations set: separation (the rest position l, stepped as an "
@@ -58,7 +53,7 @@ void reject_keys_not_for_fm(const io::ParamSet& p) {
     if (p.was_set(key)) throw InvalidParameter(key, fmt::format("{} does not apply to tapping fm: {}", key, why));
 }
 
-std::vector<double> fm_separations(const io::ParamSet& p, double length_scale) {
+std::vector<double> fm_separations(const io::ParamSet& p, const units::Unit& length) {
   if (p.was_set("separations") && p.was_set("separations_file"))
     throw InvalidParameter("separations", "give either separations or separations_file, not both");
   std::vector<double> list;
@@ -81,11 +76,11 @@ std::vector<double> fm_separations(const io::ParamSet& p, double length_scale) {
     const long n = p.integer("points");
     for (long i = 0; i < n; ++i) list.push_back(lo + (hi - lo) * static_cast<double>(i) / static_cast<double>(n - 1));
   }
-  for (double& l : list) l /= length_scale;
+  for (double& l : list) l = length.internal(l);
   std::sort(list.begin(), list.end(), std::greater<>());
   return list;
 }
 
-double fm_amplitude(const io::ParamSet& p, double length_scale) { return p.real("amplitude") / length_scale; }
+double fm_amplitude(const io::ParamSet& p, const units::Unit& length) { return length.internal(p.real("amplitude")); }
 
 }  // namespace afmkit::cli

@@ -3,6 +3,7 @@
 // tapping_sim_params.hpp): the amplitude setpoint, the separations, the continuation's bisections.
 #include <vector>
 
+#include "afmkit/core/units.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/tapping/fm.hpp"
 #include "afmkit/tapping/units.hpp"
@@ -18,8 +19,8 @@ void add_tapping_fm_params(io::ParamSet& p);
 void reject_keys_not_for_fm(const io::ParamSet& p);
 /// The separations (model units), in decreasing order (an approach): the explicit list when one is given, else
 /// `points` equally spaced in [separation_min, separation_max].
-std::vector<double> fm_separations(const io::ParamSet& p, double length_scale);
+std::vector<double> fm_separations(const io::ParamSet& p, const units::Unit& length);
 /// The amplitude setpoint A in model units.
-double fm_amplitude(const io::ParamSet& p, double length_scale);
+double fm_amplitude(const io::ParamSet& p, const units::Unit& length);
 
 }  // namespace afmkit::cli

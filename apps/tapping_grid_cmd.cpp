@@ -52,7 +52,7 @@ std::string fingerprint(const std::string& text) {
 }
 
 void run_grid(const io::ParamSet& p, Captured* capture) {
-  const TappingScales scales = tapping_scales_from(p);
+  const TappingUnits u(tapping_scales_from(p));
   const double lo = p.real("separation_min"), hi = p.real("separation_max");
   if (!(lo < hi))
     throw InvalidParameter("separation_min", fmt::format("separation_min = {} is out of range: must be < "
@@ -65,7 +65,7 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
   const tapping::TappingModel base = tapping_model_from(p);
   const std::vector<double> separations = linspace(lo, hi, points);
   std::vector<double> normalised(points);
-  for (std::size_t i = 0; i < points; ++i) normalised[i] = separations[i] / scales.length;
+  for (std::size_t i = 0; i < points; ++i) normalised[i] = u.length.internal(separations[i]);
 
   tapping::OrbitSearchOptions options;
   options.shooting = shooting_options_from(p);
@@ -96,7 +96,7 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
   for (Output& o : outputs) o.values.assign(points, o.length ? nan : 0.0);
   for (std::size_t i = 0; i < points; ++i)
     for (const tapping::FoundOrbit& f : results[i].orbits) {
-      const double amplitude = f.metrics.amplitude * scales.length;
+      const double amplitude = u.length(f.metrics.amplitude);
       all.values[i] += 1;
       if (tapping::tip_trapped(f.metrics)) trapped_orbits.values[i] += 1;
       if (!f.orbit.stable) continue;
@@ -106,7 +106,7 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
       stable.values[i] += 1;
     }
 
-  const std::string length = scales.length_unit;
+  const std::string& length = u.length.name;
   nlohmann::json parameters = p.to_json();
   parameters.erase("store");
   parameters.erase("quiet");
@@ -183,13 +183,9 @@ void register_tapping_grid(CLI::App& tapping) {
       [](io::ParamSet& p) {
         add_tapping_model_params(p);
         add_tapping_sim_params(p);
-        p.group("Grid")
-            .real("separation_min", 5.0, "smallest separation of the grid", io::Range::closed(-1e6, 1e6))
-            .unit(kLengthUnit)
-            .real("separation_max", 15.0, "largest separation of the grid, > separation_min",
-                  io::Range::closed(-1e6, 1e6))
-            .unit(kLengthUnit)
-            .integer("points", 41, "separations, equally spaced from separation_min to separation_max", 2, 100000000);
+        p.group("Grid");
+        add_separation_range_params(p, 5.0, 15.0);
+        p.integer("points", 41, "separations, equally spaced from separation_min to separation_max", 2, 100000000);
         p.group("Output")
             .file("store", "out/tapping_grid.zarr",
                   "Zarr store the grid is written to (a folder, complete or not at all; an existing afmkit store "

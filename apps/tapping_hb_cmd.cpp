@@ -22,6 +22,7 @@
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_tables.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -33,18 +34,18 @@ constexpr double kHeldRowBytes = 1024.0;
 /// Points of the curve in memory at once when it is streamed.
 constexpr std::size_t kChunkPoints = 4096;
 
-nlohmann::json point_json(const tapping::HbPoint& p, const TappingScales& s) {
+nlohmann::json point_json(const tapping::HbPoint& p, const TappingUnits& u) {
   return {{"q", p.q},
-          {"separation", p.separation * s.length},
-          {"amplitude", p.amplitude * s.length},
-          {"offset", p.offset * s.length},
+          {"separation", u.length(p.separation)},
+          {"amplitude", u.length(p.amplitude)},
+          {"offset", u.length(p.offset)},
           {"phase", p.phase},
           {"branch", tapping::branch_name(p.branch)}};
 }
 
 /// The units: by dimension, and per results key (the units of study outputs, docs/study.md#outputs).
-nlohmann::json hb_units(const TappingScales& s) {
-  const std::string L = s.length_unit;
+nlohmann::json hb_units(const TappingUnits& u) {
+  const std::string& L = u.length.name;
   const nlohmann::json point = {{"q", "dimensionless"}, {"separation", L}, {"amplitude", L}, {"offset", L},
                                 {"phase", "rad"}, {"branch", "label"}, {"kind", "label"}};
   return {{"length", L},       {"phase", "rad"},   {"q", "dimensionless"},
@@ -71,7 +72,7 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   if (!(q_min < q_max))
     throw InvalidParameter("q_max", fmt::format("q_max = {} is out of range: must be > q_min = {}", q_max, q_min));
   const tapping::TappingModel model = tapping_model_from(p, law_object_of(capture));
-  const TappingScales scales = tapping_scales_from(p);
+  const TappingUnits u(tapping_scales_from(p));
 
   tapping::HbCurveOptions options;
   options.q_min = q_min;
@@ -88,32 +89,32 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   // (the streamed chunk is checked too: a malformed AFMKIT_MEMORY_LIMIT is refused as on every run)
   if (out.holds_rows()) memory::require_fits("points", static_cast<double>(options.points), 2.0 * kHeldRowBytes);
   else memory::require_fits("points", static_cast<double>(std::min(options.points, kChunkPoints)), sizeof(tapping::HbPoint));
-  auto rows = out.open(hb_table(scales));
+  auto rows = out.open(hb_table(u));
   const std::size_t count = tapping::harmonic_balance_curve_chunks(
       model, options, [&](std::span<const tapping::HbPoint> chunk) { rows.add_all(chunk); }, kChunkPoints);
 
   // the model and options are checked: what is refused from here on was computed (core/computed.hpp)
   const tapping::HarmonicBalance hb = computed("harmonic balance", [&] { return tapping::HarmonicBalance(model); });
   // folds as records sorted by separation (as `tapping sweep` reports its folds and jumps)
-  const nlohmann::json folds = computed("harmonic balance: its folds", [&] { return hb_fold_records(hb, scales); });
+  const nlohmann::json folds = computed("harmonic balance: its folds", [&] { return hb_fold_records(hb, u); });
   nlohmann::json solutions = nlohmann::json::array();
   for (const tapping::HbPoint& s :
        computed("harmonic balance: the solutions at separation", [&] { return hb.solutions(model.separation); }))
-    solutions.push_back(point_json(s, scales));
+    solutions.push_back(point_json(s, u));
   nlohmann::json results = {{"folds", folds},
-                            {"free_amplitude", hb.free_amplitude() * scales.length},
+                            {"free_amplitude", u.length(hb.free_amplitude())},
                             {"solutions_at_separation", solutions},
                             {"rows", out.rows()},
                             {"status", hb_status(count == 0, solutions.empty())},
                             {"note", hb_note(count == 0, solutions.empty(), q_min, q_max,
-                                             io::summary_value(p.real("separation"), scales.length_unit, 6))},
-                            {"units", hb_units(scales)}};
+                                             summary_value(p.real("separation"), u.length, 6))},
+                            {"units", hb_units(u)}};
   if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
     if (const auto limit = tapping::minimum_separation_limit(model))
-      results["minimum_separation_limit"] = *limit * scales.length;  // −∞ is written "-inf"
+      results["minimum_separation_limit"] = u.length(*limit);  // −∞ is written "-inf"
   }
   out.finish(results, fmt::format("{} fold(s), {} solution(s) at separation {}", folds.size(), solutions.size(),
-                                  io::summary_value(p.real("separation"), scales.length_unit, 6)));
+                                  summary_value(p.real("separation"), u.length, 6)));
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "tapping_params.hpp"
+#include "unit_tagged.hpp"
 #include "work_budget.hpp"
 
 namespace afmkit::cli {
@@ -65,14 +66,9 @@ void add_modes_params(io::ParamSet& p) {
             "liquid: quality factor of mode 1 from the fluid damping alone (0: no fluid damping)",
             Range::closed(0.0, 1e9))
       .unit("dimensionless")
-      .group("Approach")
-      .real("separation_min", 5.0, "smallest separation (rest position to surface) of the approach",
-            Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .real("separation_max", 12.0, "largest separation, where the approach starts; >= separation_min",
-            Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .integer("points", 8, "separations of the approach (1: separation_max only)", 1, 10000000)
+      .group("Approach");
+  add_separation_range_params(p, 5.0, 12.0);
+  p.integer("points", 8, "separations of the approach (1: separation_max only)", 1, 10000000)
       .integer("settle_periods", 0,
                "drive periods simulated at each separation before the lock-in (0: automatic, 2 Q_i f_drive/f_i at "
                "least: every transient decays by exp(-2 pi))",
@@ -131,7 +127,7 @@ tapping::MultiModeModel modes_model(const io::ParamSet& p, const tapping::Tappin
     const double a1 = single.free_amplitude();
     drives.emplace_back(tapping::drive_for_mode_amplitude(list, excitation, medium, 0, wa, a1), wa);
   }
-  const double a2 = p.real("second_free_amplitude") / tapping_scales_from(p).length;
+  const double a2 = TappingUnits(tapping_scales_from(p)).length.internal(p.real("second_free_amplitude"));
   if (a2 > 0) {
     if (modes < 2)
       throw InvalidParameter("second_free_amplitude", "second_free_amplitude drives mode 2: it needs modes >= 2");
@@ -150,7 +146,7 @@ tapping::MultiModeModel modes_model(const io::ParamSet& p, const tapping::Tappin
   return {list, drives, excitation, medium, single.law, single.separation};
 }
 
-std::vector<double> modes_approach(const io::ParamSet& p, double length_scale) {
+std::vector<double> modes_approach(const io::ParamSet& p, const units::Unit& length) {
   const double lo = p.real("separation_min"), hi = p.real("separation_max");
   if (!(lo <= hi))
     throw InvalidParameter("separation_min",
@@ -158,46 +154,75 @@ std::vector<double> modes_approach(const io::ParamSet& p, double length_scale) {
   const long n = p.integer("points");
   std::vector<double> list;
   for (long i = 0; i < n; ++i)
-    list.push_back((n == 1 ? hi : hi - (hi - lo) * static_cast<double>(i) / static_cast<double>(n - 1)) / length_scale);
+    list.push_back(length.internal(n == 1 ? hi : hi - (hi - lo) * static_cast<double>(i) / static_cast<double>(n - 1)));
   return list;
 }
 
-std::vector<io::Column> modes_columns(const TappingScales& s, const std::string& energy) {
-  const std::string L = s.length_unit;
-  return {{"separation", L, "separation l: rest position of the tip above the sample surface"},
-          {"min_gap", L, "smallest tip-sample distance over the lock-in window (sampled)"},
-          {"peak_force", s.force_unit, "largest tip-sample force over the window (sampled; positive: repulsive)"},
-          {"offset", L, "mean tip position over the window"},
-          {"amplitude_1", L, "amplitude of mode 1 at drive 1"},
-          {"phase_1", "rad", "phase lag of mode 1 at drive 1 (pi/2: free, at resonance)"},
-          {"amplitude_2", L, "amplitude of mode 2 at drive 2 (at drive 1 with one drive; nan with one mode)"},
-          {"phase_2", "rad", "phase lag of mode 2 at drive 2 (at drive 1 with one drive): the bimodal observable"},
-          {"amplitude_3", L, "amplitude of mode 3 at drive 1 (nan with fewer modes)"},
-          {"phase_3", "rad", "phase lag of mode 3 at drive 1"},
-          {"tip_amplitude_1", L, "amplitude of the tip (sum of the modes, base motion included) at drive 1"},
-          {"tip_phase_1", "rad", "phase lag of the tip at drive 1"},
-          {"tip_amplitude_2", L, "amplitude of the tip at drive 2 (nan with one drive)"},
-          {"tip_phase_2", "rad", "phase lag of the tip at drive 2"},
-          {"drive_work_1", energy, "work of the drive on mode 1 over the window"},
-          {"drive_work_2", energy, "work of the drive on mode 2 over the window"},
-          {"drive_work_3", energy, "work of the drive on mode 3 over the window"},
-          {"damping_loss_1", energy, "energy lost to the damping of mode 1 over the window"},
-          {"damping_loss_2", energy, "energy lost to the damping of mode 2"},
-          {"damping_loss_3", energy, "energy lost to the damping of mode 3"},
-          {"tip_work_1", energy, "work of the tip-sample force on mode 1 (negative: the sample takes energy)"},
-          {"tip_work_2", energy, "work of the tip-sample force on mode 2"},
-          {"tip_work_3", energy, "work of the tip-sample force on mode 3"},
-          {"energy_residual", energy, "largest |drive work - damping loss + tip work - change of stored energy| of a "
-                                      "mode (the energy balance; integration error)"},
-          {"impacts", "count", "entries into contact during the window and the settling before it"},
-          {"periodic", "boolean (0/1)", "1: measured on a periodic orbit found by shooting (--periodic)"}};
+/// The table, one row per separation: `m` modes, `nd` drives (columns of absent modes or drives: nan).
+io::TableOf<tapping::ModalResponse> modes_table(const TappingUnits& u, int m, int nd) {
+  using R = tapping::ModalResponse;
+  using E = tapping::ModeEnergy;
+  const units::Unit& L = u.length;
+  const int d2 = nd > 1 ? 1 : 0;
+  const auto amp = [m, nd](int i, int d) {
+    return [m, nd, i, d](const R& pt) { return i < m && d < nd ? pt.mode[i][d].amplitude : kModesNan; };
+  };
+  const auto ph = [m, nd](int i, int d) {
+    return [m, nd, i, d](const R& pt) { return i < m && d < nd ? pt.mode[i][d].phase : kModesNan; };
+  };
+  const auto work = [m](int i, double E::*field) {
+    return [m, i, field](const R& pt) { return i < m ? pt.energy[i].*field : kModesNan; };
+  };
+  return {{"separation", L, "separation l: rest position of the tip above the sample surface", &R::separation},
+          {"min_gap", L, "smallest tip-sample distance over the lock-in window (sampled)", &R::min_gap},
+          {"peak_force", u.force, "largest tip-sample force over the window (sampled; positive: repulsive)",
+           &R::peak_force},
+          {"offset", L, "mean tip position over the window", &R::mean},
+          {"amplitude_1", L, "amplitude of mode 1 at drive 1", amp(0, 0)},
+          {"phase_1", "rad", "phase lag of mode 1 at drive 1 (pi/2: free, at resonance)", ph(0, 0)},
+          {"amplitude_2", L, "amplitude of mode 2 at drive 2 (at drive 1 with one drive; nan with one mode)",
+           amp(1, d2)},
+          {"phase_2", "rad", "phase lag of mode 2 at drive 2 (at drive 1 with one drive): the bimodal observable",
+           ph(1, d2)},
+          {"amplitude_3", L, "amplitude of mode 3 at drive 1 (nan with fewer modes)", amp(2, 0)},
+          {"phase_3", "rad", "phase lag of mode 3 at drive 1", ph(2, 0)},
+          {"tip_amplitude_1", L, "amplitude of the tip (sum of the modes, base motion included) at drive 1",
+           [](const R& pt) { return pt.tip[0].amplitude; }},
+          {"tip_phase_1", "rad", "phase lag of the tip at drive 1", [](const R& pt) { return pt.tip[0].phase; }},
+          {"tip_amplitude_2", L, "amplitude of the tip at drive 2 (nan with one drive)",
+           [nd](const R& pt) { return nd > 1 ? pt.tip[1].amplitude : kModesNan; }},
+          {"tip_phase_2", "rad", "phase lag of the tip at drive 2",
+           [nd](const R& pt) { return nd > 1 ? pt.tip[1].phase : kModesNan; }},
+          {"drive_work_1", u.energy, "work of the drive on mode 1 over the window", work(0, &E::drive_work)},
+          {"drive_work_2", u.energy, "work of the drive on mode 2 over the window", work(1, &E::drive_work)},
+          {"drive_work_3", u.energy, "work of the drive on mode 3 over the window", work(2, &E::drive_work)},
+          {"damping_loss_1", u.energy, "energy lost to the damping of mode 1 over the window",
+           work(0, &E::damping_loss)},
+          {"damping_loss_2", u.energy, "energy lost to the damping of mode 2", work(1, &E::damping_loss)},
+          {"damping_loss_3", u.energy, "energy lost to the damping of mode 3", work(2, &E::damping_loss)},
+          {"tip_work_1", u.energy, "work of the tip-sample force on mode 1 (negative: the sample takes energy)",
+           work(0, &E::tip_work)},
+          {"tip_work_2", u.energy, "work of the tip-sample force on mode 2", work(1, &E::tip_work)},
+          {"tip_work_3", u.energy, "work of the tip-sample force on mode 3", work(2, &E::tip_work)},
+          {"energy_residual", u.energy,
+           "largest |drive work - damping loss + tip work - change of stored energy| of a mode (the energy balance; "
+           "integration error)",
+           [m](const R& pt) {
+             double residual = 0.0;
+             for (int i = 0; i < m; ++i) residual = std::max(residual, std::abs(pt.energy[i].residual()));
+             return residual;
+           }},
+          {"impacts", "count", "entries into contact during the window and the settling before it",
+           [](const R& pt) { return pt.stats.impacts; }},
+          {"periodic", "boolean (0/1)", "1: measured on a periodic orbit found by shooting (--periodic)",
+           &R::periodic}};
 }
 
 void run_modes(const io::ParamSet& p, Captured* capture) {
   const tapping::TappingModel single = tapping_model_from(p, law_object_of(capture));
-  const TappingScales s = tapping_scales_from(p);
+  const TappingUnits u(tapping_scales_from(p));
   const tapping::MultiModeModel model = modes_model(p, single);
-  const std::vector<double> separations = modes_approach(p, s.length);
+  const std::vector<double> separations = modes_approach(p, u.length);
   tapping::ModalResponseOptions options;
   options.settle_periods = p.integer("settle_periods");
   options.lockin_periods = p.integer("lockin_periods");
@@ -230,64 +255,47 @@ void run_modes(const io::ParamSet& p, Captured* capture) {
   progress.finish();
 
   const bool physical = p.text("units") == "physical";
-  const std::string energy = physical ? "aJ" : s.energy_unit;
   CommandOutput out(p, capture, "tapping modes");
-  out.open(modes_columns(s, energy));
   const int m = model.mode_count(), nd = model.drive_count();
-  const double len = s.length, en = s.energy;
-  double worst_residual = 0.0;
-  for (const tapping::ModalResponse& pt : r) {
-    auto amp = [&](int i, int d) { return i < m && d < nd ? pt.mode[i][d].amplitude * len : kModesNan; };
-    auto ph = [&](int i, int d) { return i < m && d < nd ? pt.mode[i][d].phase : kModesNan; };
-    auto work = [&](int i, double tapping::ModeEnergy::*field) { return i < m ? pt.energy[i].*field * en : kModesNan; };
-    const int d2 = nd > 1 ? 1 : 0;
-    double residual = 0.0;
-    for (int i = 0; i < m; ++i) residual = std::max(residual, std::abs(pt.energy[i].residual()) * en);
-    worst_residual = std::max(worst_residual, residual);
-    out.row(pt.separation * len, pt.min_gap * len, pt.peak_force * s.force, pt.mean * len, amp(0, 0), ph(0, 0),
-            amp(1, d2), ph(1, d2), amp(2, 0), ph(2, 0), pt.tip[0].amplitude * len, pt.tip[0].phase,
-            nd > 1 ? pt.tip[1].amplitude * len : kModesNan, nd > 1 ? pt.tip[1].phase : kModesNan,
-            work(0, &tapping::ModeEnergy::drive_work), work(1, &tapping::ModeEnergy::drive_work),
-            work(2, &tapping::ModeEnergy::drive_work), work(0, &tapping::ModeEnergy::damping_loss),
-            work(1, &tapping::ModeEnergy::damping_loss), work(2, &tapping::ModeEnergy::damping_loss),
-            work(0, &tapping::ModeEnergy::tip_work), work(1, &tapping::ModeEnergy::tip_work),
-            work(2, &tapping::ModeEnergy::tip_work), residual, pt.stats.impacts, pt.periodic);
-  }
-  const double time_scale = s.time;
+  out.open(modes_table(u, m, nd)).add_all(r);
+  double worst_residual = 0.0;  // in the model's energy unit
+  for (const tapping::ModalResponse& pt : r)
+    for (int i = 0; i < m; ++i) worst_residual = std::max(worst_residual, std::abs(pt.energy[i].residual()));
+  // ω [rad/t] -> f (Hz, or cycles per t)
+  const units::Unit frequency{physical ? "Hz" : "1/t", 1.0, 2.0 * std::numbers::pi * u.time.multiply};
   nlohmann::json results;
   results["modes"] = m;
   results["drives"] = nd;
   results["excitation"] = tapping::excitation_name(model.excitation);
   std::vector<double> freq, quality;
   for (int i = 0; i < m; ++i) {
-    freq.push_back(model.frequency(i) / (2.0 * std::numbers::pi * time_scale));
+    freq.push_back(frequency(model.frequency(i)));
     quality.push_back(model.quality_factor(i));
   }
   results["mode_frequencies"] = freq;
   results["mode_quality_factors"] = quality;
   std::vector<double> free_amplitudes;
-  for (int i = 0; i < m; ++i) free_amplitudes.push_back(std::abs(model.free_response(i, i < nd ? i : 0)) * len);
+  for (int i = 0; i < m; ++i) free_amplitudes.push_back(u.length(std::abs(model.free_response(i, i < nd ? i : 0))));
   results["free_amplitudes"] = free_amplitudes;
   results["settle_periods"] = options.settle_periods_for(model);
   results["rows"] = static_cast<long>(r.size());
-  results["largest_energy_residual"] = worst_residual;
+  results["largest_energy_residual"] = u.energy(worst_residual);
   results["periodic_rows"] = std::count_if(r.begin(), r.end(), [](const auto& q) { return q.periodic; });
   results["status"] = "ok";
-  const std::string freq_unit = physical ? "Hz" : "1/t";
-  results["units"] = {{"mode_frequencies", freq_unit}, {"mode_quality_factors", "dimensionless"},
-                      {"free_amplitudes", s.length_unit}, {"settle_periods", "count"}, {"rows", "count"},
-                      {"largest_energy_residual", energy}, {"periodic_rows", "count"}};
+  results["units"] = {{"mode_frequencies", frequency.name}, {"mode_quality_factors", "dimensionless"},
+                      {"free_amplitudes", u.length.name}, {"settle_periods", "count"}, {"rows", "count"},
+                      {"largest_energy_residual", u.energy.name}, {"periodic_rows", "count"}};
   std::string summary = fmt::format("{} modes ({} excitation, {} drive{}), {} separations", m,
                                     tapping::excitation_name(model.excitation), nd, nd > 1 ? "s" : "", r.size());
   if (!r.empty()) {
     const auto& last = r.back();
     const int d2 = nd > 1 ? 1 : 0;
     summary += fmt::format("\nclosest, separation {}: A1 = {}, phase1 = {:.4f} rad",
-                           io::summary_value(last.separation * len, s.length_unit),
-                           io::summary_value(last.mode[0][0].amplitude * len, s.length_unit), last.mode[0][0].phase);
+                           summary_value(last.separation, u.length),
+                           summary_value(last.mode[0][0].amplitude, u.length), last.mode[0][0].phase);
     if (m > 1)
       summary += fmt::format(", A2 = {}, phase2 = {:.4f} rad",
-                             io::summary_value(last.mode[1][d2].amplitude * len, s.length_unit),
+                             summary_value(last.mode[1][d2].amplitude, u.length),
                              last.mode[1][d2].phase);
   }
   out.finish(results, summary);

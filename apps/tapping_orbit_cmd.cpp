@@ -22,6 +22,7 @@
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -36,8 +37,20 @@ nlohmann::json seeds_by_kind(const std::vector<int>& seeds, const tapping::Orbit
   return j;
 }
 
+/// One seed of the search: how it started and which orbits it converged to.
+UnitTagged seed_record(const tapping::SearchSeed& seed, const TappingUnits& u) {
+  UnitTagged j;
+  j.add("kind", tapping::seed_kind_name(seed.kind))
+      .add("initial_position", seed.start.position, u.length)
+      .add("initial_velocity", seed.start.velocity, u.velocity)
+      .add("orbits", seed.orbits, "count");
+  if (seed.kind == tapping::SeedKind::grid)
+    j.add("grid_phase", seed.grid_phase, "rad").add("grid_amplitude", seed.grid_amplitude, u.length);
+  return j;
+}
+
 /// How find_orbits searched: seeds per kind, converged per kind, the continuation bracket, every seed.
-nlohmann::json search_json(const tapping::OrbitSearchReport& r, const TappingScales& s) {
+UnitTagged search_record(const tapping::OrbitSearchReport& r, const TappingUnits& u) {
   nlohmann::json by_kind = nlohmann::json::object(), converged = nlohmann::json::object();
   for (int k = 0; k < tapping::seed_kind_count; ++k) {
     const char* name = tapping::seed_kind_name(static_cast<tapping::SeedKind>(k));
@@ -45,56 +58,69 @@ nlohmann::json search_json(const tapping::OrbitSearchReport& r, const TappingSca
     converged[name] = r.converged_by_kind[k];
   }
   nlohmann::json seeds = nlohmann::json::array();
-  for (const tapping::SearchSeed& seed : r.seeds) {
-    nlohmann::json j = {{"kind", tapping::seed_kind_name(seed.kind)},
-                        {"initial_position", seed.start.position * s.length},
-                        {"initial_velocity", seed.start.velocity * s.length / s.time},
-                        {"orbits", seed.orbits}};
-    if (seed.kind == tapping::SeedKind::grid) {
-      j["grid_phase"] = seed.grid_phase;
-      j["grid_amplitude"] = seed.grid_amplitude * s.length;
-    }
-    seeds.push_back(j);
-  }
-  return {{"seeds_by_kind", by_kind},
-          {"converged_by_kind", converged},
-          {"seeds_total", r.seeds.size()},
-          {"continuation_runs", r.continuation_runs},
-          {"continuation_bracket", {r.bracket_min * s.length, r.bracket_max * s.length}},
-          {"seconds", r.seconds},
-          {"seeds", seeds}};
+  for (const tapping::SearchSeed& seed : r.seeds) seeds.push_back(seed_record(seed, u).values());
+  UnitTagged j;
+  j.add("seeds_by_kind", by_kind, "count")
+      .add("converged_by_kind", converged, "count")
+      .add("seeds_total", r.seeds.size(), "count")
+      .add("continuation_runs", r.continuation_runs, "count")
+      .add("continuation_bracket", std::vector<double>{r.bracket_min, r.bracket_max}, u.length)
+      .add("seconds", r.seconds, "s")
+      .add("seeds", seeds)
+      .unit("seeds", seed_record(tapping::SearchSeed{}, u).units());  // a grid seed: every field
+  return j;
 }
 
-nlohmann::json orbit_json(const tapping::FoundOrbit& f, const tapping::OrbitSearchReport& report,
-                          const TappingScales& s) {
+UnitTagged orbit_record(const tapping::FoundOrbit& f, const tapping::OrbitSearchReport& report,
+                        const TappingUnits& u) {
   const auto& m = f.metrics;
   const auto& o = f.orbit;
-  return {{"source", tapping::orbit_source_name(f.source)},
-          {"found_by", seeds_by_kind(f.seeds, report)},
-          {"seeds", f.seeds},
-          {"period_multiple", o.period_multiple},
-          {"stable", o.stable},
-          {"floquet_max", o.floquet_max},
-          {"floquet_multipliers",
+  UnitTagged j;
+  j.add("source", tapping::orbit_source_name(f.source))
+      .add("found_by", seeds_by_kind(f.seeds, report), "count")
+      .add("seeds", f.seeds, "count")
+      .add("period_multiple", o.period_multiple, "count")
+      .add("stable", o.stable, "boolean (0/1)")
+      .add("floquet_max", o.floquet_max, "dimensionless")
+      .add("floquet_multipliers",
            {{{"re", o.floquet_multipliers[0].real()}, {"im", o.floquet_multipliers[0].imag()}},
-            {{"re", o.floquet_multipliers[1].real()}, {"im", o.floquet_multipliers[1].imag()}}}},
-          {"amplitude", m.amplitude * s.length},
-          {"offset", m.offset * s.length},
-          {"phase", m.phase},
-          {"harmonics", {m.harmonics[0] * s.length, m.harmonics[1] * s.length, m.harmonics[2] * s.length,
-                         m.harmonics[3] * s.length}},
-          {"contact_fraction", m.contact_fraction},
-          {"peak_force", m.peak_force * s.force},
-          {"min_gap", m.min_gap * s.length},
-          {"drive_work", m.drive_work * s.energy},
-          {"viscous_dissipation", m.viscous_dissipation * s.energy},
-          {"contact_dissipation", m.contact_dissipation * s.energy},
-          {"energy_dissipated", m.energy_dissipated() * s.energy},
-          {"sticking_time", m.sticking_duration * s.time},
-          {"initial_position", o.initial.position * s.length},
-          {"initial_velocity", o.initial.velocity * s.length / s.time},
-          {"shooting_residual", o.residual},
-          {"trapped", tapping::tip_trapped(m)}};
+            {{"re", o.floquet_multipliers[1].real()}, {"im", o.floquet_multipliers[1].imag()}}},
+           "dimensionless")
+      .add("amplitude", m.amplitude, u.length)
+      .add("offset", m.offset, u.length)
+      .add("phase", m.phase, "rad")
+      .add("harmonics", std::vector<double>(m.harmonics.begin(), m.harmonics.end()), u.length)
+      .add("contact_fraction", m.contact_fraction, "dimensionless")
+      .add("peak_force", m.peak_force, u.force)
+      .add("min_gap", m.min_gap, u.length)
+      .add("drive_work", m.drive_work, u.energy)
+      .add("viscous_dissipation", m.viscous_dissipation, u.energy)
+      .add("contact_dissipation", m.contact_dissipation, u.energy)
+      .add("energy_dissipated", m.energy_dissipated(), u.energy)
+      .add("sticking_time", m.sticking_duration, u.time)
+      .add("initial_position", o.initial.position, u.length)
+      .add("initial_velocity", o.initial.velocity, u.velocity)
+      .add("shooting_residual", o.residual, "dimensionless")
+      .add("trapped", tapping::tip_trapped(m));
+  return j;
+}
+
+UnitTagged hb_record(const tapping::HbPoint& h, const TappingUnits& u) {
+  UnitTagged j;
+  j.add("branch", tapping::branch_name(h.branch))
+      .add("q", h.q, "dimensionless")
+      .add("amplitude", h.amplitude, u.length)
+      .add("offset", h.offset, u.length)
+      .add("phase", h.phase, "rad");
+  return j;
+}
+
+UnitTagged transient_record(const tapping::TransientOutcome& t) {
+  UnitTagged j;
+  j.add("kind", tapping::response_kind_name(t.kind)).add("periods_simulated", t.periods_simulated, "count");
+  if (t.orbit) j.add("period_multiple", t.orbit->period_multiple, "count");
+  if (!t.message.empty()) j.add("message", t.message);
+  return j;
 }
 
 /// What the search found, in words (docs/conventions.md#statuses): "ok" (an orbit on which the tip taps),
@@ -102,40 +128,22 @@ nlohmann::json orbit_json(const tapping::FoundOrbit& f, const tapping::OrbitSear
 struct OrbitStatus {
   std::string status, note;
 };
-OrbitStatus orbit_status(const tapping::OrbitSearchResult& r, double separation, const std::string& unit) {
+OrbitStatus orbit_status(const tapping::OrbitSearchResult& r, double separation, const units::Unit& length) {
   if (r.orbits.empty())
     return {"no_orbit", fmt::format("no periodic orbit found at separation {} (see the search report)",
-                                    io::summary_value(separation, unit))};
+                                    summary_value(separation, length))};
   for (const tapping::FoundOrbit& f : r.orbits)
     if (!tapping::tip_trapped(f.metrics)) return {"ok", ""};
   return {"tip_trapped",
           fmt::format("tip trapped: on every orbit found ({}) the tip sticks to the sample or stays in contact over "
                       "the whole period at separation {} (held by the sample: an attraction larger than the drive "
                       "can pull off); no tapping orbit",
-                      r.orbits.size(), io::summary_value(separation, unit))};
-}
-
-/// The unit of every number of orbit_json.
-nlohmann::json orbit_units(const TappingScales& s) {
-  const std::string L = s.length_unit;
-  return {{"found_by", "count"},           {"seeds", "count"},
-          {"period_multiple", "count"},    {"stable", "boolean (0/1)"},
-          {"floquet_max", "dimensionless"}, {"floquet_multipliers", "dimensionless"},
-          {"amplitude", L},                {"offset", L},
-          {"phase", "rad"},                {"harmonics", L},
-          {"contact_fraction", "dimensionless"}, {"peak_force", s.force_unit},
-          {"min_gap", L},                  {"drive_work", s.energy_unit},
-          {"viscous_dissipation", s.energy_unit}, {"contact_dissipation", s.energy_unit},
-          {"energy_dissipated", s.energy_unit},   {"sticking_time", s.time_unit},
-          {"initial_position", L},         {"initial_velocity", L + "/" + s.time_unit},
-          {"shooting_residual", "dimensionless"}};
+                      r.orbits.size(), summary_value(separation, length))};
 }
 
 /// The table: one row per orbit found.
-io::TableOf<tapping::FoundOrbit> orbit_table(const TappingScales& s) {
+io::TableOf<tapping::FoundOrbit> orbit_table(const TappingUnits& u) {
   using F = tapping::FoundOrbit;
-  const std::string L = s.length_unit, velocity = L + "/" + s.time_unit;
-  const double l = s.length, force = s.force, energy = s.energy, time = s.time;
   return {
       {"source", "label", "how the orbit was found first (harmonic_balance, transient, grid, contact, continuation)",
        [](const F& f) { return tapping::orbit_source_name(f.source); }},
@@ -143,33 +151,33 @@ io::TableOf<tapping::FoundOrbit> orbit_table(const TappingScales& s) {
        [](const F& f) { return f.orbit.period_multiple; }},
       {"stable", "boolean (0/1)", "1: all Floquet multipliers inside the unit circle",
        [](const F& f) { return f.orbit.stable; }},
-      {"amplitude", L, "first-harmonic amplitude B", [l](const F& f) { return f.metrics.amplitude * l; }},
-      {"offset", L, "mean deflection A", [l](const F& f) { return f.metrics.offset * l; }},
+      {"amplitude", u.length, "first-harmonic amplitude B", [](const F& f) { return f.metrics.amplitude; }},
+      {"offset", u.length, "mean deflection A", [](const F& f) { return f.metrics.offset; }},
       {"phase", "rad", "phase lag φ of the first harmonic behind the drive (docs/conventions.md), in (-π, π]",
        [](const F& f) { return f.metrics.phase; }},
-      {"harmonic_2", L, "amplitude of the 2nd harmonic", [l](const F& f) { return f.metrics.harmonics[0] * l; }},
-      {"harmonic_3", L, "amplitude of the 3rd harmonic", [l](const F& f) { return f.metrics.harmonics[1] * l; }},
-      {"harmonic_4", L, "amplitude of the 4th harmonic", [l](const F& f) { return f.metrics.harmonics[2] * l; }},
-      {"harmonic_5", L, "amplitude of the 5th harmonic", [l](const F& f) { return f.metrics.harmonics[3] * l; }},
+      {"harmonic_2", u.length, "amplitude of the 2nd harmonic", [](const F& f) { return f.metrics.harmonics[0]; }},
+      {"harmonic_3", u.length, "amplitude of the 3rd harmonic", [](const F& f) { return f.metrics.harmonics[1]; }},
+      {"harmonic_4", u.length, "amplitude of the 4th harmonic", [](const F& f) { return f.metrics.harmonics[2]; }},
+      {"harmonic_5", u.length, "amplitude of the 5th harmonic", [](const F& f) { return f.metrics.harmonics[3]; }},
       {"contact_fraction", "dimensionless", "fraction of the period with the gap below the law's contact gap",
        [](const F& f) { return f.metrics.contact_fraction; }},
-      {"peak_force", s.force_unit, "largest tip-sample force (positive: repulsive)",
-       [force](const F& f) { return f.metrics.peak_force * force; }},
-      {"min_gap", L, "smallest gap x + l", [l](const F& f) { return f.metrics.min_gap * l; }},
-      {"energy_dissipated", s.energy_unit, "energy dissipated per drive period (viscous + contact)",
-       [energy](const F& f) { return f.metrics.energy_dissipated() * energy; }},
-      {"viscous_dissipation", s.energy_unit, "viscous (cantilever damping) part per drive period",
-       [energy](const F& f) { return f.metrics.viscous_dissipation * energy; }},
-      {"contact_dissipation", s.energy_unit, "tip-sample (hysteresis) part per drive period",
-       [energy](const F& f) { return f.metrics.contact_dissipation * energy; }},
+      {"peak_force", u.force, "largest tip-sample force (positive: repulsive)",
+       [](const F& f) { return f.metrics.peak_force; }},
+      {"min_gap", u.length, "smallest gap x + l", [](const F& f) { return f.metrics.min_gap; }},
+      {"energy_dissipated", u.energy, "energy dissipated per drive period (viscous + contact)",
+       [](const F& f) { return f.metrics.energy_dissipated(); }},
+      {"viscous_dissipation", u.energy, "viscous (cantilever damping) part per drive period",
+       [](const F& f) { return f.metrics.viscous_dissipation; }},
+      {"contact_dissipation", u.energy, "tip-sample (hysteresis) part per drive period",
+       [](const F& f) { return f.metrics.contact_dissipation; }},
       {"floquet_max", "dimensionless", "largest Floquet multiplier modulus",
        [](const F& f) { return f.orbit.floquet_max; }},
-      {"sticking_time", s.time_unit, "time spent sticking to the sample per orbit",
-       [time](const F& f) { return f.metrics.sticking_duration * time; }},
-      {"initial_position", L, "tip position x at drive phase 0 on the orbit",
-       [l](const F& f) { return f.orbit.initial.position * l; }},
-      {"initial_velocity", velocity, "tip velocity at drive phase 0 on the orbit",
-       [l, time](const F& f) { return f.orbit.initial.velocity * l / time; }},
+      {"sticking_time", u.time, "time spent sticking to the sample per orbit",
+       [](const F& f) { return f.metrics.sticking_duration; }},
+      {"initial_position", u.length, "tip position x at drive phase 0 on the orbit",
+       [](const F& f) { return f.orbit.initial.position; }},
+      {"initial_velocity", u.velocity, "tip velocity at drive phase 0 on the orbit",
+       [](const F& f) { return f.orbit.initial.velocity; }},
       {"trapped", "boolean (0/1)",
        "1: the tip sticks to the sample or stays in contact over the whole period (no tapping; "
        "docs/conventions.md#statuses)",
@@ -178,7 +186,7 @@ io::TableOf<tapping::FoundOrbit> orbit_table(const TappingScales& s) {
 
 void run_orbit(const io::ParamSet& p, Captured* capture) {
   const tapping::TappingModel model = tapping_model_from(p, law_object_of(capture));
-  const TappingScales scales = tapping_scales_from(p);
+  const TappingUnits u(tapping_scales_from(p));
   tapping::OrbitSearchOptions options;
   options.shooting = shooting_options_from(p);
   options.transient = transient_options_from(p);
@@ -192,56 +200,51 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   options.cancellation = cancellation_of(capture);
   const tapping::OrbitSearchResult r = tapping::find_orbits(model, options);
   progress.finish();
-  const OrbitStatus status = orbit_status(r, p.real("separation"), scales.length_unit);
+  const OrbitStatus status = orbit_status(r, p.real("separation"), u.length);
 
+  // every entry with its unit (the sidecar's "units", per results key: docs/study.md#outputs)
   nlohmann::json orbits = nlohmann::json::array();
-  for (const tapping::FoundOrbit& f : r.orbits) orbits.push_back(orbit_json(f, r.report, scales));
+  for (const tapping::FoundOrbit& f : r.orbits) orbits.push_back(orbit_record(f, r.report, u).values());
   nlohmann::json hb = nlohmann::json::array();
-  for (const tapping::HbPoint& h : r.harmonic_balance)
-    hb.push_back({{"branch", tapping::branch_name(h.branch)},
-                  {"q", h.q},
-                  {"amplitude", h.amplitude * scales.length},
-                  {"offset", h.offset * scales.length},
-                  {"phase", h.phase}});
+  for (const tapping::HbPoint& h : r.harmonic_balance) hb.push_back(hb_record(h, u).values());
   nlohmann::json transients = nlohmann::json::array();
-  for (const tapping::TransientOutcome& t : r.transients) {
-    nlohmann::json j = {{"kind", tapping::response_kind_name(t.kind)}, {"periods_simulated", t.periods_simulated}};
-    if (t.orbit) j["period_multiple"] = t.orbit->period_multiple;
-    if (!t.message.empty()) j["message"] = t.message;
-    transients.push_back(j);
-  }
-  const std::string length = scales.length_unit, velocity = length + "/" + scales.time_unit;
-  const nlohmann::json summary = {
-      {"separation", p.real("separation")},
-      {"free_amplitude", model.free_amplitude() * scales.length},
-      {"harmonic_balance", hb},
-      {"orbits", orbits},
-      {"transients", transients},
-      {"search", search_json(r.report, scales)},
-      {"status", status.status},
-      {"note", status.note},
-      {"units",
-       {{"length", length}, {"velocity", velocity}, {"force", scales.force_unit}, {"energy", scales.energy_unit},
-        {"time", scales.time_unit}, {"phase", "rad"}, {"seconds", "s"},
-        // per results key (the units of study outputs, docs/study.md#outputs)
-        {"separation", length}, {"free_amplitude", length},
-        {"harmonic_balance", {{"q", "dimensionless"}, {"amplitude", length}, {"offset", length}, {"phase", "rad"}}},
-        {"orbits", orbit_units(scales)},
-        {"transients", {{"periods_simulated", "count"}, {"period_multiple", "count"}}},
-        {"search", {{"seeds_by_kind", "count"}, {"converged_by_kind", "count"}, {"seeds_total", "count"},
-                    {"continuation_runs", "count"}, {"continuation_bracket", length}, {"seconds", "s"},
-                    {"seeds", {{"initial_position", length}, {"initial_velocity", velocity}, {"orbits", "count"},
-                               {"grid_phase", "rad"}, {"grid_amplitude", length}}}}}}}};
+  for (const tapping::TransientOutcome& t : r.transients) transients.push_back(transient_record(t).values());
+  // the units of the rows of each array: those of a record with every field
+  const tapping::FoundOrbit any_orbit{};
+  tapping::TransientOutcome any_transient;
+  any_transient.orbit = tapping::PeriodicOrbit{};
+  UnitTagged results;
+  results.add("separation", p.real("separation"), u.length)
+      .add("free_amplitude", model.free_amplitude(), u.length)
+      .add("harmonic_balance", hb)
+      .unit("harmonic_balance", hb_record(tapping::HbPoint{}, u).units())
+      .add("orbits", orbits)
+      .unit("orbits", orbit_record(any_orbit, r.report, u).units())
+      .add("transients", transients)
+      .unit("transients", transient_record(any_transient).units())
+      .add("search", search_record(r.report, u))
+      .add("status", status.status)
+      .add("note", status.note)
+      // the units of the whole run
+      .unit("length", u.length.name)
+      .unit("velocity", u.velocity.name)
+      .unit("force", u.force.name)
+      .unit("energy", u.energy.name)
+      .unit("time", u.time.name)
+      .unit("phase", "rad")
+      .unit("seconds", "s");
+  nlohmann::json summary = results.values();
+  summary["units"] = results.units();
   CommandOutput out(p, capture, "tapping orbit");
-  out.open(orbit_table(scales)).add_all(r.orbits);
+  out.open(orbit_table(u)).add_all(r.orbits);
   if (p.flag("json")) {
     out.finish(summary, "");
     return;
   }
   // lengths by magnitude in physical units, said to be normalised otherwise (docs/units.md#summaries)
-  const auto len = [&](double model_length) { return io::summary_value(model_length * scales.length, length, 6); };
-  fmt::print("separation {}: {} HB solution(s), {} periodic orbit(s); phases in rad\n",
-             io::summary_value(p.real("separation"), length, 6), hb.size(), r.orbits.size());
+  const auto len = [&](double model_length) { return summary_value(model_length, u.length, 6); };
+  fmt::print("separation {}: {} HB solution(s), {} periodic orbit(s); phases in rad\n", len(p.real("separation")),
+             hb.size(), r.orbits.size());
   for (const tapping::HbPoint& h : r.harmonic_balance)
     fmt::print("  HB {:5s} amplitude {}  offset {}  phase {:.6g} rad\n", tapping::branch_name(h.branch),
                len(h.amplitude), len(h.offset), h.phase);

@@ -89,6 +89,16 @@ void add_separation_list_params(io::ParamSet& p, const std::string& help) {
       .only_if_given(uniform_grid_keys());
 }
 
+void add_separation_range_params(io::ParamSet& p, double min_default, double max_default) {
+  p.real("separation_min", min_default, "smallest separation (rest position to the surface) of the range visited",
+         Range::closed(-1e6, 1e6))
+      .unit(kLengthUnit)
+      .real("separation_max", max_default,
+            "largest separation of the range visited, where an approach starts (not below separation_min)",
+            Range::closed(-1e6, 1e6))
+      .unit(kLengthUnit);
+}
+
 void add_tapping_model_params(io::ParamSet& p) {
   p.group("Model");
   p.text("units", "normalised", "unit system of the model parameters and results", {"normalised", "physical"})

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "afmkit/core/units.hpp"
 #include "afmkit/io/params.hpp"
 #include "afmkit/tapping/model.hpp"
 #include "afmkit/tapping/units.hpp"
@@ -21,6 +22,10 @@ inline std::vector<std::string> uniform_grid_keys() { return {"separation_min", 
 /// (uniform_grid_keys) in the records; shared by tapping sweep and tapping fm.
 void add_separation_list_params(io::ParamSet& p, const std::string& help);
 
+/// separation_min and separation_max of the commands that visit a range of separations (tapping sweep, grid, fm,
+/// modes), each with its defaults; in [-1e6, 1e6] like every separation (each command checks their order).
+void add_separation_range_params(io::ParamSet& p, double min_default, double max_default);
+
 /// units, cantilever, drive, force law, separation.
 void add_tapping_model_params(io::ParamSet& p);
 /// The normalised model at the parameter `separation` (nm in physical units). `law_object`: the caller's law of
@@ -30,5 +35,18 @@ tapping::TappingModel tapping_model_from(const io::ParamSet& p,
 using TappingScales = tapping::UnitScales;
 /// Factors converting model quantities to the user's units (all 1 for normalised units).
 TappingScales tapping_scales_from(const io::ParamSet& p);
+
+/// The units of the tapping commands' results, each converting a model quantity into the user's unit and naming it
+/// (nm, nN, aJ, s in physical runs; L, L/t^2, L^2/t^2, t in normalised ones): the one edge from the model's
+/// normalised units to the user's (afmkit/core/units.hpp, docs/units.md).
+struct TappingUnits {
+  units::Unit length, force, energy, time, velocity;
+  explicit TappingUnits(const TappingScales& s)
+      : length{s.length_unit, s.length},
+        force{s.force_unit, s.force},
+        energy{s.energy_unit, s.energy},
+        time{s.time_unit, s.time},
+        velocity(length.per(time)) {}
+};
 
 }  // namespace afmkit::cli

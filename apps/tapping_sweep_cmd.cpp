@@ -32,13 +32,13 @@ namespace afmkit::cli {
 
 namespace {
 
-nlohmann::json scaled(const std::vector<double>& v, double f) {
+nlohmann::json scaled(const std::vector<double>& v, const units::Unit& u) {
   nlohmann::json j = nlohmann::json::array();
-  for (double x : v) j.push_back(x * f);
+  for (double x : v) j.push_back(u(x));
   return j;
 }
-std::vector<double> scaled_values(std::vector<double> v, double f) {
-  for (double& x : v) x *= f;
+std::vector<double> scaled_values(std::vector<double> v, const units::Unit& u) {
+  for (double& x : v) x = u(x);
   return v;
 }
 
@@ -54,28 +54,28 @@ nlohmann::json sorted_by_separation(nlohmann::json records) {
 }
 
 /// The instrument sweep's jumps as records, sorted by separation.
-nlohmann::json jump_records(const std::vector<tapping::SweepJump>& jumps, const TappingScales& s) {
+nlohmann::json jump_records(const std::vector<tapping::SweepJump>& jumps, const TappingUnits& u) {
   nlohmann::json out = nlohmann::json::array();
   for (const tapping::SweepJump& j : jumps)
-    out.push_back({{"separation", j.separation * s.length},
-                   {"tolerance", j.tolerance * s.length},
+    out.push_back({{"separation", u.length(j.separation)},
+                   {"tolerance", u.length(j.tolerance)},
                    {"direction", tapping::direction_name(j.direction)},
                    {"located", j.located},
                    {"branch", branch_of(j.from_metrics)},
-                   {"amplitude_before", j.from_metrics.amplitude * s.length},
-                   {"amplitude_after", j.to_metrics.amplitude * s.length},
+                   {"amplitude_before", u.length(j.from_metrics.amplitude)},
+                   {"amplitude_after", u.length(j.to_metrics.amplitude)},
                    {"landed_periodic", j.landed_periodic}});
   return sorted_by_separation(std::move(out));
 }
 
 /// The continuation's folds as records (as `tapping hb` reports its folds), sorted by separation.
-nlohmann::json fold_records(const tapping::ContinuationResult& c, const TappingScales& s) {
+nlohmann::json fold_records(const tapping::ContinuationResult& c, const TappingUnits& u) {
   nlohmann::json out = nlohmann::json::array();
   for (const tapping::ContinuationFold& f : c.folds) {
     const tapping::OrbitMetrics& m = c.points.at(f.point).metrics;
-    out.push_back({{"separation", f.separation * s.length},
-                   {"amplitude", m.amplitude * s.length},
-                   {"offset", m.offset * s.length},
+    out.push_back({{"separation", u.length(f.separation)},
+                   {"amplitude", u.length(m.amplitude)},
+                   {"offset", u.length(m.offset)},
                    {"phase", m.phase},
                    {"branch", branch_of(m)},
                    {"kind", f.separation_maximum ? "maximum" : "minimum"}});
@@ -84,11 +84,11 @@ nlohmann::json fold_records(const tapping::ContinuationResult& c, const TappingS
 }
 
 /// The units: by dimension, and per results key (the units of study outputs, docs/study.md#outputs).
-nlohmann::json sweep_units(const TappingScales& s) {
-  const std::string L = s.length_unit;
+nlohmann::json sweep_units(const TappingUnits& u) {
+  const std::string& L = u.length.name;
   return {{"length", L},
-          {"energy", s.energy_unit},
-          {"force", s.force_unit},
+          {"energy", u.energy.name},
+          {"force", u.force.name},
           {"approach_jumps", L},
           {"retract_jumps", L},
           {"jump_tolerance", L},
@@ -106,7 +106,7 @@ nlohmann::json sweep_units(const TappingScales& s) {
 
 /// The separations of the instrument sweep (model units): the explicit list (`separations` or `separations_file`)
 /// when one is given, else `points` equally spaced in [separation_min, separation_max].
-std::vector<double> sweep_separations(const io::ParamSet& p, double length_scale) {
+std::vector<double> sweep_separations(const io::ParamSet& p, const units::Unit& length) {
   if (p.was_set("separations") && p.was_set("separations_file"))
     throw InvalidParameter("separations", "give either separations or separations_file, not both");
   std::vector<double> list;
@@ -117,7 +117,7 @@ std::vector<double> sweep_separations(const io::ParamSet& p, double length_scale
   for (double& l : list) {
     if (!(std::abs(l) <= 1e6))
       throw InvalidParameter(key, fmt::format("{} contains {}: every separation must be in [-1e+06, 1e+06]", key, l));
-    l /= length_scale;
+    l = length.internal(l);
   }
   std::sort(list.begin(), list.end());
   list.erase(std::unique(list.begin(), list.end()), list.end());
@@ -174,7 +174,7 @@ nlohmann::json records_sorted_by(nlohmann::json records, const std::string& key)
 /// parameter_max, then up) and continuation through folds, with the swept value first in every row and record.
 void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
   const tapping::TappingModel base = tapping_model_from(p, law_object_of(capture));
-  const TappingScales scales = tapping_scales_from(p);
+  const TappingUnits u(tapping_scales_from(p));
   const SweptParameter swept = swept_parameter_from(p, law_object_of(capture));
   const std::string& name = swept.name;
   const int points = static_cast<int>(p.integer("points"));
@@ -195,7 +195,7 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
   };
 
   CommandOutput out(p, capture, "tapping sweep");
-  io::TableOf<tapping::SweepPoint> table = sweep_table(scales, false);
+  io::TableOf<tapping::SweepPoint> table = sweep_table(u, false);
   table
       .prepend({name, unit,
                 name == "drive_frequency"
@@ -248,8 +248,8 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
                        {"direction", sweep_direction_label(j.direction, false)},
                        {"located", j.located},
                        {"branch", branch_of(j.from_metrics)},
-                       {"amplitude_before", j.from_metrics.amplitude * scales.length},
-                       {"amplitude_after", j.to_metrics.amplitude * scales.length},
+                       {"amplitude_before", u.length(j.from_metrics.amplitude)},
+                       {"amplitude_after", u.length(j.to_metrics.amplitude)},
                        {"landed_periodic", j.landed_periodic}});
     results["jumps"] = records_sorted_by(std::move(jumps), name);
     const double tolerance = options.jump_tolerance * magnitude;
@@ -266,7 +266,7 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
     tapping::ContinuationOptions options;
     options.shooting = shooting_options_from(p);
     options.harmonic_balance = beside;
-    options.max_step = p.real("max_arclength_step") / scales.length;
+    options.max_step = u.length.internal(p.real("max_arclength_step"));
     options.initial_step = std::min(options.initial_step, options.max_step);
     options.max_points = static_cast<int>(p.integer("max_continuation_points"));
     options.cancellation = cancellation_of(capture);
@@ -280,8 +280,8 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
     for (const tapping::ContinuationFold& f : c.folds) {
       const tapping::OrbitMetrics& m = c.points.at(f.point).metrics;
       folds.push_back({{name, f.parameter},
-                       {"amplitude", m.amplitude * scales.length},
-                       {"offset", m.offset * scales.length},
+                       {"amplitude", u.length(m.amplitude)},
+                       {"offset", u.length(m.offset)},
                        {"phase", m.phase},
                        {"branch", branch_of(m)},
                        {"kind", f.separation_maximum ? "maximum" : "minimum"}});
@@ -296,14 +296,14 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
                            summary.empty() ? "" : "\n", name, c.points.size(), values_text(at),
                            values_text(c.grazing), c.stop_reason);
   }
-  results["free_amplitude"] = base.free_amplitude() * scales.length;
+  results["free_amplitude"] = u.length(base.free_amplitude());
   results["rows"] = out.rows();
   results["trapped_rows"] = trapped;
   record_trapped(results, summary, out.rows(), trapped, "value");
-  const std::string L = scales.length_unit;
+  const std::string& L = u.length.name;
   results["units"] = {{"length", L},
-                      {"energy", scales.energy_unit},
-                      {"force", scales.force_unit},
+                      {"energy", u.energy.name},
+                      {"force", u.force.name},
                       {"parameter", "label"},
                       {"harmonic_balance", "label"},
                       {"down_jumps", unit},
@@ -331,9 +331,9 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
                                               "separation's range is separation_min, separation_max)",
                                               key));
   const tapping::TappingModel base = tapping_model_from(p, law_object_of(capture));
-  const TappingScales scales = tapping_scales_from(p);
-  const std::vector<double> list = sweep_separations(p, scales.length);
-  double l_min = p.real("separation_min") / scales.length, l_max = p.real("separation_max") / scales.length;
+  const TappingUnits u(tapping_scales_from(p));
+  const std::vector<double> list = sweep_separations(p, u.length);
+  double l_min = u.length.internal(p.real("separation_min")), l_max = u.length.internal(p.real("separation_max"));
   if (!list.empty()) {
     l_min = list.front();
     l_max = list.back();
@@ -353,7 +353,7 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
   const bool beside = hb_beside(p, base);
 
   CommandOutput out(p, capture, "tapping sweep");
-  auto rows = out.open(sweep_table(scales));
+  auto rows = out.open(sweep_table(u));
   long trapped = 0;  // rows on which the tip does not tap (column trapped)
   const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) {
     rows.add_all(points);
@@ -389,27 +389,27 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     transient_progress.finish();
     write_rows(r.approach);
     write_rows(r.retract);
-    results["approach_jumps"] = scaled(r.approach_jumps, scales.length);
-    results["retract_jumps"] = scaled(r.retract_jumps, scales.length);
-    results["jumps"] = jump_records(r.jumps, scales);
-    const double tolerance = options.jump_tolerance * base.free_amplitude() * scales.length;
+    results["approach_jumps"] = scaled(r.approach_jumps, u.length);
+    results["retract_jumps"] = scaled(r.retract_jumps, u.length);
+    results["jumps"] = jump_records(r.jumps, u);
+    const double tolerance = u.length(options.jump_tolerance * base.free_amplitude());
     results["jump_tolerance"] = tolerance;
     if (!retract) results["directions"] = "approach";
     summary += retract
                    ? fmt::format("instrument sweep: jumps on approach at {}; on retract at {} (located to ±{})",
-                                 io::summary_values(scaled_values(r.approach_jumps, scales.length), scales.length_unit),
-                                 io::summary_values(scaled_values(r.retract_jumps, scales.length), scales.length_unit),
-                                 io::summary_value(tolerance, scales.length_unit, 3))
+                                 io::summary_values(scaled_values(r.approach_jumps, u.length), u.length.name),
+                                 io::summary_values(scaled_values(r.retract_jumps, u.length), u.length.name),
+                                 io::summary_value(tolerance, u.length.name, 3))
                    : fmt::format("instrument sweep: jumps on approach at {} (located to ±{}); no retract pass "
                                  "(directions = approach)",
-                                 io::summary_values(scaled_values(r.approach_jumps, scales.length), scales.length_unit),
-                                 io::summary_value(tolerance, scales.length_unit, 3));
+                                 io::summary_values(scaled_values(r.approach_jumps, u.length), u.length.name),
+                                 io::summary_value(tolerance, u.length.name, 3));
   }
   if (continuation) {
     tapping::ContinuationOptions options;
     options.shooting = shooting_options_from(p);
     options.harmonic_balance = beside;
-    options.max_step = p.real("max_arclength_step") / scales.length;
+    options.max_step = u.length.internal(p.real("max_arclength_step"));
     options.initial_step = std::min(options.initial_step, options.max_step);
     options.max_points = static_cast<int>(p.integer("max_continuation_points"));
     options.cancellation = cancellation_of(capture);
@@ -417,22 +417,22 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     const tapping::ContinuationResult c =
         computed("branch continuation", [&] { return tapping::sweep_continuation(base, l_min, l_max, options); });
     write_rows(c.points);
-    results["folds"] = fold_records(c, scales);
-    results["grazing"] = scaled(c.grazing, scales.length);
+    results["folds"] = fold_records(c, u);
+    results["grazing"] = scaled(c.grazing, u.length);
     results["continuation_stop"] = c.stop_reason;
     results["continuation_points"] = c.points.size();
     std::vector<double> folds;
     for (const auto& f : results["folds"]) folds.push_back(f["separation"].get<double>());
     summary += fmt::format("{}continuation: {} points, folds at {}; grazing at {} ({})", summary.empty() ? "" : "\n",
-                           c.points.size(), io::summary_values(folds, scales.length_unit),
-                           io::summary_values(scaled_values(c.grazing, scales.length), scales.length_unit),
+                           c.points.size(), io::summary_values(folds, u.length.name),
+                           io::summary_values(scaled_values(c.grazing, u.length), u.length.name),
                            c.stop_reason);
   }
-  results["free_amplitude"] = base.free_amplitude() * scales.length;
+  results["free_amplitude"] = u.length(base.free_amplitude());
   results["rows"] = out.rows();
   results["trapped_rows"] = trapped;
   record_trapped(results, summary, out.rows(), trapped, "separation");
-  results["units"] = sweep_units(scales);
+  results["units"] = sweep_units(u);
   for (const char* key : {"harmonic_balance", "directions"})  // present only where an option turned something off
     if (results.contains(key)) results["units"][key] = "label";
   out.finish(results, summary);
@@ -449,12 +449,9 @@ void register_tapping_sweep(CLI::App& tapping) {
       [](io::ParamSet& p) {
         add_tapping_model_params(p);
         add_tapping_sim_params(p);
-        p.group("Sweep")
-            .real("separation_min", 5.0, "smallest separation of the sweep", io::Range::any())
-            .unit(kLengthUnit)
-            .real("separation_max", 15.0, "largest separation of the sweep, > separation_min", io::Range::any())
-            .unit(kLengthUnit)
-            .integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000);
+        p.group("Sweep");
+        add_separation_range_params(p, 5.0, 15.0);
+        p.integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000);
         add_separation_list_params(p, "explicit separations of the instrument sweep instead of the uniform grid (any "
                                       "order, e.g. 20,18,16,15.5); the continuation runs between the smallest and the "
                                       "largest");

@@ -11,16 +11,17 @@
 #include "afmkit/tapping/sweep.hpp"
 #include "afmkit/tapping/units.hpp"
 #include "command.hpp"
+#include "tapping_params.hpp"
 
 namespace afmkit::cli {
 
 /// The harmonic-balance curve's table: q, separation, amplitude, offset, phase, branch (lengths in the units of
 /// `scales`), one row per HbPoint.
-io::TableOf<tapping::HbPoint> hb_table(const tapping::UnitScales& scales);
+io::TableOf<tapping::HbPoint> hb_table(const TappingUnits& units);
 
 /// The folds of harmonic balance as records (q, separation, amplitude, offset, phase, branch, kind = maximum or
 /// minimum of l(q)) sorted by separation — as `tapping hb` and `demo` report them.
-nlohmann::json hb_fold_records(const tapping::HarmonicBalance& hb, const tapping::UnitScales& s);
+nlohmann::json hb_fold_records(const tapping::HarmonicBalance& hb, const TappingUnits& units);
 
 /// Direction label of a row: approach / retract in separation sweeps, down / up in sweeps of another parameter
 /// (the values visited from the largest down, then back up); continuation either way.
@@ -33,6 +34,6 @@ inline const char* sweep_direction_label(tapping::SweepDirection d, bool separat
 /// arclength, harmonic_2, harmonic_3, hb_amplitude, hb_offset, hb_phase, hb_solutions, trapped. `separation_sweep`
 /// false (a sweep in another parameter): directions are labelled down / up (the caller puts the swept parameter's
 /// column first).
-io::TableOf<tapping::SweepPoint> sweep_table(const tapping::UnitScales& scales, bool separation_sweep = true);
+io::TableOf<tapping::SweepPoint> sweep_table(const TappingUnits& units, bool separation_sweep = true);
 
 }  // namespace afmkit::cli

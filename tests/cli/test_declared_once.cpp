@@ -17,8 +17,18 @@
 #include <string>
 #include <vector>
 
+#include <cmath>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "afmkit/core/units.hpp"
 #include "afmkit/io/params.hpp"
+#include "afmkit/io/table.hpp"
+#include "cli_run.hpp"
 #include "command.hpp"
+#include "described_params.hpp"
+#include "unit_tagged.hpp"
 
 namespace {
 
@@ -100,10 +110,9 @@ const DeclaredOnceList kDeclaredOnceNotYetMerged = {
     {"quality_factor", {3, "tapping, spectroscopy fit/reconstruct: defaults (100, required, 400) and ranges differ"}},
     {"free_amplitude", {3, "tapping (physical units), spectroscopy fit/reconstruct: defaults and ranges differ"}},
     {"amplitude", {3, "tapping fm (nm or L), spectroscopy fit/reconstruct (FM amplitude, nm): defaults differ"}},
-    {"drive_frequency", {2, "spectroscopy fit and reconstruct: the same AM drive frequency, declared in each"}},
-    {"separation_min", {5, "tapping sweep, grid, fm, modes and demo: defaults differ and ranges disagree (any finite "
-                       "vs [-1e6, 1e6])"}},
-    {"separation_max", {5, "tapping sweep, grid, fm, modes and demo: as separation_min"}},
+    {"separation_min", {2, "tapping sweep, grid, fm and modes (add_separation_range_params) and demo, whose defaults "
+                       "are the demonstration case scaled to free_amplitude (any finite value)"}},
+    {"separation_max", {2, "as separation_min"}},
     {"points", {8, "the separations of tapping sweep, grid, fm, modes and demo (in [1 or 2, 1e6, 1e7 or 1e8]); the other "
                "commands' points are other counts (impact's history samples, hb's q samples, control tf's grid)"}},
     {"approach_stiffness", {2, "the hysteresis law's K_a: the law registry's (add_law_params; impact, spectroscopy "
@@ -195,6 +204,85 @@ TEST(DeclaredOnce, AKeyDeclaredAtTwoPlacesIsFound) {
   // a listed key declared at one more place than listed is reported
   EXPECT_TRUE(declared_once_violations(declared_once_sites(twice), {{"declared_once_q", {2, "two"}}}, {}).empty());
   EXPECT_EQ(declared_once_violations(declared_once_sites(twice), {{"declared_once_q", {3, "three"}}}, {}).size(), 1u);
+}
+
+
+// Units at one edge (afmkit/core/units.hpp): a user's number is converted once on its way in (real_si, from the
+// unit its parameter declares) and once on its way out (the Unit of a column or a results entry, which also names
+// the unit). A conversion done twice or missed changes these values by a factor of 1e9 (or k, 2π f0).
+TEST(UnitsAtOneEdge, AParameterIsReadInItsDeclaredUnitAsSi) {
+  afmkit::io::ParamSet p;
+  p.real("units_edge_gap", 1.0, "a gap").unit("nm");
+  p.real("units_edge_f0", 300.0, "a frequency").unit("kHz");
+  p.real("units_edge_k", 40.0, "a stiffness").unit("N/m");
+  p.real("units_edge_q", 2.0, "a ratio").unit("units of Omega");
+  EXPECT_EQ(afmkit::cli::real_si(p, "units_edge_gap"), 1e-9);   // 1 nm = 1e-9 m, not 1 m and not 1e-18 m
+  EXPECT_EQ(afmkit::cli::real_si(p, "units_edge_f0"), 300e3);    // 300 kHz = 3e5 Hz
+  EXPECT_EQ(afmkit::cli::real_si(p, "units_edge_k"), 40.0);      // N/m is SI
+  p.set_from_string("units_edge_gap", "2.5");
+  EXPECT_EQ(afmkit::cli::real_si(p, "units_edge_gap"), 2.5 * 1e-9);
+  EXPECT_THROW(afmkit::cli::real_si(p, "units_edge_q"), std::logic_error);  // no SI form: a programming error
+}
+
+TEST(UnitsAtOneEdge, AColumnConvertsItsValueIntoTheUnitItNames) {
+  struct UnitsEdgeRow {
+    double gap;      // m (SI)
+    double model_v;  // model units L/t
+  };
+  const afmkit::units::Unit length{"nm", 3.0}, time{"s", 0.5};
+  const afmkit::io::TableOf<UnitsEdgeRow> table{
+      {"gap", afmkit::units::from_si("nm"), "a gap", &UnitsEdgeRow::gap},
+      {"velocity", length.per(time), "a velocity", &UnitsEdgeRow::model_v}};
+  const auto columns = table.columns();
+  EXPECT_EQ(columns[0].unit, "nm");
+  EXPECT_EQ(columns[1].unit, "nm/s");
+  const UnitsEdgeRow row{2e-9, 1.0};
+  EXPECT_DOUBLE_EQ(std::get<double>(table.entries()[0].value(row)), 2.0);
+  EXPECT_DOUBLE_EQ(std::get<double>(table.entries()[1].value(row)), 6.0);  // 1 L/t * 3 nm/L / (0.5 s/t)
+  // a results entry: the value and its unit declared together
+  afmkit::cli::UnitTagged tagged;
+  tagged.add("gap", 2e-9, afmkit::units::from_si("nm")).add("count", 3, "count").add("name", "x");
+  EXPECT_DOUBLE_EQ(tagged.values()["gap"].get<double>(), 2.0);
+  EXPECT_EQ(tagged.units(), (nlohmann::json{{"gap", "nm"}, {"count", "count"}}));
+  EXPECT_DOUBLE_EQ(afmkit::units::degrees_from_radians()(std::acos(-1.0)), 180.0);
+}
+
+TEST(UnitsAtOneEdge, TappingOrbitInPhysicalUnitsIsTheNormalisedOrbitScaledOnce) {
+  // the same model (law attractive) run in physical units (k = 2 N/m, f0 = 1 kHz, A_free = 10 nm, Q = 50,
+  // ω/ω_n = 1) and in its normalised form (ω_n = 1, Γ = A_free |1 - r^2 + i r/Q| = A_free/Q, stiffnesses and
+  // adhesions divided by k): lengths equal (L = nm), forces and energies k times, velocities 2π f0 times. A scale
+  // applied twice or not at all (or to the wrong quantity) breaks one of these.
+  const double k = 2.0, f0_hz = 1e3, a_free = 10.0, q = 50.0, ks_a = 8.0, ks_b = 6.0, f_a = 0.2, f_b = 0.4;
+  const std::string common = " --law attractive --quality-factor 50 --separation 9 --json --output orbit.csv";
+  afmkit_test::TempDir dir;
+  const auto phys = afmkit_test::run_cli(
+      "tapping orbit --units physical --spring-constant 2 --resonance-frequency 1 --free-amplitude 10 "
+      "--sample-stiffness-approach 8 --sample-stiffness-departure 6 --adhesion-approach 0.2 --adhesion-departure 0.4" +
+          common, dir);
+  ASSERT_EQ(phys.status, 0) << phys.err;
+  const auto norm = afmkit_test::run_cli(
+      "tapping orbit --drive-amplitude " + std::to_string(a_free / q) + " --approach-stiffness " +
+          std::to_string(ks_a / k) + " --departure-stiffness " + std::to_string(ks_b / k) + " --approach-adhesion " +
+          std::to_string(f_a / k) + " --departure-adhesion " + std::to_string(f_b / k) + common, dir);
+  ASSERT_EQ(norm.status, 0) << norm.err;
+  const auto pj = nlohmann::json::parse(phys.out), nj = nlohmann::json::parse(norm.out);
+  ASSERT_FALSE(pj["orbits"].empty());
+  ASSERT_EQ(pj["orbits"].size(), nj["orbits"].size());
+  const auto& po = pj["orbits"][0];
+  const auto& no = nj["orbits"][0];
+  const double omega = 2.0 * std::acos(-1.0) * f0_hz;
+  const auto near = [](double a, double b) { return std::abs(a - b) <= 1e-5 * std::max(std::abs(b), 1e-3); };
+  EXPECT_TRUE(near(po["amplitude"].get<double>(), no["amplitude"].get<double>())) << po["amplitude"];
+  EXPECT_TRUE(near(po["peak_force"].get<double>(), k * no["peak_force"].get<double>())) << po["peak_force"];
+  EXPECT_TRUE(near(po["drive_work"].get<double>(), k * no["drive_work"].get<double>())) << po["drive_work"];
+  EXPECT_TRUE(near(po["contact_dissipation"].get<double>(), k * no["contact_dissipation"].get<double>()))
+      << po["contact_dissipation"];
+  EXPECT_TRUE(near(po["initial_velocity"].get<double>(), omega * no["initial_velocity"].get<double>()))
+      << po["initial_velocity"];
+  EXPECT_TRUE(near(pj["free_amplitude"].get<double>(), a_free)) << pj["free_amplitude"];
+  EXPECT_EQ(pj["units"]["orbits"]["peak_force"], "nN");
+  EXPECT_EQ(pj["units"]["orbits"]["initial_velocity"], "nm/s");
+  EXPECT_EQ(nj["units"]["orbits"]["initial_velocity"], "L/t");
 }
 
 }  // namespace

@@ -1,13 +1,14 @@
 """r.params records what a run used, and replays (issue 24 §2): a key whose default is another key records that
 key's value, a default the command computes records the computed value, an alternative not given is left out."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import afmkit
 from afmkit import _afmkit
-from afmkit import spectroscopy_fit
+from afmkit import spectroscopy_fit, spectroscopy_reconstruct
 
 # fast settings per command (each run takes well under a second)
 FAST = {
@@ -31,6 +32,8 @@ FAST = {
     "control export": dict(harmonics=3, sample_rate=1000.0),
     "spectroscopy fit": dict(spring_constant=40.0, resonance_frequency=300.0, quality_factor=100.0,
                              free_amplitude=10.0, parameters="phase_offset"),
+    "spectroscopy reconstruct": dict(spring_constant=40.0, amplitude=2.0, round_trip="first_order",
+                                     noise_realisations=0, law_output=""),
 }
 # commands that write files whatever the output keys say: into the test's folder
 def _am_curve(d):
@@ -42,7 +45,9 @@ def _am_curve(d):
 
 
 FILES = {"demo": lambda d: dict(output_dir=str(d / "demo")), "control export": lambda d: dict(output=str(d / "f.h")),
-         "spectroscopy fit": _am_curve}
+         "spectroscopy fit": _am_curve,
+         "spectroscopy reconstruct": lambda d: dict(
+             input=str(Path(__file__).resolve().parents[2] / "examples" / "configs" / "fm_curve_dmt.csv"))}
 FUNCTIONS = {
     "impact": afmkit.impact, "tapping hb": afmkit.tapping.hb, "tapping orbit": afmkit.tapping.orbit,
     "tapping sweep": afmkit.tapping.sweep, "tapping fm": afmkit.tapping.fm, "control tf": afmkit.control.tf, "control roots": afmkit.control.roots,
@@ -51,6 +56,7 @@ FUNCTIONS = {
     "control margin": afmkit.control.margin, "control chart": afmkit.control.chart,
     "control tune": afmkit.control.tune, "control simulate": afmkit.control.simulate, "scan": afmkit.scan,
     "demo": afmkit.demo, "control export": afmkit.control.export, "spectroscopy fit": spectroscopy_fit.run,
+    "spectroscopy reconstruct": spectroscopy_reconstruct.reconstruct,
 }
 # a value for the followed key, inside its range, other than its default
 NEW_VALUE = {"hamaker": 1e-19, "effective_modulus": 3.0, "plant_rate": 7.0, "delay": 0.05, "bandwidth": 5000.0,

@@ -26,6 +26,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "afmkit/core/units.hpp"
 #include "afmkit/io/output.hpp"
 
 namespace afmkit::io {
@@ -62,6 +63,14 @@ struct ColumnOf {
   ColumnOf(std::string name, std::string unit, std::string description, Accessor accessor)
       : column{std::move(name), std::move(unit), std::move(description)},
         value([f = std::move(accessor)](const Row& row) { return to_cell(std::invoke(f, row)); }) {}
+  /// A number whose unit converts the row's value (SI or the model's units) into the unit shown: the column's unit
+  /// and its conversion are one declaration (afmkit/core/units.hpp), e.g. {"amplitude", units.length, …, &P::amplitude}.
+  template <class Accessor>
+  ColumnOf(std::string name, const units::Unit& unit, std::string description, Accessor accessor)
+      : column{std::move(name), unit.name, std::move(description)},
+        value([u = unit, f = std::move(accessor)](const Row& row) {
+          return to_cell(u(static_cast<double>(std::invoke(f, row))));
+        }) {}
 };
 
 /// One grid dimension: the column spanning it, the dimension's name (the column's name, or the name of the

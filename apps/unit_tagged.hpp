@@ -1,0 +1,73 @@
+#pragma once
+// Results whose numbers carry their units (the output edge of afmkit/core/units.hpp): each entry is declared once,
+// with the Unit that converts the program's value and names the unit, and the sidecar's "units" object is built
+// from the same declarations as the values, so that a value and its unit cannot drift apart.
+//   UnitTagged orbit;
+//   orbit.add("amplitude", m.amplitude, u.length)            // value * scale, unit "nm" (or "L")
+//        .add("stable", o.stable, "boolean (0/1)")           // shown as computed, with its unit
+//        .add("source", "hb_plus");                           // a label: no unit
+//   summary["orbit"] = orbit.values();  units["orbit"] = orbit.units();
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "afmkit/core/units.hpp"
+#include "afmkit/io/quantity.hpp"
+
+namespace afmkit::cli {
+
+class UnitTagged {
+ public:
+  /// A number converted by `unit`.
+  UnitTagged& add(const std::string& key, double value, const units::Unit& unit) {
+    values_[key] = unit(value);
+    units_[key] = unit.name;
+    return *this;
+  }
+  /// Numbers converted by `unit`, one JSON array.
+  UnitTagged& add(const std::string& key, const std::vector<double>& values, const units::Unit& unit) {
+    nlohmann::json a = nlohmann::json::array();
+    for (double v : values) a.push_back(unit(v));
+    values_[key] = std::move(a);
+    units_[key] = unit.name;
+    return *this;
+  }
+  /// A value shown as computed (counts, flags, rad, dimensionless numbers) and its unit.
+  UnitTagged& add(const std::string& key, nlohmann::json value, const char* unit) {
+    values_[key] = std::move(value);
+    units_[key] = unit;
+    return *this;
+  }
+  /// A value without a unit (a label, a text).
+  UnitTagged& add(const std::string& key, nlohmann::json value) {
+    values_[key] = std::move(value);
+    return *this;
+  }
+  /// A nested record: its values and its units under `key`.
+  UnitTagged& add(const std::string& key, const UnitTagged& nested) {
+    values_[key] = nested.values_;
+    units_[key] = nested.units_;
+    return *this;
+  }
+  /// A unit without a value here (an entry whose values are listed elsewhere, e.g. in the rows of an array).
+  UnitTagged& unit(const std::string& key, nlohmann::json unit) {
+    units_[key] = std::move(unit);
+    return *this;
+  }
+
+  const nlohmann::json& values() const& { return values_; }
+  const nlohmann::json& units() const& { return units_; }
+
+ private:
+  nlohmann::json values_ = nlohmann::json::object();
+  nlohmann::json units_ = nlohmann::json::object();
+};
+
+/// A length, time, force or energy of a summary line, converted by `unit` and printed in it (io::summary_value).
+inline std::string summary_value(double value, const units::Unit& unit, int digits = 4) {
+  return io::summary_value(unit(value), unit.name, digits);
+}
+
+}  // namespace afmkit::cli
