@@ -8,6 +8,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/scan/levelling.hpp"
 #include "afmkit/scan/sample_generators.hpp"
+#include "afmkit/scan/uncontrolled_saturation.hpp"
 #include "afmkit/scan/virtual_scan.hpp"
 
 namespace {
@@ -117,3 +118,58 @@ TEST(VirtualScan, TurnsMustOverlapAtTheImageResolution) {
 }
 
 }  // namespace
+
+namespace {
+// The uncontrolled comparison run, started where the convex-combination bound lets it saturate, against the full
+// run from sample 0: the same first saturated sample (bit-equal radius) in every case, and far fewer samples.
+InstrumentSpec uncontrolled_case(double sample_rate, double radial_speed, double start_radius) {
+  InstrumentSpec s;
+  s.spiral.sample_rate = sample_rate;
+  s.spiral.end_radius = 4e-3;
+  s.spiral.start_radius = start_radius;
+  s.spiral.radial_speed = radial_speed;
+  return s;
+}
+}  // namespace
+
+TEST(UncontrolledSaturation, SkippedRunFindsTheFullRunsFirstSaturatedSample) {
+  const Surface rough_surface = rough_tilted(4.1e-3, 0.05);
+  const Grid g{256, 256, 8.2e-3, 8.2e-3, -4.1e-3, -4.1e-3};
+  const Surface grating_surface(grating(g, GratingSpec{800e-6, 50e-9, 0.5, 0.0}), Tilt(0.05 * std::numbers::pi / 180, 2.0));
+  const Surface steep(flat(g), Tilt(0.1 * std::numbers::pi / 180, -1.0));     // saturates early (r ≈ 1.15 mm)
+  const Surface gentle(flat(g), Tilt(0.02 * std::numbers::pi / 180, 0.0));    // never saturates within 4 mm
+  struct Case {
+    const Surface* surface;
+    InstrumentSpec spec;
+  };
+  InstrumentSpec slow_plant = uncontrolled_case(20e3, 1e-3, 0.0);
+  slow_plant.plant.bandwidth = 2 * std::numbers::pi * 200;  // a longer memory: the settling stretch grows
+  for (const Case& c : {Case{&rough_surface, uncontrolled_case(20e3, 1e-3, 0.0)},
+                        Case{&grating_surface, uncontrolled_case(50e3, 2e-3, 0.5e-3)},
+                        Case{&steep, uncontrolled_case(20e3, 1e-3, 0.0)},
+                        Case{&gentle, uncontrolled_case(20e3, 1e-3, 0.0)}, Case{&rough_surface, slow_plant}}) {
+    const UncontrolledSaturation fast = first_uncontrolled_saturation(c.spec, *c.surface);
+    const UncontrolledSaturation full = first_uncontrolled_saturation_full(c.spec, *c.surface);
+    EXPECT_EQ(fast.saturates, full.saturates);
+    EXPECT_EQ(fast.radius, full.radius);  // the same sample: bit-equal
+    if (fast.samples > 0) EXPECT_EQ(fast.first_sample % 4096, 0);  // where the tip angle is exact
+    if (full.saturates) {
+      EXPECT_LT(fast.samples, full.samples);
+    } else {
+      EXPECT_EQ(fast.samples, 0);  // nothing simulated: the bound holds to the end
+    }
+  }
+  // the steep tilt saturates where the steady first harmonic r tan ψ γ/√(γ² + Ω²) reaches R_d (independent check
+  // that the case exercises a saturation); the rough one starts late in the scan
+  EXPECT_TRUE(first_uncontrolled_saturation(uncontrolled_case(20e3, 1e-3, 0.0), steep).saturates);
+  EXPECT_GT(first_uncontrolled_saturation(uncontrolled_case(20e3, 1e-3, 0.0), rough_surface).first_sample, 0);
+}
+
+TEST(UncontrolledSaturation, NoisyDetectorRunsFromTheStart) {
+  InstrumentSpec s = uncontrolled_case(20e3, 1e-3, 0.0);
+  s.detector.noise = 1e-9;
+  const Surface surface = rough_tilted(4.1e-3, 0.05);
+  const UncontrolledSaturation fast = first_uncontrolled_saturation(s, surface);
+  EXPECT_EQ(fast.first_sample, 0);
+  EXPECT_EQ(fast.radius, first_uncontrolled_saturation_full(s, surface).radius);
+}
