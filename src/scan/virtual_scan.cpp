@@ -9,6 +9,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/scan/levelling.hpp"
+#include "afmkit/scan/observer_thread.hpp"
 #include "afmkit/scan/spiral_imager.hpp"
 #include "afmkit/scan/uncontrolled_saturation.hpp"
 
@@ -102,7 +103,14 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   std::vector<ScanObserver*> chain{&imaging, &metrics};
   if (options.extra) chain.push_back(options.extra);
   ObserverChain observers(chain);
-  const ScanRun run = simulate_scan(instrument, surface, observers, options.progress, options.cancellation);
+  // the imaging, the per-turn metrics and the extra observer run on a second thread, a batch behind the simulation
+  // (none of them stops the scan: the samples and the images are those of the direct chain)
+  ScanRun run;
+  {
+    ObserverThread behind(observers);
+    run = simulate_scan(instrument, surface, behind, options.progress, options.cancellation);
+    if (behind.finish()) run.stopped_early = true;
+  }
   std::vector<HeightMap> images = imager.finish();
 
   const bool inverse = instrument.reconstruction.method == Reconstruction::inverse;

@@ -4,9 +4,12 @@
 
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
+#include <vector>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/scan/levelling.hpp"
+#include "afmkit/scan/observer_thread.hpp"
 #include "afmkit/scan/sample_generators.hpp"
 #include "afmkit/scan/uncontrolled_saturation.hpp"
 #include "afmkit/scan/virtual_scan.hpp"
@@ -172,4 +175,46 @@ TEST(UncontrolledSaturation, NoisyDetectorRunsFromTheStart) {
   const UncontrolledSaturation fast = first_uncontrolled_saturation(s, surface);
   EXPECT_EQ(fast.first_sample, 0);
   EXPECT_EQ(fast.radius, first_uncontrolled_saturation_full(s, surface).radius);
+}
+
+namespace {
+// Records the sample indices it sees; stops or throws at a chosen index.
+struct IndexRecorder final : ScanObserver {
+  std::vector<std::int64_t> seen;
+  std::int64_t stop_at = -1, throw_at = -1;
+  bool sample(const ScanSample& s) override {
+    if (s.index == throw_at) throw std::runtime_error("observer failed");
+    seen.push_back(s.index);
+    return s.index != stop_at;
+  }
+};
+ScanSample sample_numbered(std::int64_t n) { return ScanSample{n, 0, 0, 0, 0, 0, 0, 0, 0, 0, false}; }
+}  // namespace
+
+TEST(ObserverThread, SeesEverySampleInOrderAndStopsOrRethrowsLikeTheObserver) {
+  IndexRecorder all;
+  {
+    ObserverThread behind(all, 7);
+    for (std::int64_t n = 0; n < 1000; ++n) ASSERT_TRUE(behind.sample(sample_numbered(n)));
+    EXPECT_FALSE(behind.finish());
+  }
+  ASSERT_EQ(all.seen.size(), 1000U);
+  for (std::int64_t n = 0; n < 1000; ++n) EXPECT_EQ(all.seen[static_cast<std::size_t>(n)], n);
+
+  IndexRecorder stopping;
+  stopping.stop_at = 100;
+  ObserverThread behind(stopping, 8);
+  std::int64_t handed = 0;
+  while (handed < 100000 && behind.sample(sample_numbered(handed))) ++handed;
+  EXPECT_TRUE(behind.finish());
+  EXPECT_EQ(stopping.seen.back(), 100);  // nothing after the stop reaches the observer
+  EXPECT_LT(handed, 100 + 4 * 8 + 8);    // the caller is told within a few batches
+
+  IndexRecorder failing;
+  failing.throw_at = 50;
+  ObserverThread failing_behind(failing, 8);
+  for (std::int64_t n = 0; n < 200 && failing_behind.sample(sample_numbered(n)); ++n) {
+  }
+  EXPECT_THROW(failing_behind.finish(), std::runtime_error);
+  EXPECT_EQ(failing.seen.size(), 50U);
 }
