@@ -218,3 +218,60 @@ TEST(ObserverThread, SeesEverySampleInOrderAndStopsOrRethrowsLikeTheObserver) {
   EXPECT_THROW(failing_behind.finish(), std::runtime_error);
   EXPECT_EQ(failing.seen.size(), 50U);
 }
+
+namespace {
+// The imaging floor against the sampling (issue 27 §5): an ideal instrument (no noise, the plant known) whose
+// reconstruction is exact, on a 0.8 mm disc, 50 Hz spindle, 4 µm pitch, imaged to 128² (12.5 µm pixels).
+InstrumentSpec floor_scan(double sample_rate) {
+  InstrumentSpec s;
+  s.spiral.sample_rate = sample_rate;
+  s.spiral.end_radius = 0.8e-3;
+  s.spiral.radial_speed = 200e-6;
+  return s;
+}
+const Grid& floor_map_grid() {
+  static const Grid g{256, 256, 1.64e-3, 1.64e-3, -0.82e-3, -0.82e-3};  // 6.4 µm pixels
+  return g;
+}
+}  // namespace
+
+TEST(ImagingFloor, SharpEdgesCostTheStraightEdgeEstimateAndFallWithDenserSampling) {
+  // grating lines along y, period P = 160 µm, H = 50 nm: each edge crossed by a turn becomes, by the linear
+  // interpolation along the turn, a ramp over one sample step w = Δθ |y| (projected on x), mean squared error H²/6
+  // over it; summed over the edges (density 2/P) and the disc: MSE = (4 / 9π) H² Δθ R / P — an estimate for steps
+  // (the truth's own ramps, one map pixel wide, lower it)
+  const double period = 160e-6, height = 50e-9;
+  const Surface surface(grating(floor_map_grid(), GratingSpec{period, height, 0.5, 0.0}), Tilt(0.0, 0.0));
+  double floors[2];
+  int k = 0;
+  for (const double rate : {10e3, 40e3}) {  // 200 and 800 samples per turn: 25 and 6.3 µm apart at the rim
+    const InstrumentSpec s = floor_scan(rate);
+    const VirtualScan v = run_virtual_scan(s, surface, image_grid(s, 128));
+    EXPECT_LT(v.budget.reconstruction, 1e-9 * v.sample_rms_height);  // the instrument adds nothing
+    EXPECT_NEAR(v.inverse_rms_error, v.budget.imaging, 1e-9 * v.sample_rms_height);
+    const double dtheta = 2 * std::numbers::pi / (rate / s.spiral.spindle_frequency);
+    const double estimate = height * std::sqrt(4.0 / (9.0 * std::numbers::pi) * dtheta * s.spiral.end_radius / period);
+    if (k == 0) {  // steps 25 µm apart against 6.4 µm ramps: near the estimate, below it
+      EXPECT_LT(v.budget.imaging, estimate);
+      EXPECT_GT(v.budget.imaging, 0.4 * estimate);
+    }
+    floors[k++] = v.budget.imaging;
+  }
+  EXPECT_GT(floors[0] / floors[1], 1.8);  // 4× denser: at least the √4 of steps
+}
+
+TEST(ImagingFloor, ASmoothSampleFallsAsTheSquareOfTheAngularStep) {
+  // correlation length 300 µm: the header's bound (Δθ² + Δφ²) K / 8 dominates the pitch term p² H / 8, so the floor
+  // falls about 16× for 4× the samples per turn
+  const Surface surface(rough(floor_map_grid(), RoughSpec{20e-9, 300e-6, 5}), Tilt(0.0, 0.0));
+  double floors[2];
+  int k = 0;
+  for (const double rate : {10e3, 40e3}) {
+    const InstrumentSpec s = floor_scan(rate);
+    const VirtualScan v = run_virtual_scan(s, surface, image_grid(s, 128));
+    EXPECT_LT(v.budget.reconstruction, 1e-9 * v.sample_rms_height);
+    floors[k++] = v.budget.imaging;
+  }
+  EXPECT_GT(floors[0] / floors[1], 8.0);
+  EXPECT_LT(floors[0] / floors[1], 20.0);
+}
