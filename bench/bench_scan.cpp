@@ -34,11 +34,13 @@ const Surface& sample() {
   return s;
 }
 
+// Arg 1: imaging on a second thread (the default; CPU = the simulating thread's), 0: all on one thread (before).
 void BM_ScanAndImage1024(benchmark::State& state) {
   const InstrumentSpec s = ten_million();
   sample();  // generate the sample outside the timing
   VirtualScanOptions o;
   o.compare_without_control = false;
+  o.imaging_thread = state.range(0) != 0;
   for (auto _ : state) {
     VirtualScan v = run_virtual_scan(s, sample(), image_grid(s, 1024), o);
     benchmark::DoNotOptimize(v.topography_rms_error);
@@ -48,7 +50,7 @@ void BM_ScanAndImage1024(benchmark::State& state) {
                                                        benchmark::Counter::kIsIterationInvariantRate |
                                                            benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_ScanAndImage1024)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_ScanAndImage1024)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 void BM_ScanAndImageWithUncontrolledComparison(benchmark::State& state) {
   const InstrumentSpec s = ten_million();

@@ -106,10 +106,12 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   // the imaging, the per-turn metrics and the extra observer run on a second thread, a batch behind the simulation
   // (none of them stops the scan: the samples and the images are those of the direct chain)
   ScanRun run;
-  {
+  if (options.imaging_thread) {
     ObserverThread behind(observers);
     run = simulate_scan(instrument, surface, behind, options.progress, options.cancellation);
     if (behind.finish()) run.stopped_early = true;
+  } else {
+    run = simulate_scan(instrument, surface, observers, options.progress, options.cancellation);
   }
   std::vector<HeightMap> images = imager.finish();
 

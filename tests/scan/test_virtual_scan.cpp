@@ -275,3 +275,23 @@ TEST(ImagingFloor, ASmoothSampleFallsAsTheSquareOfTheAngularStep) {
   EXPECT_GT(floors[0] / floors[1], 8.0);
   EXPECT_LT(floors[0] / floors[1], 20.0);
 }
+
+TEST(ObserverThread, TheScanImagedOnASecondThreadIsTheScanImagedDirectly) {
+  const InstrumentSpec s = small_scan();
+  const Surface surface = rough_tilted(4.1e-3, 0.05);
+  VirtualScanOptions direct;
+  direct.imaging_thread = false;
+  std::vector<double> turns_direct, turns_threaded;
+  direct.on_turn = [&](const TurnRecord& r) { turns_direct.push_back(r.deflection_first_harmonic); };
+  VirtualScanOptions threaded;
+  threaded.on_turn = [&](const TurnRecord& r) { turns_threaded.push_back(r.deflection_first_harmonic); };
+  const VirtualScan a = run_virtual_scan(s, surface, image_grid(s, 64), direct);
+  const VirtualScan b = run_virtual_scan(s, surface, image_grid(s, 64), threaded);
+  EXPECT_EQ(turns_direct, turns_threaded);
+  EXPECT_EQ(a.topography.data().size(), b.topography.data().size());
+  for (std::size_t k = 0; k < a.topography.size(); ++k)
+    if (std::isfinite(a.topography.data()[k]) || std::isfinite(b.topography.data()[k]))
+      ASSERT_EQ(a.topography.data()[k], b.topography.data()[k]) << k;
+  EXPECT_EQ(a.topography_rms_error, b.topography_rms_error);
+  EXPECT_EQ(a.run.samples, b.run.samples);
+}
