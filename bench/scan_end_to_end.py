@@ -45,15 +45,31 @@ def sidecar_without_paths(path, folder):
     return json.loads(text)
 
 
+def json_differences(old, new, path=""):
+    """The key paths where two JSON values differ (added, removed or changed)."""
+    if isinstance(old, dict) and isinstance(new, dict):
+        out = []
+        for k in sorted(set(old) | set(new)):
+            p = f"{path}.{k}" if path else k
+            if k not in old:
+                out.append(f"+{p}")
+            elif k not in new:
+                out.append(f"-{p}")
+            else:
+                out += json_differences(old[k], new[k], p)
+        return out
+    return [] if old == new else [path]
+
+
 def compare(new_folder, old_folder):
     differing = []
     for name in sorted(os.listdir(old_folder)):
         a, b = os.path.join(old_folder, name), os.path.join(new_folder, name)
         if name.endswith(".json"):
-            same = sidecar_without_paths(a, old_folder) == sidecar_without_paths(b, new_folder)
-        else:
-            same = os.path.exists(b) and filecmp.cmp(a, b, shallow=False)
-        if not same:
+            keys = json_differences(sidecar_without_paths(a, old_folder), sidecar_without_paths(b, new_folder))
+            if keys:
+                differing.append(f"{name} ({', '.join(keys)})")
+        elif not (os.path.exists(b) and filecmp.cmp(a, b, shallow=False)):
             differing.append(name)
     return len(os.listdir(old_folder)), differing
 
