@@ -16,7 +16,7 @@ class StopAtFirstSaturation final : public ScanObserver {
   bool sample(const ScanSample& s) override { return !s.saturated; }
 };
 
-UncontrolledSaturation run_from(const InstrumentSpec& off, const Surface& surface, std::int64_t first,
+UncontrolledSaturation run_uncontrolled_from(const InstrumentSpec& off, const Surface& surface, std::int64_t first,
                                 const Cancellation& cancellation) {
   StopAtFirstSaturation stop;
   const ScanRun run = simulate_scan(off, surface, stop, {}, cancellation, first);
@@ -28,7 +28,7 @@ UncontrolledSaturation run_from(const InstrumentSpec& off, const Surface& surfac
   return out;
 }
 
-InstrumentSpec without_control(const InstrumentSpec& instrument) {
+InstrumentSpec with_control_off(const InstrumentSpec& instrument) {
   InstrumentSpec off = instrument;
   off.controller.enabled = false;
   off.validate();
@@ -39,13 +39,13 @@ InstrumentSpec without_control(const InstrumentSpec& instrument) {
 
 UncontrolledSaturation first_uncontrolled_saturation_full(const InstrumentSpec& instrument, const Surface& surface,
                                                           const Cancellation& cancellation) {
-  return run_from(without_control(instrument), surface, 0, cancellation);
+  return run_uncontrolled_from(with_control_off(instrument), surface, 0, cancellation);
 }
 
 UncontrolledSaturation first_uncontrolled_saturation(const InstrumentSpec& instrument, const Surface& surface,
                                                      const Cancellation& cancellation) {
-  const InstrumentSpec off = without_control(instrument);
-  if (off.detector.noise > 0.0) return run_from(off, surface, 0, cancellation);  // noise is unbounded: no skip
+  const InstrumentSpec off = with_control_off(instrument);
+  if (off.detector.noise > 0.0) return run_uncontrolled_from(off, surface, 0, cancellation);  // noise is unbounded: no skip
   const SpiralSpec& s = off.spiral;
   double largest = 0.0;
   for (const double z : surface.map().data()) largest = std::max(largest, std::abs(z));
@@ -71,7 +71,7 @@ UncontrolledSaturation first_uncontrolled_saturation(const InstrumentSpec& instr
   std::int64_t first = std::max<std::int64_t>(critical - settle, 0);
   first -= first % 4096;
   if (first >= total) first = 0;  // (not reached: critical < total here)
-  return run_from(off, surface, first, cancellation);
+  return run_uncontrolled_from(off, surface, first, cancellation);
 }
 
 }  // namespace afmkit::scan
