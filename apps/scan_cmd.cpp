@@ -157,6 +157,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       {"sample_rms_height", result.sample_rms_height},
       {"error_budget",
        {{"imaging", budget.imaging},
+        {"imaging_relative", relative(budget.imaging)},
         {"reconstruction", budget.reconstruction},
         {"reconstruction_relative", relative(budget.reconstruction)},
         {"plant_mismatch", budget.plant_mismatch},
@@ -167,7 +168,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
         {"predicted", budget.predicted},
         {"pole", budget.pole},
         {"settle_samples", budget.settle_samples},
-        {"units", {{"imaging", "m"}, {"reconstruction", "m"}, {"reconstruction_relative", "dimensionless"}, {"plant_mismatch", "dimensionless"}, {"plant", "m"},
+        {"units", {{"imaging", "m"}, {"imaging_relative", "dimensionless"}, {"reconstruction", "m"}, {"reconstruction_relative", "dimensionless"}, {"plant_mismatch", "dimensionless"}, {"plant", "m"},
                    {"noise_gain", "dimensionless"}, {"image_noise_gain", "dimensionless"},
                    {"noise", "m"}, {"predicted", "m"}, {"pole", "dimensionless"},
                    {"settle_samples", "count"}}}}},
@@ -196,7 +197,8 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       "afmkit scan: {} samples, {} turns, controller {}; saturated {:.3g} % of samples; largest radius before the "
       "detector saturates {} in this run{}, {} with the controller off; scan-area gain {}; topography RMS "
       "error {} (levelled; {} reconstruction; {}; {} reconstruction: {}); error "
-      "budget of the inverse: imaging {}, reconstruction {} ({}), plant knowledge {} (assumed rate {:+.3g} %), "
+      "budget of the inverse: imaging {} ({} against the real truth: the sampling's floor), reconstruction {} ({} "
+      "against the truth imaged through the same sampling), plant knowledge {} (assumed rate {:+.3g} %), "
       "noise {} (gain {:.4g} at the samples, {:.4g} in the image), predicted {}{}",
       result.run.samples, result.turns, instrument.controller.enabled ? "on" : "off",
       100.0 * result.saturated_fraction, io::quantity(result.max_radius_with_control, "m"),
@@ -207,7 +209,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
                  : fmt::format("{} of the sample's RMS height {}", percent(result.topography_rms_error),
                                io::quantity(result.sample_rms_height, "m")),
       other, io::quantity(inverse ? result.lagged_rms_error : result.inverse_rms_error, "m"),
-      io::quantity(budget.imaging, "m"), io::quantity(budget.reconstruction, "m"),
+      io::quantity(budget.imaging, "m"), percent(budget.imaging), io::quantity(budget.reconstruction, "m"),
       percent(budget.reconstruction),
       io::quantity(budget.plant, "m"), 100.0 * budget.plant_mismatch,
       io::quantity(budget.noise, "m"), budget.noise_gain, budget.image_noise_gain, io::quantity(budget.predicted, "m"),

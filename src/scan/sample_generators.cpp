@@ -9,6 +9,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/validate.hpp"
+#include "gaussian_rows.hpp"
 
 namespace afmkit::scan {
 namespace {
@@ -218,22 +219,12 @@ HeightMap rough(const Grid& grid, const RoughSpec& spec) {
   std::vector<double> smoothed_rows(static_cast<std::size_t>(padded_rows * columns));
   for (long j = 0; j < padded_rows; ++j) {
     for (double& w : noise_row) w = normal(generator);
-    double* target = smoothed_rows.data() + j * columns;  // zero-initialised
-    for (std::size_t m = 0; m < kernel_x.size(); ++m) {  // target[i] += k[m] · noise at column i − half_x + m
-      const double weight = kernel_x[m];
-      const double* source = noise_row.data() + m;
-      for (long i = 0; i < columns; ++i) target[i] += weight * source[i];
-    }
+    // target[i] = Σ_m k[m] · noise at column i − half_x + m
+    detail::convolve_along_row(noise_row.data(), kernel_x.data(), kernel_x.size(),
+                               smoothed_rows.data() + j * columns, columns);
   }
-  // Pass 2: convolve along y, a whole row at a time (contiguous inner loop).
-  for (long j = 0; j < rows; ++j) {
-    double* target = out.data() + j * columns;
-    for (std::size_t m = 0; m < kernel_y.size(); ++m) {
-      const double weight = kernel_y[m];
-      const double* source = smoothed_rows.data() + (j + static_cast<long>(m)) * columns;
-      for (long i = 0; i < columns; ++i) target[i] += weight * source[i];
-    }
-  }
+  // Pass 2: convolve along y: out[j][i] = Σ_m k[m] · smoothed_rows[j + m][i].
+  detail::convolve_down_columns(smoothed_rows.data(), columns, rows, kernel_y.data(), kernel_y.size(), out.data());
   // Remove the mean, scale to the RMS (two passes for accuracy).
   double mean = 0.0;
   for (const double z : out) mean += z;

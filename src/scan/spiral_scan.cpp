@@ -9,7 +9,10 @@
 #include <optional>
 #include <random>
 
+#include <fmt/format.h>
+
 #include "afmkit/control/realtime_filter.hpp"
+#include "afmkit/core/error.hpp"
 
 namespace afmkit::scan {
 
@@ -46,7 +49,7 @@ inline double relax_ramp(double y, double g_start, double g_end, double lag, dou
 
 ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, ScanObserver& observer,
                       const std::function<void(std::int64_t, std::int64_t)>& progress,
-                      const Cancellation& cancellation) {
+                      const Cancellation& cancellation, std::int64_t first_sample) {
   instrument.validate();
   const SpiralSpec& spiral = instrument.spiral;
   const PlantSpec& plant = instrument.plant;
@@ -55,6 +58,9 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
   const double omega = spiral.rotation_frequency();
   const double gamma = plant.bandwidth;
   const std::int64_t total = spiral.samples();
+  if (first_sample < 0 || first_sample % 4096 != 0 || (first_sample > 0 && first_sample >= total))
+    throw InvalidParameter("first_sample", fmt::format("first_sample = {} is out of range: must be a multiple of 4096 "
+                                                       "below the scan's {} samples (or 0)", first_sample, total));
 
   std::optional<control::RealtimeFilter> filter;
   if (instrument.controller.enabled)
@@ -101,9 +107,9 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
     sin_theta = sin_theta * cos_step + cos_theta * sin_step;
     cos_theta = c;
   };
-  double f = height_at(0);
+  double f = height_at(first_sample);
   double y = f, y_hat = 0.0;  // the deflection settled on the surface before the scan starts; no actuator motion
-  for (std::int64_t n = 0; n < total; ++n) {
+  for (std::int64_t n = first_sample; n < total; ++n) {
     const double t = static_cast<double>(n) * h;
     const double theta = omega * t;
     const double r = spiral.start_radius + spiral.radial_speed * t;

@@ -9,7 +9,9 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/scan/levelling.hpp"
+#include "afmkit/scan/observer_thread.hpp"
 #include "afmkit/scan/spiral_imager.hpp"
+#include "afmkit/scan/uncontrolled_saturation.hpp"
 
 namespace afmkit::scan {
 
@@ -34,12 +36,6 @@ class ImagingObserver final : public ScanObserver {
 
  private:
   SpiralImager& imager_;
-};
-
-// Stops the scan at the first saturated sample.
-class StopAtSaturation final : public ScanObserver {
- public:
-  bool sample(const ScanSample& s) override { return !s.saturated; }
 };
 
 HeightMap truth_on(const HeightMap& image, const Surface& surface) {
@@ -107,7 +103,16 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   std::vector<ScanObserver*> chain{&imaging, &metrics};
   if (options.extra) chain.push_back(options.extra);
   ObserverChain observers(chain);
-  const ScanRun run = simulate_scan(instrument, surface, observers, options.progress, options.cancellation);
+  // the imaging, the per-turn metrics and the extra observer run on a second thread, a batch behind the simulation
+  // (none of them stops the scan: the samples and the images are those of the direct chain)
+  ScanRun run;
+  if (options.imaging_thread) {
+    ObserverThread behind(observers);
+    run = simulate_scan(instrument, surface, behind, options.progress, options.cancellation);
+    if (behind.finish()) run.stopped_early = true;
+  } else {
+    run = simulate_scan(instrument, surface, observers, options.progress, options.cancellation);
+  }
   std::vector<HeightMap> images = imager.finish();
 
   const bool inverse = instrument.reconstruction.method == Reconstruction::inverse;
@@ -127,13 +132,10 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   out.max_radius_without_control = kNaN;
   out.scan_area_gain = kNaN;
   if (options.compare_without_control) {
-    InstrumentSpec off = instrument;
-    off.controller.enabled = false;
-    StopAtSaturation stop;
-    const ScanRun uncontrolled = simulate_scan(off, surface, stop, {}, options.cancellation);
-    out.saturates_without_control = uncontrolled.saturated_samples > 0;
-    out.max_radius_without_control =
-        out.saturates_without_control ? uncontrolled.first_saturation_radius : spiral.end_radius;
+    // simulated only where it can saturate (uncontrolled_saturation.hpp)
+    const UncontrolledSaturation uncontrolled = first_uncontrolled_saturation(instrument, surface, options.cancellation);
+    out.saturates_without_control = uncontrolled.saturates;
+    out.max_radius_without_control = uncontrolled.radius;
     if (out.saturates_without_control && out.max_radius_without_control > r0) {
       out.scan_area_gain = annulus(out.max_radius_with_control, r0) / annulus(out.max_radius_without_control, r0);
       out.scan_area_gain_is_lower_bound = !out.saturates_with_control;

@@ -55,6 +55,8 @@ TEST(ScanCli, WritesImagesGwyddionOpensAndTheControllerBuysArea) {
   // the inverse reconstruction (the default) against the lagged one beside it (docs/scan.md#reconstruction)
   EXPECT_EQ(printed["reconstruction"], "inverse");
   EXPECT_LT(printed["error_budget"]["reconstruction"].get<double>(), 1e-6 * printed["sample_rms_height"].get<double>());
+  EXPECT_DOUBLE_EQ(printed["error_budget"]["imaging_relative"].get<double>(),
+                   printed["error_budget"]["imaging"].get<double>() / printed["sample_rms_height"].get<double>());
   EXPECT_GT(printed["lagged_rms_error"].get<double>(), 3 * printed["inverse_rms_error"].get<double>());  // 15 vs 3.5 nm
   EXPECT_EQ(printed["error_budget"]["units"]["noise_gain"], "dimensionless");
 

@@ -4,10 +4,14 @@
 
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
+#include <vector>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/scan/levelling.hpp"
+#include "afmkit/scan/observer_thread.hpp"
 #include "afmkit/scan/sample_generators.hpp"
+#include "afmkit/scan/uncontrolled_saturation.hpp"
 #include "afmkit/scan/virtual_scan.hpp"
 
 namespace {
@@ -117,3 +121,177 @@ TEST(VirtualScan, TurnsMustOverlapAtTheImageResolution) {
 }
 
 }  // namespace
+
+namespace {
+// The uncontrolled comparison run, started where the convex-combination bound lets it saturate, against the full
+// run from sample 0: the same first saturated sample (bit-equal radius) in every case, and far fewer samples.
+InstrumentSpec uncontrolled_case(double sample_rate, double radial_speed, double start_radius) {
+  InstrumentSpec s;
+  s.spiral.sample_rate = sample_rate;
+  s.spiral.end_radius = 4e-3;
+  s.spiral.start_radius = start_radius;
+  s.spiral.radial_speed = radial_speed;
+  return s;
+}
+}  // namespace
+
+TEST(UncontrolledSaturation, SkippedRunFindsTheFullRunsFirstSaturatedSample) {
+  const Surface rough_surface = rough_tilted(4.1e-3, 0.05);
+  const Grid g{256, 256, 8.2e-3, 8.2e-3, -4.1e-3, -4.1e-3};
+  const Surface grating_surface(grating(g, GratingSpec{800e-6, 50e-9, 0.5, 0.0}), Tilt(0.05 * std::numbers::pi / 180, 2.0));
+  const Surface steep(flat(g), Tilt(0.1 * std::numbers::pi / 180, -1.0));     // saturates early (r ≈ 1.15 mm)
+  const Surface gentle(flat(g), Tilt(0.02 * std::numbers::pi / 180, 0.0));    // never saturates within 4 mm
+  struct Case {
+    const Surface* surface;
+    InstrumentSpec spec;
+  };
+  InstrumentSpec slow_plant = uncontrolled_case(20e3, 1e-3, 0.0);
+  slow_plant.plant.bandwidth = 2 * std::numbers::pi * 200;  // a longer memory: the settling stretch grows
+  for (const Case& c : {Case{&rough_surface, uncontrolled_case(20e3, 1e-3, 0.0)},
+                        Case{&grating_surface, uncontrolled_case(50e3, 2e-3, 0.5e-3)},
+                        Case{&steep, uncontrolled_case(20e3, 1e-3, 0.0)},
+                        Case{&gentle, uncontrolled_case(20e3, 1e-3, 0.0)}, Case{&rough_surface, slow_plant}}) {
+    const UncontrolledSaturation fast = first_uncontrolled_saturation(c.spec, *c.surface);
+    const UncontrolledSaturation full = first_uncontrolled_saturation_full(c.spec, *c.surface);
+    EXPECT_EQ(fast.saturates, full.saturates);
+    EXPECT_EQ(fast.radius, full.radius);  // the same sample: bit-equal
+    if (fast.samples > 0) EXPECT_EQ(fast.first_sample % 4096, 0);  // where the tip angle is exact
+    if (full.saturates) {
+      EXPECT_LT(fast.samples, full.samples);
+    } else {
+      EXPECT_EQ(fast.samples, 0);  // nothing simulated: the bound holds to the end
+    }
+  }
+  // the steep tilt saturates where the steady first harmonic r tan ψ γ/√(γ² + Ω²) reaches R_d (independent check
+  // that the case exercises a saturation); the rough one starts late in the scan
+  EXPECT_TRUE(first_uncontrolled_saturation(uncontrolled_case(20e3, 1e-3, 0.0), steep).saturates);
+  EXPECT_GT(first_uncontrolled_saturation(uncontrolled_case(20e3, 1e-3, 0.0), rough_surface).first_sample, 0);
+}
+
+TEST(UncontrolledSaturation, NoisyDetectorRunsFromTheStart) {
+  InstrumentSpec s = uncontrolled_case(20e3, 1e-3, 0.0);
+  s.detector.noise = 1e-9;
+  const Surface surface = rough_tilted(4.1e-3, 0.05);
+  const UncontrolledSaturation fast = first_uncontrolled_saturation(s, surface);
+  EXPECT_EQ(fast.first_sample, 0);
+  EXPECT_EQ(fast.radius, first_uncontrolled_saturation_full(s, surface).radius);
+}
+
+namespace {
+// Records the sample indices it sees; stops or throws at a chosen index.
+struct IndexRecorder final : ScanObserver {
+  std::vector<std::int64_t> seen;
+  std::int64_t stop_at = -1, throw_at = -1;
+  bool sample(const ScanSample& s) override {
+    if (s.index == throw_at) throw std::runtime_error("observer failed");
+    seen.push_back(s.index);
+    return s.index != stop_at;
+  }
+};
+ScanSample sample_numbered(std::int64_t n) { return ScanSample{n, 0, 0, 0, 0, 0, 0, 0, 0, 0, false}; }
+}  // namespace
+
+TEST(ObserverThread, SeesEverySampleInOrderAndStopsOrRethrowsLikeTheObserver) {
+  IndexRecorder all;
+  {
+    ObserverThread behind(all, 7);
+    for (std::int64_t n = 0; n < 1000; ++n) ASSERT_TRUE(behind.sample(sample_numbered(n)));
+    EXPECT_FALSE(behind.finish());
+  }
+  ASSERT_EQ(all.seen.size(), 1000U);
+  for (std::int64_t n = 0; n < 1000; ++n) EXPECT_EQ(all.seen[static_cast<std::size_t>(n)], n);
+
+  IndexRecorder stopping;
+  stopping.stop_at = 100;
+  ObserverThread behind(stopping, 8);
+  std::int64_t handed = 0;
+  while (handed < 100000 && behind.sample(sample_numbered(handed))) ++handed;
+  EXPECT_TRUE(behind.finish());
+  EXPECT_EQ(stopping.seen.back(), 100);  // nothing after the stop reaches the observer
+  EXPECT_LT(handed, 100 + 4 * 8 + 8);    // the caller is told within a few batches
+
+  IndexRecorder failing;
+  failing.throw_at = 50;
+  ObserverThread failing_behind(failing, 8);
+  for (std::int64_t n = 0; n < 200 && failing_behind.sample(sample_numbered(n)); ++n) {
+  }
+  EXPECT_THROW(failing_behind.finish(), std::runtime_error);
+  EXPECT_EQ(failing.seen.size(), 50U);
+}
+
+namespace {
+// The imaging floor against the sampling (issue 27 §5): an ideal instrument (no noise, the plant known) whose
+// reconstruction is exact, on a 0.8 mm disc, 50 Hz spindle, 4 µm pitch, imaged to 128² (12.5 µm pixels).
+InstrumentSpec floor_scan(double sample_rate) {
+  InstrumentSpec s;
+  s.spiral.sample_rate = sample_rate;
+  s.spiral.end_radius = 0.8e-3;
+  s.spiral.radial_speed = 200e-6;
+  return s;
+}
+const Grid& floor_map_grid() {
+  static const Grid g{256, 256, 1.64e-3, 1.64e-3, -0.82e-3, -0.82e-3};  // 6.4 µm pixels
+  return g;
+}
+}  // namespace
+
+TEST(ImagingFloor, SharpEdgesCostTheStraightEdgeEstimateAndFallWithDenserSampling) {
+  // grating lines along y, period P = 160 µm, H = 50 nm: each edge crossed by a turn becomes, by the linear
+  // interpolation along the turn, a ramp over one sample step w = Δθ |y| (projected on x), mean squared error H²/6
+  // over it; summed over the edges (density 2/P) and the disc: MSE = (4 / 9π) H² Δθ R / P — an estimate for steps
+  // (the truth's own ramps, one map pixel wide, lower it)
+  const double period = 160e-6, height = 50e-9;
+  const Surface surface(grating(floor_map_grid(), GratingSpec{period, height, 0.5, 0.0}), Tilt(0.0, 0.0));
+  double floors[2];
+  int k = 0;
+  for (const double rate : {10e3, 40e3}) {  // 200 and 800 samples per turn: 25 and 6.3 µm apart at the rim
+    const InstrumentSpec s = floor_scan(rate);
+    const VirtualScan v = run_virtual_scan(s, surface, image_grid(s, 128));
+    EXPECT_LT(v.budget.reconstruction, 1e-9 * v.sample_rms_height);  // the instrument adds nothing
+    EXPECT_NEAR(v.inverse_rms_error, v.budget.imaging, 1e-9 * v.sample_rms_height);
+    const double dtheta = 2 * std::numbers::pi / (rate / s.spiral.spindle_frequency);
+    const double estimate = height * std::sqrt(4.0 / (9.0 * std::numbers::pi) * dtheta * s.spiral.end_radius / period);
+    if (k == 0) {  // steps 25 µm apart against 6.4 µm ramps: near the estimate, below it
+      EXPECT_LT(v.budget.imaging, estimate);
+      EXPECT_GT(v.budget.imaging, 0.4 * estimate);
+    }
+    floors[k++] = v.budget.imaging;
+  }
+  EXPECT_GT(floors[0] / floors[1], 1.8);  // 4× denser: at least the √4 of steps
+}
+
+TEST(ImagingFloor, ASmoothSampleFallsAsTheSquareOfTheAngularStep) {
+  // correlation length 300 µm: the header's bound (Δθ² + Δφ²) K / 8 dominates the pitch term p² H / 8, so the floor
+  // falls about 16× for 4× the samples per turn
+  const Surface surface(rough(floor_map_grid(), RoughSpec{20e-9, 300e-6, 5}), Tilt(0.0, 0.0));
+  double floors[2];
+  int k = 0;
+  for (const double rate : {10e3, 40e3}) {
+    const InstrumentSpec s = floor_scan(rate);
+    const VirtualScan v = run_virtual_scan(s, surface, image_grid(s, 128));
+    EXPECT_LT(v.budget.reconstruction, 1e-9 * v.sample_rms_height);
+    floors[k++] = v.budget.imaging;
+  }
+  EXPECT_GT(floors[0] / floors[1], 8.0);
+  EXPECT_LT(floors[0] / floors[1], 20.0);
+}
+
+TEST(ObserverThread, TheScanImagedOnASecondThreadIsTheScanImagedDirectly) {
+  const InstrumentSpec s = small_scan();
+  const Surface surface = rough_tilted(4.1e-3, 0.05);
+  VirtualScanOptions direct;
+  direct.imaging_thread = false;
+  std::vector<double> turns_direct, turns_threaded;
+  direct.on_turn = [&](const TurnRecord& r) { turns_direct.push_back(r.deflection_first_harmonic); };
+  VirtualScanOptions threaded;
+  threaded.on_turn = [&](const TurnRecord& r) { turns_threaded.push_back(r.deflection_first_harmonic); };
+  const VirtualScan a = run_virtual_scan(s, surface, image_grid(s, 64), direct);
+  const VirtualScan b = run_virtual_scan(s, surface, image_grid(s, 64), threaded);
+  EXPECT_EQ(turns_direct, turns_threaded);
+  EXPECT_EQ(a.topography.data().size(), b.topography.data().size());
+  for (std::size_t k = 0; k < a.topography.size(); ++k)
+    if (std::isfinite(a.topography.data()[k]) || std::isfinite(b.topography.data()[k]))
+      ASSERT_EQ(a.topography.data()[k], b.topography.data()[k]) << k;
+  EXPECT_EQ(a.topography_rms_error, b.topography_rms_error);
+  EXPECT_EQ(a.run.samples, b.run.samples);
+}

@@ -73,8 +73,12 @@ struct ScanRun {
 /// Runs the scan of `surface` by `instrument` (validated first: InvalidParameter naming the field), calling
 /// `observer` for every sample. `progress(done, total)` (may be empty) is called about every 2^16 samples.
 /// `cancellation` is checked every 65536 samples (core/cancellation.hpp).
+/// `first_sample` > 0 starts the scan at that sample (a multiple of 4096, where the tip's angle is computed exactly,
+/// so every later tip position is the full run's to the bit; InvalidParameter "first_sample" otherwise, or when it is
+/// not below samples()), with the plant settled on the surface there (y = f) and no control history: for the
+/// uncontrolled run, whose state forgets its start as e^{−γ t} (uncontrolled_saturation.hpp).
 ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, ScanObserver& observer,
                       const std::function<void(std::int64_t, std::int64_t)>& progress = {},
-                      const Cancellation& cancellation = {});
+                      const Cancellation& cancellation = {}, std::int64_t first_sample = 0);
 
 }  // namespace afmkit::scan

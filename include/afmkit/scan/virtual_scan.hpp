@@ -34,8 +34,13 @@ Grid image_grid(const InstrumentSpec& instrument, long resolution);
 
 struct VirtualScanOptions {
   bool compare_without_control = true;  ///< run the second, uncontrolled scan for the saturation radius
-  ScanObserver* extra = nullptr;        ///< also receives every sample of the main run (e.g. a time-series writer)
-  std::function<void(const TurnRecord&)> on_turn;  ///< each complete turn of the main run
+  /// image on a second thread, a batch behind the simulation (observer_thread.hpp); false: everything on the
+  /// calling thread (the same results)
+  bool imaging_thread = true;
+  /// also receives every sample of the main run (e.g. a time-series writer); called, like on_turn, on the imaging
+  /// thread when there is one, never concurrently with itself or on_turn
+  ScanObserver* extra = nullptr;
+  std::function<void(const TurnRecord&)> on_turn;  ///< each complete turn of the main run (on that thread)
   std::function<void(std::int64_t, std::int64_t)> progress;  ///< (samples done, total) of the main run
   Cancellation cancellation;  ///< checked every 65536 samples of both runs (core/cancellation.hpp)
 };
