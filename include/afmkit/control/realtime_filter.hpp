@@ -104,13 +104,20 @@ class RealtimeFilter {
   /// (N ≤ 11) and the modes are updated four lanes at a time (bench/bench_control_sim.cpp).
   void step_block(std::span<const double> in, std::span<double> out) noexcept;
 
-  /// Vector width of the modal kernel: Auto = 32-byte vectors (AVX2) where the processor has them, else 16-byte
-  /// ones; Portable = 16-byte vectors always. Every lane does the same operations in the same order, so the outputs
-  /// are the same bits either way (tests/control_sim/test_realtime_block.cpp); for timing and for such checks.
-  enum class Vectorisation { Auto, Portable };
+  /// Build of the modal block kernel: Auto = the widest this processor runs (Avx512 = 64-byte vectors on x86-64
+  /// with AVX-512 F/VL/DQ/BW, Avx2 = 32-byte vectors, else Portable = 16-byte vectors, plain C++ on every target).
+  /// Every lane does the same operations in the same order and the output sum keeps one order, so the outputs are
+  /// the same bits whichever build runs (tests/control_sim/test_realtime_block.cpp); for timing and such checks. A
+  /// build this processor (or compiler) lacks is not chosen: the filter runs the widest one below it instead
+  /// (vectorisation() says which runs; vectorisation_available() says beforehand).
+  enum class Vectorisation { Auto, Portable, Avx2, Avx512 };
   void set_vectorisation(Vectorisation v) noexcept;
-  /// Whether step_block() runs the 32-byte build (step() always runs the 16-byte one, inlined).
-  bool uses_wide_vectors() const noexcept { return wide_; }
+  /// The build step_block() runs (never Auto; step() always runs the 16-byte one, inlined).
+  Vectorisation vectorisation() const noexcept { return path_; }
+  /// Whether this processor runs the build v (Auto and Portable: always).
+  static bool vectorisation_available(Vectorisation v) noexcept;
+  /// Whether step_block() runs a build wider than the 16-byte one.
+  bool uses_wide_vectors() const noexcept { return path_ != Vectorisation::Portable; }
 
   /// Bumpless change of all parameters (see above).
   void reconfigure(const OscillatorBank& controller, double sample_rate);
@@ -211,7 +218,7 @@ class RealtimeFilter {
   std::vector<double> q_, q_tmp_;  // internal coordinates: modal (the kernel's layout, see pack()) or physical
   double held_ = 0.0;
   double input_limit_ = kDefaultInputLimit;
-  bool wide_ = false;  // modal kernel: the AVX2 build (x86-64 with AVX2; the same bits as the portable one)
+  Vectorisation path_ = Vectorisation::Portable;  // modal block kernel build (set_vectorisation; never Auto)
   std::uint64_t skipped_ = 0, samples_ = 0;
 };
 

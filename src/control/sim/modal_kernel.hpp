@@ -8,8 +8,13 @@
 //   q1 ← (c1 q1 + s1 q2) + g1 m,   q2 ← (c2 q2 + s2 q1) + g2 m
 //   u = (acc0 + acc2) + (acc1 + acc3)
 // Every lane does the same IEEE operations in the same order whatever the vector width the compiler uses (two SSE2
-// halves, one AVX register, NEON pairs) and the floating-point contraction is off (ISO C++), so the block path
-// (state in registers across samples) and the per-sample path (state in memory) give the same bits.
+// halves, one AVX register, half of an AVX-512 register, NEON pairs) and no multiply-add is fused (the library
+// compiles this with -ffp-contract=off, and the AVX-512 build, whose target has FMA, says so itself), so the block
+// path (state in registers across samples) and the per-sample path (state in memory) give the same bits.
+// Fusing (FMA) would cut the operations per mode and sample from 14 to 8 and one rounding of three on the chain
+// that carries the state from sample to sample, but every fused result differs in its last bits from the separate
+// ones (a processor without FMA, x86-64's SSE2 baseline, cannot reproduce them but by a slow software fma), so the
+// builds would no longer agree bit for bit with step() and with each other: docs/embedding.md.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -131,6 +136,7 @@ AFMKIT_ALWAYS_INLINE V coef(const double* cf, int g, Coef k) noexcept {
 template <class V, class State>
 AFMKIT_ALWAYS_INLINE double coast_input(const double* cf, const State& st, int groups) noexcept {
   V acc = V::broadcast(0.0);
+#pragma GCC unroll 4
   for (int g = 0; g < groups; ++g) acc = acc + (coef<V>(cf, g, kE1) * st.a(g) + coef<V>(cf, g, kE2) * st.b(g));
   return acc.lane_sum();
 }
@@ -140,6 +146,7 @@ template <class V, class State>
 AFMKIT_ALWAYS_INLINE double modal_sample(const double* cf, State& st, int groups, double m) noexcept {
   const V mv = V::broadcast(m);
   V acc = V::broadcast(0.0);
+#pragma GCC unroll 4  // G known (LocalState): unrolled whole, so the state stays in registers, never on the stack
   for (int g = 0; g < groups; ++g) {
     const V a = st.a(g), b = st.b(g), c = coef<V>(cf, g, kC), s = coef<V>(cf, g, kS);
     acc = acc + (coef<V>(cf, g, kW1) * a + coef<V>(cf, g, kW2) * b);
@@ -232,25 +239,180 @@ inline void modal_block_portable(ModalRun& run, double* state, const double* in,
 }
 #endif
 
-/// Whether this processor runs the AVX2 build.
-inline bool modal_wide_available() noexcept {
 #ifdef AFMKIT_MODAL_AVX2
-  return __builtin_cpu_supports("avx2");
-#else
-  return false;
-#endif
+// The AVX-512 build: two groups side by side in one 64-byte register (lanes 0-3 group 2p, lanes 4-7 group 2p + 1),
+// an odd last group in a 32-byte one. The per-lane operations are those of Wide4; the output sum keeps Wide4's order
+// (acc ← acc + t_g for g = 0, 1, …, then (a0 + a2) + (a1 + a3)) by adding the two 32-byte halves of a pair's terms
+// one after the other. The coefficients are copied into local vectors once per block: with 32 registers they stay
+// in registers for G ≤ 4 (N ≤ 15), and the stores to `out` cannot alias them.
+typedef double v8d __attribute__((vector_size(64)));
+#define AFMKIT_AVX512_TARGET gnu::target("avx512f,avx512vl,avx512dq,avx512bw")
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE v4d lo4(v8d x) noexcept {
+  return __builtin_shufflevector(x, x, 0, 1, 2, 3);
+}
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE v4d hi4(v8d x) noexcept {
+  return __builtin_shufflevector(x, x, 4, 5, 6, 7);
+}
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE v8d join(v4d a, v4d b) noexcept {
+  return __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7);
+}
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE v4d load4(const double* p) noexcept {
+  v4d x;
+  std::memcpy(&x, p, sizeof x);
+  return x;
+}
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE void store4(double* p, v4d x) noexcept { std::memcpy(p, &x, sizeof x); }
+
+/// G groups: P = G / 2 pairs in 64-byte vectors, an odd last group in a 32-byte one (T = 1 if there is one).
+template <int G>
+struct Local512 {
+  static constexpr int P = G / 2, T = G % 2;
+  v8d k8[kCoefs][P > 0 ? P : 1];
+  v4d k4[kCoefs];
+  v8d s1[P > 0 ? P : 1], s2[P > 0 ? P : 1];
+  v4d t1, t2;
+};
+
+template <int G>
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE double coast_input_512(const Local512<G>& L) noexcept {
+  v4d acc = v4d{0.0, 0.0, 0.0, 0.0};
+#pragma GCC unroll 8
+  for (int p = 0; p < Local512<G>::P; ++p) {
+    const v8d t = L.k8[kE1][p] * L.s1[p] + L.k8[kE2][p] * L.s2[p];
+    acc = acc + lo4(t);
+    acc = acc + hi4(t);
+  }
+  if constexpr (Local512<G>::T) acc = acc + (L.k4[kE1] * L.t1 + L.k4[kE2] * L.t2);
+  return (acc[0] + acc[2]) + (acc[1] + acc[3]);
 }
 
-/// A block through the AVX2 build when `wide` (and it exists), else the portable one: the same bits either way.
-inline void modal_block_dispatch(bool wide, ModalRun& run, double* state, const double* in, double* out,
+template <int G>
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE double modal_sample_512(Local512<G>& L, double m) noexcept {
+  const v8d m8 = v8d{m, m, m, m, m, m, m, m};
+  const v4d m4 = v4d{m, m, m, m};
+  v4d acc = v4d{0.0, 0.0, 0.0, 0.0};
+#pragma GCC unroll 8
+  for (int p = 0; p < Local512<G>::P; ++p) {
+    const v8d a = L.s1[p], b = L.s2[p], c = L.k8[kC][p], s = L.k8[kS][p];
+    const v8d t = L.k8[kW1][p] * a + L.k8[kW2][p] * b;
+    acc = acc + lo4(t);  // group 2p, then group 2p + 1: Wide4's order
+    acc = acc + hi4(t);
+    L.s1[p] = (c * a - s * b) + L.k8[kG1][p] * m8;
+    L.s2[p] = (c * b + s * a) + L.k8[kG2][p] * m8;
+  }
+  if constexpr (Local512<G>::T) {
+    const v4d a = L.t1, b = L.t2, c = L.k4[kC], s = L.k4[kS];
+    acc = acc + (L.k4[kW1] * a + L.k4[kW2] * b);
+    L.t1 = (c * a - s * b) + L.k4[kG1] * m4;
+    L.t2 = (c * b + s * a) + L.k4[kG2] * m4;
+  }
+  return (acc[0] + acc[2]) + (acc[1] + acc[3]);
+}
+
+template <int G>
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE void modal_block_local_512(ModalRun& run, double* state,
+                                                                           const double* in, double* out,
+                                                                           std::size_t n) noexcept {
+  constexpr int P = Local512<G>::P;
+  const double* cf = run.groups;
+  Local512<G> L;
+#pragma GCC unroll 8
+  for (int k = 0; k < kCoefs; ++k) {
+#pragma GCC unroll 8
+    for (int p = 0; p < P; ++p)
+      L.k8[k][p] = join(load4(cf + kGroupDoubles * (2 * p) + 4 * k), load4(cf + kGroupDoubles * (2 * p + 1) + 4 * k));
+    if constexpr (Local512<G>::T) L.k4[k] = load4(cf + kGroupDoubles * (G - 1) + 4 * k);
+  }
+#pragma GCC unroll 8
+  for (int p = 0; p < P; ++p) {  // q1 of groups 2p, 2p + 1 are adjacent in memory, and so are their q2
+    L.s1[p] = join(load4(state + 8 * p), load4(state + 8 * p + 4));
+    L.s2[p] = join(load4(state + 4 * G + 8 * p), load4(state + 4 * G + 8 * p + 4));
+  }
+  if constexpr (Local512<G>::T) {
+    L.t1 = load4(state + 4 * (G - 1));
+    L.t2 = load4(state + 4 * (2 * G - 1));
+  }
+  const double limit = run.input_limit;
+  double held = run.held;
+  std::uint64_t skipped = run.skipped;
+  for (std::size_t i = 0; i < n; ++i) {  // as modal_block
+    double m = in[i];
+    const bool skip = !(std::abs(m) <= limit);
+    if (skip) m = coast_input_512<G>(L);
+    const double u = modal_sample_512<G>(L, m);
+    if (skip) ++skipped;
+    else held = u;
+    out[i] = held;
+  }
+  run.held = held;
+  run.skipped = skipped;
+#pragma GCC unroll 8
+  for (int p = 0; p < P; ++p) {
+    store4(state + 8 * p, lo4(L.s1[p]));
+    store4(state + 8 * p + 4, hi4(L.s1[p]));
+    store4(state + 4 * G + 8 * p, lo4(L.s2[p]));
+    store4(state + 4 * G + 8 * p + 4, hi4(L.s2[p]));
+  }
+  if constexpr (Local512<G>::T) {
+    store4(state + 4 * (G - 1), L.t1);
+    store4(state + 4 * (2 * G - 1), L.t2);
+  }
+}
+
+[[AFMKIT_AVX512_TARGET, gnu::optimize("fp-contract=off"), gnu::noinline]] inline void modal_block_avx512(ModalRun& run, double* state, const double* in,
+                                                                      double* out, std::size_t n) noexcept {
+  switch (run.group_count) {  // the state in registers up to 8 groups (N ≤ 31): 8 of the 32 registers
+    case 1: modal_block_local_512<1>(run, state, in, out, n); return;
+    case 2: modal_block_local_512<2>(run, state, in, out, n); return;
+    case 3: modal_block_local_512<3>(run, state, in, out, n); return;
+    case 4: modal_block_local_512<4>(run, state, in, out, n); return;
+    case 5: modal_block_local_512<5>(run, state, in, out, n); return;
+    case 6: modal_block_local_512<6>(run, state, in, out, n); return;
+    case 7: modal_block_local_512<7>(run, state, in, out, n); return;
+    case 8: modal_block_local_512<8>(run, state, in, out, n); return;
+    default: modal_block_memory<Wide4>(run, state, in, out, n);  // 32-byte lanes with 32 registers
+  }
+}
+#endif
+
+/// The builds of the block kernel, narrowest first; every one gives the same bits.
+enum class ModalPath { Portable, Avx2, Avx512 };
+
+/// Whether this processor runs the build `p` (and this compiler made it).
+inline bool modal_path_available(ModalPath p) noexcept {
+  switch (p) {
+    case ModalPath::Portable: return true;
+#ifdef AFMKIT_MODAL_AVX2
+    case ModalPath::Avx2: return __builtin_cpu_supports("avx2");
+    case ModalPath::Avx512:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+             __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw");
+#endif
+    default: return false;
+  }
+}
+
+/// The widest build this processor runs.
+inline ModalPath modal_best_path() noexcept {
+  if (modal_path_available(ModalPath::Avx512)) return ModalPath::Avx512;
+  if (modal_path_available(ModalPath::Avx2)) return ModalPath::Avx2;
+  return ModalPath::Portable;
+}
+
+/// A block through the build `path` (which must be available): the same bits whichever.
+inline void modal_block_dispatch(ModalPath path, ModalRun& run, double* state, const double* in, double* out,
                                  std::size_t n) noexcept {
 #ifdef AFMKIT_MODAL_AVX2
-  if (wide) {
+  if (path == ModalPath::Avx512) {
+    modal_block_avx512(run, state, in, out, n);
+    return;
+  }
+  if (path == ModalPath::Avx2) {
     modal_block_avx2(run, state, in, out, n);
     return;
   }
 #else
-  (void)wide;
+  (void)path;
 #endif
   modal_block_portable_registers(run, state, in, out, n);
 }
