@@ -253,6 +253,11 @@ typedef double v8d __attribute__((vector_size(64)));
 [[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE v4d hi4(v8d x) noexcept {
   return __builtin_shufflevector(x, x, 4, 5, 6, 7);
 }
+/// (a0 + a2) + (a1 + a3), as Wide4::lane_sum, in two additions and two shuffles.
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE double lane_sum4(v4d a) noexcept {
+  const v2d t = __builtin_shufflevector(a, a, 0, 1) + __builtin_shufflevector(a, a, 2, 3);  // (a0 + a2, a1 + a3)
+  return t[0] + t[1];
+}
 [[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE v8d join(v4d a, v4d b) noexcept {
   return __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7);
 }
@@ -283,13 +288,12 @@ template <int G>
     acc = acc + hi4(t);
   }
   if constexpr (Local512<G>::T) acc = acc + (L.k4[kE1] * L.t1 + L.k4[kE2] * L.t2);
-  return (acc[0] + acc[2]) + (acc[1] + acc[3]);
+  return lane_sum4(acc);
 }
 
 template <int G>
-[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE double modal_sample_512(Local512<G>& L, double m) noexcept {
-  const v8d m8 = v8d{m, m, m, m, m, m, m, m};
-  const v4d m4 = v4d{m, m, m, m};
+[[AFMKIT_AVX512_TARGET]] AFMKIT_ALWAYS_INLINE double modal_sample_512(Local512<G>& L, v8d m8) noexcept {
+  const v4d m4 = lo4(m8);
   v4d acc = v4d{0.0, 0.0, 0.0, 0.0};
 #pragma GCC unroll 8
   for (int p = 0; p < Local512<G>::P; ++p) {
@@ -306,7 +310,7 @@ template <int G>
     L.t1 = (c * a - s * b) + L.k4[kG1] * m4;
     L.t2 = (c * b + s * a) + L.k4[kG2] * m4;
   }
-  return (acc[0] + acc[2]) + (acc[1] + acc[3]);
+  return lane_sum4(acc);
 }
 
 template <int G>
@@ -339,7 +343,7 @@ template <int G>
     double m = in[i];
     const bool skip = !(std::abs(m) <= limit);
     if (skip) m = coast_input_512<G>(L);
-    const double u = modal_sample_512<G>(L, m);
+    const double u = modal_sample_512<G>(L, v8d{m, m, m, m, m, m, m, m});
     if (skip) ++skipped;
     else held = u;
     out[i] = held;
@@ -370,7 +374,8 @@ template <int G>
     case 6: modal_block_local_512<6>(run, state, in, out, n); return;
     case 7: modal_block_local_512<7>(run, state, in, out, n); return;
     case 8: modal_block_local_512<8>(run, state, in, out, n); return;
-    default: modal_block_memory<Wide4>(run, state, in, out, n);  // 32-byte lanes with 32 registers
+    default:  // state in memory: 64-byte vectors gain nothing on a core that splits them in two 32-byte halves
+      modal_block_avx2(run, state, in, out, n);  // (AMD Zen 4; measured: bench_control_sim BM_RealtimeFilterBuilds)
   }
 }
 #endif
