@@ -114,6 +114,7 @@ template <class W>
   for (int l = 0; l < L; ++l) c[l] = one, d[l] = zero;
   for (int k = 0; k < 6; ++k)
     for (int l = 0; l < L; ++l) x[k][l] = 1.0 + k + l, y[k][l] = 2.0 + k - l;
+#pragma GCC unroll 1  // one round per iteration: at -O3 GCC unrolled the rounds and spilled the chains
   for (long r = 0; r < reps; ++r) {
 #pragma GCC unroll 6
     for (int k = 0; k < 6; ++k) x[k] = x[k] * c;
@@ -133,6 +134,7 @@ template <class W>
   for (int l = 0; l < L; ++l) c[l] = one, d[l] = zero;
   for (int k = 0; k < 12; ++k)
     for (int l = 0; l < L; ++l) x[k][l] = 1.0 + k + l;
+#pragma GCC unroll 1
   for (long r = 0; r < reps; ++r) {
 #pragma GCC unroll 12
     for (int k = 0; k < 12; ++k) x[k] = x[k] * c + d;  // contracted to one FMA (fp-contract on here)
@@ -142,18 +144,17 @@ template <class W>
     for (int l = 0; l < L; ++l) s += x[k][l];
   return s;
 }
-[[gnu::target("avx2"), gnu::noinline, gnu::optimize("fp-contract=off")]] double peak_avx2_mul_add(long r, double a, double b) {
+#define AFMKIT_PEAK_FN(isa, contract) [[gnu::target(isa), gnu::noinline, gnu::optimize(contract)]] double
+AFMKIT_PEAK_FN("avx2", "fp-contract=off") peak_avx2_mul_add(long r, double a, double b) {
   return peak_mul_add_body<bench_v4d>(r, a, b);
 }
-[[gnu::target("avx512f,avx512vl"), gnu::noinline, gnu::optimize("fp-contract=off")]] double peak_avx512_mul_add(long r, double a,
-                                                                                                  double b) {
+AFMKIT_PEAK_FN("avx512f,avx512vl", "fp-contract=off") peak_avx512_mul_add(long r, double a, double b) {
   return peak_mul_add_body<bench_v8d>(r, a, b);
 }
-[[gnu::target("avx2,fma"), gnu::noinline, gnu::optimize("fp-contract=fast")]] double peak_avx2_fma(long r, double a, double b) {
+AFMKIT_PEAK_FN("avx2,fma", "fp-contract=fast") peak_avx2_fma(long r, double a, double b) {
   return peak_fma_body<bench_v4d>(r, a, b);
 }
-[[gnu::target("avx512f,avx512vl"), gnu::noinline, gnu::optimize("fp-contract=fast")]] double peak_avx512_fma(long r, double a,
-                                                                                                double b) {
+AFMKIT_PEAK_FN("avx512f,avx512vl", "fp-contract=fast") peak_avx512_fma(long r, double a, double b) {
   return peak_fma_body<bench_v8d>(r, a, b);
 }
 #pragma GCC diagnostic pop
@@ -208,7 +209,8 @@ void BM_RealtimeFilterBuilds(benchmark::State& state) {
   }
   // flops per rep: mul + add 12 ops × lanes, FMA 12 × 2 × lanes
   const double peak_flops[4] = {12.0 * 4, 24.0 * 4, 12.0 * 8, 24.0 * 8};
-  const char* peak_names[4] = {"peak_mul_add_GFLOPs", "peak_fma_GFLOPs", "peak512_mul_add_GFLOPs", "peak512_fma_GFLOPs"};
+  const char* peak_names[4] = {"peak_mul_add_GFLOPs", "peak_fma_GFLOPs", "peak512_mul_add_GFLOPs",
+                               "peak512_fma_GFLOPs"};
   double gflops[4] = {0, 0, 0, 0};
   for (int k = 0; k < 4; ++k)
     if (!t_peak[k].empty()) {

@@ -212,6 +212,25 @@ AFMKIT_ALWAYS_INLINE void modal_block_memory(ModalRun& run, double* state, const
   modal_block<V>(run, st, run.group_count, in, out, n);
 }
 
+/// modal_block_memory on a 64-byte aligned copy of the state (up to kAlignedGroups groups, N ≤ 511: 8 KiB of stack): the
+/// state is read and written every sample, and the caller's array (a std::vector) is only 16-byte aligned, so a
+/// 32-byte access could straddle two cache lines (measured: 10 % slower at N = 50 for one alignment of two).
+inline constexpr int kAlignedGroups = 128;
+template <class V>
+AFMKIT_ALWAYS_INLINE void modal_block_memory_aligned(ModalRun& run, double* state, const double* in, double* out,
+                                                     std::size_t n) noexcept {
+  const int groups = run.group_count;
+  if (groups > kAlignedGroups) {
+    modal_block_memory<V>(run, state, in, out, n);
+    return;
+  }
+  alignas(64) double local[8 * kAlignedGroups];
+  const std::size_t bytes = 8 * static_cast<std::size_t>(groups) * sizeof(double);
+  std::memcpy(local, state, bytes);
+  modal_block_memory<V>(run, local, in, out, n);
+  std::memcpy(state, local, bytes);
+}
+
 // Entry points: the portable spelling (inlined into the caller) and, on x86-64 with GCC, the AVX2 build.
 inline void modal_block_portable(ModalRun& run, double* state, const double* in, double* out, std::size_t n) noexcept {
   modal_block_memory<Pair2>(run, state, in, out, n);
@@ -222,7 +241,7 @@ inline void modal_block_portable(ModalRun& run, double* state, const double* in,
     case 1: modal_block_local<1, Pair2>(run, state, in, out, n); return;
     case 2: modal_block_local<2, Pair2>(run, state, in, out, n); return;
     case 3: modal_block_local<3, Pair2>(run, state, in, out, n); return;
-    default: modal_block_memory<Pair2>(run, state, in, out, n);
+    default: modal_block_memory_aligned<Pair2>(run, state, in, out, n);
   }
 }
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
@@ -234,7 +253,7 @@ inline void modal_block_portable(ModalRun& run, double* state, const double* in,
     case 2: modal_block_local<2, Wide4>(run, state, in, out, n); return;
     case 3: modal_block_local<3, Wide4>(run, state, in, out, n); return;
     case 4: modal_block_local<4, Wide4>(run, state, in, out, n); return;
-    default: modal_block_memory<Wide4>(run, state, in, out, n);
+    default: modal_block_memory_aligned<Wide4>(run, state, in, out, n);
   }
 }
 #endif
