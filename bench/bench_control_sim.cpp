@@ -27,6 +27,14 @@ std::vector<double> input_signal(std::size_t n) {
   return v;
 }
 
+// Median of the per-iteration times: on a shared machine an interval that lost the core to another process is an
+// outlier, not a share of the average.
+double median_seconds(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
 void filter_step(benchmark::State& state, SampledForm form) {
   const int n = static_cast<int>(state.range(0));
   const double fs = std::max(2000.0, 40.0 * n) / kT;
@@ -62,7 +70,8 @@ void BM_RealtimeFilterStepBlock(benchmark::State& state) {
 BENCHMARK(BM_RealtimeFilterStepBlock)->Arg(1)->Arg(10)->Arg(50);
 
 // The block path against the per-sample path, interleaved in the same iterations (same machine state): counters
-// block_MSps, step_MSps and speedup = step time / block time (they give the same bits, test_realtime_block.cpp).
+// block_MSps, step_MSps and speedup = step time / block time (they give the same bits, test_realtime_block.cpp),
+// from the medians of the per-iteration times.
 void BM_RealtimeFilterBlockVsStep(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const double fs = std::max(2000.0, 40.0 * n) / kT;
@@ -72,7 +81,7 @@ void BM_RealtimeFilterBlockVsStep(benchmark::State& state) {
   const auto in = input_signal(4096);
   std::vector<double> out(in.size()), out_step(in.size());
   using clock = std::chrono::steady_clock;
-  double t_block = 0.0, t_step = 0.0;
+  std::vector<double> t_block, t_step;
   for (auto _ : state) {
     const auto t0 = clock::now();
     fb.step_block(in, out);
@@ -81,15 +90,15 @@ void BM_RealtimeFilterBlockVsStep(benchmark::State& state) {
     for (std::size_t i = 0; i < in.size(); ++i) out_step[i] = fstep.step(in[i]);
     benchmark::ClobberMemory();
     const auto t2 = clock::now();
-    t_block += std::chrono::duration<double>(t1 - t0).count();
-    t_step += std::chrono::duration<double>(t2 - t1).count();
+    t_block.push_back(std::chrono::duration<double>(t1 - t0).count());
+    t_step.push_back(std::chrono::duration<double>(t2 - t1).count());
     benchmark::DoNotOptimize(out.data());
     benchmark::DoNotOptimize(out_step.data());
   }
-  const double samples = static_cast<double>(state.iterations()) * static_cast<double>(in.size());
-  state.counters["block_MSps"] = samples / t_block * 1e-6;
-  state.counters["step_MSps"] = samples / t_step * 1e-6;
-  state.counters["speedup"] = t_step / t_block;
+  const double samples = static_cast<double>(in.size()), tb = median_seconds(t_block), ts = median_seconds(t_step);
+  state.counters["block_MSps"] = samples / tb * 1e-6;
+  state.counters["step_MSps"] = samples / ts * 1e-6;
+  state.counters["speedup"] = ts / tb;
   state.counters["wide"] = fb.uses_wide_vectors() ? 1 : 0;
 }
 BENCHMARK(BM_RealtimeFilterBlockVsStep)->ArgsProduct({{1, 10, 50, 200}, {0, 1}})->ArgNames({"N", "portable"});
@@ -105,24 +114,24 @@ BENCHMARK(BM_RealtimeFilterBlockVsStep)->ArgsProduct({{1, 10, 50, 200}, {0, 1}})
 #pragma GCC diagnostic ignored "-Wpsabi"
 typedef double bench_v4d __attribute__((vector_size(32)));
 typedef double bench_v8d __attribute__((vector_size(64)));
-// 6 independent multiply chains and 6 add chains (latency × pipes = 3 × 2 each; 14 of the 16 AVX2 registers),
-// `reps` rounds.
+// 7 independent multiply chains and 7 add chains (latency × pipes = 3 × 2 each, one more for slack; with the two
+// constants all 16 AVX2 registers), `reps` rounds.
 template <class W>
 [[gnu::always_inline]] inline double peak_mul_add_body(long reps, double one, double zero) {
   constexpr int L = sizeof(W) / sizeof(double);
-  W x[6], y[6], c, d;
+  W x[7], y[7], c, d;
   for (int l = 0; l < L; ++l) c[l] = one, d[l] = zero;
-  for (int k = 0; k < 6; ++k)
+  for (int k = 0; k < 7; ++k)
     for (int l = 0; l < L; ++l) x[k][l] = 1.0 + k + l, y[k][l] = 2.0 + k - l;
 #pragma GCC unroll 1  // one round per iteration: at -O3 GCC unrolled the rounds and spilled the chains
   for (long r = 0; r < reps; ++r) {
-#pragma GCC unroll 6
-    for (int k = 0; k < 6; ++k) x[k] = x[k] * c;
-#pragma GCC unroll 6
-    for (int k = 0; k < 6; ++k) y[k] = y[k] + d;
+#pragma GCC unroll 7
+    for (int k = 0; k < 7; ++k) x[k] = x[k] * c;
+#pragma GCC unroll 7
+    for (int k = 0; k < 7; ++k) y[k] = y[k] + d;
   }
   double s = 0.0;
-  for (int k = 0; k < 6; ++k)
+  for (int k = 0; k < 7; ++k)
     for (int l = 0; l < L; ++l) s += x[k][l] + y[k][l];
   return s;
 }
@@ -161,14 +170,6 @@ AFMKIT_PEAK_FN("avx512f,avx512vl", "fp-contract=fast") peak_avx512_fma(long r, d
 #define AFMKIT_BENCH_PEAK 1
 #endif
 
-// Median of the per-iteration times: on a shared machine an interval that lost the core to another process is an
-// outlier, not a share of the average.
-double median_seconds(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
 void BM_RealtimeFilterBuilds(benchmark::State& state) {
   using V = RealtimeFilter::Vectorisation;
   using clock = std::chrono::steady_clock;
@@ -187,7 +188,7 @@ void BM_RealtimeFilterBuilds(benchmark::State& state) {
   double one = 1.0, zero = 0.0;
   benchmark::DoNotOptimize(one);
   benchmark::DoNotOptimize(zero);
-  constexpr long kPeakReps = 20000;  // 12 vector ops per rep (6 mul + 6 add), 12 FMAs per rep
+  constexpr long kPeakReps = 20000;  // 14 vector ops per rep (7 mul + 7 add), 12 FMAs per rep
   for (auto _ : state) {
     for (int b = 0; b < 3; ++b) {
       if (f[static_cast<std::size_t>(b)].vectorisation() != builds[b]) continue;  // not on this processor
@@ -207,8 +208,8 @@ void BM_RealtimeFilterBuilds(benchmark::State& state) {
     }
 #endif
   }
-  // flops per rep: mul + add 12 ops × lanes, FMA 12 × 2 × lanes
-  const double peak_flops[4] = {12.0 * 4, 24.0 * 4, 12.0 * 8, 24.0 * 8};
+  // flops per rep: mul + add 14 ops × lanes, FMA 12 × 2 × lanes
+  const double peak_flops[4] = {14.0 * 4, 24.0 * 4, 14.0 * 8, 24.0 * 8};
   const char* peak_names[4] = {"peak_mul_add_GFLOPs", "peak_fma_GFLOPs", "peak512_mul_add_GFLOPs",
                                "peak512_fma_GFLOPs"};
   double gflops[4] = {0, 0, 0, 0};
