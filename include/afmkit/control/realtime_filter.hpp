@@ -100,8 +100,9 @@ class RealtimeFilter {
   /// Output u_n for the measured sample m_n (see above). noexcept, O(N).
   double step(double measured) noexcept;
   /// step() for each sample, with the same result bit for bit; in and out may alias; processes
-  /// min(in.size(), out.size()) samples. For the modal form the state stays in registers across the block
-  /// (N ≤ 11) and the modes are updated four lanes at a time (bench/bench_control_sim.cpp).
+  /// min(in.size(), out.size()) samples. For the modal form the modes are updated four lanes at a time and the state
+  /// stays in registers across the block (N ≤ 31 with AVX-512, N ≤ 11 with AVX2; docs/embedding.md,
+  /// bench/bench_control_sim.cpp).
   void step_block(std::span<const double> in, std::span<double> out) noexcept;
 
   /// Build of the modal block kernel: Auto = the widest this processor runs (Avx512 = 64-byte vectors on x86-64
