@@ -49,6 +49,7 @@
 #include <complex>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <span>
 #include <vector>
 
@@ -174,6 +175,16 @@ class RealtimeFilter {
 
  private:
   enum class Kind { Modal, Dense, Block };
+  template <class T>
+  struct Aligned64 {  // std::allocator on 64-byte boundaries (C++17 aligned new)
+    using value_type = T;
+    Aligned64() noexcept = default;
+    template <class U>
+    Aligned64(const Aligned64<U>&) noexcept {}
+    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
+    void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, std::align_val_t{64}); }
+    friend bool operator==(const Aligned64&, const Aligned64&) noexcept { return true; }
+  };
   struct Discretisation {
     Kind kind = Kind::Modal;
     int n = 0;       // 2N+1
@@ -195,9 +206,10 @@ class RealtimeFilter {
     };
     std::vector<Mode> modes;    // modal: pairs, then reals (physical z = V q, V never stored)
     // modal, as the per-sample kernel runs it (src/control/sim/modal_kernel.hpp): the modes in groups of four lanes,
-    // 40 coefficients per group; the state q_ is then q1 of every lane, then q2 (8·groups doubles)
+    // 32 coefficients per group, 64-byte aligned (a 32-byte load never straddles two cache lines: with the state in
+    // memory every coefficient is read every sample); the state q_ is then q1 of every lane, then q2 (8·groups doubles)
     int groups = 0;
-    std::vector<double> packed;
+    std::vector<double, Aligned64<double>> packed;
     std::uint64_t fingerprint = 0;
   };
   static Discretisation discretise(const OscillatorBank& bank, double sample_rate, SampledForm form);
