@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "afmkit/control/realtime_filter.hpp"
@@ -59,7 +60,7 @@ TEST_P(BlockEqualsStep, BitForBitInBothWidthsAndAnyBlockSizes) {
   for (std::size_t i = 0; i < in.size(); ++i) expected[i] = ref.step(in[i]);
   ASSERT_GT(ref.skipped_samples(), 100u);  // the skip path is exercised
 
-  for (V width : {V::Auto, V::Portable}) {
+  for (V width : {V::Auto, V::Portable, V::Avx2, V::Avx512}) {  // a build the processor lacks: a narrower one
     RealtimeFilter f = make(n_harm);
     f.set_vectorisation(width);
     std::vector<double> out(in.size(), -1.0);
@@ -73,7 +74,7 @@ TEST_P(BlockEqualsStep, BitForBitInBothWidthsAndAnyBlockSizes) {
     }
     std::size_t mismatches = 0;
     for (std::size_t i = 0; i < in.size(); ++i) mismatches += !same_bits(out[i], expected[i]);
-    EXPECT_EQ(mismatches, 0u) << "N = " << n_harm << (width == V::Auto ? " auto width" : " portable");
+    EXPECT_EQ(mismatches, 0u) << "N = " << n_harm << " build " << static_cast<int>(f.vectorisation());
     EXPECT_EQ(f.skipped_samples(), ref.skipped_samples());
     EXPECT_EQ(f.samples(), ref.samples());
     EXPECT_TRUE(same_bits(f.last_output(), ref.last_output()));
@@ -98,6 +99,67 @@ TEST_P(BlockEqualsStep, InPlaceAndAfterRestoreState) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Harmonics, BlockEqualsStep, ::testing::Values(1, 2, 7, 10, 11, 12, 50, 120));
+
+// Each build forced in turn (a build this processor lacks is skipped, with a message): the same bits as step(),
+// sample for sample, on long random inputs, for N from one group of four modes to beyond the register-resident
+// sizes of every build (AVX-512: up to 8 groups, N ≤ 31; AVX2: 4 groups; 16-byte: 3 groups).
+class ForcedBuildSameBits : public ::testing::TestWithParam<V> {};
+
+TEST_P(ForcedBuildSameBits, AsStepSampleForSample) {
+  const V build = GetParam();
+  if (!RealtimeFilter::vectorisation_available(build))
+    GTEST_SKIP() << "this processor lacks the " << (build == V::Avx512 ? "AVX-512 (F, VL, DQ, BW)" : "AVX2")
+                 << " build of the modal kernel (or the compiler did not make it): not compared";
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> uni(-2.0, 2.0);
+  std::uniform_int_distribution<std::size_t> block(1, 3000);
+  for (int n_harm : {1, 4, 10, 13, 17, 21, 25, 29, 35}) {
+    auto in = hostile_signal(30000, 101u + static_cast<unsigned>(n_harm));
+    for (double& x : in)
+      if (std::isfinite(x) && std::abs(x) < 10.0) x += uni(rng);  // broadband on top: every mode excited
+    RealtimeFilter ref = make(n_harm), f = make(n_harm);
+    f.set_vectorisation(build);
+    ASSERT_EQ(f.vectorisation(), build);
+    std::vector<double> expected(in.size()), out(in.size(), -1.0);
+    for (std::size_t i = 0; i < in.size(); ++i) expected[i] = ref.step(in[i]);
+    for (std::size_t pos = 0; pos < in.size();) {
+      const std::size_t len = std::min(block(rng), in.size() - pos);
+      f.step_block(std::span(in).subspan(pos, len), std::span(out).subspan(pos, len));
+      pos += len;
+    }
+    std::size_t mismatches = 0, first = in.size();
+    for (std::size_t i = 0; i < in.size(); ++i)
+      if (!same_bits(out[i], expected[i])) first = std::min(first, i), ++mismatches;
+    EXPECT_EQ(mismatches, 0u) << "N = " << n_harm << ", first at sample " << first;
+    EXPECT_EQ(f.skipped_samples(), ref.skipped_samples());
+    EXPECT_EQ(f.save_state(), ref.save_state()) << "N = " << n_harm;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Builds, ForcedBuildSameBits, ::testing::Values(V::Portable, V::Avx2, V::Avx512),
+                         [](const ::testing::TestParamInfo<V>& i) {
+                           return std::string(i.param == V::Portable ? "Portable"
+                                              : i.param == V::Avx2   ? "Avx2"
+                                                                     : "Avx512");
+                         });
+
+TEST(ForcedBuildSameBits, AutoIsTheWidestAvailableAndALackingBuildFallsBack) {
+  RealtimeFilter f = make(10);
+  const V widest = RealtimeFilter::vectorisation_available(V::Avx512) ? V::Avx512
+                   : RealtimeFilter::vectorisation_available(V::Avx2) ? V::Avx2
+                                                                      : V::Portable;
+  EXPECT_EQ(f.vectorisation(), widest);  // the constructor chooses Auto
+  f.set_vectorisation(V::Portable);
+  EXPECT_EQ(f.vectorisation(), V::Portable);
+  EXPECT_FALSE(f.uses_wide_vectors());
+  f.set_vectorisation(V::Avx512);
+  EXPECT_EQ(f.vectorisation(), widest);  // Avx512 if available, else the widest below it
+  f.set_vectorisation(V::Avx2);
+  EXPECT_EQ(f.vectorisation(), RealtimeFilter::vectorisation_available(V::Avx2) ? V::Avx2 : V::Portable);
+  f.set_vectorisation(V::Auto);
+  EXPECT_EQ(f.vectorisation(), widest);
+  EXPECT_TRUE(RealtimeFilter::vectorisation_available(V::Portable));
+}
 
 TEST(ModalCoefficients, TheDocumentedRecursionReproducesStep) {
   // An independent scalar implementation of the recursion stated for ModalCoefficients (pairs, then reals; output

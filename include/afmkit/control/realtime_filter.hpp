@@ -49,6 +49,7 @@
 #include <complex>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <span>
 #include <vector>
 
@@ -100,17 +101,25 @@ class RealtimeFilter {
   /// Output u_n for the measured sample m_n (see above). noexcept, O(N).
   double step(double measured) noexcept;
   /// step() for each sample, with the same result bit for bit; in and out may alias; processes
-  /// min(in.size(), out.size()) samples. For the modal form the state stays in registers across the block
-  /// (N ≤ 11) and the modes are updated four lanes at a time (bench/bench_control_sim.cpp).
+  /// min(in.size(), out.size()) samples. For the modal form the modes are updated four lanes at a time and the state
+  /// stays in registers across the block (N ≤ 31 with AVX-512, N ≤ 11 with AVX2; docs/embedding.md,
+  /// bench/bench_control_sim.cpp).
   void step_block(std::span<const double> in, std::span<double> out) noexcept;
 
-  /// Vector width of the modal kernel: Auto = 32-byte vectors (AVX2) where the processor has them, else 16-byte
-  /// ones; Portable = 16-byte vectors always. Every lane does the same operations in the same order, so the outputs
-  /// are the same bits either way (tests/control_sim/test_realtime_block.cpp); for timing and for such checks.
-  enum class Vectorisation { Auto, Portable };
+  /// Build of the modal block kernel: Auto = the widest this processor runs (Avx512 = 64-byte vectors on x86-64
+  /// with AVX-512 F/VL/DQ/BW, Avx2 = 32-byte vectors, else Portable = 16-byte vectors, plain C++ on every target).
+  /// Every lane does the same operations in the same order and the output sum keeps one order, so the outputs are
+  /// the same bits whichever build runs (tests/control_sim/test_realtime_block.cpp); for timing and such checks. A
+  /// build this processor (or compiler) lacks is not chosen: the filter runs the widest one below it instead
+  /// (vectorisation() says which runs; vectorisation_available() says beforehand).
+  enum class Vectorisation { Auto, Portable, Avx2, Avx512 };
   void set_vectorisation(Vectorisation v) noexcept;
-  /// Whether step_block() runs the 32-byte build (step() always runs the 16-byte one, inlined).
-  bool uses_wide_vectors() const noexcept { return wide_; }
+  /// The build step_block() runs (never Auto; step() always runs the 16-byte one, inlined).
+  Vectorisation vectorisation() const noexcept { return path_; }
+  /// Whether this processor runs the build v (Auto and Portable: always).
+  static bool vectorisation_available(Vectorisation v) noexcept;
+  /// Whether step_block() runs a build wider than the 16-byte one.
+  bool uses_wide_vectors() const noexcept { return path_ != Vectorisation::Portable; }
 
   /// Bumpless change of all parameters (see above).
   void reconfigure(const OscillatorBank& controller, double sample_rate);
@@ -166,6 +175,16 @@ class RealtimeFilter {
 
  private:
   enum class Kind { Modal, Dense, Block };
+  template <class T>
+  struct Aligned64 {  // std::allocator on 64-byte boundaries (C++17 aligned new)
+    using value_type = T;
+    Aligned64() noexcept = default;
+    template <class U>
+    Aligned64(const Aligned64<U>&) noexcept {}
+    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
+    void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, std::align_val_t{64}); }
+    friend bool operator==(const Aligned64&, const Aligned64&) noexcept { return true; }
+  };
   struct Discretisation {
     Kind kind = Kind::Modal;
     int n = 0;       // 2N+1
@@ -187,9 +206,10 @@ class RealtimeFilter {
     };
     std::vector<Mode> modes;    // modal: pairs, then reals (physical z = V q, V never stored)
     // modal, as the per-sample kernel runs it (src/control/sim/modal_kernel.hpp): the modes in groups of four lanes,
-    // 40 coefficients per group; the state q_ is then q1 of every lane, then q2 (8·groups doubles)
+    // 32 coefficients per group, 64-byte aligned (a 32-byte load never straddles two cache lines: with the state in
+    // memory every coefficient is read every sample); the state q_ is then q1 of every lane, then q2 (8·groups doubles)
     int groups = 0;
-    std::vector<double> packed;
+    std::vector<double, Aligned64<double>> packed;
     std::uint64_t fingerprint = 0;
   };
   static Discretisation discretise(const OscillatorBank& bank, double sample_rate, SampledForm form);
@@ -211,7 +231,7 @@ class RealtimeFilter {
   std::vector<double> q_, q_tmp_;  // internal coordinates: modal (the kernel's layout, see pack()) or physical
   double held_ = 0.0;
   double input_limit_ = kDefaultInputLimit;
-  bool wide_ = false;  // modal kernel: the AVX2 build (x86-64 with AVX2; the same bits as the portable one)
+  Vectorisation path_ = Vectorisation::Portable;  // modal block kernel build (set_vectorisation; never Auto)
   std::uint64_t skipped_ = 0, samples_ = 0;
 };
 

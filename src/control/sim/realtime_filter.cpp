@@ -373,7 +373,7 @@ RealtimeFilter::RealtimeFilter(const OscillatorBank& controller, double sample_r
     : bank_(controller), sample_rate_(sample_rate), form_(form), disc_(discretise(controller, sample_rate, form)) {
   q_ = pack(disc_, std::vector<double>(static_cast<std::size_t>(disc_.n), 0.0).data());
   q_tmp_.assign(static_cast<std::size_t>(disc_.n), 0.0);
-  wide_ = detail::modal_wide_available();
+  set_vectorisation(Vectorisation::Auto);
 }
 
 std::vector<double> RealtimeFilter::pack(const Discretisation& d, const double* internal) {
@@ -448,7 +448,10 @@ double RealtimeFilter::coast_input() const noexcept {
 void RealtimeFilter::run_modal(const double* in, double* out, std::size_t n) noexcept {
   detail::ModalRun run{disc_.packed.data(), disc_.groups, input_limit_, held_, skipped_};
   if (n == 1) detail::modal_block_portable(run, q_.data(), in, out, 1);  // step(): inlined, state in memory
-  else detail::modal_block_dispatch(wide_, run, q_.data(), in, out, n);
+  else detail::modal_block_dispatch(path_ == Vectorisation::Avx512 ? detail::ModalPath::Avx512
+                                    : path_ == Vectorisation::Avx2 ? detail::ModalPath::Avx2
+                                                                   : detail::ModalPath::Portable,
+                                    run, q_.data(), in, out, n);
   held_ = run.held;
   skipped_ = run.skipped;
   samples_ += n;
@@ -524,8 +527,20 @@ void RealtimeFilter::reconfigure(const OscillatorBank& controller, double sample
 
 void RealtimeFilter::set_gain(double gain) { reconfigure(bank_.with_gain(gain), sample_rate_); }
 
+bool RealtimeFilter::vectorisation_available(Vectorisation v) noexcept {
+  switch (v) {
+    case Vectorisation::Avx512: return detail::modal_path_available(detail::ModalPath::Avx512);
+    case Vectorisation::Avx2: return detail::modal_path_available(detail::ModalPath::Avx2);
+    default: return true;
+  }
+}
+
 void RealtimeFilter::set_vectorisation(Vectorisation v) noexcept {
-  wide_ = v == Vectorisation::Auto && detail::modal_wide_available();
+  // Auto or an unavailable build: the widest available one not wider than asked (Auto: the widest of all)
+  if (v == Vectorisation::Auto) v = Vectorisation::Avx512;
+  if (v == Vectorisation::Avx512 && !vectorisation_available(v)) v = Vectorisation::Avx2;
+  if (v == Vectorisation::Avx2 && !vectorisation_available(v)) v = Vectorisation::Portable;
+  path_ = v;
 }
 
 void RealtimeFilter::set_input_limit(double limit) {
