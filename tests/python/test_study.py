@@ -200,7 +200,9 @@ def test_the_local_pool_gives_the_serial_numbers_bit_for_bit_and_survives_a_kill
     same(ds.load(), serial)
 
 
-def test_an_interrupted_study_resumes_and_recomputes_only_missing_chunks(serial, tmp_path):
+def test_an_interrupted_study_resumes_and_recomputes_only_missing_chunks(serial, tmp_path, monkeypatch):
+    """Resumed on local workers (LOCAL_POOL_SECONDS = 0: the first pending chunk, in this process, measures the
+    cost; the pool computes the rest)."""
     path = tmp_path / "r.zarr"
     code = ("import sys; from afmkit.study import Study, run; "
             f"s = Study.make(**{ORBIT!r}); "
@@ -226,7 +228,10 @@ def test_an_interrupted_study_resumes_and_recomputes_only_missing_chunks(serial,
     finished = [".".join(map(str, np.unravel_index(i, grid))) for i in np.flatnonzero(done)]
     stamps = {path / name / key: (path / name / key).stat().st_mtime_ns for key in finished}
     before = int(done.sum())
-    ds = run(orbit_study(), path, scheduler="serial", progress=False)
+    monkeypatch.setattr(sys.modules["afmkit.study.run"], "LOCAL_POOL_SECONDS", 0.0)
+    started = _spy_local_pool(monkeypatch)
+    ds = run(orbit_study(), path, scheduler="local", workers=2, progress=False)
+    assert len(started) == 1
     same(ds.load(), serial)
     rewritten = [p for p, t in stamps.items() if p.stat().st_mtime_ns != t]
     assert rewritten == [], f"finished chunks were recomputed: {rewritten}"
