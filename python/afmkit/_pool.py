@@ -17,7 +17,10 @@ def _init(owner: int) -> None:
 def start_fork_server(preload: list, threads: int) -> multiprocessing.context.BaseContext:
     """Starts this process's fork server (once per process: it then serves every pool) importing the modules
     `preload`, with OMP_NUM_THREADS = `threads` (read by the OpenMP runtime when afmkit's module is loaded there);
-    returns at once: the imports go on in the server while this process continues."""
+    returns at once: the imports go on in the server while this process continues. Where there is no fork server
+    (Windows), a spawn context: each worker imports what it needs."""
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
     ctx = multiprocessing.get_context("forkserver")
     ctx.set_forkserver_preload(list(preload))
     old = os.environ.get("OMP_NUM_THREADS")
