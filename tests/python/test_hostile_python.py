@@ -374,6 +374,30 @@ def test_a_report_killed_outright_takes_its_workers_with_it(tmp_path):
     assert left == [], "workers outlived the report process"
 
 
+def test_a_figure_worker_killed_fails_the_report_with_status_1_and_keeps_the_page(tmp_path):
+    """A figure worker lost (killed, out of memory) is the machine's failure, not the caller's: exit 1 naming it,
+    the previous page untouched (a worker lost while figures were still being handed out raised a bare
+    BrokenProcessPool traceback)."""
+    cli = os.environ["AFMKIT_CLI"]
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "index.html").write_text("the previous report")
+    proc = subprocess.Popen([cli, "report", "--output-dir", str(out), "--jobs", "2", "--figures",
+                             "seed003-fig4,seed003-fig2,seed003-fig3"], stderr=subprocess.PIPE, text=True)
+    assert "figures with" in proc.stderr.readline()
+    deadline = time.monotonic() + 30
+    workers = []
+    while time.monotonic() < deadline and not workers:  # a worker: a child of the fork server
+        workers = [p for server in _children(proc.pid) for p in _children(server)]
+        time.sleep(0.01)
+    assert workers, "no worker started"
+    os.kill(workers[0], signal.SIGKILL)
+    err = proc.communicate(timeout=120)[1]
+    assert proc.returncode == 1, err
+    assert "a figure worker process was lost" in err and "Traceback" not in err, err
+    assert (out / "index.html").read_text() == "the previous report"
+
+
 def test_a_study_killed_outright_takes_its_local_workers_with_it(tmp_path):
     """The study's local pool (afmkit._pool, as afmkit.study.run uses it), its process killed by SIGKILL while a
     worker is busy in code that holds the GIL (as a computation without a GIL release does): the worker ends with

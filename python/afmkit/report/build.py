@@ -187,20 +187,29 @@ def _in_process(order, staging, done, tasks, started) -> None:
 def _in_pool(order, staging, done, tasks, started, jobs: int) -> None:
     """`jobs` worker processes forked from a fork server that has imported Matplotlib, NumPy, afmkit and the figure
     modules once (afmkit._pool), each with cores / jobs OpenMP threads; the longest figures are started first."""
+    from concurrent.futures.process import BrokenProcessPool
+
     from .. import _pool
 
     threads = max(1, (os.cpu_count() or 1) // jobs)
     with _pool.pool(min(jobs, len(order)), _PRELOAD, threads) as pool:
-        pending = {pool.submit(_run_figure, m, n, str(staging)): (m, n, i) for m, n, i in order}
+        pending = {}
         try:
+            for m, n, i in order:
+                pending[pool.submit(_run_figure, m, n, str(staging))] = (m, n, i)
             for fut in futures.as_completed(pending):
                 m, n, figure_id = pending[fut]
                 try:
                     fig = fut.result()
+                except BrokenProcessPool:
+                    raise
                 except Exception as e:  # a figure that fails fails the report (index.html unchanged)
                     detail = "".join(traceback.format_exception(e))
                     raise ReportFailure(f"figure {figure_id} ({m}.{n}) failed:\n{detail}") from None
                 _accept(fig, m, n, figure_id, done, tasks, started)
+        except BrokenProcessPool:  # a worker killed (out of memory, a signal) before its figure
+            raise ReportFailure("a figure worker process was lost (killed, or out of memory): the report is "
+                                "incomplete") from None
         except BaseException:
             for fut in pending:
                 fut.cancel()

@@ -386,8 +386,10 @@ def _run_local(path, definition, pending, n, bar) -> None:
     target = str(path.resolve())
     for attempt in range(LOCAL_RETRIES + 1):
         with _pool.pool(min(n, len(left)), _PRELOAD, 1) as workers:
-            futures = {workers.submit(compute_chunk, target, definition, i): i for i in left}
+            futures = {}
             try:
+                for i in left:  # a worker lost meanwhile breaks the pool here already
+                    futures[workers.submit(compute_chunk, target, definition, i)] = i
                 for f in as_completed(futures):
                     f.result()
                     left.remove(futures[f])
