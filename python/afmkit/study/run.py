@@ -207,9 +207,10 @@ def _pilot(study: Study, measure: bool = True):
 
 
 #: A local study (scheduler "local") is computed by worker processes only when the computation left is at least
-#: this long (s of CPU time, estimated from the pilot points or the first chunk) and there are 2 workers or more: below it, the
-#: pool's start (a fork server importing NumPy, Zarr and afmkit, then a fork per worker: about 0.3 s of one core)
-#: would cost more than it saves, and the chunks are computed in this process (docs/study.md#running-it).
+#: this long (s of CPU time, estimated from the pilot points or the first chunk) and there are 2 workers or more:
+#: below it, the pool's start (a fork server importing NumPy, Zarr and afmkit, then a fork per worker: about 0.3 s
+#: of one core) would cost more than it saves, and the chunks are computed in this process
+#: (docs/study.md#running-it).
 LOCAL_POOL_SECONDS = 1.5
 
 #: What the local workers import once, in the fork server they are forked from (afmkit._pool).
