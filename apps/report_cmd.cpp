@@ -28,7 +28,7 @@ void register_report(CLI::App& app) {
   add_command(
       app, "report",
       "every figure of both papers and beyond, computed with afmkit, in one HTML page (out/report/index.html) "
-      "with captions and a table of key numbers; Python + Matplotlib, about 5 seconds on 2 cores",
+      "with captions and a table of key numbers; Python + Matplotlib, a few seconds on 2 cores",
       [](io::ParamSet& p) {
         p.group("Report")
             .file("output_dir", "out/report", "folder the report is written to (index.html and the figures' PNG "

@@ -83,7 +83,7 @@ void register_study(CLI::App& app) {
   add_command(
       study, "run",
       "run (or resume) the study described in a TOML file: named axes, the computation at each point, the outputs; "
-      "results in a Zarr store (xarray), chunks written as they finish; Python + Dask",
+      "results in a Zarr store (xarray), chunks written as they finish; Python (Dask for a cluster)",
       [](io::ParamSet& p) {
         p.group("Study")
             .file("file", "", "the study's TOML file: name, computation, outputs, [parameters], [axes] and an "
@@ -96,10 +96,11 @@ void register_study(CLI::App& app) {
             .writes([](const std::string& store) { return std::vector<io::WrittenPath>{{store, true}}; })
             .default_text("the file's [run] store, else out/<name>.zarr")
             .text("scheduler", "local",
-                  "where the chunks are computed: serial (this process), local (a Dask cluster of one worker process "
-                  "per core on this machine) or the address of a running Dask scheduler, tcp://host:8786")
+                  "where the chunks are computed: serial (this process), local (worker processes on this machine, "
+                  "one per core, when the study is long enough for them to pay: docs/study.md) or the address of a "
+                  "running Dask scheduler, tcp://host:8786")
             .default_text("the file's [run] scheduler, else local")
-            .integer("workers", 1, "worker processes of the local cluster", 1, 4096)
+            .integer("workers", 1, "worker processes of the local pool", 1, 4096)
             .default_text("one per core")
             .real("chunk_seconds", 1.0, "computation per chunk, measured on the first points; each chunk is one call "
                                         "into C++ and one write to the store",

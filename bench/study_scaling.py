@@ -1,76 +1,155 @@
-"""Benchmark of parameter studies (docs/study.md): scheduling overhead of Dask against the serial run at the default
-chunk size (about 1 s of computation per chunk), and the speed-up of 2 workers over 1, all in this process.
+#!/usr/bin/env python3
+"""`afmkit study run` as users run it (issue 28 §5): the start-up of a short study (<= 1 s serially) and the
+speed-up of 2 local workers over the serial run for a study of about 15 s (>= 1.8x on an idle 2-core machine),
+each against the study runner of an earlier commit (--baseline: a Dask LocalCluster for "local") in the same run.
 
-    PYTHONPATH=build/python /usr/bin/python3 bench/study_scaling.py [--chunks 16]
+Each run is a whole process, `python3 -m afmkit.study run FILE` (what `afmkit study run` execs), timed until it and
+every process it started have ended: wall time, and CPU time of all of them (this script is a child subreaper, so
+orphans such as a fork server or Dask's processes are reaped and counted here). Configurations run in interleaved
+rounds; medians, ratios and the machine's load average (os.getloadavg, 1 min) during the runs are printed, and the
+results of every configuration are compared with the serial run's, bit for bit.
 
-Prints the per-point cost, the wall times (the fastest of --repeat interleaved runs of the whole study) and the ratios the issue sets targets for (overhead <= 5 %, 2 workers
->= 1.8x one worker on 2 cores). Run it on an otherwise idle machine.
+    PYTHONPATH=build/python /usr/bin/python3 bench/study_scaling.py [--runs 3] [--seconds 15] [--baseline ec6a91b]
 """
 import argparse
+import ctypes
+import glob
 import os
 import shutil
+import statistics
+import subprocess
+import sys
 import tempfile
 import time
+from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import distributed  # noqa: E402
+ROOT = Path(__file__).resolve().parent.parent
 
-from afmkit.study import Study, run  # noqa: E402
-from afmkit.study.run import _pilot  # noqa: E402
+STUDY = """name = "bench"
+computation = "tapping.orbit"
+outputs = ["max(amplitude | stable)", "count(amplitude | stable)"]
+[parameters]
+law = "attractive"
+approach_adhesion = 0.5
+departure_adhesion = 1.0
+frequency_ratio = 1.005
+[axes]
+separation = {{ start = 7.0, stop = 21.0, points = {points} }}
+"""
 
 
-def study(points: int) -> Study:
-    return Study.make("tapping.orbit",
-                      axes={"separation": {"start": 7.0, "stop": 21.0, "points": points}},
-                      outputs=["max(amplitude | stable)", "count(amplitude | stable)"],
-                      parameters={"law": "attractive", "approach_adhesion": 0.5, "departure_adhesion": 1.0,
-                                  "frequency_ratio": 1.005})
+def subreaper() -> None:
+    libc = ctypes.CDLL(None, use_errno=True)
+    if libc.prctl(36, 1, 0, 0, 0) != 0:  # PR_SET_CHILD_SUBREAPER
+        sys.exit("cannot become a child subreaper (Linux prctl): the CPU time of orphans would be missed")
 
 
-def timed(fn) -> float:
+def children_cpu() -> float:
+    t = os.times()
+    return t.children_user + t.children_system
+
+
+def run(argv, env, cwd) -> tuple:
+    """(wall s, CPU s of the process and all its descendants, load average at the end)."""
+    cpu0 = children_cpu()
     start = time.perf_counter()
-    fn()
-    return time.perf_counter() - start
+    p = subprocess.Popen(argv, env=env, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    err = p.communicate()[1]
+    while True:  # orphans it left: reaped here, their CPU counted
+        try:
+            os.waitpid(-1, 0)
+        except ChildProcessError:
+            break
+    wall = time.perf_counter() - start
+    if p.returncode != 0:
+        sys.exit(f"{' '.join(argv)} exited {p.returncode}:\n{err}")
+    return wall, children_cpu() - cpu0, os.getloadavg()[0]
+
+
+def old_tree(ref: str, build: Path, into: Path) -> Path:
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", ref, "python/afmkit"], check=True,
+                             capture_output=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+    for so in glob.glob(str(build / "python" / "afmkit" / "_afmkit*.so")):
+        shutil.copy(so, into / "python" / "afmkit")
+    return into / "python"
+
+
+def same_results(a: Path, b: Path) -> bool:
+    import numpy as np
+    import zarr
+
+    ga, gb = zarr.open_group(str(a), mode="r"), zarr.open_group(str(b), mode="r")
+    names = [n for n in ga.array_keys() if not n.startswith("chunk_")]
+    return all(np.array_equal(ga[n][:], gb[n][:], equal_nan=True) for n in names)
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--chunks", type=int, default=32, help="chunks of about 1 s each")
-    parser.add_argument("--repeat", type=int, default=3, help="runs of each configuration; the fastest counts")
-    args = parser.parse_args()
-    cost, _ = _pilot(study(200))
-    per_chunk = max(1, round(1.0 / cost))
-    s = study(per_chunk * args.chunks)
-    print(f"per point: {cost * 1e3:.1f} ms; {per_chunk} points per chunk (about 1 s); {args.chunks} chunks, "
-          f"{s.size} points")
-    work = tempfile.mkdtemp(prefix="afmkit-bench-study-")
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--build", default=str(ROOT / "build"))
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--seconds", type=float, default=15.0, help="the long study's computation on one core")
+    ap.add_argument("--short-points", type=int, default=4, help="points of the short study (start-up)")
+    ap.add_argument("--baseline", default="ec6a91b", help="git commit of the old study runner")
+    args = ap.parse_args()
+    subreaper()
+    build = Path(args.build).resolve()
+    sys.path.insert(0, str(build / "python"))
+    from afmkit.study import Study
+    from afmkit.study.run import _pilot
+
+    work = Path(tempfile.mkdtemp(prefix="afmkit-bench-study-"))
     try:
-        def cluster(n):
-            return distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                            dashboard_address=None, host="127.0.0.1", env={"OMP_NUM_THREADS": "1"})
+        packages = {"new": build / "python", "old": old_tree(args.baseline, build, work)}
+        (work / "probe.toml").write_text(STUDY.format(points=200))
+        probe = Study.from_toml(str(work / "probe.toml"))
+        cost = _pilot(probe)[2]  # CPU time per point
+        points = max(2, round(args.seconds / cost))
+        (work / "short.toml").write_text(STUDY.format(points=args.short_points))
+        (work / "long.toml").write_text(STUDY.format(points=points))
+        print(f"per point {cost * 1e3:.1f} ms: long study {points} points (~{points * cost:.1f} s on one core), "
+              f"short study {args.short_points} points; {os.cpu_count()} cores")
+        configs = [  # (label, package, study file, scheduler)
+            ("short, serial (new)", "new", "short", "serial"), ("short, serial (old)", "old", "short", "serial"),
+            ("short, local (new)", "new", "short", "local"), ("short, local (old: Dask)", "old", "short", "local"),
+            ("long, serial (new)", "new", "long", "serial"), ("long, local 2 (new)", "new", "long", "local"),
+            ("long, local 2 (old: Dask)", "old", "long", "local"),
+        ]
+        samples = {c[0]: [] for c in configs}
+        for k in range(args.runs):  # interleaved rounds
+            for label, pkg, which, scheduler in (configs if k % 2 == 0 else configs[::-1]):
+                store = work / f"{label.replace(' ', '_').replace(',', '').replace(':', '')}-{k}.zarr"
+                env = dict(os.environ, PYTHONPATH=str(packages[pkg]))
+                samples[label].append(run([sys.executable, "-m", "afmkit.study", "run", str(work / f"{which}.toml"),
+                                           "--store", str(store), "--scheduler", scheduler, "--workers", "2",
+                                           "--quiet"], env, work))
+        med = {}
+        print(f"{'':<28} {'wall s':>7} {'CPU s':>7} {'load':>6}   runs (wall s)")
+        for label, s in samples.items():
+            med[label] = (statistics.median(w for w, _, _ in s), statistics.median(c for _, c, _ in s))
+            print(f"{label:<28} {med[label][0]:7.2f} {med[label][1]:7.2f} "
+                  f"{statistics.median(l for *_, l in s):6.2f}   " + " ".join(f"{w:.2f}" for w, *_ in s))
 
-        def timed_run(name, scheduler, k):
-            run(study(8), f"{work}/warm-up-{name}-{k}.zarr", scheduler=scheduler, chunk_points=2, progress=False)
-            return timed(lambda: run(s, f"{work}/{name}-{k}.zarr", scheduler=scheduler, chunk_points=per_chunk,
-                                     progress=False))
+        def ratio(a, b, i=0):
+            return med[a][i] / med[b][i]
 
-        # rounds interleave the configurations so that drifts of the machine's speed hit all three alike; each
-        # configuration runs alone (a new cluster per round), after a small warm-up study (imports, worker start-up:
-        # not its time); the fastest whole run (pilot, store, chunks, opening the results) of each counts
-        times = {"serial": [], 1: [], 2: []}
-        for k in range(args.repeat):
-            times["serial"].append(timed_run("serial", "serial", k))
-            for n in (1, 2):
-                with cluster(n) as c, distributed.Client(c) as client:
-                    times[n].append(timed_run(f"dask{n}", client, k))
-        t_serial, results = min(times["serial"]), {1: min(times[1]), 2: min(times[2])}
-        print("runs (s): " + "; ".join(f"{name}: " + " ".join(f"{t:.2f}" for t in ts) for name, ts in times.items()))
-        print(f"serial (this process)     {t_serial:7.2f} s")
-        print(f"Dask, 1 worker            {results[1]:7.2f} s   overhead {100 * (results[1] / t_serial - 1):+.1f} % "
-              f"(target <= 5 %)")
-        print(f"Dask, 2 workers           {results[2]:7.2f} s   speed-up over 1 worker {results[1] / results[2]:.2f}x "
-              f"(target >= 1.8x on 2 cores)")
+        print(f"short study serial, new / old: wall {ratio('short, serial (new)', 'short, serial (old)'):.2f}, "
+              f"CPU {ratio('short, serial (new)', 'short, serial (old)', 1):.2f}; target <= 1 s start-up: "
+              f"{'met' if med['short, serial (new)'][0] <= 1.0 else 'NOT met'} "
+              f"({med['short, serial (new)'][0]:.2f} s for {args.short_points} points)")
+        print(f"short study local, new / old: wall {ratio('short, local (new)', 'short, local (old: Dask)'):.2f}, "
+              f"CPU {ratio('short, local (new)', 'short, local (old: Dask)', 1):.2f}")
+        s_new = ratio("long, serial (new)", "long, local 2 (new)")
+        print(f"long study, 2 local workers over serial: new {s_new:.2f}x, old (Dask) "
+              f"{ratio('long, serial (new)', 'long, local 2 (old: Dask)'):.2f}x; target >= 1.8x on an idle 2-core "
+              f"machine: {'met' if s_new >= 1.8 else 'NOT met'} (load {os.getloadavg()[0]:.2f})")
+        reference = work / "long_serial_(new)-0.zarr"
+        mismatched = [p.name for p in sorted(work.glob("*.zarr")) if p.name.startswith("long")
+                      and not same_results(reference, p)]
+        print("results bit for bit the serial run's: " + ("yes, every long run" if not mismatched
+                                                            else f"NO: {', '.join(mismatched)}"))
     finally:
         shutil.rmtree(work, ignore_errors=True)
 

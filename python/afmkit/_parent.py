@@ -87,3 +87,27 @@ class TiedToParent:
 
     def release_key(self, key, state, cause, reason, report) -> None:
         pass
+
+
+def die_with_fork_server(owner: int) -> None:
+    """In a worker forked by a multiprocessing fork server (the report's figure workers, the study's local pool):
+    end when the fork server ends, which it does as soon as `owner` (the process that started it) ends, even by
+    SIGKILL (its pipe from the owner reaches end of file); a worker whose owner is already gone ends at once."""
+    try:
+        from multiprocessing import forkserver
+    except ImportError:  # no fork server here (Windows): a spawned worker, whose parent is the owner
+        forkserver = None
+
+    # a forked worker inherits the write end of the pipe whose end of file tells the fork server that its owner and
+    # every worker are gone: closed here, the server ends with its owner (and the workers with the server)
+    server = getattr(forkserver, "_forkserver", None)
+    if getattr(server, "_forkserver_alive_fd", None) is not None:
+        os.close(server._forkserver_alive_fd)
+        server._forkserver_alive_fd = None
+    die_with_parent(os.getppid())
+    try:
+        os.kill(owner, 0)
+    except ProcessLookupError:
+        os._exit(1)
+    except PermissionError:
+        pass

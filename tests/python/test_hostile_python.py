@@ -339,19 +339,30 @@ def _alive(pid: int) -> bool:
     return state != "Z"
 
 
+def _descendants(pid: int) -> list:
+    out, todo = [], [pid]
+    while todo:
+        kids = _children(todo.pop())
+        out += kids
+        todo += kids
+    return out
+
+
 def test_a_report_killed_outright_takes_its_workers_with_it(tmp_path):
+    """The figure workers are forked by a fork server (afmkit._pool): the server and the workers end with the report
+    process killed by SIGKILL."""
     cli = os.environ["AFMKIT_CLI"]
     proc = subprocess.Popen([cli, "report", "--output-dir", str(tmp_path / "rep"), "--jobs", "2", "--figures",
                              "seed003-fig4,seed003-fig2"], stderr=subprocess.PIPE, text=True)
     assert "figures with" in proc.stderr.readline()
     deadline = time.monotonic() + 30
     workers = []
-    while time.monotonic() < deadline and len(workers) < 2:
-        workers = [p for p in _children(proc.pid) if b"spawn_main" in _cmdline(p)]
+    while time.monotonic() < deadline and len(workers) < 3:  # the fork server and its 2 workers
+        workers = _descendants(proc.pid)
         time.sleep(0.1)
-    assert len(workers) == 2, "the workers did not start"
+    assert len(workers) >= 3, "the workers did not start"
     time.sleep(1.0)  # the workers are computing their figures
-    workers = _children(proc.pid)  # the figure workers and any helper process of multiprocessing
+    workers = _descendants(proc.pid)
     proc.kill()
     proc.wait()
     deadline = time.monotonic() + 5
@@ -363,25 +374,50 @@ def test_a_report_killed_outright_takes_its_workers_with_it(tmp_path):
     assert left == [], "workers outlived the report process"
 
 
-def test_a_study_killed_outright_takes_its_dask_workers_with_it(tmp_path):
-    """The study's LocalCluster (afmkit.study.run), its process killed by SIGKILL while a worker is busy in code
-    that holds the GIL (as a computation without a GIL release does): the worker ends with it at once (issue 24 §3).
-    Dask's own watch (a thread of the worker reading a pipe) cannot run while the GIL is held: the worker would
-    finish its task first (here 60 s); afmkit._parent ties it to the study process through the kernel."""
+def test_a_figure_worker_killed_fails_the_report_with_status_1_and_keeps_the_page(tmp_path):
+    """A figure worker lost (killed, out of memory) is the machine's failure, not the caller's: exit 1 naming it,
+    the previous page untouched (a worker lost while figures were still being handed out raised a bare
+    BrokenProcessPool traceback)."""
+    cli = os.environ["AFMKIT_CLI"]
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "index.html").write_text("the previous report")
+    proc = subprocess.Popen([cli, "report", "--output-dir", str(out), "--jobs", "2", "--figures",
+                             "seed003-fig4,seed003-fig2,seed003-fig3"], stderr=subprocess.PIPE, text=True)
+    assert "figures with" in proc.stderr.readline()
+    deadline = time.monotonic() + 30
+    workers = []
+    while time.monotonic() < deadline and not workers:  # a worker: a child of the fork server
+        workers = [p for server in _children(proc.pid) for p in _children(server)]
+        time.sleep(0.01)
+    assert workers, "no worker started"
+    os.kill(workers[0], signal.SIGKILL)
+    err = proc.communicate(timeout=120)[1]
+    assert proc.returncode == 1, err
+    assert "a figure worker process was lost" in err and "Traceback" not in err, err
+    assert (out / "index.html").read_text() == "the previous report"
+
+
+def test_a_study_killed_outright_takes_its_local_workers_with_it(tmp_path):
+    """The study's local pool (afmkit._pool, as afmkit.study.run uses it), its process killed by SIGKILL while a
+    worker is busy in code that holds the GIL (as a computation without a GIL release does): the worker ends with
+    it at once (issue 24 §3), through the kernel (PR_SET_PDEATHSIG on the fork server, which ends with its owner)."""
+    (tmp_path / "hostile_busy.py").write_text(
+        "import ctypes\n"
+        "def busy():\n"
+        "    ctypes.PyDLL(None).sleep(60)  # a C call that keeps the GIL (PyDLL does not release it)\n")
     script = tmp_path / "study_parent.py"
     script.write_text(
-        "import ctypes, os, time\n"
-        "from afmkit.study.run import _client\n"
-        "def busy():\n"
-        "    ctypes.PyDLL(None).sleep(60)  # a C call that keeps the GIL (PyDLL does not release it)\n"
+        "import os, time\n"
+        "from afmkit import _pool\n"
+        "import hostile_busy\n"
         "if __name__ == '__main__':\n"
-        "    client, cluster, _ = _client(None, 1)\n"
-        "    pids = list(client.run(os.getpid).values())\n"
-        "    future = client.submit(busy, pure=False)\n"
+        "    workers = _pool.pool(1, ['afmkit.study.run'], 1)\n"
+        "    future = workers.submit(hostile_busy.busy)\n"
         "    time.sleep(1.5)  # the task has started\n"
-        "    print(' '.join(map(str, pids)), flush=True)\n"
+        "    print(' '.join(map(str, workers._processes)), flush=True)\n"
         "    time.sleep(120)\n")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path), *sys.path]))
     proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
                             text=True, env=env)
     import select
@@ -390,6 +426,7 @@ def test_a_study_killed_outright_takes_its_dask_workers_with_it(tmp_path):
     if len(workers) != 1:
         proc.kill()
     assert len(workers) == 1 and _alive(workers[0]), "the worker did not start"
+    workers += _descendants(proc.pid)  # and the fork server
     proc.kill()
     proc.wait()
     deadline = time.monotonic() + 5
@@ -398,7 +435,7 @@ def test_a_study_killed_outright_takes_its_dask_workers_with_it(tmp_path):
     left = [p for p in workers if _alive(p)]
     for p in left:  # do not leave them to the rest of the test run
         os.kill(p, signal.SIGKILL)
-    assert left == [], "a Dask worker outlived the study process"
+    assert left == [], "a worker outlived the study process"
 
 
 def test_a_store_removed_while_the_study_runs_is_named_without_zarrs_template(tmp_path):

@@ -30,6 +30,37 @@ def test_figure_ids_are_unique_and_cover_both_papers_and_beyond():
         assert wanted in ids
 
 
+def test_the_report_lists_its_figures_as_the_modules_do_without_importing_matplotlib():
+    """Listing and selecting figures (the report's parent process) imports neither Matplotlib nor the figure modules
+    (issue 28 §5: their import is paid once, in the fork server of the workers): REPORT_FIGURES is the modules'
+    FIGURES, in report order."""
+    import importlib
+    import sys
+
+    from afmkit.report.build import FIGURE_MODULES, REPORT_FIGURES
+
+    code = ("import sys, afmkit.report as r; print(','.join(r.figure_ids())); "
+            "print(sorted(m for m in ('matplotlib', 'afmkit.figures.seed000', 'afmkit.figures.seed003', "
+            "'afmkit.figures.scan') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))).stdout.splitlines()
+    assert out[1] == "[]"
+    expected = [(m, fn.__name__, fn.figure_id) for m in FIGURE_MODULES
+                for fn in importlib.import_module(f"afmkit.figures.{m}").FIGURES]
+    assert [f[:3] for f in REPORT_FIGURES] == expected
+    assert out[0].split(",") == [e[2] for e in expected]
+    assert all(cost > 0 for *_, cost in REPORT_FIGURES)
+
+
+def test_the_longest_figures_are_started_first():
+    from afmkit.report.build import REPORT_FIGURES, _figure_list, _longest_first
+
+    cost = {figure_id: c for _, _, figure_id, c in REPORT_FIGURES}
+    order = _longest_first(_figure_list())
+    assert sorted(order) == sorted(_figure_list())
+    assert [cost[t[2]] for t in order] == sorted(cost.values(), reverse=True)
+
+
 def test_a_selection_writes_a_page_with_just_those_figures(tmp_path):
     r = report("--output-dir", "rep", "--figures", QUICK, cwd=tmp_path)
     assert r.returncode == 0, r.stderr

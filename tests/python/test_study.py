@@ -132,7 +132,77 @@ def test_a_worker_killed_mid_study_and_the_study_still_completes(cluster, serial
     cluster.wait_for_workers(2, timeout=60)  # the nanny restarted it
 
 
-def test_an_interrupted_study_resumes_and_recomputes_only_missing_chunks(serial, tmp_path):
+def _spy_local_pool(monkeypatch):
+    """Counts the local pools the study starts (afmkit._pool.pool, as afmkit.study.run calls it)."""
+    from afmkit import _pool
+    started = []
+    real = _pool.pool
+
+    def counted(*args, **kwargs):
+        started.append(args)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(_pool, "pool", counted)
+    return started
+
+
+def test_a_short_local_study_runs_in_this_process(serial, tmp_path, monkeypatch):
+    """Issue 28 §5: a study whose computation is shorter than LOCAL_POOL_SECONDS (this one: 27 orbits, about
+    0.4 s) starts no worker processes; its numbers are the serial run's."""
+    started = _spy_local_pool(monkeypatch)
+    runner = sys.modules["afmkit.study.run"]
+    assert runner.LOCAL_POOL_SECONDS >= 1.0
+    ds = run(orbit_study(), tmp_path / "short.zarr", scheduler="local", workers=2, chunk_points=4, progress=False)
+    assert started == []
+    same(ds.load(), serial)
+
+
+def test_the_local_pool_gives_the_serial_numbers_bit_for_bit_and_survives_a_killed_worker(serial, tmp_path,
+                                                                                         monkeypatch):
+    """The local pool (2 processes forked from a fork server), forced by LOCAL_POOL_SECONDS = 0: one of its workers
+    killed as soon as it exists, the chunks not done go to a new pool, the numbers are the serial run's."""
+    import multiprocessing.forkserver as mpfs
+    runner = sys.modules["afmkit.study.run"]
+    monkeypatch.setattr(runner, "LOCAL_POOL_SECONDS", 0.0)
+    started = _spy_local_pool(monkeypatch)
+    killed = []
+    stop = threading.Event()
+
+    def kill_first_worker():
+        while not stop.is_set():
+            server = getattr(mpfs._forkserver, "_forkserver_pid", None)
+            kids = []
+            if server:
+                for entry in os.listdir("/proc"):
+                    try:
+                        with open(f"/proc/{entry}/stat") as f:
+                            fields = f.read().rsplit(")", 1)[1].split()
+                    except (OSError, IndexError):
+                        continue
+                    if int(fields[1]) == server and fields[0] != "Z":
+                        kids.append(int(entry))
+            if kids:
+                os.kill(kids[0], signal.SIGKILL)
+                killed.append(kids[0])
+                return
+            time.sleep(0.002)
+
+    watcher = threading.Thread(target=kill_first_worker)
+    watcher.start()
+    try:
+        ds = run(orbit_study(), tmp_path / "pool.zarr", scheduler="local", workers=2, chunk_points=1,
+                 progress=False)
+    finally:
+        stop.set()
+        watcher.join()
+    assert killed, "no worker was seen"
+    assert len(started) >= 2 and started[0][0] == 2  # the pool of 2 workers, and another after the kill
+    same(ds.load(), serial)
+
+
+def test_an_interrupted_study_resumes_and_recomputes_only_missing_chunks(serial, tmp_path, monkeypatch):
+    """Resumed on local workers (LOCAL_POOL_SECONDS = 0: the first pending chunk, in this process, measures the
+    cost; the pool computes the rest)."""
     path = tmp_path / "r.zarr"
     code = ("import sys; from afmkit.study import Study, run; "
             f"s = Study.make(**{ORBIT!r}); "
@@ -158,7 +228,10 @@ def test_an_interrupted_study_resumes_and_recomputes_only_missing_chunks(serial,
     finished = [".".join(map(str, np.unravel_index(i, grid))) for i in np.flatnonzero(done)]
     stamps = {path / name / key: (path / name / key).stat().st_mtime_ns for key in finished}
     before = int(done.sum())
-    ds = run(orbit_study(), path, scheduler="serial", progress=False)
+    monkeypatch.setattr(sys.modules["afmkit.study.run"], "LOCAL_POOL_SECONDS", 0.0)
+    started = _spy_local_pool(monkeypatch)
+    ds = run(orbit_study(), path, scheduler="local", workers=2, progress=False)
+    assert len(started) == 1
     same(ds.load(), serial)
     rewritten = [p for p, t in stamps.items() if p.stat().st_mtime_ns != t]
     assert rewritten == [], f"finished chunks were recomputed: {rewritten}"
@@ -226,10 +299,14 @@ def test_netcdf_on_request(serial, tmp_path):
 def test_the_example_study_runs_from_the_command_line_and_finds_the_hb_hysteresis_bands(tmp_path):
     source = os.environ["AFMKIT_SOURCE_DIR"]
     store = tmp_path / "jumps.zarr"
-    r = subprocess.run([sys.executable, "-m", "afmkit.study", "run", f"{source}/examples/studies/attractive_jumps.toml",
-                        "--store", str(store), "--workers", "2"], capture_output=True, text=True, timeout=300)  # local
+    r = subprocess.run([sys.executable, "-X", "importtime", "-m", "afmkit.study", "run",
+                        f"{source}/examples/studies/attractive_jumps.toml", "--store", str(store), "--workers", "2"],
+                       capture_output=True, text=True, timeout=300)  # local
     assert r.returncode == 0, r.stderr
     assert "chunks" in r.stderr  # progress lines
+    # issue 28 §5: the command imports neither Dask nor xarray (half a second each; the results are not opened)
+    imported = {line.rsplit("|", 1)[1].strip() for line in r.stderr.splitlines() if line.startswith("import time:")}
+    assert "zarr" in imported and not imported & {"xarray", "distributed", "dask"}
     ds = xr.open_zarr(store)
     assert ds.attrs["study_name"] == "attractive_jumps"
     # independent check: two stable orbits coexist exactly between the HB curve's jump points — the free

@@ -19,7 +19,7 @@ def main(argv=None) -> int:
 
     signal.signal(signal.SIGTERM, terminated)
     try:
-        path = build(args.output_dir, jobs=args.jobs, figures=args.figures)
+        path = build(args.output_dir, jobs=args.jobs, figures=args.figures, _own_process=True)
     except (ReportError, ReportFailure) as e:
         print(f"afmkit report: {e}", file=sys.stderr)
         return e.status

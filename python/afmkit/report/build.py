@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import concurrent.futures as futures
 import importlib
-import multiprocessing
 import os
 import shutil
 import sys
@@ -13,10 +12,32 @@ import traceback
 from pathlib import Path
 
 from .._files import unique_temporary
-from .._parent import die_with_parent
 
 #: Figure modules (python/afmkit/figures/<name>.py), in report order; each lists its figures in FIGURES.
 FIGURE_MODULES = ["seed000", "seed003", "scan"]
+
+#: Every figure of the report, in report order: (module, function, id, cost). The same list as the modules' FIGURES
+#: (a test checks it), written out so that listing or selecting figures imports neither Matplotlib nor the figure
+#: modules. cost: the figure's CPU time in seconds (one core, one OpenMP thread; bench/report_speed.py --imports
+#: prints it), to start the longest first so that the processes finish together.
+REPORT_FIGURES = [
+    ("seed000", "fig3", "seed000-fig3", 0.10),
+    ("seed000", "fig4", "seed000-fig4", 0.09),
+    ("seed000", "fig_attractive", "seed000-attractive", 0.30),
+    ("seed000", "fig_hb_vs_orbits", "beyond-hb-vs-orbits", 0.30),
+    ("seed000", "fig_impact", "beyond-impact", 0.14),
+    ("seed003", "fig2", "seed003-fig2", 0.60),
+    ("seed003", "fig3", "seed003-fig3", 0.33),
+    ("seed003", "fig4", "seed003-fig4", 1.19),
+    ("seed003", "fig5", "seed003-fig5", 0.27),
+    ("seed003", "fig7", "seed003-fig7", 0.53),
+    ("seed003", "spotchecks", "beyond-chart-spotchecks", 0.49),
+    ("seed003", "tuning", "beyond-tuning", 0.73),
+    ("scan", "scan_images", "beyond-scan-images", 0.85),
+]
+
+#: What the figure workers import once, in the fork server they are forked from (afmkit._pool).
+_PRELOAD = ["afmkit.report.build", *(f"afmkit.figures.{m}" for m in FIGURE_MODULES)]
 
 
 class ReportError(ValueError):
@@ -66,12 +87,14 @@ def _remove_stale_staging(out: Path) -> None:
 
 
 def _figure_list():
-    tasks = []
-    for module in FIGURE_MODULES:
-        mod = importlib.import_module(f"afmkit.figures.{module}")
-        for fn in mod.FIGURES:
-            tasks.append((module, fn.__name__, fn.figure_id))
-    return tasks
+    return [(module, name, figure_id) for module, name, figure_id, _ in REPORT_FIGURES]
+
+
+def _longest_first(tasks) -> list:
+    """The tasks in the order they are started: the most costly first (REPORT_FIGURES), so that no process is left
+    with a long figure when the others are done."""
+    cost = {figure_id: c for _, _, figure_id, c in REPORT_FIGURES}
+    return sorted(tasks, key=lambda t: -cost.get(t[2], 0.0))
 
 
 def _select(tasks, figures: str):
@@ -102,11 +125,6 @@ def _run_figure(module: str, name: str, staging: str):
     plt.close(fig)
     entry.seconds = time.perf_counter() - start
     return entry
-
-
-def _worker_init(threads: int, parent: int) -> None:
-    die_with_parent(parent)
-    os.environ["OMP_NUM_THREADS"] = str(threads)
 
 
 def speed_numbers() -> list:
@@ -147,7 +165,58 @@ def _progress(done: int, total: int, fig, started: float) -> None:
           file=sys.stderr, flush=True)
 
 
-def build(output_dir="out/report", jobs: int = 2, figures: str = "all") -> Path:
+def _accept(fig, module: str, name: str, figure_id: str, done: dict, tasks, started) -> None:
+    if fig.id != figure_id:
+        raise ReportFailure(f"figure function {module}.{name} returned id {fig.id}, marked {figure_id}")
+    done[figure_id] = fig
+    _progress(len(done), len(tasks), fig, started)
+
+
+def _in_process(order, staging, done, tasks, started) -> None:
+    """One process (jobs = 1, or a single figure) in `afmkit report`: a pool would only add its start-up. Not from
+    a caller's Python session (build()), whose Matplotlib backend the figures' Agg would replace."""
+    for m, n, figure_id in order:
+        try:
+            fig = _run_figure(m, n, str(staging))
+        except Exception as e:  # a figure that fails fails the report (index.html unchanged)
+            detail = "".join(traceback.format_exception(e))
+            raise ReportFailure(f"figure {figure_id} ({m}.{n}) failed:\n{detail}") from None
+        _accept(fig, m, n, figure_id, done, tasks, started)
+
+
+def _in_pool(order, staging, done, tasks, started, jobs: int) -> None:
+    """`jobs` worker processes forked from a fork server that has imported Matplotlib, NumPy, afmkit and the figure
+    modules once (afmkit._pool), each with cores / jobs OpenMP threads; the longest figures are started first."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    from .. import _pool
+
+    threads = max(1, (os.cpu_count() or 1) // jobs)
+    with _pool.pool(min(jobs, len(order)), _PRELOAD, threads) as pool:
+        pending = {}
+        try:
+            for m, n, i in order:
+                pending[pool.submit(_run_figure, m, n, str(staging))] = (m, n, i)
+            for fut in futures.as_completed(pending):
+                m, n, figure_id = pending[fut]
+                try:
+                    fig = fut.result()
+                except BrokenProcessPool:
+                    raise
+                except Exception as e:  # a figure that fails fails the report (index.html unchanged)
+                    detail = "".join(traceback.format_exception(e))
+                    raise ReportFailure(f"figure {figure_id} ({m}.{n}) failed:\n{detail}") from None
+                _accept(fig, m, n, figure_id, done, tasks, started)
+        except BrokenProcessPool:  # a worker killed (out of memory, a signal) before its figure
+            raise ReportFailure("a figure worker process was lost (killed, or out of memory): the report is "
+                                "incomplete") from None
+        except BaseException:
+            for fut in pending:
+                fut.cancel()
+            raise
+
+
+def build(output_dir="out/report", jobs: int = 2, figures: str = "all", *, _own_process: bool = False) -> Path:
     """Computes the figures and writes ``<output_dir>/index.html`` (replaced only when complete); returns its path.
 
     ``figures`` is "all" or a comma-separated list of figure ids (:func:`figure_ids`).
@@ -179,27 +248,11 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all") -> Path:
     try:
         print(f"afmkit report: {len(tasks)} figures with {jobs} process(es) into {out}/", file=sys.stderr, flush=True)
         done = {}
-        threads = max(1, (os.cpu_count() or 1) // jobs)
-        ctx = multiprocessing.get_context("spawn")  # a clean OpenMP runtime per worker
-        with futures.ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
-                                         initargs=(threads, os.getpid())) as pool:
-            pending = {pool.submit(_run_figure, m, n, str(staging)): (m, n, i) for m, n, i in tasks}
-            try:
-                for fut in futures.as_completed(pending):
-                    m, n, figure_id = pending[fut]
-                    try:
-                        fig = fut.result()
-                    except Exception as e:  # a figure that fails fails the report (index.html unchanged)
-                        detail = "".join(traceback.format_exception(e))
-                        raise ReportFailure(f"figure {figure_id} ({m}.{n}) failed:\n{detail}") from None
-                    if fig.id != figure_id:
-                        raise ReportFailure(f"figure function {m}.{n} returned id {fig.id}, marked {figure_id}")
-                    done[figure_id] = fig
-                    _progress(len(done), len(tasks), fig, started)
-            except BaseException:
-                for fut in pending:
-                    fut.cancel()
-                raise
+        order = _longest_first(tasks)
+        if _own_process and (jobs == 1 or len(tasks) == 1):  # no pool: the figures in this process
+            _in_process(order, staging, done, tasks, started)
+        else:
+            _in_pool(order, staging, done, tasks, started, jobs)
         speed = speed_numbers()
         ordered = [done[t[2]] for t in tasks]
         for fig in ordered:

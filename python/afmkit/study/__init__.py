@@ -6,7 +6,7 @@ results as an xarray Dataset stored in Zarr (docs/study.md).
                                           "frequency_ratio": [0.99, 1.0, 1.005]},
                    outputs=["max(amplitude | stable)", "count(amplitude | stable)"],
                    parameters={"law": "attractive", "approach_adhesion": 0.5, "departure_adhesion": 1.0})
-    ds = run(s, "out/jumps.zarr")                  # a LocalCluster, one worker per core
+    ds = run(s, "out/jumps.zarr")                  # local workers, one per core (when the study is long enough)
     ds = run(s, "out/jumps.zarr", scheduler="serial")
     ds = run(s, "out/jumps.zarr", scheduler="tcp://head:8786")
 """

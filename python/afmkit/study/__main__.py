@@ -10,7 +10,7 @@ import sys
 
 from .._commands import argument_parser, commands, declared_defaults
 from .definition import StudyError, Study, read_toml
-from .run import StudyFailure, run
+from .run import StudyFailure, compute, results
 
 _KIND_TYPES = {"file": (str,), "text": (str,), "integer": (int,), "real": (int, float)}
 #: The [run] table's fields — the options of `afmkit study run` as it declares them, but the study file itself and
@@ -79,9 +79,12 @@ def main(argv=None) -> int:
             return value if value is not None else declared[name] if declared[name] is not None else default
 
         store = pick("store", f"out/{study.name}.zarr")
-        ds = run(study, store, scheduler=pick("scheduler"), workers=pick("workers"),
-                 chunk_seconds=pick("chunk_seconds"), chunk_points=pick("chunk_points"),
-                 progress=not args.quiet, netcdf=pick("netcdf"))
+        netcdf = pick("netcdf")
+        path, failed = compute(study, store, scheduler=pick("scheduler"), workers=pick("workers"),
+                               chunk_seconds=pick("chunk_seconds"), chunk_points=pick("chunk_points"),
+                               progress=not args.quiet, netcdf=netcdf)
+        if netcdf is not None:  # xarray only for the NetCDF file (its import is half of a short study's start-up)
+            results(path, failed, netcdf)
     except (StudyError, ValueError, TypeError) as e:
         field = getattr(e, "field", None) or getattr(e, "parameter", None)
         print(f"afmkit study: {where(e)}{e}" + (f" [field: {field}]" if field and field not in str(e) else ""),
@@ -100,7 +103,7 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("afmkit study: interrupted; finished chunks are kept, run again to resume", file=sys.stderr)
         return 130
-    print(f"afmkit study: {study.size} points in {store} ({ds.attrs['failed_points']} failed numerically)")
+    print(f"afmkit study: {study.size} points in {store} ({failed} failed numerically)")
     return 0
 
 

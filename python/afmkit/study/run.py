@@ -1,4 +1,5 @@
-"""Running a study: serially, on a local Dask cluster (one worker process per core), or on an existing cluster.
+"""Running a study: serially, on worker processes of this machine (one per core, when the study is long enough for
+them to pay), or on a Dask cluster.
 
 The grid is cut into chunks of about `chunk_seconds` of computation (measured on a pilot point); each chunk is
 computed in C++ in one call (`_afmkit.evaluate_points`) and written to its own part of the Zarr store, then marked
@@ -17,7 +18,6 @@ from pathlib import Path
 import numpy as np
 
 from .._files import unique_temporary
-from .._parent import TiedToParent
 from . import store as zstore
 from .definition import Study, StudyError, parameters_of, require_memory
 
@@ -178,7 +178,9 @@ class _Progress:
 
 
 def _pilot(study: Study, measure: bool = True):
-    """Runs the first point: checks parameters and outputs, finds the units, and (measure) the cost of a point."""
+    """Runs the first point: checks parameters and outputs, finds the units, and (measure) the cost of a point:
+    (wall s per point, the outputs' units, CPU s per point). The CPU time decides whether local workers pay (the
+    machine's load does not make a short study look long)."""
     from .. import _afmkit
 
     params = parameters_of(study.command)
@@ -187,7 +189,7 @@ def _pilot(study: Study, measure: bool = True):
     # the first ≤ 64 points of the grid, for up to 0.3 s (only the first when the cost is not wanted): checks
     # the output selectors and measures the cost of a point
     points = _points(study, zstore.chunk_slices(study.shape, zstore.chunk_shape(study.shape, 64 if measure else 1), 0))
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     n = 0
     while n < len(points):
         _afmkit.evaluate_points(study.command, dict(study.parameters), [a.name for a in study.axes],
@@ -196,29 +198,39 @@ def _pilot(study: Study, measure: bool = True):
         if time.perf_counter() - start > 0.3:
             break
     cost = (time.perf_counter() - start) / n
+    cpu_cost = (time.process_time() - cpu_start) / n
     # the unit of each output as the selector resolves it (docs/study.md#outputs): count, a column's unit, or the
     # command's "units" entry for a results path
     out_units = list(_afmkit.output_units(study.command, dict(study.parameters), [a.name for a in study.axes],
                                           points[:n], list(study.outputs)))
-    return cost, out_units
+    return cost, out_units, cpu_cost
+
+
+#: A local study (scheduler "local") is computed by worker processes only when the computation left is at least
+#: this long (s of CPU time, estimated from the pilot points or the first chunk) and there are 2 workers or more:
+#: below it, the pool's start (a fork server importing NumPy, Zarr and afmkit, then a fork per worker: about 0.3 s
+#: of one core) would cost more than it saves, and the chunks are computed in this process
+#: (docs/study.md#running-it).
+LOCAL_POOL_SECONDS = 1.5
+
+#: What the local workers import once, in the fork server they are forked from (afmkit._pool).
+_PRELOAD = ["zarr", "afmkit.study.run"]
+
+#: Times a local study starts its worker processes again after losing one (killed, out of memory) before it gives up.
+LOCAL_RETRIES = 3
+
+
+def _local_workers(workers: int | None) -> int:
+    return workers or os.cpu_count() or 1
 
 
 def _client(scheduler, workers: int | None):
-    """(client, cluster or None, whether the client is ours to close): the distributed.Client given, one at an
-    address (checked within a few seconds), or one of a new LocalCluster."""
+    """(client, cluster or None, whether the client is ours to close): the distributed.Client given, or one at an
+    address (checked within a few seconds)."""
     import distributed
 
     if isinstance(scheduler, distributed.Client):
         return scheduler, None, False
-    if scheduler in (None, "local"):
-        n = workers or os.cpu_count() or 1
-        # every worker process ends with this one, even when it is killed outright (afmkit._parent: Linux
-        # PR_SET_PDEATHSIG, a watchdog elsewhere): no orphan keeps computing
-        cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                           host="127.0.0.1", env={"OMP_NUM_THREADS": "1"})
-        client = distributed.Client(cluster)
-        client.register_worker_plugin(TiedToParent(os.getpid()))  # also applied to workers started later
-        return client, cluster, True
     try:
         return distributed.Client(scheduler, timeout="5s"), None, True
     except (OSError, TimeoutError) as e:
@@ -229,15 +241,24 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
         chunk_points: int | None = None, progress: bool | str = True, netcdf=None):
     """Computes `study` into the Zarr store `store` and returns its results as an xarray Dataset.
 
-    scheduler: "serial" (this process), None or "local" (a LocalCluster, `workers` processes, default one per
-    core), an address "tcp://host:8786" of a running Dask scheduler, or a distributed.Client. chunk_seconds: the
-    computation per chunk (measured on a pilot point), or chunk_points points per chunk. progress: True (a line
-    per second on standard error), False, or "dask" (Dask's progress bar: a widget in a notebook, a text bar in a
-    terminal; lines when serial). A store that exists must
+    scheduler: "serial" (this process), None or "local" (`workers` processes of this machine, default one per
+    core, when the computation left is at least LOCAL_POOL_SECONDS long; else this process), an address
+    "tcp://host:8786" of a running Dask scheduler, or a distributed.Client (a distributed.LocalCluster's for Dask
+    on this machine). chunk_seconds: the computation per chunk (measured on the pilot points), or chunk_points
+    points per chunk. progress: True (a line per second on standard error), False, or "dask" (Dask's progress
+    bar: a widget in a notebook, a text bar in a terminal; lines when not on Dask). A store that exists must
     hold this study (resumed: only chunks not done are computed); netcdf: also write the results there.
     """
-    import xarray as xr
+    path, failed = compute(study, store, scheduler=scheduler, workers=workers, chunk_seconds=chunk_seconds,
+                           chunk_points=chunk_points, progress=progress, netcdf=netcdf)
+    return results(path, failed, netcdf)
 
+
+def compute(study: Study, store, *, scheduler=None, workers: int | None = None, chunk_seconds: float = 1.0,
+            chunk_points: int | None = None, progress: bool | str = True, netcdf=None) -> tuple:
+    """What run does but open the results: computes `study` into `store` (the arguments of run; `netcdf` is only
+    checked); returns (the store's path, the number of points that failed numerically). `afmkit study run` calls it
+    without importing xarray."""
     from .. import __version__
 
     if chunk_points is not None and (not isinstance(chunk_points, int) or isinstance(chunk_points, bool)
@@ -258,28 +279,38 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
         # the NetCDF file is written from memory: every output and coordinate of every point
         require_memory("netcdf", study.size, 8 * (len(study.outputs) + 1))
     client = None
+    cost = None  # CPU time of one point (s), when the pilot measured it
+    local = scheduler in (None, "local")
     try:
         try:
             if path.exists():
                 root, chunks = zstore.open_existing(path, study)
             else:
-                cost, units = _pilot(study, measure=chunk_points is None)
-                target = chunk_points or max(1, round(chunk_seconds / max(cost, 1e-9)))
+                measure = chunk_points is None or (local and _local_workers(workers) > 1)
+                wall, units, cpu = _pilot(study, measure=measure)
+                cost = cpu if measure else None
+                target = chunk_points or max(1, round(chunk_seconds / max(wall, 1e-9)))
                 chunks = zstore.chunk_shape(study.shape, target)
                 # the chunk bookkeeping (done flags, the list of pending chunks) is held in memory
                 require_memory("axes", math.prod(zstore.chunk_grid(study.shape, chunks)), 64)
-                if scheduler != "serial":
+                if scheduler != "serial" and not local:
                     client = _client(scheduler, workers)  # an unreachable scheduler is refused before the store
                 path.parent.mkdir(parents=True, exist_ok=True)
                 zstore.create(path, study, chunks, units, __version__)
                 root, chunks = zstore.open_existing(path, study)
         except OSError as e:
             raise write_error("store", path, e) from None
-        _compute(study, path, root, chunks, scheduler, workers, progress, client)
+        _compute(study, path, root, chunks, scheduler, workers, progress, client, cost)
     finally:
         if client is not None:
             _close(client)
-    failed = int(root["chunk_failed"][:].sum())  # read here: not a Dask computation on the study's cluster
+    return path, int(root["chunk_failed"][:].sum())  # read here: not a Dask computation on the study's cluster
+
+
+def results(path: Path, failed: int, netcdf=None):
+    """The study's results in the store `path` as an xarray Dataset (and written to `netcdf` when given)."""
+    import xarray as xr
+
     ds = xr.open_zarr(str(path), consolidated=True)
     ds = ds.drop_vars(["chunk_done", "chunk_failed"])
     ds.attrs["failed_points"] = failed
@@ -299,22 +330,35 @@ def run(study: Study, store, *, scheduler=None, workers: int | None = None, chun
     return ds
 
 
-def _compute(study, path, root, chunks, scheduler, workers, progress, client) -> None:
-    """Computes the chunks of the store not done yet."""
+def _compute(study, path, root, chunks, scheduler, workers, progress, client, cost=None) -> None:
+    """Computes the chunks of the store not done yet: serially, on local worker processes when they pay, or on the
+    Dask cluster of `client` (or of the address `scheduler`)."""
     done = root["chunk_done"][:]
     pending = [int(i) for i in np.flatnonzero(done == 0)]
     total = len(done)
+    local = scheduler in (None, "local")
     bar = _Progress(total, int(np.prod(chunks)), study.size, progress is True or
-                    (progress == "dask" and scheduler == "serial"))
+                    (progress == "dask" and (scheduler == "serial" or local)))
     bar.done = total - len(pending)
     definition = study.definition()
     try:
         if pending:
-            if scheduler == "serial":
-                for i in pending:
-                    compute_chunk(str(path), definition, i)
+            if scheduler == "serial" or local:
+                n = _local_workers(workers) if local else 1
+                if n > 1 and len(pending) > 1 and cost is None:  # a resumed store: the first chunk measures the cost
+                    start = time.process_time()
+                    compute_chunk(str(path), definition, pending.pop(0))
                     bar.done += 1
                     bar.step()
+                    cost = (time.process_time() - start) / int(np.prod(chunks))
+                left = 0.0 if cost is None else cost * int(np.prod(chunks)) * len(pending)
+                if n > 1 and len(pending) > 1 and left >= LOCAL_POOL_SECONDS:
+                    _run_local(path, definition, pending, n, bar)
+                else:
+                    for i in pending:
+                        compute_chunk(str(path), definition, i)
+                        bar.done += 1
+                        bar.step()
             else:
                 own = client is None  # resuming a store: the cluster is opened only when chunks are pending
                 if own:
@@ -327,6 +371,41 @@ def _compute(study, path, root, chunks, scheduler, workers, progress, client) ->
     except OSError as e:  # writing a chunk: a full or read-only file system, the store removed meanwhile
         raise write_error("store", path, e) from None
     bar.step(final=True)
+
+
+def _run_local(path, definition, pending, n, bar) -> None:
+    """The chunks `pending` on `n` worker processes of this machine, forked from a fork server that has imported
+    NumPy, Zarr and afmkit once (afmkit._pool), one OpenMP thread each. A worker lost (killed, out of memory) breaks
+    the pool: the chunks not done are given to a new one, up to LOCAL_RETRIES times (a chunk's writes are
+    idempotent); a chunk that raises stops the study."""
+    from concurrent.futures import as_completed
+    from concurrent.futures.process import BrokenProcessPool
+
+    from .. import _pool
+
+    left = list(pending)
+    target = str(path.resolve())
+    for attempt in range(LOCAL_RETRIES + 1):
+        with _pool.pool(min(n, len(left)), _PRELOAD, 1) as workers:
+            futures = {}
+            try:
+                for i in left:  # a worker lost meanwhile breaks the pool here already
+                    futures[workers.submit(compute_chunk, target, definition, i)] = i
+                for f in as_completed(futures):
+                    f.result()
+                    left.remove(futures[f])
+                    bar.done += 1
+                    bar.step()
+                return
+            except BrokenProcessPool:
+                if attempt == LOCAL_RETRIES:
+                    raise StudyFailure("workers", f"a worker process of the local pool was lost {attempt + 1} times "
+                                                  f"(killed, or out of memory); {len(left)} chunks are not done: "
+                                                  f"finished chunks are kept, run again to resume") from None
+            except BaseException:
+                for f in futures:
+                    f.cancel()
+                raise
 
 
 def _close(client) -> None:
