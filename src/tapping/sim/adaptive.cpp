@@ -144,8 +144,7 @@ template <class Field, std::size_t N>
 class Dopri5 {
  public:
   using State = std::array<double, N>;
-  Dopri5(double absolute_tolerance, double relative_tolerance, double max_step, const State& floor = {},
-         std::size_t /*controlled: all components (see run)*/ = N)
+  Dopri5(double absolute_tolerance, double relative_tolerance, double max_step, const State& floor = {})
       : dense_(Controlled(FloorErrorChecker<N>{absolute_tolerance, relative_tolerance, floor},
                           odeint::default_step_adjuster<double, double>(max_step))) {}
   void initialize(const Field& field, const State& y, double t, double dt) {
@@ -192,12 +191,7 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
   State floor{};
   if constexpr (N == 8)
     for (std::size_t i = 2; i < N; ++i) floor[i] = 1.0;
-  // DOP853 (smooth laws) controls the error of the state alone and carries the variational equations on its
-  // steps: the map with sensitivities is then the map without them to the last bit, so Newton may iterate on
-  // the cheap map and integrate the sensitivities once at the converged state (try_shoot_near). Dopri5 (laws
-  // only C¹) controls them too: their right-hand side jumps at the knots the state crosses smoothly.
-  constexpr std::size_t state_components = N == 8 ? 2 : N;
-  Stepper dense(options.absolute_tolerance, options.relative_tolerance, max_dt, floor, state_components);
+  Stepper dense(options.absolute_tolerance, options.relative_tolerance, max_dt, floor);
   std::array<Guard, 3> guards;
   GuardSamples a, b;
   State y{}, tmp{};

@@ -23,17 +23,9 @@ class Dop853 {
  public:
   using State = std::array<double, N>;
 
-  /// Error control per component i < controlled: |err_i| ≤ atol + rtol · max(|y_i|, |y_i,new|, magnitude_floor[i])
-  /// (RMS over those components). Components from `controlled` on are carried along on the steps the first ones
-  /// choose: with controlled = the model's state, a run that also carries the variational equations takes the
-  /// very steps of the run without them, so both give the same state to the last bit.
-  Dop853(double absolute_tolerance, double relative_tolerance, double max_step, const State& magnitude_floor = {},
-         std::size_t controlled = N)
-      : atol_(absolute_tolerance),
-        rtol_(relative_tolerance),
-        max_step_(max_step),
-        floor_(magnitude_floor),
-        controlled_(std::min(controlled, N)) {}
+  /// Error control per component i: |err_i| ≤ atol + rtol · max(|y_i|, |y_i,new|, magnitude_floor[i]) (RMS).
+  Dop853(double absolute_tolerance, double relative_tolerance, double max_step, const State& magnitude_floor = {})
+      : atol_(absolute_tolerance), rtol_(relative_tolerance), max_step_(max_step), floor_(magnitude_floor) {}
 
   /// Start at (t, y) with the vector field `field` and a first trial step dt.
   void initialize(const Field& field, const State& y, double t, double dt) {
@@ -74,20 +66,20 @@ class Dop853 {
       State err5{}, err3{};
       for (int j = 0; j < 13; ++j) {
         const double w5 = e5[j], w3 = e3[j];
-        for (std::size_t i = 0; i < controlled_; ++i) {
+        for (std::size_t i = 0; i < N; ++i) {
           err5[i] += w5 * k_[j][i];
           err3[i] += w3 * k_[j][i];
         }
       }
       double s5 = 0.0, s3 = 0.0;
-      for (std::size_t i = 0; i < controlled_; ++i) {
+      for (std::size_t i = 0; i < N; ++i) {
         const double e5v = err5[i], e3v = err3[i];
         const double sk = atol_ + rtol_ * std::max({std::abs(y_[i]), std::abs(y_new[i]), floor_[i]});
         s5 += (e5v / sk) * (e5v / sk);
         s3 += (e3v / sk) * (e3v / sk);
       }
       const double denominator = s5 + 0.01 * s3;
-      const double err = denominator > 0.0 ? h * s5 / std::sqrt(static_cast<double>(controlled_) * denominator) : 0.0;
+      const double err = denominator > 0.0 ? h * s5 / std::sqrt(static_cast<double>(N) * denominator) : 0.0;
       if (!std::isfinite(err))
         throw NumericalFailure(fmt::format("tapping simulation (adaptive): non-finite state at t = {:.9g}", t_));
       // step-size factor: 0.9 err^(−1/8), within [1/3, 6] (Hairer's defaults), no growth right after a rejection
@@ -181,7 +173,6 @@ class Dop853 {
 
   double atol_, rtol_, max_step_;
   State floor_;
-  std::size_t controlled_;
   mutable Field field_{};
   State y_{}, y_old_{}, k0_old_{};
   double t_ = 0.0, t_old_ = 0.0, h_ = 0.0, h_used_ = 0.0;
