@@ -59,6 +59,14 @@ StroboscopicMap stroboscopic_map(const TappingModel& model, TipState start, int 
 /// (so callers can try another guess); throws NumericalFailure when the time budget is exhausted.
 std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess, int period_multiple,
                                        const ShootingOptions& options = {});
+/// try_shoot from a guess near a known orbit `near` of a neighbouring model (the previous point of a branch): the
+/// first Newton iterations evaluate the map without its sensitivities, with Broyden updates of near's Jacobian
+/// M − I, until the residual is within the tolerance (or they stop reducing it); try_shoot then starts there, so
+/// the variational equations are integrated at the converged state (usually there only: the two maps differ by
+/// the integrator's tolerance) and the monodromy and multipliers are those of the converged orbit, as try_shoot's.
+/// `iterations` counts both kinds.
+std::optional<PeriodicOrbit> try_shoot_near(const TappingModel& model, TipState guess, const PeriodicOrbit& near,
+                                            const ShootingOptions& options = {});
 /// As try_shoot, but non-convergence -> NumericalFailure with the residual in the message.
 PeriodicOrbit shoot(const TappingModel& model, TipState guess, int period_multiple, const ShootingOptions& options = {});
 

@@ -52,6 +52,10 @@ struct SweepOptions {
   /// amplitude until it settles on a periodic orbit (the exit from it is known to that sub-step).
   double transient_step = 0.005;
   bool parallel = true;  // OpenMP where points are independent (HB evaluation, grid sweeps, both directions)
+  /// Newton along the followed branch iterates on the map without sensitivities from the previous orbit's
+  /// Jacobian (try_shoot_near) and integrates them once per orbit; false: every iteration integrates them (the
+  /// path before; kept for benchmarks and tests that compare the two).
+  bool lazy_sensitivities = true;
   /// Called with the number of newly finished points (thread-safe callers only: may be called concurrently).
   std::function<void(long)> progress;
   Cancellation cancellation;  // checked once per point (core/cancellation.hpp)

@@ -47,6 +47,13 @@ double scaled_norm(const Eigen::Vector2d& r, const Eigen::Vector2d& y, double om
   return std::max(std::abs(r.x()), std::abs(r.y()) / omega) / scale;
 }
 
+/// The Newton tolerance: the adaptive integrator's map is only as smooth as its tolerance: do not ask Newton for more.
+double newton_tolerance(const TappingModel& model, const ShootingOptions& options) {
+  return resolve_integrator(model, options.simulation.integrator) == Integrator::adaptive
+             ? std::max(options.tolerance, 10.0 * options.simulation.relative_tolerance)
+             : options.tolerance;
+}
+
 }  // namespace
 
 std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess, int period_multiple,
@@ -56,10 +63,7 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
   validate::finite("position", guess.position);
   validate::finite("velocity", guess.velocity);
   const auto start_time = std::chrono::steady_clock::now();
-  // the adaptive integrator's map is only as smooth as its tolerance: do not ask Newton for more
-  const double tolerance = resolve_integrator(model, options.simulation.integrator) == Integrator::adaptive
-                               ? std::max(options.tolerance, 10.0 * options.simulation.relative_tolerance)
-                               : options.tolerance;
+  const double tolerance = newton_tolerance(model, options);
   const double omega = model.drive.frequency;
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
@@ -150,6 +154,50 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
     if (!accepted && norm > 1e3 * tolerance) return std::nullopt;
   }
   return std::nullopt;
+}
+
+std::optional<PeriodicOrbit> try_shoot_near(const TappingModel& model, TipState guess, const PeriodicOrbit& near,
+                                            const ShootingOptions& options) {
+  options.validate();
+  validate::finite("position", guess.position);
+  validate::finite("velocity", guess.velocity);
+  const int n = near.period_multiple;
+  const double tolerance = newton_tolerance(model, options), omega = model.drive.frequency;
+  SimulationOptions cheap = options.simulation;
+  cheap.sensitivity = false;
+  const bool memory = guess.contact;
+  Eigen::Vector2d y(guess.position, guess.velocity);
+  auto residual = [&](const Eigen::Vector2d& at, bool& same_memory) {
+    const SimulationResult m = simulate(model, 0.0, {at.x(), at.y(), memory}, n * model.period(), cheap);
+    same_memory = m.state.contact == memory;
+    return Eigen::Vector2d(m.state.position - at.x(), m.state.velocity - at.y());
+  };
+  bool same_memory = true;
+  Eigen::Vector2d r = residual(y, same_memory);
+  double norm = scaled_norm(r, y, omega);
+  // Newton–Broyden on the map without sensitivities, from the Jacobian of the nearby orbit (Broyden's "good"
+  // update J += (Δr − JΔy)Δyᵀ/|Δy|²); any step that does not reduce the residual hands over to try_shoot
+  Eigen::Matrix2d jac = near.monodromy - Eigen::Matrix2d::Identity();
+  int iterations = 0;
+  while (same_memory && norm > tolerance && iterations < options.max_iterations) {
+    const Eigen::FullPivLU<Eigen::Matrix2d> lu(jac);
+    if (!lu.isInvertible()) break;
+    const Eigen::Vector2d step = -lu.solve(r);
+    if (!step.allFinite()) break;
+    const Eigen::Vector2d trial = y + step;
+    bool trial_memory = true;
+    const Eigen::Vector2d rt = residual(trial, trial_memory);
+    const double nt = scaled_norm(rt, trial, omega);
+    if (!trial_memory || !(nt < norm)) break;
+    jac += ((rt - r) - jac * step) * step.transpose() / step.squaredNorm();
+    y = trial;
+    r = rt;
+    norm = nt;
+    ++iterations;
+  }
+  auto orbit = try_shoot(model, {y.x(), y.y(), memory}, n, options);
+  if (orbit) orbit->iterations += iterations;
+  return orbit;
 }
 
 PeriodicOrbit shoot(const TappingModel& model, TipState guess, int period_multiple, const ShootingOptions& options) {

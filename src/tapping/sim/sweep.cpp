@@ -112,15 +112,23 @@ std::optional<Eigen::Vector2d> branch_slope(const PeriodicOrbit& orbit, const Ei
 
 /// Whether one Newton step for the fixed point of the stroboscopic map, taken from the scaled state `from`,
 /// lands ten times closer to the scaled state `target` than `from` is (or within Newton-level agreement).
+/// `target_monodromy`: the Jacobian of the map at the target orbit, used for the step instead of the one at
+/// `from` when given (the map is then evaluated without sensitivities: a Newton step with the Jacobian at the
+/// root is as good to second order in the distance, and a guess in another basin still steps away from it).
 bool newton_heads_for(const TappingModel& model, const Eigen::Vector2d& from, const Eigen::Vector2d& target, int n,
-                      double omega, const SimulationOptions& simulation, bool memory) {
+                      double omega, const SimulationOptions& simulation, bool memory,
+                      const Eigen::Matrix2d* target_monodromy = nullptr) {
   const double before = (from - target).norm();
   try {
-    const StroboscopicMap m = stroboscopic_map(model, {from.x(), from.y() * omega, memory}, n, simulation);
-    const Eigen::Matrix2d jac = m.sensitivity.topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity();
+    SimulationOptions o = simulation;
+    o.sensitivity = target_monodromy == nullptr;
+    const SimulationResult m = simulate(model, 0.0, {from.x(), from.y() * omega, memory}, n * model.period(), o);
+    const Eigen::Matrix2d jac =
+        (target_monodromy ? *target_monodromy : Eigen::Matrix2d(m.sensitivity.topLeftCorner<2, 2>())) -
+        Eigen::Matrix2d::Identity();
     const Eigen::FullPivLU<Eigen::Matrix2d> lu(jac);
     if (!lu.isInvertible()) return false;
-    const Eigen::Vector2d residual(m.end.position - from.x(), m.end.velocity - from.y() * omega);
+    const Eigen::Vector2d residual(m.state.position - from.x(), m.state.velocity - from.y() * omega);
     const Eigen::Vector2d step = -lu.solve(residual);
     const Eigen::Vector2d after = from + Eigen::Vector2d(step.x(), step.y() / omega);
     const double scale = std::max(1.0, target.norm());
@@ -166,9 +174,16 @@ constexpr double kMaxMultiplierMove = 0.25;
 }  // namespace
 
 namespace {
+/// An orbit of the followed branch before the one followed from (scaled state z = (x, ẋ/ω) at the parameter value
+/// `at`): with it Newton starts from the quadratic through both orbits with the tangent of the last one.
+struct BranchBehind {
+  Eigen::Vector2d z;
+  double at = 0.0;
+};
+
 /// follow_stable_branch along any parameter: `from` is an orbit at p = l_from, l_to the value to reach.
 BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit& from, double l_from, double l_to,
-                          const SweepOptions& options);
+                          const SweepOptions& options, std::optional<BranchBehind> behind = std::nullopt);
 }  // namespace
 
 BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
@@ -182,8 +197,23 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
 
 namespace {
 
+/// Newton's starting guess at l_next: the tangent prediction `predicted` from z (at `at`, slope `slope`) plus the
+/// curvature of the branch seen from the orbit behind (the quadratic through both with the tangent at z, O(Δl³)
+/// off a smooth branch instead of O(Δl²)); the tangent prediction where the quadratic term is not the smaller one
+/// (a corner or a fold between: the curvature says nothing there).
+Eigen::Vector2d starting_guess(const Eigen::Vector2d& predicted, const Eigen::Vector2d& z, const Eigen::Vector2d& slope,
+                               double at, double l_next, const std::optional<BranchBehind>& behind) {
+  if (!behind) return predicted;
+  const double back = behind->at - at, ahead = l_next - at;
+  if (!(back != 0.0) || (back > 0) == (ahead > 0)) return predicted;  // the orbit behind must lie behind
+  const Eigen::Vector2d curvature = (behind->z - z - back * slope) / (back * back);
+  const Eigen::Vector2d quadratic = ahead * ahead * curvature;
+  if (!quadratic.allFinite() || quadratic.norm() > 0.5 * std::abs(ahead) * slope.norm()) return predicted;
+  return predicted + quadratic;
+}
+
 BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit& from, double l_from, double l_to,
-                          const SweepOptions& options) {
+                          const SweepOptions& options, std::optional<BranchBehind> behind) {
   const TappingModel& base = path.base;
   const ShootingOptions& shooting = options.shooting;
   const double omega = base.drive.frequency;
@@ -231,17 +261,35 @@ BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit
     const double l_next = std::abs(remaining - h) <= 1e-14 * std::max(1.0, std::abs(l_to)) ? l_to : at + h;
     const Eigen::Vector2d z = scaled(current.initial, omega);
     const Eigen::Vector2d predicted = z + (l_next - at) * *slope;
-    std::optional<PeriodicOrbit> next;
     ++out.substeps;
-    try {
-      next = try_shoot(path.at(l_next), {predicted.x(), predicted.y() * omega, current.initial.contact}, n, quick);
-    } catch (const NumericalFailure&) {
-      next.reset();
-    }
+    const TappingModel at_next = path.at(l_next);
+    // Newton at l_next: lazy (try_shoot_near: the sensitivities once, at the converged orbit) from the quadratic
+    // guess, then from the tangent prediction; eager (try_shoot: at every iteration) from the tangent prediction
+    auto solve = [&](bool lazy) {
+      std::optional<PeriodicOrbit> o;
+      try {
+        if (lazy) {
+          const Eigen::Vector2d start = starting_guess(predicted, z, *slope, at, l_next, behind);
+          o = try_shoot_near(at_next, {start.x(), start.y() * omega, current.initial.contact}, current, quick);
+          if (!o && start != predicted)
+            o = try_shoot_near(at_next, {predicted.x(), predicted.y() * omega, current.initial.contact}, current, quick);
+        } else {
+          o = try_shoot(at_next, {predicted.x(), predicted.y() * omega, current.initial.contact}, n, quick);
+        }
+      } catch (const NumericalFailure&) {
+        o.reset();
+      }
+      return o;
+    };
+    std::optional<PeriodicOrbit> next;
     std::optional<Eigen::Vector2d> slope_next;  // of the new orbit's branch
     bool accepted = false;
     bool resolved = true;  // false: the sub-step was too long to see the stability (not a failure of the branch)
-    if (next && next->stable && next->period_multiple == n) {
+    auto judge = [&](bool lazy) {
+      slope_next.reset();
+      accepted = false;
+      resolved = true;
+      if (!(next && next->stable && next->period_multiple == n)) return;
       // continuity, both ways: (1) the corrector moves the prediction by at most |Δl| times the larger of the two
       // branch slopes (O(Δl²) on a smooth branch, O(Δl) at a corner where the slope changes, e.g. grazing; another
       // branch stays a finite distance away however small Δl is); (2) the step taken back from the new orbit
@@ -268,19 +316,30 @@ BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit
         const TappingModel at_current = path.at(at);
         // usually one Newton step from the backward prediction shows where it goes: it closes 90 % of the
         // distance to the current orbit (quadratic convergence towards it). Otherwise Newton decides in full.
-        accepted = newton_heads_for(at_current, back_guess, z, n, omega, quick.simulation, current.initial.contact);
+        accepted = newton_heads_for(at_current, back_guess, z, n, omega, quick.simulation, current.initial.contact,
+                                    lazy ? &current.monodromy : nullptr);
         if (!accepted) {
           std::optional<PeriodicOrbit> back;
           try {
-            back = try_shoot(at_current, {back_guess.x(), back_guess.y() * omega, current.initial.contact}, n, quick);
+            const TipState guess{back_guess.x(), back_guess.y() * omega, current.initial.contact};
+            back = lazy ? try_shoot_near(at_current, guess, current, quick) : try_shoot(at_current, guess, n, quick);
           } catch (const NumericalFailure&) {
             back.reset();
           }
           accepted = back && (scaled(back->initial, omega) - z).norm() <= 1e-6 * scale;
         }
       }
+    };
+    next = solve(options.lazy_sensitivities);
+    judge(options.lazy_sensitivities);
+    if (options.lazy_sensitivities && resolved && !accepted) {
+      // Broyden's iterates may reach another orbit nearby than Newton's (in a period-doubling cascade orbits lie
+      // close) or none: the sub-step is refused only as the eager path refuses it
+      next = solve(false);
+      judge(false);
     }
     if (accepted) {
+      behind = BranchBehind{z, at};
       current = *next;
       at = l_next;
       slope = slope_next;
@@ -349,7 +408,8 @@ SweepJump make_jump(const detail::ParameterPath& path, double separation, double
 /// be stable the tip lands (transient) just beyond; a response that does not settle is stepped by transients in
 /// sub-steps of transient_step·A_free until it settles on a periodic orbit.
 SweepPoint continue_point(const detail::ParameterPath& path, double l_to, const SweepPoint& previous,
-                          SweepDirection direction, const SweepOptions& options, std::vector<SweepJump>& jumps) {
+                          SweepDirection direction, const SweepOptions& options, std::vector<SweepJump>& jumps,
+                          const SweepPoint* before = nullptr) {
   if (previous.periodic && !previous.orbit.stable) {
     // a neutrally stable periodic response (e.g. a tip resting on the sample) has no stable branch to follow: it
     // settles (or not) at the new value; a jump is known to the grid's resolution only
@@ -385,7 +445,12 @@ SweepPoint continue_point(const detail::ParameterPath& path, double l_to, const 
       l_at = l_next;
       continue;
     }
-    const BranchFollow f = follow_along(path, orbit, l_at, l_to, options);
+    // the point before the previous one, on the same stable branch (no jump, the same period and memory)
+    std::optional<BranchBehind> behind;
+    if (pass == 0 && before && before->periodic && before->orbit.stable && !previous.jumped &&
+        before->orbit.period_multiple == orbit.period_multiple && before->orbit.initial.contact == orbit.initial.contact)
+      behind = BranchBehind{scaled(before->orbit.initial, path.base.drive.frequency), before->parameter};
+    const BranchFollow f = follow_along(path, orbit, l_at, l_to, options, behind);
     if (f.reached) {
       SweepPoint p;
       p.separation = f.reached->separation;
@@ -432,7 +497,7 @@ std::vector<SweepPoint> run_direction(const detail::ParameterPath& path, const s
   if (options.progress) options.progress(1);
   for (std::size_t k = 1; k < ls.size(); ++k) {
     options.cancellation.check();
-    out.push_back(continue_point(path, ls[k], out[k - 1], direction, options, jumps));
+    out.push_back(continue_point(path, ls[k], out[k - 1], direction, options, jumps, k >= 2 ? &out[k - 2] : nullptr));
     if (options.progress) options.progress(1);
   }
   return out;
