@@ -77,7 +77,8 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
   }
   outputs_.commit();
   if (capture_ != nullptr) {
-    capture_->results = results;
+    if (capture_->take_results) capture_->take_results(results);
+    else capture_->results = results;
     capture_->grid = grid;
     capture_->columns = columns_;
     capture_->rows = std::move(rows_);

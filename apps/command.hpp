@@ -39,6 +39,9 @@ namespace afmkit::cli {
 struct Captured {
   bool want_rows = true;  ///< false: the caller reads only results and columns (no rows kept, no history recorded)
   nlohmann::json results = nlohmann::json::object();
+  /// Set: CommandOutput::finish hands the summary document to it instead of copying it into `results` (the Python
+  /// module converts it to Python objects there; a copy of a large document costs as much as a short run).
+  std::function<void(const nlohmann::json&)> take_results;
   std::vector<io::Column> columns;
   nlohmann::json rows = nlohmann::json::array();
   /// Stop request of the caller (Python: Ctrl-C); the long computations check it once per point. The command line

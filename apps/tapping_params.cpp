@@ -30,13 +30,19 @@ std::vector<std::string> physical_keys() {
   return keys;
 }
 
+/// physical_keys(), worked out once (the built-in laws are fixed): every run checks them.
+const std::vector<std::string>& physical_keys_once() {
+  static const std::vector<std::string> keys = physical_keys();
+  return keys;
+}
+
 bool physical(const io::ParamSet& p) { return p.text("units") == "physical"; }
 
 void reject_foreign_keys(const io::ParamSet& p) {
   const bool phys = physical(p);
   std::vector<std::string> foreign;
   if (phys) foreign.assign(normalised_keys.begin(), normalised_keys.end());
-  else foreign = physical_keys();
+  else foreign = physical_keys_once();
   for (const std::string& k : foreign) {
     if (p.was_set(k))
       throw InvalidParameter(k, fmt::format("{} applies only with units = {}; this run uses units = {}", k,
@@ -53,7 +59,7 @@ const LawKeyAliases physical_aliases = {{"sample_stiffness_approach", "approach_
 
 impact::ForceLaw law_from(const io::ParamSet& p, const tapping::PhysicalCantilever* pc,
                           const std::shared_ptr<const impact::ForceLawModel>& object) {
-  const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  static const impact::LawRegistry registry = impact::LawRegistry::builtin();  // fixed: built once, not per run
   // law = python without its object (the command line): say so first, whatever the units
   if (registry.find(p.text("law")).needs_object && !object) return law_from_params(p, registry, {}, object);
   if (!pc) {

@@ -43,26 +43,56 @@ py::object value_to_python(const io::ParamSet::Value& v) {
   return std::visit([](const auto& x) -> py::object { return py::cast(x); }, v);
 }
 
-py::object json_to_python(const nlohmann::json& j) {
+/// `j` as Python objects (dict, list, str, int, float, bool, None), built with the C API directly: a summary
+/// document holds hundreds of values (the orbit search's seeds), and pybind11's accessors per item cost as much as
+/// a short computation (bench/command_layer.py). Dict keys in the document's order (nlohmann's: sorted).
+PyObject* json_to_object(const nlohmann::json& j) {
   switch (j.type()) {
-    case nlohmann::json::value_t::null: return py::none();
-    case nlohmann::json::value_t::boolean: return py::bool_(j.get<bool>());
-    case nlohmann::json::value_t::number_integer: return py::int_(j.get<std::int64_t>());
-    case nlohmann::json::value_t::number_unsigned: return py::int_(j.get<std::uint64_t>());
-    case nlohmann::json::value_t::number_float: return py::float_(j.get<double>());
-    case nlohmann::json::value_t::string: return py::str(j.get<std::string>());
+    case nlohmann::json::value_t::boolean: return PyBool_FromLong(j.get<bool>() ? 1 : 0);
+    case nlohmann::json::value_t::number_integer: return PyLong_FromLongLong(j.get<std::int64_t>());
+    case nlohmann::json::value_t::number_unsigned: return PyLong_FromUnsignedLongLong(j.get<std::uint64_t>());
+    case nlohmann::json::value_t::number_float: return PyFloat_FromDouble(j.get<double>());
+    case nlohmann::json::value_t::string: {
+      const std::string& t = j.get_ref<const std::string&>();
+      return PyUnicode_FromStringAndSize(t.data(), static_cast<Py_ssize_t>(t.size()));
+    }
     case nlohmann::json::value_t::array: {
-      py::list l;
-      for (const auto& x : j) l.append(json_to_python(x));
+      PyObject* l = PyList_New(static_cast<Py_ssize_t>(j.size()));
+      if (l == nullptr) return nullptr;
+      Py_ssize_t i = 0;
+      for (const auto& x : j) {
+        PyObject* v = json_to_object(x);
+        if (v == nullptr) {
+          Py_DECREF(l);
+          return nullptr;
+        }
+        PyList_SET_ITEM(l, i++, v);  // steals v
+      }
       return l;
     }
     case nlohmann::json::value_t::object: {
-      py::dict d;
-      for (const auto& [k, x] : j.items()) d[py::str(k)] = json_to_python(x);
+      PyObject* d = PyDict_New();
+      if (d == nullptr) return nullptr;
+      for (const auto& [k, x] : j.items()) {
+        PyObject* key = PyUnicode_FromStringAndSize(k.data(), static_cast<Py_ssize_t>(k.size()));
+        PyObject* v = key == nullptr ? nullptr : json_to_object(x);
+        const int failed = v == nullptr ? -1 : PyDict_SetItem(d, key, v);
+        Py_XDECREF(key);
+        Py_XDECREF(v);
+        if (failed != 0) {
+          Py_DECREF(d);
+          return nullptr;
+        }
+      }
       return d;
     }
-    default: return py::none();
+    default: Py_RETURN_NONE;  // null (and discarded/binary, which a summary never holds)
   }
+}
+py::object json_to_python(const nlohmann::json& j) {
+  PyObject* o = json_to_object(j);
+  if (o == nullptr) throw py::error_already_set();
+  return py::reinterpret_steal<py::object>(o);
 }
 
 /// Whether column `c` is a flag (unit "boolean", "boolean (0/1)") holding only booleans or 0/1 (no NaN).
@@ -180,13 +210,18 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
   captured.cancellation = interrupts.cancellation();
   io::ProgressSink progress(progress_to_python);  // progress lines to sys.stderr (Jupyter), not to descriptor 2
+  py::object results;  // the summary as Python objects, converted where the command hands it over (no copy)
+  captured.take_results = [&results](const nlohmann::json& document) {
+    py::gil_scoped_acquire gil;  // the computation runs without the GIL
+    results = json_to_python(document);
+  };
   try {
     interrupts.run([&] { s.run(p, &captured); });
   } catch (const PythonLawError& e) {  // the user's law failed: their error (exit-2 style), not a crash
     throw InvalidParameter("law", e.what());
   }
   py::dict out;
-  out["results"] = json_to_python(captured.results);
+  out["results"] = results ? results : json_to_python(captured.results);
   py::list columns;
   py::dict table;
   for (std::size_t c = 0; c < captured.columns.size(); ++c) {

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <variant>
 #include <vector>
@@ -139,22 +142,41 @@ const cli::CommandSpec& command_spec(const std::string& path) {
   throw py::value_error("no afmkit command '" + path + "'");
 }
 
-io::ParamSet python_params(const cli::CommandSpec& spec) {
-  io::ParamSet p;
-  spec.declare(p);
-  for (const auto& d : p.describe()) {
-    const bool table_file = d.key == "output" || (d.key.size() > 7 && d.key.ends_with("_output"));
-    if (table_file && d.kind == "file") p.set_default(d.key, "");
-    if (d.key == "json" && d.kind == "flag") p.set_default("json", "true");
+namespace {
+/// A command's parameters with Python's defaults, declared once per process (a command's declaration is fixed: its
+/// keys, defaults and ranges do not depend on the run) and copied for each call: declaring them and describing them
+/// again on every call cost more than a short computation (bench/command_layer.py).
+struct Prototype {
+  io::ParamSet params;
+  std::vector<io::ParamSet::Description> described;
+};
+const Prototype& prototype(const cli::CommandSpec& spec) {
+  static std::mutex mutex;  // callers hold the GIL; the lock keeps the cache sound without it
+  static std::map<std::string, std::unique_ptr<const Prototype>> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  std::unique_ptr<const Prototype>& slot = cache[spec.path];
+  if (!slot) {
+    io::ParamSet p;
+    spec.declare(p);
+    for (const auto& d : p.describe()) {
+      const bool table_file = d.key == "output" || (d.key.size() > 7 && d.key.ends_with("_output"));
+      if (table_file && d.kind == "file") p.set_default(d.key, "");
+      if (d.key == "json" && d.kind == "flag") p.set_default("json", "true");
+    }
+    std::vector<io::ParamSet::Description> described = p.describe();
+    slot = std::make_unique<const Prototype>(Prototype{std::move(p), std::move(described)});
   }
-  return p;
+  return *slot;
 }
+}  // namespace
+
+io::ParamSet python_params(const cli::CommandSpec& spec) { return prototype(spec).params; }
 
 io::ParamSet params_from_python(const std::string& path, const std::string& name, const py::dict& kwargs,
                                 const std::vector<std::string>& hidden) {
-  const cli::CommandSpec& s = command_spec(path);
-  io::ParamSet p = python_params(s);
-  const std::vector<io::ParamSet::Description> described = p.describe();
+  const Prototype& declared = prototype(command_spec(path));
+  io::ParamSet p = declared.params;
+  const std::vector<io::ParamSet::Description>& described = declared.described;
   auto visible = [&](const std::string& key) {
     return key != "json" && std::find(hidden.begin(), hidden.end(), key) == hidden.end();
   };

@@ -318,6 +318,7 @@ nlohmann::json finite_json(nlohmann::json value) {
 }
 
 std::string json_text(const nlohmann::json& value) { return finite_json(value).dump(2); }
+std::string json_text(nlohmann::json&& value) { return finite_json(std::move(value)).dump(2); }
 
 TableWriter::TableWriter(std::string path, std::vector<Column> columns)
     : path_(std::move(path)), columns_(std::move(columns)) {
@@ -435,7 +436,7 @@ void TableWriter::stage(const nlohmann::json& sidecar, OutputSet& set) {
   try {
     nlohmann::json described = sidecar;
     described["columns"] = columns_json(columns_);
-    meta = write_temporary(path_ + ".json", json_text(described) + "\n");
+    meta = write_temporary(path_ + ".json", json_text(std::move(described)) + "\n");  // no second copy
   } catch (...) {
     discard();
     throw;

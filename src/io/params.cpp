@@ -589,7 +589,14 @@ const ParamSet::Entry& ParamSet::current(const std::string& key) const {
   while (!e->set && !e->used && !e->follows.empty()) e = &entry(e->follows);
   return *e;
 }
-bool ParamSet::recorded(const std::string& key) const {
+bool ParamSet::recorded(const std::string& key) const { return recorded(key, replaced()); }
+std::vector<std::string_view> ParamSet::replaced() const {
+  std::vector<std::string_view> out;  // few: only_if_given alternatives that were given
+  for (const auto& [other, o] : entries_)
+    if (o.only_if_given && o.set) out.insert(out.end(), o.instead_of.begin(), o.instead_of.end());
+  return out;
+}
+bool ParamSet::recorded(const std::string& key, const std::vector<std::string_view>& replaced) const {
   const Entry& e = entry(key);
   if (e.only_if_given && !e.set) return false;
   for (const auto& [on, values] : e.applies)  // a key of another unit system or law than the run's
@@ -597,10 +604,8 @@ bool ParamSet::recorded(const std::string& key) const {
       return false;
   for (const auto& condition : e.applies_if)  // a key of another controller than the run's
     if (!condition(*this)) return false;
-  for (const auto& [other, o] : entries_)
-    if (o.only_if_given && o.set && std::find(o.instead_of.begin(), o.instead_of.end(), key) != o.instead_of.end())
-      return false;
-  return true;
+  // given, an alternative stands for these keys (only_if_given(instead_of))
+  return std::find(replaced.begin(), replaced.end(), std::string_view(key)) == replaced.end();
 }
 double ParamSet::real(const std::string& key) const { return std::get<double>(current(key).value); }
 long ParamSet::integer(const std::string& key) const { return std::get<long>(current(key).value); }
@@ -613,8 +618,9 @@ bool ParamSet::was_set(const std::string& key) const { return entry(key).set; }
 
 nlohmann::json ParamSet::units_json() const {
   nlohmann::json j = nlohmann::json::object();
+  const std::vector<std::string_view> gone = replaced();
   for (const auto& key : order_)
-    if (!entries_.at(key).unit.empty() && recorded(key)) j[key] = entries_.at(key).unit;
+    if (!entries_.at(key).unit.empty() && recorded(key, gone)) j[key] = entries_.at(key).unit;
   return j;
 }
 
@@ -622,8 +628,9 @@ nlohmann::json ParamSet::to_json() const {
   nlohmann::json j = nlohmann::json::object();
   // the values the run used: a key that follows another records the followed value, a value recorded by
   // record_used replaces the default, an alternative not given is left out (params.hpp)
+  const std::vector<std::string_view> gone = replaced();
   for (const auto& key : order_) {
-    if (recorded(key)) std::visit([&](const auto& v) { j[key] = v; }, current(key).value);
+    if (recorded(key, gone)) std::visit([&](const auto& v) { j[key] = v; }, current(key).value);
   }
   return j;
 }

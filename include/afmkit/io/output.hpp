@@ -37,6 +37,8 @@ nlohmann::json columns_json(const std::vector<Column>& columns);
 nlohmann::json finite_json(nlohmann::json value);
 /// `finite_json(value)` as indented text (what sidecars and `--json` print).
 std::string json_text(const nlohmann::json& value);
+/// The same, consuming `value` (no copy of a large document).
+std::string json_text(nlohmann::json&& value);
 
 /// Files committed together: each is written completely to its own temporary beside its target first (add, or a
 /// TableWriter's stage), then commit() moves them all into place with SIGINT/SIGTERM/SIGHUP held back and the

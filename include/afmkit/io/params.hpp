@@ -9,6 +9,7 @@
 #include <optional>
 #include "afmkit/core/source_location.hpp"
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -199,6 +200,10 @@ class ParamSet {
   const Entry& current(const std::string& key) const;
   /// Whether `key` goes into the records (to_json, units_json).
   bool recorded(const std::string& key) const;
+  /// The keys that alternatives given stand for (only_if_given(instead_of)): left out of the records. Computed
+  /// once per record, not once per key.
+  std::vector<std::string_view> replaced() const;
+  bool recorded(const std::string& key, const std::vector<std::string_view>& replaced) const;
   std::map<std::string, Entry> entries_;
   std::vector<std::string> order_;
   std::string config_path_;
