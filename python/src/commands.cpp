@@ -177,15 +177,17 @@ py::list describe(const CommandSpec& s, bool python) {
 
 /// A progress line of a command (io::Progress) written to Python's sys.stderr as it is then (Jupyter shows it under
 /// the running cell; contextlib.redirect_stderr catches it), from whichever thread advances the progress: the
-/// computation runs without the GIL, so the line takes it. A stderr that fails to write drops the line.
-void progress_to_python(const std::string& line) {
+/// computation runs without the GIL, so the line takes it. A Ctrl-C whose handler runs inside the write stops the
+/// computation (`interrupts`: it must not be lost with the line); a stderr that fails to write drops the line.
+void progress_to_python(const std::string& line, SignalPoll& interrupts) {
   py::gil_scoped_acquire gil;
   try {
     py::object err = py::module_::import("sys").attr("stderr");
     if (err.is_none()) return;
     err.attr("write")(line + "\n");
     err.attr("flush")();
-  } catch (py::error_already_set&) {
+  } catch (py::error_already_set& e) {
+    if (interrupts.hold(e)) return;  // the stop request: raised when the computation stops at its next check
     // a closed or broken sys.stderr: progress is not worth an error (the computation goes on)
   }
 }
@@ -209,7 +211,8 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   const io::ParamSet p = params_from_python(path, name, given);
   SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
   captured.cancellation = interrupts.cancellation();
-  io::ProgressSink progress(progress_to_python);  // progress lines to sys.stderr (Jupyter), not to descriptor 2
+  // progress lines to sys.stderr (Jupyter), not to descriptor 2
+  io::ProgressSink progress([&interrupts](const std::string& line) { progress_to_python(line, interrupts); });
   py::object results;  // the summary as Python objects, converted where the command hands it over (no copy)
   captured.take_results = [&results](const nlohmann::json& document) {
     py::gil_scoped_acquire gil;  // the computation runs without the GIL

@@ -31,6 +31,16 @@ struct SignalPoll::State {
 SignalPoll::SignalPoll()
     : state_(std::make_shared<State>()), cancellation_([s = state_] { return s->poll(); }) {}
 
+bool SignalPoll::hold(py::error_already_set& e) {
+  if (!e.matches(PyExc_KeyboardInterrupt) && !e.matches(PyExc_SystemExit)) return false;
+  if (!state_->type) {
+    e.restore();
+    PyErr_Fetch(&state_->type, &state_->value, &state_->traceback);
+  }
+  cancellation_.request();
+  return true;
+}
+
 void SignalPoll::raise() {
   if (state_->type) {
     PyErr_Restore(state_->type, state_->value, state_->traceback);

@@ -17,6 +17,11 @@ class SignalPoll {
   SignalPoll();
   /// The Cancellation to give the computation (copies share this poll).
   Cancellation cancellation() const { return cancellation_; }
+  /// With the GIL held, from Python code the computation called back (a progress line written to sys.stderr): a
+  /// KeyboardInterrupt or SystemExit raised there — a signal handler runs inside any Python code of the main thread,
+  /// and has then consumed its signal — is kept as the stop request (the first one wins): the computation stops at
+  /// its next check and run() raises it. Returns whether `e` was such a request (else the caller handles it).
+  bool hold(pybind11::error_already_set& e);
   /// Runs `body` (with the GIL released); a Cancelled from it raises the Python exception that stopped it.
   template <class Body>
   void run(Body&& body) {

@@ -3,6 +3,7 @@ given overlapping buffers or forged states, Ctrl-C during long computations, tex
 definitions and run settings that are wrong in kind, reports killed outright. Each case ends in a clear error of
 the right class (ValueError: the caller's; RuntimeError: a failure) or in the right result — never a crash, a
 traceback, a hang or a silent wrong answer."""
+import contextlib
 import errno
 import os
 import signal
@@ -125,13 +126,29 @@ def test_restore_state_refuses_a_state_no_filter_saved_and_keeps_its_own(index, 
 
 # ---- Ctrl-C during long computations ---------------------------------------------------------------------------
 
+def test_a_ctrl_c_whose_handler_runs_inside_a_progress_line_stops_the_computation():
+    # Python runs a signal handler inside whatever Python code the main thread runs next: here the progress line
+    # written to sys.stderr, where its KeyboardInterrupt must stop the computation, not be dropped with the line
+    class InterruptedStderr:
+        def write(self, text):
+            raise KeyboardInterrupt
+
+        def flush(self):
+            pass
+
+    t = time.monotonic()
+    with contextlib.redirect_stderr(InterruptedStderr()), pytest.raises(KeyboardInterrupt):
+        afmkit.scan(sample_rate=1e6, radial_speed=2e-5, image_output="", output="")  # 2e8 samples: about 20 s
+    assert time.monotonic() - t < 10.0  # stopped after the first progress line (about a second in)
+
+
 @pytest.mark.parametrize("call", [
     "afmkit.control.chart(x_points=1500, y_points=1500)",                      # about a minute
     "afmkit.control.tune(coarse_points=400, delay_max=0.2)",
     "afmkit.tapping.sweep(points=20000, separation_min=5, separation_max=25)",
     "afmkit.tapping.sweep(points=20, mode='continuation', max_continuation_points=200000, "
     "separation_min=10, separation_max=40, max_arclength_step=1e-4)",      # 20000 points take 5 s
-    "afmkit.scan(sample_rate=1e6)",                                           # about 30 s
+    "afmkit.scan(sample_rate=1e6, radial_speed=2e-5)",                        # 2e8 samples: about 20 s
     "afmkit.tapping.hb(law='dmt', units='physical', points=3000000)",          # about 50 s
 ])
 def test_ctrl_c_stops_a_long_computation_within_a_second_with_keyboard_interrupt(call):
