@@ -12,20 +12,18 @@ results of every configuration are compared with the serial run's, bit for bit.
     PYTHONPATH=build/python /usr/bin/python3 bench/study_scaling.py [--runs 3] [--seconds 15] [--baseline ec6a91b]
 """
 import argparse
-import ctypes
-import glob
 import os
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 ROOT = Path(__file__).resolve().parent.parent
+
+from whole_process import old_tree, run, subreaper  # noqa: E402  (bench/ is the script's folder)
 
 STUDY = """name = "bench"
 computation = "tapping.orbit"
@@ -38,43 +36,6 @@ frequency_ratio = 1.005
 [axes]
 separation = {{ start = 7.0, stop = 21.0, points = {points} }}
 """
-
-
-def subreaper() -> None:
-    libc = ctypes.CDLL(None, use_errno=True)
-    if libc.prctl(36, 1, 0, 0, 0) != 0:  # PR_SET_CHILD_SUBREAPER
-        sys.exit("cannot become a child subreaper (Linux prctl): the CPU time of orphans would be missed")
-
-
-def children_cpu() -> float:
-    t = os.times()
-    return t.children_user + t.children_system
-
-
-def run(argv, env, cwd) -> tuple:
-    """(wall s, CPU s of the process and all its descendants, load average at the end)."""
-    cpu0 = children_cpu()
-    start = time.perf_counter()
-    p = subprocess.Popen(argv, env=env, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    err = p.communicate()[1]
-    while True:  # orphans it left: reaped here, their CPU counted
-        try:
-            os.waitpid(-1, 0)
-        except ChildProcessError:
-            break
-    wall = time.perf_counter() - start
-    if p.returncode != 0:
-        sys.exit(f"{' '.join(argv)} exited {p.returncode}:\n{err}")
-    return wall, children_cpu() - cpu0, os.getloadavg()[0]
-
-
-def old_tree(ref: str, build: Path, into: Path) -> Path:
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", ref, "python/afmkit"], check=True,
-                             capture_output=True).stdout
-    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
-    for so in glob.glob(str(build / "python" / "afmkit" / "_afmkit*.so")):
-        shutil.copy(so, into / "python" / "afmkit")
-    return into / "python"
 
 
 def same_results(a: Path, b: Path) -> bool:
@@ -124,7 +85,7 @@ def main() -> None:
                 env = dict(os.environ, PYTHONPATH=str(packages[pkg]))
                 samples[label].append(run([sys.executable, "-m", "afmkit.study", "run", str(work / f"{which}.toml"),
                                            "--store", str(store), "--scheduler", scheduler, "--workers", "2",
-                                           "--quiet"], env, work))
+                                           "--quiet"], env, work)[:3])
         med = {}
         print(f"{'':<28} {'wall s':>7} {'CPU s':>7} {'load':>6}   runs (wall s)")
         for label, s in samples.items():
