@@ -405,3 +405,25 @@ def test_tapping_grid_writes_the_layout_of_the_equivalent_study_with_the_same_nu
     assert r.returncode == 2 and "store" in r.stderr and "not an afmkit store" in r.stderr
     assert sorted(p.name for p in other.iterdir()) == ["a.jpg"]
     assert not [p for p in tmp_path.iterdir() if ".tmp." in p.name or ".old." in p.name]
+
+
+def test_dask_xarray_and_netcdf4_are_needed_only_where_they_are_used(tmp_path):
+    # the machine without python3-distributed, python3-xarray and python3-netcdf4 (find_spec answers None for them):
+    # a serial or local study runs; a scheduler address or a NetCDF file names the missing Debian packages (exit 1)
+    study = tmp_path / "s.toml"
+    study.write_text('computation = "tapping.hb"\noutputs = ["free_amplitude"]\n[axes]\nquality_factor = [50.0, 60.0]\n')
+    code = ("import importlib.util as u, sys\nreal = u.find_spec\n"
+            "u.find_spec = lambda name, *a: None if name in ('distributed', 'xarray', 'netCDF4') else real(name, *a)\n"
+            "from afmkit.study.__main__ import main\nsys.exit(main(sys.argv[1:]))\n")
+
+    def study_run(*extra):
+        return subprocess.run([sys.executable, "-c", code, "run", str(study), "--quiet", *extra], capture_output=True,
+                              text=True, timeout=120)
+
+    ok = study_run("--store", str(tmp_path / "a.zarr"))
+    assert ok.returncode == 0, ok.stderr
+    address = study_run("--store", str(tmp_path / "b.zarr"), "--scheduler", "tcp://127.0.0.1:1")
+    assert address.returncode == 1 and "needs the Debian packages python3-distributed" in address.stderr
+    assert not (tmp_path / "b.zarr").exists()
+    netcdf = study_run("--store", str(tmp_path / "c.zarr"), "--netcdf", str(tmp_path / "c.nc"))
+    assert netcdf.returncode == 1 and "python3-xarray python3-netcdf4" in netcdf.stderr

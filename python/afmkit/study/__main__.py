@@ -59,12 +59,14 @@ def main(argv=None) -> int:
     def where(e) -> str:  # every message names the study file
         return "" if args.file in str(e) else f"{args.file}: "
 
-    missing = [pkg for module, pkg in (("xarray", "python3-xarray"), ("zarr", "python3-zarr"),
-                                       ("distributed", "python3-distributed"), ("netCDF4", "python3-netcdf4"))
-               if importlib.util.find_spec(module) is None]
-    if missing:  # the machine's set-up, not the study file: exit 1
-        print(f"afmkit study: needs the Debian packages {' '.join(missing)} (scripts/bootstrap.sh --all installs "
-              "them; docs/study.md)", file=sys.stderr)
+    def missing(needed) -> int:  # the machine's set-up, not the study file: exit 1 (0: nothing missing)
+        absent = [pkg for module, pkg in needed if importlib.util.find_spec(module) is None]
+        if absent:
+            print(f"afmkit study: needs the Debian packages {' '.join(absent)} (scripts/bootstrap.sh --all installs "
+                  "them; docs/study.md)", file=sys.stderr)
+        return 1 if absent else 0
+
+    if missing([("zarr", "python3-zarr")]):
         return 1
     try:
         study = Study.from_toml(args.file)
@@ -80,7 +82,13 @@ def main(argv=None) -> int:
 
         store = pick("store", f"out/{study.name}.zarr")
         netcdf = pick("netcdf")
-        path, failed = compute(study, store, scheduler=pick("scheduler"), workers=pick("workers"),
+        scheduler = pick("scheduler")
+        # Dask only for a scheduler's address, xarray and netCDF4 only for the NetCDF file
+        needed = ([("distributed", "python3-distributed")] if "://" in str(scheduler or "") else []) + (
+            [("xarray", "python3-xarray"), ("netCDF4", "python3-netcdf4")] if netcdf is not None else [])
+        if missing(needed):
+            return 1
+        path, failed = compute(study, store, scheduler=scheduler, workers=pick("workers"),
                                chunk_seconds=pick("chunk_seconds"), chunk_points=pick("chunk_points"),
                                progress=not args.quiet, netcdf=netcdf)
         if netcdf is not None:  # xarray only for the NetCDF file (its import is half of a short study's start-up)
