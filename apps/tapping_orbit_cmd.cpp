@@ -101,7 +101,7 @@ UnitTagged orbit_record(const tapping::FoundOrbit& f, const tapping::OrbitSearch
       .add("initial_position", o.initial.position, u.length)
       .add("initial_velocity", o.initial.velocity, u.velocity)
       .add("shooting_residual", o.residual, "dimensionless")
-      .add("trapped", tapping::tip_trapped(m));
+      .add("trapped", tapping::tip_trapped(m), "boolean (0/1)");
   return j;
 }
 

@@ -87,3 +87,30 @@ TEST(SummaryUnits, NormalisedNumbersSayTheyAreNormalised) {
   const auto roots = run_cli("control roots --harmonics 3 --output ''", dir);
   EXPECT_NE(roots.out.find("(normalised, units of Omega; "), std::string::npos) << roots.out;
 }
+
+namespace {
+/// The keys of `record` holding a number or a boolean (or arrays / objects of them) that `units` does not name.
+std::vector<std::string> summary_units_missing(const nlohmann::json& record, const nlohmann::json& units) {
+  std::vector<std::string> missing;
+  for (const auto& [key, value] : record.items()) {
+    const bool numeric = value.is_number() || value.is_boolean() || value.is_array() ||
+                         (value.is_object() && !value.empty());
+    if (numeric && !units.contains(key)) missing.push_back(key);
+  }
+  return missing;
+}
+}  // namespace
+
+TEST(SummaryUnits, EveryNumberOfATappingOrbitRecordHasItsUnit) {
+  // the orbit records (numbers, flags, nested seeds) and the HB solutions beside them: each key named in `units`
+  TempDir dir;
+  const auto r = run_cli("tapping orbit --units physical --separation 5 --output o.csv", dir);
+  ASSERT_TRUE(r.status == 0 || r.status == 1) << r.err;
+  const auto results = nlohmann::json::parse(slurp(dir.path / "o.csv.json")).at("results");
+  ASSERT_FALSE(results.at("orbits").empty());
+  for (const auto& o : results.at("orbits"))
+    EXPECT_EQ(summary_units_missing(o, results.at("units").at("orbits")), std::vector<std::string>{}) << o.dump();
+  for (const auto& h : results.at("harmonic_balance"))
+    EXPECT_EQ(summary_units_missing(h, results.at("units").at("harmonic_balance")), std::vector<std::string>{})
+        << h.dump();
+}
