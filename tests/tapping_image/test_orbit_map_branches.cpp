@@ -12,6 +12,7 @@
 #include "afmkit/impact/force_law.hpp"
 #include "afmkit/scan/sample_generators.hpp"
 #include "afmkit/tapping/image/quasi_static.hpp"
+#include "image_fixtures.hpp"
 
 namespace afmkit::tapping::image {
 namespace {
@@ -110,17 +111,6 @@ UnitScales synth_scales() {
   return s;
 }
 
-double synth_step(const scan::HeightMap& h) {  // right quarter minus left quarter
-  const long nx = h.x_resolution(), ny = h.y_resolution();
-  double left = 0, right = 0;
-  for (long j = 0; j < ny; ++j)
-    for (long i = 0; i < nx / 4; ++i) {
-      left += h(i, j);
-      right += h(nx - 1 - i, j);
-    }
-  return (right - left) / static_cast<double>(ny * (nx / 4));
-}
-
 ImagingResult synth_image(double step_height, double speed) {
   const scan::Grid g{600, 600, 1.2e-6, 1.2e-6, -0.6e-6, -0.6e-6};
   const scan::Surface s(scan::steps(g, {0.6e-6, step_height, 0.0}), scan::Tilt(0.0, 0.0));
@@ -138,7 +128,7 @@ ImagingResult synth_image(double step_height, double speed) {
 TEST(OrbitMapBranches, AStepWithinTheMarginIsImagedWithItsHeight) {
   const ImagingResult r = synth_image(3e-9, 2e-6);  // margin 12 − 7.5 = 4.5 nm
   EXPECT_NEAR(r.engaged_separation, 12e-9, 1e-18);
-  EXPECT_NEAR(synth_step(r.trace.height), 3e-9, 1e-13);
+  EXPECT_NEAR(test::right_minus_left_quarter(r.trace.height), 3e-9, 1e-13);
   for (double v : r.trace.regime.data()) EXPECT_EQ(v, 1.0);
   EXPECT_EQ(r.trace.regime_switches[0], 0);
 }
@@ -146,7 +136,7 @@ TEST(OrbitMapBranches, AStepWithinTheMarginIsImagedWithItsHeight) {
 TEST(OrbitMapBranches, AStepBeyondTheMarginSwitchesToRepulsiveAndIsImagedLowerByTheBranchesSeparation) {
   const ImagingResult r = synth_image(6e-9, 20e-6);
   // trace: on the upper terrace the loop holds H at 7 nm instead of L at 12 nm: 6 − 5 = 1 nm
-  EXPECT_NEAR(synth_step(r.trace.height), 1e-9, 1e-13);
+  EXPECT_NEAR(test::right_minus_left_quarter(r.trace.height), 1e-9, 1e-13);
   EXPECT_EQ(r.trace.regime(0, 0), 1.0);
   EXPECT_EQ(r.trace.regime(63, 0), 2.0);
   EXPECT_EQ(r.trace.regime_switches[0], 1);
@@ -154,7 +144,7 @@ TEST(OrbitMapBranches, AStepBeyondTheMarginSwitchesToRepulsiveAndIsImagedLowerBy
   // end (12.5): back to L at 12 nm on the lower terrace, so the retrace shows the same 1 nm
   EXPECT_EQ(r.retrace.regime(63, 0), 2.0);
   EXPECT_EQ(r.retrace.regime(0, 0), 1.0);
-  EXPECT_NEAR(synth_step(r.retrace.height), 1e-9, 1e-13);
+  EXPECT_NEAR(test::right_minus_left_quarter(r.retrace.height), 1e-9, 1e-13);
   const ImagingMetrics m = imaging_metrics(r);
   EXPECT_GT(m.fraction_repulsive, 0.0);
   EXPECT_GT(m.fraction_attractive, 0.0);

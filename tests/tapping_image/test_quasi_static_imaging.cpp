@@ -20,6 +20,7 @@
 #include "afmkit/tapping/image/quasi_static.hpp"
 #include "afmkit/tapping/image/time_domain.hpp"
 #include "afmkit/tapping/units.hpp"
+#include "image_fixtures.hpp"
 
 namespace afmkit::tapping::image {
 namespace {
@@ -32,11 +33,7 @@ const PhysicalCantilever& qimg_cantilever() {
   static const PhysicalCantilever pc(40.0, 300.0, kQimgQ, kQimgA0, 1.0);
   return pc;
 }
-TappingModel qimg_model() {
-  const PhysicalCantilever& pc = qimg_cantilever();
-  const impact::DmtLaw dmt(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165);
-  return {pc.cantilever(), pc.drive(), pc.normalised_law(impact::ForceLaw(dmt)), 20.0};
-}
+TappingModel qimg_model() { return test::dmt_defaults_model(qimg_cantilever()); }
 
 struct QimgCase {
   SweepResult sweep;
@@ -125,18 +122,6 @@ void qimg_check_flat() {
   EXPECT_EQ(m.switches_per_line, 0.0);
 }
 
-/// The height image's step: mean height of the right quarter minus the left quarter of every line.
-double qimg_step(const scan::HeightMap& h) {
-  const long nx = h.x_resolution(), ny = h.y_resolution();
-  double left = 0, right = 0;
-  for (long j = 0; j < ny; ++j)
-    for (long i = 0; i < nx / 4; ++i) {
-      left += h(i, j);
-      right += h(nx - 1 - i, j);
-    }
-  return (right - left) / static_cast<double>(ny * (nx / 4));
-}
-
 void qimg_check_step_on_one_branch() {
   // one step up at x = 0 (terraces 2 µm wide over a 1 µm scan), lower than the margin of the attractive branch
   const double a_sp = kQimgSetpoint * kQimgA0;
@@ -149,8 +134,8 @@ void qimg_check_step_on_one_branch() {
   FeedbackSpec f;
   f.setpoint = kQimgSetpoint;
   const ImagingResult r = qimg_scan(s, qimg_raster(64, 4, 1e-6, 2e-6), f);
-  EXPECT_NEAR(qimg_step(r.trace.height), height, 1e-4 * height);
-  EXPECT_NEAR(qimg_step(r.retrace.height), height, 1e-4 * height);
+  EXPECT_NEAR(test::right_minus_left_quarter(r.trace.height), height, 1e-4 * height);
+  EXPECT_NEAR(test::right_minus_left_quarter(r.retrace.height), height, 1e-4 * height);
   for (double v : r.trace.regime.data()) EXPECT_EQ(v, 1.0);  // attractive throughout
 }
 
@@ -170,7 +155,7 @@ void qimg_check_step_switching_branch() {
   // trace: the step up pushes the tip below the attractive branch's end: repulsive on the upper terrace, which is
   // imaged lower by l_att − l_rep
   const double expected = height - (l_att - *l_rep) * 1e-9;
-  EXPECT_NEAR(qimg_step(r.trace.height), expected, 0.01e-9);
+  EXPECT_NEAR(test::right_minus_left_quarter(r.trace.height), expected, 0.01e-9);
   EXPECT_EQ(r.trace.regime(0, 0), 1.0);
   EXPECT_EQ(r.trace.regime(63, 0), 2.0);
   EXPECT_GE(r.trace.regime_switches[0], 1);

@@ -15,6 +15,7 @@
 #include "afmkit/tapping/image/quasi_static.hpp"
 #include "afmkit/tapping/image/time_domain.hpp"
 #include "afmkit/tapping/units.hpp"
+#include "image_fixtures.hpp"
 
 namespace afmkit::tapping::image {
 namespace {
@@ -26,11 +27,7 @@ const PhysicalCantilever& tdimg_cantilever() {
   static const PhysicalCantilever pc(40.0, 300.0, kTdimgQ, kTdimgA0, 1.0);
   return pc;
 }
-TappingModel tdimg_model() {
-  const PhysicalCantilever& pc = tdimg_cantilever();
-  const impact::DmtLaw dmt(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165);
-  return {pc.cantilever(), pc.drive(), pc.normalised_law(impact::ForceLaw(dmt)), 20.0};
-}
+TappingModel tdimg_model() { return test::dmt_defaults_model(tdimg_cantilever()); }
 const OrbitMap& tdimg_map() {
   static const OrbitMap m = [] {
     OrbitMapOptions o;
@@ -69,18 +66,6 @@ TimeDomainEngine tdimg_engine(long lockin_cycles = 1) {
   o.lockin_cycles = lockin_cycles;
   o.lockin_bandwidth = tdimg_feedback().lockin_bandwidth;
   return TimeDomainEngine(tdimg_model(), tdimg_map(), tdimg_cantilever().scales(), o);
-}
-
-/// The height image's step: mean height of the right quarter minus the left quarter of every line.
-double tdimg_step(const scan::HeightMap& h) {
-  const long nx = h.x_resolution(), ny = h.y_resolution();
-  double left = 0, right = 0;
-  for (long j = 0; j < ny; ++j)
-    for (long i = 0; i < nx / 4; ++i) {
-      left += h(i, j);
-      right += h(nx - 1 - i, j);
-    }
-  return (right - left) / static_cast<double>(ny * (nx / 4));
 }
 
 TEST(TimeDomainImaging, AFlatSampleHoldsTheSetPointAndImagesZeroHeight) {
@@ -137,7 +122,8 @@ TEST(TimeDomainImaging, AStepIsImagedAsTheQuasiStaticEngineImagesIt) {
   const double bound = 2.0 * height * std::exp(-(t_s - tau_c - tau_li) / tau_loop);
   ASSERT_LT(bound, 0.1 * height);  // the case resolves the step
   for (const auto& [t, qq] : {std::pair{&r.trace, &q.trace}, std::pair{&r.retrace, &q.retrace}}) {
-    const double td_step = tdimg_step(t->height), qs_step = tdimg_step(qq->height);
+    const double td_step = test::right_minus_left_quarter(t->height);
+    const double qs_step = test::right_minus_left_quarter(qq->height);
     EXPECT_NEAR(td_step, qs_step, bound);
     EXPECT_NEAR(td_step, height, bound);
   }
