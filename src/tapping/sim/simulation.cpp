@@ -57,16 +57,22 @@ SimulationResult run_system(const TappingSystem& sys, Integrator integrator, dou
   rs.mode = sys.initial_mode(t_begin, rs.y);
   if (rs.mode.branch == ContactBranch::sticking) {
     ++rs.stats.sticking_count;
-    rs.jacobian(1, 1) = 0.0;  // a velocity perturbation is absorbed by the sticking (saltation diag(1, 0, 1))
+    // a velocity perturbation is absorbed by the sticking (saltation diag(1, 0, 1)); one mode only (no
+    // variational equations for several)
+    if (!sys.modal()) rs.jacobian(1, 1) = 0.0;
   }
   if (integrator == Integrator::closed_form)
     detail::run_closed_form(sys, rs, t_end, options, observer);
   else
     detail::run_adaptive(sys, rs, t_end, options, observer);
   if (!std::isfinite(rs.y.position) || !std::isfinite(rs.y.velocity))
-    throw NumericalFailure(fmt::format("tapping simulation: the motion diverges (state x = {}, dx/dt = {} at t = {:.9g}); "
-                                       "a law that creates energy (allow_energy_gain) can drive it without bound",
-                                       rs.y.position, rs.y.velocity, rs.t));
+    throw NumericalFailure(
+        sys.modal() ? fmt::format("tapping simulation (modes): the motion diverges (state x = {}, dx/dt = {} at "
+                                  "t = {:.9g})",
+                                  rs.y.position, rs.y.velocity, rs.t)
+                    : fmt::format("tapping simulation: the motion diverges (state x = {}, dx/dt = {} at t = {:.9g}); "
+                                  "a law that creates energy (allow_energy_gain) can drive it without bound",
+                                  rs.y.position, rs.y.velocity, rs.t));
   SimulationResult out;
   out.time = rs.t;
   out.state = rs.y;
@@ -107,31 +113,10 @@ SimulationResult simulate(const MultiModeModel& model, double t_begin, TipState 
   if (options.integrator == Integrator::closed_form)
     throw InvalidParameter("integrator", "integrator = closed_form is available for one eigenmode only (the modes "
                                          "are integrated by the adaptive integrator)");
-  if (!std::isfinite(t_begin)) validate::finite("t_begin", t_begin);
-  if (!std::isfinite(t_end)) validate::finite("t_end", t_end);
-  if (!(t_end >= t_begin)) validate::require(false, "t_end", t_end, fmt::format(">= t_begin = {}", t_begin));
-  if (!std::isfinite(start.position)) validate::finite("position", start.position);
-  if (!std::isfinite(start.velocity)) validate::finite("velocity", start.velocity);
+  check_run(t_begin, start, t_end);
   for (double c : start.modal)
     if (!std::isfinite(c)) validate::finite("modal coordinate", c);
-  const TappingSystem sys(model);
-  detail::RunState rs;
-  rs.t = t_begin;
-  rs.y = start;
-  rs.mode = sys.initial_mode(t_begin, rs.y);
-  if (rs.mode.branch == ContactBranch::sticking) ++rs.stats.sticking_count;
-  detail::run_adaptive(sys, rs, t_end, options, observer);
-  if (!std::isfinite(rs.y.position) || !std::isfinite(rs.y.velocity))
-    throw NumericalFailure(fmt::format("tapping simulation (modes): the motion diverges (state x = {}, dx/dt = {} at "
-                                       "t = {:.9g})",
-                                       rs.y.position, rs.y.velocity, rs.t));
-  SimulationResult out;
-  out.time = rs.t;
-  out.state = rs.y;
-  out.state.contact = rs.mode.contact;
-  out.mode = rs.mode;
-  out.stats = rs.stats;
-  return out;
+  return run_system(TappingSystem(model), Integrator::adaptive, t_begin, start, t_end, options, observer);
 }
 
 namespace detail {
