@@ -99,10 +99,8 @@ FmCurveEvaluation FmForwardModel::warm(const ModelValues& values, const FmCurveE
   e.jacobians = from.jacobians;
   e.jumped.assign(n, false);
   const double a = s.amplitude;
-  std::atomic<long> solves{0};
-  const bool all = each_point(n, options_.parallel, [&](std::size_t i) {
+  const EachPointResult done = each_point(n, options_.parallel, [&](std::size_t i) {
     const tapping::FmOrbit& old = from.orbits[i];
-    ++solves;
     std::optional<tapping::FmOrbit> o;
     try {
       o = tapping::try_solve_fm(s, separation(values, i), old.state, quick, &e.jacobians[i]);
@@ -117,8 +115,8 @@ FmCurveEvaluation FmForwardModel::warm(const ModelValues& values, const FmCurveE
     e.orbits[i] = *o;
     return true;
   });
-  orbits_ += solves.load();
-  if (!all) return walk(values);
+  orbits_ += done.visited;
+  if (!done.all) return walk(values);
   finish(e);
   return e;
 }

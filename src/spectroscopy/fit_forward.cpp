@@ -240,11 +240,9 @@ CurveEvaluation AmForwardModel::warm(const ModelValues& values, const CurveEvalu
   plain.sensitivity = false;
   const double omega = m.drive.frequency;
   const double amplitude = m.free_amplitude();
-  std::atomic<long> solves{0};
-  const bool all = each_point(n, options_.parallel, [&](std::size_t i) {
+  const EachPointResult done = each_point(n, options_.parallel, [&](std::size_t i) {
     const PeriodicOrbit& old = from.orbits[i];
     const TappingModel at = m.with_separation(separation(values, i));
-    ++solves;
     std::optional<PeriodicOrbit> o;
     if (chord) {
       // one chord-Newton step with the monodromy of `old`: z' = z − (M − I)⁻¹ (P'(z) − z), off the perturbed
@@ -274,8 +272,8 @@ CurveEvaluation AmForwardModel::warm(const ModelValues& values, const CurveEvalu
     e.orbits[i].separation = at.separation;
     return true;
   });
-  orbits_ += solves.load();
-  if (!all) return walk(values);
+  orbits_ += done.visited;
+  if (!done.all) return walk(values);
   if (!chord) {
     // where `from` jumped (its branch ended between the points i − 1 and i), the branch must still end there: the
     // orbit at i − 1 followed to l_i must not arrive (else the jump moved past a point: the whole sweep decides)

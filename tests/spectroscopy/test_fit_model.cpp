@@ -1,6 +1,10 @@
 // The forward model of `spectroscopy fit` against the sweep engine it stands on (tapping::sweep_instrument), and
 // the parameter transformations.
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -88,6 +92,28 @@ TEST(FitModel, CalibrationEntersAsDocumented) {
   o.initial["amplitude_scale"] = 1.2;
   const AmPrediction c = predict_am_curve({40e-9, 39e-9, 38e-9}, model_settings(), o);
   EXPECT_NEAR(c.amplitude[0], 20e-9, 4e-12);
+}
+
+// A warm evaluation stops after the first failing point; how many points it ran (the fit's orbit_evaluations) must not
+// depend on the threads' timing, or a record would not replay. Points after the failure are slowed unevenly so that
+// a thread-timed stop would run a varying number of them.
+TEST(FitModel, AWarmEvaluationRunsTheSamePointsWhateverTheThreadsTiming) {
+  const std::size_t n = 100, failing = 40;
+  for (int round = 0; round < 5; ++round) {
+    std::vector<std::atomic<int>> ran(n);
+    const EachPointResult r = each_point(n, true, [&](std::size_t i) {
+      ran[i]++;
+      if ((i + round) % 3 == 0) std::this_thread::sleep_for(std::chrono::microseconds(200));
+      return i != failing;
+    });
+    EXPECT_FALSE(r.all);
+    const std::size_t block_end = (failing / kEachPointBlock + 1) * kEachPointBlock;
+    EXPECT_EQ(r.visited, static_cast<long>(block_end));
+    for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(ran[i].load(), i < block_end ? 1 : 0) << "point " << i;
+  }
+  const EachPointResult every = each_point(n, true, [](std::size_t) { return true; });
+  EXPECT_TRUE(every.all);
+  EXPECT_EQ(every.visited, static_cast<long>(n));
 }
 
 TEST(FitModel, TransformsKeepTheRange) {

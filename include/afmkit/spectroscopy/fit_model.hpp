@@ -2,6 +2,7 @@
 // The forward models of `spectroscopy fit` (fit.hpp): amplitude and phase (AM) or frequency shift and dissipation
 // (FM) along a measured curve from afmkit's periodic orbits, and the parameter transformations. Internal to the fit
 // (its tests use it too).
+#include <algorithm>
 #include <atomic>
 #include <map>
 #include <string>
@@ -27,20 +28,32 @@ double calibration_value(const FitOptions& options, const std::string& name);
 double to_parameter(const FitParameterInfo& p, double u);
 double parameter_derivative(const FitParameterInfo& p, double u);
 
-/// Runs point(i) for every i < n (OpenMP threads when `parallel`) until one returns false or throws; true when every
-/// point succeeded (a warm-started evaluation: each point from the previous curve's orbit there).
+/// What each_point did: whether every point succeeded, and how many points it ran.
+struct EachPointResult {
+  bool all = true;
+  long visited = 0;
+};
+
+/// Runs point(i) for every i < n (OpenMP threads when `parallel`) in blocks of kEachPointBlock points, stopping after
+/// the block in which one returns false or throws (a warm-started evaluation: each point from the previous curve's
+/// orbit there). The points run are those of the blocks up to that one: their number depends on n and on where the
+/// first failure lies, never on the threads' timing, so a fit's record (orbit_evaluations) replays exactly.
+inline constexpr std::size_t kEachPointBlock = 32;
 template <class Point>
-bool each_point(std::size_t n, bool parallel, Point&& point) {
+EachPointResult each_point(std::size_t n, bool parallel, Point&& point) {
   std::atomic<bool> failed{false};
   ExceptionCollector errors;
+  std::size_t begin = 0;
+  while (begin < n && !failed.load() && !errors.failed()) {
+    const std::size_t end = std::min(n, begin + kEachPointBlock);
 #pragma omp parallel for schedule(dynamic) if (parallel)
-  for (std::size_t i = 0; i < n; ++i) {
-    if (failed.load()) continue;
-    errors.run([&] {
-      if (!point(i)) failed = true;
-    });
+    for (std::size_t i = begin; i < end; ++i)
+      errors.run([&] {
+        if (!point(i)) failed = true;
+      });
+    begin = end;
   }
-  return !errors.failed() && !failed.load();
+  return {!errors.failed() && !failed.load(), static_cast<long>(begin)};
 }
 
 /// Every value the model needs (declared below).
