@@ -309,7 +309,7 @@ class Python(Law):
             if not (math.isfinite(damping) and damping >= 0):
                 raise ValueError(f"afmkit.laws.Python: damping = {damping} must be a finite number >= 0 (N s/m)")
             constant = float(damping)
-            damping_f = lambda d: np.full(np.shape(d), constant)
+            damping_f = _Constant(constant)
             damping_label = f"damping={constant!r}"
         else:
             damping_f = damping
@@ -334,9 +334,27 @@ class Python(Law):
         tables["damping"] = (branch(damping_f, damping_label, 1.0, non_negative=True)
                              if damping_f is not None else None)
         self.tabulation = {k: {"pieces": v["pieces"], "direct": v["direct"]} for k, v in tables.items() if v}
-        self._model = _afmkit.PythonLaw(self.label, tables["approach"], tables["departure"], tables["damping"],
-                                        gaps_nm, math.nan if contact_gap is None else float(contact_gap) * 1e9)
+        self._tables, self._gaps_nm = tables, gaps_nm
+        self._contact_nm = math.nan if contact_gap is None else float(contact_gap) * 1e9
+        self._model = self._build()
         self.energy_gain = None if departure is None else self._energy_gain(tables)
+
+    def _build(self):
+        t = self._tables
+        return _afmkit.PythonLaw(self.label, t["approach"], t["departure"], t["damping"], self._gaps_nm,
+                                 self._contact_nm)
+
+    # pickling (multiprocessing, Dask, the study runner's workers): the tabulation and the callables travel, the
+    # compiled law is rebuilt from the tabulation without calling them again; a callable pickle cannot carry (a
+    # lambda, a local function) makes pickle raise as for any object holding one
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        del state["_model"]
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._model = self._build()
 
     def _energy_gain(self, tables):
         """(distance [m], H_a [N], H_b [N]) where the departure branch lies above the approach branch (the law
@@ -373,6 +391,16 @@ class Python(Law):
         if self.switching.size:
             parts.append(f"switching_gaps={self.switching.tolist()}")
         return f"afmkit.laws.Python({', '.join(parts)})"
+
+
+class _Constant:
+    """A constant damping coefficient as a vectorised callable of the distance (picklable, unlike a lambda)."""
+
+    def __init__(self, value: float):
+        self.value = value
+
+    def __call__(self, d):
+        return np.full(np.shape(d), self.value)
 
 
 def _callable_name(f) -> str:

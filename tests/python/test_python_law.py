@@ -232,3 +232,20 @@ def test_every_law_plots_its_branches():
         assert len(ax.lines) >= 3  # approach, departure (differs), zero line
         assert "force (nN)" in ax.get_ylabel()
         plt.close(fig)
+
+
+def test_a_python_law_of_module_functions_pickles_and_runs_the_same_orbit():
+    # multiprocessing, Dask and the study runner's workers pickle their arguments: the law travels with its
+    # callables and tabulation, and is rebuilt without calling them again; a lambda fails as pickle says
+    import pickle
+
+    law = laws.Python(approach=seed_approach, departure=seed_departure, damping=1e-7, switching_gaps=[0.0])
+    back = pickle.loads(pickle.dumps(law))
+    assert back.tabulation == law.tabulation and back.label == law.label
+    d = np.linspace(-2e-9, 2e-9, 41)
+    np.testing.assert_array_equal(back.force(d).approach, law.force(d).approach)
+    np.testing.assert_array_equal(back.force(d).damping, law.force(d).damping)
+    a, b = (afmkit.tapping.orbit(law=x, separation=5.0, **CANTILEVER) for x in (law, back))
+    np.testing.assert_array_equal(np.asarray(a["amplitude"]), np.asarray(b["amplitude"]))
+    with pytest.raises((pickle.PicklingError, AttributeError)):
+        pickle.dumps(laws.Python(approach=lambda d: 0.0 * d))
