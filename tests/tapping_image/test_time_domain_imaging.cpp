@@ -130,6 +130,55 @@ TEST(TimeDomainImaging, AStepIsImagedAsTheQuasiStaticEngineImagesIt) {
   for (double v : r.trace.regime.data()) EXPECT_EQ(v, 2.0);
 }
 
+TEST(TimeDomainImaging, CyclesRunInPiecesStartFromTheStepTheLastOneEndedWith) {
+  // the engine runs the motion cycle by cycle: each piece starting from the step the last one ended with
+  // (SimulationOptions::initial_step = SimulationStats::next_step) takes about as many steps as one run over all of
+  // them (at most two more a piece: the clipped last step, the step after it), where starting afresh grows again
+  // from 1e-3 of a period (fewer steps in all).
+  // From rest (the steps are the largest, a 24th of a period: 24 of them end a rounding below the period's end,
+  // where the remainder once was refused as a step underflow) and from the free orbit's amplitude (in contact at
+  // separation 7 nm, A0 = 10 nm: two events a cycle).
+  TappingModel model = tdimg_model();
+  model.separation = 7.0;
+  const TappingSystem sys(model);
+  SimulationOptions o;
+  o.integrator = Integrator::adaptive;
+  const double period = model.period(), omega = model.drive.frequency;
+  const int pieces = 20;
+  for (const TipState start : {TipState{}, TipState{0.0, kTdimgA0 * omega}}) {
+    const SimulationResult whole = simulate(sys, 0.0, start, pieces * period, o);
+    TipState carried = start, fresh = start;
+    long carried_steps = 0, fresh_steps = 0, events = 0;
+    double next = 0.0;
+    for (int k = 0; k < pieces; ++k) {
+      SimulationOptions c = o;
+      c.initial_step = next;
+      const SimulationResult r = simulate(sys, k * period, carried, (k + 1) * period, c);
+      carried = r.state;
+      carried_steps += r.stats.steps;
+      events += r.stats.events;
+      next = r.stats.next_step;
+      EXPECT_GT(next, 0.0);
+      const SimulationResult f = simulate(sys, k * period, fresh, (k + 1) * period, o);
+      fresh = f.state;
+      fresh_steps += f.stats.steps;
+    }
+    EXPECT_EQ(events > 0, start.velocity > 0.0);
+    EXPECT_LE(carried_steps, whole.stats.steps + 2 * pieces);
+    EXPECT_LT(carried_steps, fresh_steps);
+    // the same motion to the tolerance (1e-10 relative of the amplitude, kept over 20 periods)
+    EXPECT_NEAR(carried.position, whole.state.position, 1e-7 * kTdimgA0);
+    EXPECT_NEAR(fresh.position, whole.state.position, 1e-7 * kTdimgA0);
+  }
+  o.initial_step = -1.0;
+  try {
+    o.validate();
+    ADD_FAILURE() << "initial_step < 0 accepted";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "initial_step");
+  }
+}
+
 TEST(TimeDomainImaging, BadLockInOptionsNameTheirParameter) {
   const auto tdimg_name_of = [](const TimeDomainOptions& o) {
     try {
