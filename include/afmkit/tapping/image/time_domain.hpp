@@ -34,6 +34,10 @@ struct TimeDomainOptions {
 
 class TimeDomainEngine final : public TipEngine {
  public:
+  /// The adaptive integrator's largest step in the cycles, as a fraction of the shortest period (SimulationOptions::
+  /// max_step_fraction; the closed-form flow keeps its own scan step).
+  static constexpr double kCycleMaxStepFraction = 1.0 / 12.0;
+
   /// `model`: cantilever, drive and law (model units; its separation is moved); `map`: the approach that engages
   /// (kept by reference); `scales` to SI (PhysicalCantilever::scales()).
   TimeDomainEngine(const TappingModel& model, const OrbitMap& map, const UnitScales& scales,
@@ -60,6 +64,8 @@ class TimeDomainEngine final : public TipEngine {
   double omega_, model_period_, period_;  // ω and T (model units), T [s]
   double start_ = 0.0;                     // model time of a cycle's start (the top of the engaged orbit)
   TipState state_;
+  double next_step_ = 0.0;                 // the adaptive integrator's step at the end of the last cycle
+  double free_fraction_ = 1e-9;            // |H_c| below this fraction of Γ: the free regime (regime_of)
   CycleLockIn lockin_;
   double clock_ = 0.0, target_ = 0.0;      // [s] since the engagement: cycles done, time requested
   TipReading last_;
