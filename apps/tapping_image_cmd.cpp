@@ -91,6 +91,10 @@ void declare_tapping_image(io::ParamSet& p) {
             {"quasi-static", "time-domain"})
       .integer("lockin_cycles", 1, "time-domain engine: drive cycles the lock-in averages (boxcar), at most the "
                "cycles of one pixel", 1, 1000000)
+      .real("cycle_tolerance", 1e-8, "time-domain engine: relative tolerance of the cycles' adaptive integrator "
+            "(absolute: 1e-2 of it in nm; relative_tolerance stays the orbit map's and the engagement's)",
+            io::Range::open(0.0, 1.0))
+      .unit("dimensionless")
       .real("setpoint", 0.8, "amplitude set-point A_sp / A0, in (0, 1)", io::Range::any())
       .unit("dimensionless")
       .reals("setpoint_sweep", {}, "more set-points A_sp/A0 imaged with the same orbit map (results: setpoint_sweep)",
@@ -124,6 +128,7 @@ void declare_tapping_image(io::ParamSet& p) {
   add_output_params(p, "out/tapping_image/lines.csv", "per-line metrics (regime switches, jumps, peak force)");
   add_quiet_flag(p);
   p.applies_when("lockin_cycles", "engine", {"time-domain"});
+  p.applies_when("cycle_tolerance", "engine", {"time-domain"});
 }
 
 std::vector<io::Column> tapping_image_line_columns() {
@@ -234,6 +239,10 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
   require_sample_covers_scan(p, map, raster);
   const bool time_domain = p.text("engine") == "time-domain";
   if (time_domain) require_whole_cycles(p, raster, fb, f_drive);
+  if (!time_domain && p.was_set("cycle_tolerance"))
+    throw InvalidParameter("cycle_tolerance", fmt::format("cycle_tolerance does not apply to engine = {}: it is the "
+                                                          "time-domain engine's integrator tolerance",
+                                                          p.text("engine")));
   if (!time_domain && p.was_set("lockin_cycles"))
     throw InvalidParameter("lockin_cycles", fmt::format("lockin_cycles does not apply to engine = {}: the lock-in "
                                                         "window of whole cycles is the time-domain engine's",
@@ -267,6 +276,7 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
     td.lockin_cycles = p.integer("lockin_cycles");
     td.lockin_bandwidth = fb.lockin_bandwidth;
     td.shooting = shooting_options_from(p);
+    td.cycle_tolerance = p.real("cycle_tolerance");
     td.validate();
   }
   // a new engine for each scan (the main one and every set-point of the sweep)

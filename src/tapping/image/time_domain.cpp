@@ -25,6 +25,10 @@ void TimeDomainOptions::validate() const {
   if (!(lockin_bandwidth >= 0.0 && std::isfinite(lockin_bandwidth)))
     throw InvalidParameter("lockin_bandwidth",
                            fmt::format("lockin_bandwidth = {} Hz is out of range: must be >= 0", lockin_bandwidth));
+  if (!(cycle_tolerance > 0.0 && cycle_tolerance < 1.0))
+    throw InvalidParameter("cycle_tolerance", fmt::format("cycle_tolerance = {} is out of range: the cycles' relative "
+                                                          "tolerance must be in (0, 1)",
+                                                          cycle_tolerance));
   shooting.validate();
 }
 
@@ -54,6 +58,8 @@ TimeDomainEngine::TimeDomainEngine(const TappingModel& model, const OrbitMap& ma
       period_(model.period() * scales.time),
       lockin_(options.lockin_cycles, model.period() * scales.time, options.lockin_bandwidth) {
   simulation_.sensitivity = false;
+  simulation_.relative_tolerance = options.cycle_tolerance;
+  simulation_.absolute_tolerance = 1e-2 * options.cycle_tolerance;
   // the adaptive integrator's largest step: a twelfth of the shortest period instead of a 24th (its guards still see
   // every crossing: the gap's rate ẋ changes sign at most once in a twelfth of a period); the error control sets the
   // steps below it (docs/theory-tapping.md#time-domain-imaging: steps per cycle against the tolerance)
