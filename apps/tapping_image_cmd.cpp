@@ -8,6 +8,8 @@
 #include <cmath>
 #include <numbers>
 #include <memory>
+#include <optional>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -91,6 +93,10 @@ void declare_tapping_image(io::ParamSet& p) {
             {"quasi-static", "time-domain"})
       .integer("lockin_cycles", 1, "time-domain engine: drive cycles the lock-in averages (boxcar), at most the "
                "cycles of one pixel", 1, 1000000)
+      .real("cycle_tolerance", 1e-8, "time-domain engine: relative tolerance of the cycles' adaptive integrator "
+            "(absolute: 1e-2 of it in nm; relative_tolerance stays the orbit map's and the engagement's)",
+            io::Range::open(0.0, 1.0))
+      .unit("dimensionless")
       .real("setpoint", 0.8, "amplitude set-point A_sp / A0, in (0, 1)", io::Range::any())
       .unit("dimensionless")
       .reals("setpoint_sweep", {}, "more set-points A_sp/A0 imaged with the same orbit map (results: setpoint_sweep)",
@@ -124,6 +130,7 @@ void declare_tapping_image(io::ParamSet& p) {
   add_output_params(p, "out/tapping_image/lines.csv", "per-line metrics (regime switches, jumps, peak force)");
   add_quiet_flag(p);
   p.applies_when("lockin_cycles", "engine", {"time-domain"});
+  p.applies_when("cycle_tolerance", "engine", {"time-domain"});
 }
 
 std::vector<io::Column> tapping_image_line_columns() {
@@ -234,6 +241,10 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
   require_sample_covers_scan(p, map, raster);
   const bool time_domain = p.text("engine") == "time-domain";
   if (time_domain) require_whole_cycles(p, raster, fb, f_drive);
+  if (!time_domain && p.was_set("cycle_tolerance"))
+    throw InvalidParameter("cycle_tolerance", fmt::format("cycle_tolerance does not apply to engine = {}: it is the "
+                                                          "time-domain engine's integrator tolerance",
+                                                          p.text("engine")));
   if (!time_domain && p.was_set("lockin_cycles"))
     throw InvalidParameter("lockin_cycles", fmt::format("lockin_cycles does not apply to engine = {}: the lock-in "
                                                         "window of whole cycles is the time-domain engine's",
@@ -267,6 +278,7 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
     td.lockin_cycles = p.integer("lockin_cycles");
     td.lockin_bandwidth = fb.lockin_bandwidth;
     td.shooting = shooting_options_from(p);
+    td.cycle_tolerance = p.real("cycle_tolerance");
     td.validate();
   }
   // a new engine for each scan (the main one and every set-point of the sweep)
@@ -289,30 +301,46 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
     return *hi - *lo;
   };
   const double truth_range = range_of(r.truth);
+  // the set-point sweep's scans are independent of each other and of the main one (each its own engine on the
+  // shared, read-only map and sample): computed in parallel (OpenMP), each exactly as alone; the first failure in
+  // the list's order is the one reported, as in a serial run
+  const std::vector<double>& setpoints = p.reals("setpoint_sweep");
+  std::vector<std::optional<nlohmann::json>> swept(setpoints.size());
+  std::vector<std::exception_ptr> sweep_errors(setpoints.size());
+#pragma omp parallel for schedule(dynamic) if (setpoints.size() > 1)
+  for (std::size_t k = 0; k < setpoints.size(); ++k) {
+    try {
+      const double sp = setpoints[k];
+      ti::FeedbackSpec at = fb;
+      at.setpoint = sp;
+      const std::unique_ptr<ti::TipEngine> e = make_engine();
+      ti::ImagingOptions o;
+      o.cancellation = io_options.cancellation;
+      const ti::ImagingResult rs = [&] {
+        try {
+          return ti::scan_image(*e, surface, raster, at, o);
+        } catch (const InvalidParameter& error) {  // the approach does not reach it: name the list
+          throw InvalidParameter("setpoint_sweep", fmt::format("setpoint_sweep contains {}: {}", sp, error.what()));
+        }
+      }();
+      const ti::ImagingMetrics ms = ti::imaging_metrics(rs);
+      swept[k] = nlohmann::json{{"setpoint", sp},
+                                {"engaged_separation", rs.engaged_separation},
+                                {"trace_height_rms_error", ms.trace_height_rms_error},
+                                {"apparent_height", range_of(rs.trace.height)},
+                                {"truth_height", truth_range},
+                                {"fraction_attractive", ms.fraction_attractive},
+                                {"fraction_repulsive", ms.fraction_repulsive},
+                                {"regime_switches_per_line", ms.switches_per_line},
+                                {"max_peak_force", ms.max_peak_force}};
+    } catch (...) {
+      sweep_errors[k] = std::current_exception();
+    }
+  }
   nlohmann::json setpoint_sweep = nlohmann::json::array();
-  for (double sp : p.reals("setpoint_sweep")) {
-    ti::FeedbackSpec at = fb;
-    at.setpoint = sp;
-    const std::unique_ptr<ti::TipEngine> e = make_engine();
-    ti::ImagingOptions o;
-    o.cancellation = io_options.cancellation;
-    const ti::ImagingResult rs = [&] {
-      try {
-        return ti::scan_image(*e, surface, raster, at, o);
-      } catch (const InvalidParameter& error) {  // the approach does not reach it: name the list
-        throw InvalidParameter("setpoint_sweep", fmt::format("setpoint_sweep contains {}: {}", sp, error.what()));
-      }
-    }();
-    const ti::ImagingMetrics ms = ti::imaging_metrics(rs);
-    setpoint_sweep.push_back({{"setpoint", sp},
-                              {"engaged_separation", rs.engaged_separation},
-                              {"trace_height_rms_error", ms.trace_height_rms_error},
-                              {"apparent_height", range_of(rs.trace.height)},
-                              {"truth_height", truth_range},
-                              {"fraction_attractive", ms.fraction_attractive},
-                              {"fraction_repulsive", ms.fraction_repulsive},
-                              {"regime_switches_per_line", ms.switches_per_line},
-                              {"max_peak_force", ms.max_peak_force}});
+  for (std::size_t k = 0; k < setpoints.size(); ++k) {
+    if (sweep_errors[k]) std::rethrow_exception(sweep_errors[k]);
+    setpoint_sweep.push_back(std::move(*swept[k]));
   }
 
   // the record: the sizes the run used

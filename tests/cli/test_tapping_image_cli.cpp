@@ -84,4 +84,25 @@ TEST(TappingImageCli, AFlatSampleImagesZeroHeightAtTheSetPoint) {
   EXPECT_EQ(dir.count_files(), 0u);
 }
 
+TEST(TappingImageCli, TheSetPointSweepsScansInParallelAreEachTheScanAlone) {
+  // the sweep's set-points are scanned in parallel (OpenMP), each with its own engine: the one at the main scan's
+  // set-point gives the main scan's results bit for bit, whichever thread ran it and beside whichever others
+  TempDir dir;
+  const auto r = run_cli(kTappingImageSmall + "--sample steps --steps-height 1e-9 --setpoint 0.8 "
+                         "--setpoint-sweep 0.7,0.8,0.75,0.8 --output '' --image-output '' --json", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto printed = nlohmann::json::parse(r.out);
+  const auto& sweep = printed["setpoint_sweep"];
+  ASSERT_EQ(sweep.size(), 4u);
+  for (std::size_t k : {std::size_t{1}, std::size_t{3}}) {
+    EXPECT_EQ(sweep[k]["setpoint"].get<double>(), 0.8);
+    EXPECT_EQ(sweep[k]["trace_height_rms_error"].get<double>(), printed["trace_height_rms_error"].get<double>());
+    EXPECT_EQ(sweep[k]["max_peak_force"].get<double>(), printed["max_peak_force"].get<double>());
+    EXPECT_EQ(sweep[k]["engaged_separation"].get<double>(), printed["engaged_separation"].get<double>());
+  }
+  EXPECT_EQ(sweep[0]["setpoint"].get<double>(), 0.7);  // in the list's order
+  EXPECT_EQ(sweep[2]["setpoint"].get<double>(), 0.75);
+  EXPECT_NE(sweep[0]["engaged_separation"].get<double>(), sweep[2]["engaged_separation"].get<double>());
+}
+
 }  // namespace

@@ -38,6 +38,10 @@ struct SimulationOptions {
   /// Largest step of the adaptive integrator and of the closed-form guard scan, as a fraction of the shortest
   /// period present (drive period, damped mode period): a crossing can never be stepped over.
   double max_step_fraction = 1.0 / 24.0;
+  /// First trial step of the adaptive integrator (model time; 0: 1e-3 of the drive period). A caller that runs
+  /// the motion in pieces passes the step the last piece ended with (SimulationStats::next_step) instead of
+  /// growing again from 1e-3 of a period; the error control accepts or shrinks it as any other step.
+  double initial_step = 0.0;
   long max_events = 1'000'000;  // exceeded -> NumericalFailure
   long max_steps = 50'000'000;  // adaptive steps budget -> NumericalFailure
   /// Propagate ∂(x, ẋ, l)(t_end)/∂(x, ẋ, l)(t_begin) (variational equations + saltation matrices at events).
@@ -68,6 +72,7 @@ struct SimulationStats {
   long sticking_count = 0;    // entries into the sticking mode
   double sticking_duration = 0.0;  // total time spent sticking
   long steps = 0;             // closed-form guard-scan intervals or adaptive steps
+  double next_step = 0.0;     // adaptive: the step the error control proposes at the end (for initial_step)
 };
 
 struct SimulationResult {

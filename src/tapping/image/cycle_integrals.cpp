@@ -7,34 +7,42 @@
 #include "afmkit/tapping/events.hpp"
 #include "afmkit/tapping/gauss_panels.hpp"
 #include "afmkit/tapping/system.hpp"
+#include "../sim/small_angle.hpp"
 
 namespace afmkit::tapping::image {
 
-void CycleIntegrals::force_at(const TappingSystem& system, const Segment& segment, double t) {
-  const TipState s = segment.state(t);
-  const Mode m = segment.mode();
+void CycleIntegrals::force_at(const TappingSystem& system, const Mode& m, const TipState& s) {
   peak_force = std::max(peak_force, 0.0 - system.interaction(m.branch, s.position, s.velocity, m.region));
 }
 
 void CycleIntegrals::on_segment(const TappingSystem& system, const Segment& segment) {
   const double t0 = segment.t_begin(), t1 = segment.t_end();
   if (!(t1 > t0)) return;
+  // the panels' rotations e^{iu}, |u| <= ω · panel / 2 = π/16: the series (exact to rounding) instead of sincos
+  const auto phasor = [](double u) {
+    return std::abs(u) <= tapping::detail::small_angle_limit ? tapping::detail::small_angle_phasor(u)
+                                                             : std::polar(1.0, u);
+  };
   gauss_panels<7>(
-      t0, t1, panel_, system.drive_frequency(), [](double u) { return std::polar(1.0, u); },
+      t0, t1, panel_, system.drive_frequency(), phasor,
       [&](double t, double w, std::complex<double> e) {  // e = e^{−iωt}
         const TipState s = segment.state(t);
         first_harmonic += (w * s.position) * e;
         velocity_square += w * s.velocity * s.velocity;
       },
       [](double, double) {});
-  // the largest force: at the ends, and at the bottom of the motion (ẋ rising through 0) inside the segment
-  force_at(system, segment, t0);
-  force_at(system, segment, t1);
-  const double va = segment.state(t0).velocity, vb = segment.state(t1).velocity;
-  if (va < 0.0 && vb > 0.0) {
+  // the largest force: at the ends, and at the bottom of the motion (ẋ rising through 0) inside the segment. A step
+  // that continues the last one (same mode, from its end) starts where the force was taken already.
+  const Mode m = segment.mode();
+  const TipState s0 = segment.state(t0), s1 = segment.state(t1);
+  if (!(t0 == last_end_ && m == last_mode_)) force_at(system, m, s0);
+  force_at(system, m, s1);
+  last_end_ = t1;
+  last_mode_ = m;
+  if (s0.velocity < 0.0 && s1.velocity > 0.0) {
     auto rate = [&](double t) { return segment.state(t).velocity; };
-    force_at(system, segment,
-             isolate_crossing(rate, t0, t1, CrossingDirection::rising, 1e-15 * std::max(1.0, std::abs(t1))));
+    const double tb = isolate_crossing(rate, t0, t1, CrossingDirection::rising, 1e-15 * std::max(1.0, std::abs(t1)));
+    force_at(system, m, segment.state(tb));
   }
 }
 

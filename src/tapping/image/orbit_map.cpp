@@ -22,8 +22,8 @@ const char* regime_name(Regime regime) {
 
 double SteadyState::phase() const { return std::atan2(sin_phase, cos_phase); }
 
-Regime regime_of(double in_phase_force, double drive_amplitude) {
-  if (!(std::abs(in_phase_force) > 1e-9 * drive_amplitude)) return Regime::free;
+Regime regime_of(double in_phase_force, double drive_amplitude, double free_fraction) {
+  if (!(std::abs(in_phase_force) > free_fraction * drive_amplitude)) return Regime::free;
   return in_phase_force > 0.0 ? Regime::attractive : Regime::repulsive;
 }
 

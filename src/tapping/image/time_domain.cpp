@@ -25,6 +25,10 @@ void TimeDomainOptions::validate() const {
   if (!(lockin_bandwidth >= 0.0 && std::isfinite(lockin_bandwidth)))
     throw InvalidParameter("lockin_bandwidth",
                            fmt::format("lockin_bandwidth = {} Hz is out of range: must be >= 0", lockin_bandwidth));
+  if (!(cycle_tolerance > 0.0 && cycle_tolerance < 1.0))
+    throw InvalidParameter("cycle_tolerance", fmt::format("cycle_tolerance = {} is out of range: the cycles' relative "
+                                                          "tolerance must be in (0, 1)",
+                                                          cycle_tolerance));
   shooting.validate();
 }
 
@@ -54,6 +58,18 @@ TimeDomainEngine::TimeDomainEngine(const TappingModel& model, const OrbitMap& ma
       period_(model.period() * scales.time),
       lockin_(options.lockin_cycles, model.period() * scales.time, options.lockin_bandwidth) {
   simulation_.sensitivity = false;
+  simulation_.relative_tolerance = options.cycle_tolerance;
+  simulation_.absolute_tolerance = 1e-2 * options.cycle_tolerance;
+  // the adaptive integrator's largest step: a twelfth of the shortest period instead of a 24th (its guards still see
+  // every crossing: the gap's rate ẋ changes sign at most once in a twelfth of a period); the error control sets the
+  // steps below it (docs/theory-tapping.md#time-domain-imaging: steps per cycle against the tolerance)
+  if (resolve_integrator(model, simulation_.integrator) == Integrator::adaptive) {
+    simulation_.max_step_fraction = kCycleMaxStepFraction;
+    // H_c by parts (advance) is exact for the integrated motion only to the integrator's error: at resonance its
+    // (ω_n² − ω² + icω) ∫x e^{−iωt} term cancels ΓT/2, so a relative error ε of the cycle's ∫x e^{−iωt} leaves
+    // ~ε Γ (measured: 0.6 rtol Γ on free cycles); below 10 rtol Γ a cycle is not told from free
+    free_fraction_ = std::max(free_fraction_, 10.0 * simulation_.relative_tolerance);
+  }
   metres_ = scales.length * 1e-9;  // physical model units: nm, nN, aJ, s (units.hpp)
   newtons_ = scales.force * 1e-9;
   watts_ = scales.energy * 1e-18 / period_;
@@ -64,7 +80,9 @@ TimeDomainEngine::Cycle TimeDomainEngine::run_cycle(double separation) {
   CycleIntegrals integrals(model_period_);
   const TipState a = state_;
   const double t0 = start_, t1 = start_ + model_period_;
+  simulation_.initial_step = next_step_;  // the step the last cycle ended with, not 1e-3 of a period again
   const SimulationResult r = simulate(system_, t0, a, t1, simulation_, &integrals);
+  next_step_ = r.stats.next_step;
   state_ = r.state;
   events_ += r.stats.events;
   steps_ += r.stats.steps;
@@ -89,6 +107,7 @@ TimeDomainEngine::Cycle TimeDomainEngine::run_cycle(double separation) {
 }
 
 double TimeDomainEngine::engage(double amplitude) {
+  simulation_.initial_step = 0.0;  // the engagement's runs start afresh (an engine may engage again)
   const OrbitMap::Engaged e = engage_on(map_, amplitude, metres_);
   const SteadyState s = map_.at(e.branch, e.separation);
   // the periodic orbit there: shooting from the map's first harmonic x ≈ B cos(ωt − φ) at t = 0; then the separation
@@ -135,6 +154,7 @@ double TimeDomainEngine::engage(double amplitude) {
   system_.set_separation(l);
   state_ = shot_ ? y : guess;
   start_ = 0.0;
+  next_step_ = 0.0;
   if (!shot_) {  // ten cantilever time constants 2Q/ω_n
     const double settle = 20.0 * system_.model().cantilever.quality_factor / system_.model().cantilever.natural_frequency;
     const long n = static_cast<long>(std::ceil(settle / model_period_));
@@ -193,7 +213,7 @@ TipReading TimeDomainEngine::advance(const scan::Surface& surface, double z, dou
   const double norm = std::abs(harmonic);
   const std::complex<double> lag = norm > 0.0 ? std::conj(harmonic) / norm : std::complex<double>(1.0, 0.0);
   const double in_phase_force = 2.0 / (static_cast<double>(n) * model_period_) * (lag * force).real();
-  r.regime = static_cast<int>(regime_of(in_phase_force, system_.model().drive.amplitude));
+  r.regime = static_cast<int>(regime_of(in_phase_force, system_.model().drive.amplitude, free_fraction_));
   r.branch = r.regime;  // a change of regime is the time-domain engine's jump
   last_ = r;
   return r;

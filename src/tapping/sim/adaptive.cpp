@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <limits>
 
 #include <boost/numeric/odeint.hpp>
 #include <fmt/format.h>
@@ -195,8 +196,13 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
   std::array<Guard, 3> guards;
   GuardSamples a, b;
   State y{}, tmp{};
-  double dt = std::min(max_dt, 1e-3 * drive_period);
+  double dt = std::min(max_dt, options.initial_step > 0.0 ? options.initial_step : 1e-3 * drive_period);
   while (rs.t < t_end) {
+    // an event located less than the smallest step before t_end: the state stands for that remainder
+    if (t_end - rs.t <= 16.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t_end))) {
+      rs.t = t_end;
+      break;
+    }
     // one mode: the tip rests (run_sticking); more modes: the modes move on with the tip held (ModalField)
     if (rs.mode.branch == ContactBranch::sticking && !sys.modal()) {
       run_sticking(sys, rs, t_end, options, observer);
@@ -254,6 +260,7 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
       rs.y = y1;
     }
   }
+  rs.stats.next_step = dt;
 }
 
 }  // namespace

@@ -45,7 +45,9 @@ class Dop853 {
     for (;;) {
       double h = std::min(h_, max_step_);
       bool clipped = false;
-      if (t_ + h >= t_limit) {
+      // a step that would end less than the smallest step before t_limit ends there instead (steps that add up
+      // to just below t_limit, e.g. whole periods in max_step pieces, left a remainder the next step refused)
+      if (t_ + h >= t_limit - h_min) {
         h = t_limit - t_;
         clipped = true;
       }

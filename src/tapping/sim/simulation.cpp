@@ -26,6 +26,8 @@ void SimulationOptions::validate() const {
   check_fields(*this);  // the ranges describe() declares
   if (!(max_step_fraction > 0 && max_step_fraction <= 0.25))
     validate::require(false, "max_step_fraction", max_step_fraction, "in (0, 0.25]");
+  if (!(initial_step >= 0 && std::isfinite(initial_step)))
+    validate::require(false, "initial_step", initial_step, ">= 0 and finite");
   if (max_events < 1) validate::require(false, "max_events", static_cast<double>(max_events), ">= 1");
   if (max_steps < 1) validate::require(false, "max_steps", static_cast<double>(max_steps), ">= 1");
 }

@@ -9,6 +9,9 @@
 //   Γ ∫ cos(ωt) ẋ dt = Γ (Re[x e^{−iωt}]_a^b − ω Im ∫ x e^{−iωt} dt)   (by parts).
 #include <complex>
 
+#include <limits>
+
+#include "afmkit/tapping/events.hpp"
 #include "afmkit/tapping/observer.hpp"
 
 namespace afmkit::tapping::image {
@@ -24,7 +27,9 @@ class CycleIntegrals final : public TrajectoryObserver {
 
  private:
   double panel_;
-  void force_at(const TappingSystem& system, const Segment& segment, double t);
+  double last_end_ = std::numeric_limits<double>::quiet_NaN();  // the end of the last segment and its mode
+  Mode last_mode_;
+  void force_at(const TappingSystem& system, const Mode& m, const TipState& s);
 };
 
 }  // namespace afmkit::tapping::image

@@ -22,10 +22,11 @@ namespace afmkit::tapping::image {
 /// The cycle-averaged regime of an orbit, from the sign of the in-phase first harmonic of the tip–sample force
 /// H_c = (2/T)∫ H cos(ωt − φ) dt = (ω_n² − ω²) B − Γ cos φ (exact first-harmonic balance of eq. 8): H_c < 0 the
 /// force acts as an added stiffness (repulsive regime, phase below the free phase), H_c > 0 as a softening
-/// (attractive regime), |H_c| <= 1e-9 Γ no interaction (free).
+/// (attractive regime), |H_c| <= 1e-9 Γ no interaction (free; `free_fraction` of Γ: a caller whose H_c carries a
+/// larger numerical error says so, e.g. the time-domain engine's by-parts H_c at its integrator's tolerance).
 enum class Regime { free = 0, attractive = 1, repulsive = 2 };
 const char* regime_name(Regime regime);  // "free", "attractive", "repulsive"
-Regime regime_of(double in_phase_force, double drive_amplitude);
+Regime regime_of(double in_phase_force, double drive_amplitude, double free_fraction = 1e-9);
 
 /// One steady state: the orbit's observables (model units).
 struct SteadyState {

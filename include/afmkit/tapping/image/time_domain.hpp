@@ -29,11 +29,20 @@ struct TimeDomainOptions {
   long lockin_cycles = 1;          // N: drive cycles the lock-in averages (boxcar), >= 1
   double lockin_bandwidth = 5e3;   // −3 dB bandwidth of the lock-in's output filter [Hz] (0: none)
   ShootingOptions shooting;        // the engaged orbit; shooting.simulation: the integrator of every cycle
-  void validate() const;           // InvalidParameter naming lockin_cycles, lockin_bandwidth
+  /// Relative tolerance of the cycles' adaptive integrator (absolute: 1e-2 of it, model length units); the
+  /// engagement's shooting keeps shooting.simulation's. 1e-8: the image then differs from the converged one (1e-12)
+  /// by less than its GSF files' float32 rounding (DMT + vdW, 16 nm amplitude: height 3e-15 m, amplitude 4e-15 m,
+  /// phase 7e-5 deg, peak force 4e-6 relative; docs/theory-tapping.md#time-domain-imaging).
+  double cycle_tolerance = 1e-8;
+  void validate() const;           // InvalidParameter naming lockin_cycles, lockin_bandwidth, cycle_tolerance
 };
 
 class TimeDomainEngine final : public TipEngine {
  public:
+  /// The adaptive integrator's largest step in the cycles, as a fraction of the shortest period (SimulationOptions::
+  /// max_step_fraction; the closed-form flow keeps its own scan step).
+  static constexpr double kCycleMaxStepFraction = 1.0 / 12.0;
+
   /// `model`: cantilever, drive and law (model units; its separation is moved); `map`: the approach that engages
   /// (kept by reference); `scales` to SI (PhysicalCantilever::scales()).
   TimeDomainEngine(const TappingModel& model, const OrbitMap& map, const UnitScales& scales,
@@ -60,6 +69,8 @@ class TimeDomainEngine final : public TipEngine {
   double omega_, model_period_, period_;  // ω and T (model units), T [s]
   double start_ = 0.0;                     // model time of a cycle's start (the top of the engaged orbit)
   TipState state_;
+  double next_step_ = 0.0;                 // the adaptive integrator's step at the end of the last cycle
+  double free_fraction_ = 1e-9;            // |H_c| below this fraction of Γ: the free regime (regime_of)
   CycleLockIn lockin_;
   double clock_ = 0.0, target_ = 0.0;      // [s] since the engagement: cycles done, time requested
   TipReading last_;
