@@ -32,7 +32,7 @@ def test_figure_ids_are_unique_and_cover_both_papers_and_beyond():
 
 def test_the_report_lists_its_figures_as_the_modules_do_without_importing_matplotlib():
     """Listing and selecting figures (the report's parent process) imports neither Matplotlib nor the figure modules
-    (issue 28 §5: their import is paid once, in the fork server of the workers): REPORT_FIGURES is the modules'
+    (issue 28 §5: their import is paid once, just before the workers are forked): REPORT_FIGURES is the modules'
     FIGURES, in report order."""
     import importlib
     import sys
@@ -146,3 +146,32 @@ def test_no_text_the_page_is_made_of_cites_a_file_outside_the_repository():
                 found += [(f.name, node.lineno, o) for o in ("MATH.md", "shared/", "/work/", "seeds/", "../")
                           if o in node.value]
     assert found == []
+
+
+def test_workers_forked_by_the_report_process_run_cores_over_jobs_openmp_threads():
+    """`afmkit report` forks its workers from itself (no fork server): OMP_NUM_THREADS was read by the OpenMP
+    runtime when the report process loaded afmkit, so each worker sets its own threads (build._worker_init); the
+    report process keeps its own."""
+    import ctypes
+    import sys
+
+    import afmkit  # noqa: F401  (loads the module's OpenMP runtime)
+
+    try:
+        ctypes.CDLL("libgomp.so.1", mode=os.RTLD_NOLOAD | os.RTLD_LAZY)
+    except OSError:
+        pytest.skip("afmkit's module is not built with GNU OpenMP here")
+    code = ("import ctypes, os, afmkit\n"
+            "from afmkit.report.build import _forked_pool\n"
+            "def probe():\n"
+            "    g = ctypes.CDLL('libgomp.so.1', mode=os.RTLD_NOLOAD | os.RTLD_LAZY)\n"
+            "    return g.omp_get_max_threads(), os.getppid()\n"
+            "if __name__ == '__main__':\n"
+            "    with _forked_pool(1, 1) as pool:\n"
+            "        threads, parent = pool.submit(probe).result()\n"
+            "    g = ctypes.CDLL('libgomp.so.1', mode=os.RTLD_NOLOAD | os.RTLD_LAZY)\n"
+            "    print(threads, parent == os.getpid(), g.omp_get_max_threads())\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                         env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), OMP_NUM_THREADS="3"))
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["1", "True", "3"]
