@@ -71,6 +71,7 @@ def test_a_selection_writes_a_page_with_just_those_figures(tmp_path):
         assert f'id="{fid}"' in page
         assert (tmp_path / "rep" / "figures" / f"{fid}.png").stat().st_size > 1000
     assert "restitution" in page  # the impact figure's key number
+    assert "MS/s" in page and "harmonic-balance curve" in page  # the speed rows (measured in a forked child)
     # the figures first, the key numbers after them; no citation of a file outside the repository
     assert page.rindex("<figure>") < page.index('<h2 id="numbers">')
     for outside in ("MATH.md", "shared/", "/work/", "seeds/"):
@@ -175,3 +176,23 @@ def test_workers_forked_by_the_report_process_run_cores_over_jobs_openmp_threads
                          env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), OMP_NUM_THREADS="3"))
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["1", "True", "3"]
+
+
+def test_the_speed_numbers_are_measured_in_a_child_while_the_report_process_imports():
+    """The page's speed rows are measured in a child forked before the report process imports Matplotlib (on the
+    idle core, not after the figures): the child's rows arrive through its pipe, as speed_numbers() gives them."""
+    import sys
+
+    code = ("import os\n"
+            "from afmkit.report.build import _SpeedAhead\n"
+            "ahead = _SpeedAhead.start()\n"
+            "import matplotlib.pyplot\n"
+            "rows = ahead.result()\n"
+            "print(ahead.pid != os.getpid(), len(rows), all(len(r) == 3 for r in rows), rows[0][1].endswith('MS/s'),"
+            " rows[1][1].endswith(' ms'))\n")
+    if not sys.platform.startswith("linux"):
+        pytest.skip("fork: Linux")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                         env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "2", "True", "True", "True"]

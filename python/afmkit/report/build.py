@@ -155,6 +155,52 @@ def speed_numbers() -> list:
     return rows
 
 
+class _SpeedAhead:
+    """speed_numbers() measured in a child forked before the report process imports Matplotlib: it runs on the core
+    that import leaves idle instead of after the figures (issue 28 §5). Forked while this process has run no OpenMP
+    parallel region (as the workers, _forked_pool); the child ends with this process. Where there is no fork, or the
+    child fails, result() measures here."""
+
+    def __init__(self, pid: int, fd: int):
+        self.pid, self.fd = pid, fd
+
+    @classmethod
+    def start(cls):
+        if not hasattr(os, "fork") or not sys.platform.startswith("linux"):
+            return None
+        read, write = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the child: measure, send, leave without running the parent's exit handlers
+            code = 1
+            try:
+                import pickle
+                import signal
+
+                from .._parent import die_with_parent
+
+                os.close(read)
+                signal.signal(signal.SIGTERM, signal.SIG_DFL)
+                signal.signal(signal.SIGINT, signal.SIG_DFL)
+                die_with_parent(os.getppid())
+                with os.fdopen(write, "wb") as f:
+                    f.write(pickle.dumps(speed_numbers()))
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(write)
+        return cls(pid, read)
+
+    def result(self) -> list:
+        import pickle
+
+        with os.fdopen(self.fd, "rb") as f:
+            data = f.read()
+        _, status = os.waitpid(self.pid, 0)
+        if status != 0 or not data:
+            return speed_numbers()
+        return pickle.loads(data)
+
+
 def _timed(fn) -> float:
     start = time.perf_counter()
     fn()
@@ -309,12 +355,14 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all", *, _own_
     try:
         print(f"afmkit report: {len(tasks)} figures with {jobs} process(es) into {out}/", file=sys.stderr, flush=True)
         done = {}
+        ahead = None
         order = _longest_first(tasks)
         if _own_process and (jobs == 1 or len(tasks) == 1):  # no pool: the figures in this process
             _in_process(order, staging, done, tasks, started)
         else:
+            ahead = _SpeedAhead.start() if _own_process else None
             _in_pool(order, staging, done, tasks, started, jobs, forked=_own_process)
-        speed = speed_numbers()
+        speed = ahead.result() if ahead is not None else speed_numbers()
         ordered = [done[t[2]] for t in tasks]
         for fig in ordered:
             if not (staging / fig.filename).is_file():
