@@ -166,16 +166,19 @@ def test_workers_forked_by_the_report_process_run_cores_over_jobs_openmp_threads
             "from afmkit.report.build import _forked_pool\n"
             "def probe():\n"
             "    g = ctypes.CDLL('libgomp.so.1', mode=os.RTLD_NOLOAD | os.RTLD_LAZY)\n"
-            "    return g.omp_get_max_threads(), os.getppid()\n"
+            "    import gc\n"
+            "    return g.omp_get_max_threads(), os.getppid(), gc.get_threshold()[0]\n"
             "if __name__ == '__main__':\n"
             "    with _forked_pool(1, 1) as pool:\n"
-            "        threads, parent = pool.submit(probe).result()\n"
+            "        threads, parent, gc0 = pool.submit(probe).result()\n"
             "    g = ctypes.CDLL('libgomp.so.1', mode=os.RTLD_NOLOAD | os.RTLD_LAZY)\n"
-            "    print(threads, parent == os.getpid(), g.omp_get_max_threads())\n")
+            "    print(threads, parent == os.getpid(), g.omp_get_max_threads(), gc0)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
                          env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), OMP_NUM_THREADS="3"))
     assert out.returncode == 0, out.stderr
-    assert out.stdout.split() == ["1", "True", "3"]
+    from afmkit.report.build import _WORKER_GC_THRESHOLDS
+
+    assert out.stdout.split() == ["1", "True", "3", str(_WORKER_GC_THRESHOLDS[0])]
 
 
 def test_the_speed_numbers_are_measured_in_a_child_while_the_report_process_imports():

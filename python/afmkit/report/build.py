@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import concurrent.futures as futures
+import gc
 import importlib
 import os
 import shutil
@@ -293,14 +294,23 @@ def _forked_pool(workers: int, threads: int):
     matplotlib.use("Agg")
     import matplotlib.pyplot  # noqa: F401  (what _run_figure imports)
 
+    gc.freeze()  # the imported modules' objects: never traversed by the workers' collections (nor copied on write)
     return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
                                initializer=_worker_init, initargs=(os.getpid(), threads))
+
+
+#: The cyclic garbage collector of a figure worker: Matplotlib allocates many short-lived objects, and Python's
+#: default thresholds (700, 10, 10) ran ~430 young, 40 middle and 3 full collections (60-80 ms each) over the 13
+#: figures, ~0.33 s or 6 % of their CPU; these ~30, 1 and 0 (~0.2 s), for ~10 MB more memory per worker (the cycles
+#: of finished figures are freed later).
+_WORKER_GC_THRESHOLDS = (10_000, 20, 100)
 
 
 def _worker_init(parent: int, threads: int) -> None:
     """In a worker forked from the report process: ends with it (even by SIGKILL), SIGTERM ends it (the report
     process's handler, inherited, would turn it into KeyboardInterrupt), and the OpenMP runtime that afmkit's module
-    loaded runs `threads` threads (OMP_NUM_THREADS was read when the module was loaded, before the fork)."""
+    loaded runs `threads` threads (OMP_NUM_THREADS was read when the module was loaded, before the fork); its garbage
+    collector runs less often (_WORKER_GC_THRESHOLDS)."""
     import signal
 
     from .._parent import die_with_parent
@@ -308,6 +318,7 @@ def _worker_init(parent: int, threads: int) -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     die_with_parent(parent)
     _set_openmp_threads(threads)
+    gc.set_threshold(*_WORKER_GC_THRESHOLDS)
 
 
 def _set_openmp_threads(threads: int) -> None:
