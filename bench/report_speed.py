@@ -65,6 +65,7 @@ def main() -> None:
         packages = {"new": build / "python", "old": old_tree(args.baseline, build, work)}
         if args.imports:
             import_costs(packages, args.runs)
+        load_start = os.getloadavg()[0]
         samples = {k: [] for k in packages}
         for k in range(args.runs):  # interleaved: the machine's load hits both alike
             for name, pkg in (packages.items() if k % 2 == 0 else reversed(packages.items())):
@@ -73,7 +74,8 @@ def main() -> None:
                 samples[name].append(run([sys.executable, "-m", "afmkit.report", "--output-dir", str(out),
                                           "--jobs", str(args.jobs), "--figures", args.figures], env, work))
         print(f"afmkit report --jobs {args.jobs} --figures {args.figures}: {args.runs} runs each, interleaved; "
-              f"{os.cpu_count()} cores")
+              f"{os.cpu_count()} cores; load average (1 min) {load_start:.2f} before the runs, "
+              f"{os.getloadavg()[0]:.2f} after; baseline {args.baseline}")
         print(f"{'':<12} {'wall s':>7} {'CPU s':>7} {'load':>6}   runs (wall s)")
         med = {}
         for name, s in samples.items():

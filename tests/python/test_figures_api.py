@@ -116,3 +116,34 @@ def test_a_bad_keyword_raises_a_value_error_naming_it(fn, keywords, name, tmp_pa
 def test_an_unknown_keyword_is_refused():
     with pytest.raises(TypeError, match="frequency"):
         seed000.fig3(frequency=300.0)
+
+
+def test_save_png_draws_once_and_writes_the_pixels_savefig_writes(tmp_path):
+    """finish() writes the PNG with figures.save_png (one drawing pass, zlib level 3), not savefig (which draws a
+    constrained-layout figure twice): the decoded pixels of a new figure must be those savefig(dpi=DPI) writes of
+    the same new figure (a figure drawn before is laid out again from where it was), and the figure keeps its dpi
+    and canvas."""
+    import matplotlib.image as mpimg
+
+    from afmkit.figures import DPI, save_png
+
+    def new_figure(layout):
+        fig, axes = plt.subplots(2, 2, figsize=(5, 3.5), layout=layout, sharex=True)
+        x = np.linspace(0.1, 10, 500)
+        axes[0, 0].semilogy(x, np.exp(-x), label="exp(−x)")
+        axes[0, 1].plot(x, np.sin(x))
+        mesh = axes[1, 0].pcolormesh(np.outer(np.sin(x[:40]), np.cos(x[:30])), rasterized=True)
+        axes[1, 1].set_title("τ_c [T]")
+        axes[0, 0].legend()
+        fig.colorbar(mesh, ax=axes[1, 0], label="Re s [Ω]")
+        return fig
+
+    for layout in ("constrained", None):
+        new_figure(layout).savefig(tmp_path / "savefig.png", dpi=DPI)
+        fig = new_figure(layout)
+        dpi, canvas = fig.dpi, fig.canvas
+        save_png(fig, tmp_path / "once.png")
+        assert (fig.dpi, fig.canvas) == (dpi, canvas)
+        a, b = mpimg.imread(tmp_path / "savefig.png"), mpimg.imread(tmp_path / "once.png")
+        assert a.shape == b.shape and np.array_equal(a, b), layout
+        plt.close("all")

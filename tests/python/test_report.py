@@ -32,7 +32,7 @@ def test_figure_ids_are_unique_and_cover_both_papers_and_beyond():
 
 def test_the_report_lists_its_figures_as_the_modules_do_without_importing_matplotlib():
     """Listing and selecting figures (the report's parent process) imports neither Matplotlib nor the figure modules
-    (issue 28 §5: their import is paid once, in the fork server of the workers): REPORT_FIGURES is the modules'
+    (issue 28 §5: their import is paid once, just before the workers are forked): REPORT_FIGURES is the modules'
     FIGURES, in report order."""
     import importlib
     import sys
@@ -71,6 +71,7 @@ def test_a_selection_writes_a_page_with_just_those_figures(tmp_path):
         assert f'id="{fid}"' in page
         assert (tmp_path / "rep" / "figures" / f"{fid}.png").stat().st_size > 1000
     assert "restitution" in page  # the impact figure's key number
+    assert "MS/s" in page and "harmonic-balance curve" in page  # the speed rows (measured in a forked child)
     # the figures first, the key numbers after them; no citation of a file outside the repository
     assert page.rindex("<figure>") < page.index('<h2 id="numbers">')
     for outside in ("MATH.md", "shared/", "/work/", "seeds/"):
@@ -146,3 +147,55 @@ def test_no_text_the_page_is_made_of_cites_a_file_outside_the_repository():
                 found += [(f.name, node.lineno, o) for o in ("MATH.md", "shared/", "/work/", "seeds/", "../")
                           if o in node.value]
     assert found == []
+
+
+def test_workers_forked_by_the_report_process_run_cores_over_jobs_openmp_threads():
+    """`afmkit report` forks its workers from itself (no fork server): OMP_NUM_THREADS was read by the OpenMP
+    runtime when the report process loaded afmkit, so each worker sets its own threads (build._worker_init); the
+    report process keeps its own."""
+    import ctypes
+    import sys
+
+    import afmkit  # noqa: F401  (loads the module's OpenMP runtime)
+
+    try:
+        ctypes.CDLL("libgomp.so.1", mode=os.RTLD_NOLOAD | os.RTLD_LAZY)
+    except OSError:
+        pytest.skip("afmkit's module is not built with GNU OpenMP here")
+    code = ("import ctypes, os, afmkit\n"
+            "from afmkit.report.build import _forked_pool\n"
+            "def probe():\n"
+            "    g = ctypes.CDLL('libgomp.so.1', mode=os.RTLD_NOLOAD | os.RTLD_LAZY)\n"
+            "    import gc\n"
+            "    return g.omp_get_max_threads(), os.getppid(), gc.get_threshold()[0]\n"
+            "if __name__ == '__main__':\n"
+            "    with _forked_pool(1, 1) as pool:\n"
+            "        threads, parent, gc0 = pool.submit(probe).result()\n"
+            "    g = ctypes.CDLL('libgomp.so.1', mode=os.RTLD_NOLOAD | os.RTLD_LAZY)\n"
+            "    print(threads, parent == os.getpid(), g.omp_get_max_threads(), gc0)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                         env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), OMP_NUM_THREADS="3"))
+    assert out.returncode == 0, out.stderr
+    from afmkit.report.build import _WORKER_GC_THRESHOLDS
+
+    assert out.stdout.split() == ["1", "True", "3", str(_WORKER_GC_THRESHOLDS[0])]
+
+
+def test_the_speed_numbers_are_measured_in_a_child_while_the_report_process_imports():
+    """The page's speed rows are measured in a child forked before the report process imports Matplotlib (on the
+    idle core, not after the figures): the child's rows arrive through its pipe, as speed_numbers() gives them."""
+    import sys
+
+    code = ("import os\n"
+            "from afmkit.report.build import _SpeedAhead\n"
+            "ahead = _SpeedAhead.start()\n"
+            "import matplotlib.pyplot\n"
+            "rows = ahead.result()\n"
+            "print(ahead.pid != os.getpid(), len(rows), all(len(r) == 3 for r in rows), rows[0][1].endswith('MS/s'),"
+            " rows[1][1].endswith(' ms'))\n")
+    if not sys.platform.startswith("linux"):
+        pytest.skip("fork: Linux")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+                         env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "2", "True", "True", "True"]

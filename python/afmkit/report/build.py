@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import concurrent.futures as futures
+import gc
 import importlib
 import os
 import shutil
@@ -36,7 +37,8 @@ REPORT_FIGURES = [
     ("scan", "scan_images", "beyond-scan-images", 0.85),
 ]
 
-#: What the figure workers import once, in the fork server they are forked from (afmkit._pool).
+#: What the figure workers import once, before they are forked (by the report process, or by the fork server of
+#: afmkit._pool).
 _PRELOAD = ["afmkit.report.build", *(f"afmkit.figures.{m}" for m in FIGURE_MODULES)]
 
 
@@ -154,6 +156,52 @@ def speed_numbers() -> list:
     return rows
 
 
+class _SpeedAhead:
+    """speed_numbers() measured in a child forked before the report process imports Matplotlib: it runs on the core
+    that import leaves idle instead of after the figures (issue 28 §5). Forked while this process has run no OpenMP
+    parallel region (as the workers, _forked_pool); the child ends with this process. Where there is no fork, or the
+    child fails, result() measures here."""
+
+    def __init__(self, pid: int, fd: int):
+        self.pid, self.fd = pid, fd
+
+    @classmethod
+    def start(cls):
+        if not hasattr(os, "fork") or not sys.platform.startswith("linux"):
+            return None
+        read, write = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the child: measure, send, leave without running the parent's exit handlers
+            code = 1
+            try:
+                import pickle
+                import signal
+
+                from .._parent import die_with_parent
+
+                os.close(read)
+                signal.signal(signal.SIGTERM, signal.SIG_DFL)
+                signal.signal(signal.SIGINT, signal.SIG_DFL)
+                die_with_parent(os.getppid())
+                with os.fdopen(write, "wb") as f:
+                    f.write(pickle.dumps(speed_numbers()))
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(write)
+        return cls(pid, read)
+
+    def result(self) -> list:
+        import pickle
+
+        with os.fdopen(self.fd, "rb") as f:
+            data = f.read()
+        _, status = os.waitpid(self.pid, 0)
+        if status != 0 or not data:
+            return speed_numbers()
+        return pickle.loads(data)
+
+
 def _timed(fn) -> float:
     start = time.perf_counter()
     fn()
@@ -184,15 +232,24 @@ def _in_process(order, staging, done, tasks, started) -> None:
         _accept(fig, m, n, figure_id, done, tasks, started)
 
 
-def _in_pool(order, staging, done, tasks, started, jobs: int) -> None:
-    """`jobs` worker processes forked from a fork server that has imported Matplotlib, NumPy, afmkit and the figure
-    modules once (afmkit._pool), each with cores / jobs OpenMP threads; the longest figures are started first."""
+def _in_pool(order, staging, done, tasks, started, jobs: int, forked: bool) -> None:
+    """`jobs` worker processes, each with cores / jobs OpenMP threads, that have Matplotlib, NumPy, afmkit and the
+    figure modules imported before they start; the longest figures are started first.
+
+    ``forked`` (`afmkit report` itself): this process imports them and forks the workers (_forked_pool). Otherwise
+    (build() called from a Python session, which may have run OpenMP code) the workers are forked from a fork
+    server that imports them (afmkit._pool)."""
     from concurrent.futures.process import BrokenProcessPool
 
-    from .. import _pool
-
     threads = max(1, (os.cpu_count() or 1) // jobs)
-    with _pool.pool(min(jobs, len(order)), _PRELOAD, threads) as pool:
+    workers = min(jobs, len(order))
+    if forked:
+        pool_cm = _forked_pool(workers, threads)
+    else:
+        from .. import _pool
+
+        pool_cm = _pool.pool(workers, _PRELOAD, threads)
+    with pool_cm as pool:
         pending = {}
         try:
             for m, n, i in order:
@@ -214,6 +271,67 @@ def _in_pool(order, staging, done, tasks, started, jobs: int) -> None:
             for fut in pending:
                 fut.cancel()
             raise
+
+
+def _forked_pool(workers: int, threads: int):
+    """A pool of `workers` processes forked from this process (the `afmkit report` process) once it has imported
+    what the figures need (_PRELOAD): a fork server would start another interpreter and import afmkit, NumPy and
+    Matplotlib again (issue 28 §5: ~0.2 s more on the way to the first figure). Safe because this process has run no
+    OpenMP parallel region yet (fork after one is not: the child's OpenMP threads would be missing); each worker
+    then sets its OpenMP threads (_worker_init). Where there is no fork (Windows, macOS' default), the fork server
+    or spawn context of afmkit._pool."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    if "fork" not in multiprocessing.get_all_start_methods() or not sys.platform.startswith("linux"):
+        from .. import _pool
+
+        return _pool.pool(workers, _PRELOAD, threads)
+    for module in _PRELOAD:
+        importlib.import_module(module)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot  # noqa: F401  (what _run_figure imports)
+
+    gc.freeze()  # the imported modules' objects: never traversed by the workers' collections (nor copied on write)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
+                               initializer=_worker_init, initargs=(os.getpid(), threads))
+
+
+#: The cyclic garbage collector of a figure worker: Matplotlib allocates many short-lived objects, and Python's
+#: default thresholds (700, 10, 10) ran ~430 young, 40 middle and 3 full collections (60-80 ms each) over the 13
+#: figures, ~0.33 s or 6 % of their CPU; these ~30, 1 and 0 (~0.2 s), for ~10 MB more memory per worker (the cycles
+#: of finished figures are freed later).
+_WORKER_GC_THRESHOLDS = (10_000, 20, 100)
+
+
+def _worker_init(parent: int, threads: int) -> None:
+    """In a worker forked from the report process: ends with it (even by SIGKILL), SIGTERM ends it (the report
+    process's handler, inherited, would turn it into KeyboardInterrupt), and the OpenMP runtime that afmkit's module
+    loaded runs `threads` threads (OMP_NUM_THREADS was read when the module was loaded, before the fork); its garbage
+    collector runs less often (_WORKER_GC_THRESHOLDS)."""
+    import signal
+
+    from .._parent import die_with_parent
+
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    die_with_parent(parent)
+    _set_openmp_threads(threads)
+    gc.set_threshold(*_WORKER_GC_THRESHOLDS)
+
+
+def _set_openmp_threads(threads: int) -> None:
+    """omp_set_num_threads(threads) in the OpenMP runtime already loaded in this process (GNU libgomp, LLVM libomp,
+    Intel libiomp); nothing if none is loaded."""
+    import ctypes
+
+    for name in ("libgomp.so.1", "libomp.so", "libomp.so.5", "libiomp5.so"):
+        try:
+            lib = ctypes.CDLL(name, mode=os.RTLD_NOLOAD | os.RTLD_LAZY)
+        except OSError:
+            continue
+        lib.omp_set_num_threads(ctypes.c_int(threads))
 
 
 def build(output_dir="out/report", jobs: int = 2, figures: str = "all", *, _own_process: bool = False) -> Path:
@@ -248,12 +366,14 @@ def build(output_dir="out/report", jobs: int = 2, figures: str = "all", *, _own_
     try:
         print(f"afmkit report: {len(tasks)} figures with {jobs} process(es) into {out}/", file=sys.stderr, flush=True)
         done = {}
+        ahead = None
         order = _longest_first(tasks)
         if _own_process and (jobs == 1 or len(tasks) == 1):  # no pool: the figures in this process
             _in_process(order, staging, done, tasks, started)
         else:
-            _in_pool(order, staging, done, tasks, started, jobs)
-        speed = speed_numbers()
+            ahead = _SpeedAhead.start() if _own_process else None
+            _in_pool(order, staging, done, tasks, started, jobs, forked=_own_process)
+        speed = ahead.result() if ahead is not None else speed_numbers()
         ordered = [done[t[2]] for t in tasks]
         for fig in ordered:
             if not (staging / fig.filename).is_file():
