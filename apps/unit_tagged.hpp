@@ -34,6 +34,15 @@ class UnitTagged {
     units_[key] = unit.name;
     return *this;
   }
+  /// Named numbers converted by `unit`, one JSON object (a box's edges); one unit for all of them.
+  UnitTagged& add(const std::string& key, const std::vector<std::pair<std::string, double>>& named,
+                  const units::Unit& unit) {
+    nlohmann::json o = nlohmann::json::object();
+    for (const auto& [name, v] : named) o[name] = unit(v);
+    values_[key] = std::move(o);
+    units_[key] = unit.name;
+    return *this;
+  }
   /// A value shown as computed (counts, flags, rad, dimensionless numbers) and its unit.
   UnitTagged& add(const std::string& key, nlohmann::json value, const char* unit) {
     values_[key] = std::move(value);

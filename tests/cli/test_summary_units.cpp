@@ -134,9 +134,13 @@ void collect_unitless_results(const nlohmann::json& value, const nlohmann::json*
     for (std::size_t i = 0; i < value.size(); ++i)
       collect_unitless_results(value[i], units, path + "/" + std::to_string(i), out);
   } else if (value.is_object()) {
+    // a record may carry its own units (control: settings, tau0)
+    const nlohmann::json* own = value.contains("units") && value.at("units").is_object() ? &value.at("units") : nullptr;
     for (const auto& [key, v] : value.items()) {
-      if (path.empty() && key == "units") continue;
-      const nlohmann::json* u = units != nullptr && units->is_object() && units->contains(key) ? &units->at(key) : nullptr;
+      if (key == "units" && (path.empty() || own != nullptr)) continue;
+      const nlohmann::json* u = units != nullptr && units->is_object() && units->contains(key) ? &units->at(key)
+                                : own != nullptr && own->contains(key)                        ? &own->at(key)
+                                                                                              : nullptr;
       collect_unitless_results(v, u, path + "/" + key, out);
     }
   }
@@ -175,6 +179,19 @@ TEST(SummaryUnits, EveryResultOfTappingHbSweepFmModesAndDemoHasItsUnit) {
     const auto r = run_cli(args, dir);
     ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
     EXPECT_EQ(unitless_results(dir.path / sidecar), std::vector<std::string>{}) << args;
+  }
+}
+
+TEST(SummaryUnits, EveryResultOfControlRootsAndMarginHasItsUnit) {
+  // flags (complete, box_is_proven, stable_at_reference, ...) had no unit; the settings and tau0 records carry their own
+  for (const char* args :
+       {"control roots --harmonics 3 --output r.csv", "control roots --controller infinite --output r.csv",
+        "control margin --harmonics 3 --output r.csv", "control margin --controller single --output r.csv",
+        "control margin --compare --harmonics 3 --output r.csv"}) {
+    TempDir dir;
+    const auto r = run_cli(args, dir);
+    ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
+    EXPECT_EQ(unitless_results(dir.path / "r.csv.json"), std::vector<std::string>{}) << args;
   }
 }
 
