@@ -182,15 +182,20 @@ TEST(SummaryUnits, EveryResultOfTappingHbSweepFmModesAndDemoHasItsUnit) {
   }
 }
 
-TEST(SummaryUnits, EveryResultOfControlRootsMarginAndChartHasItsUnit) {
-  // on main the flags (complete, box_is_proven, stable_at_reference, ...) and the chart's counts had no unit, the
+TEST(SummaryUnits, EveryResultOfControlRootsMarginChartSimulateAndTuneHasItsUnit) {
+  // on main the flags (complete, box_is_proven, stable_at_reference, diverged, converged, ...) and the chart's counts
+  // had no unit, the
   // margin map no units at all; the settings and tau0 records carry their own
   for (const char* args :
        {"control roots --harmonics 3 --output r.csv", "control roots --controller infinite --output r.csv",
         "control margin --harmonics 3 --output r.csv", "control margin --controller single --output r.csv",
         "control margin --compare --harmonics 3 --output r.csv",
         "control chart --harmonics 3 --x-points 8 --y-points 8 --delays 0.1,0.2 --output r.csv",
-        "control chart --harmonics 3 --quantity margin --x-points 6 --y-points 6 --output r.csv"}) {
+        "control chart --harmonics 3 --quantity margin --x-points 6 --y-points 6 --output r.csv",
+        "control simulate --harmonics 3 --signal 0.2,1.2,0.5,-0.8,-0.4 --signal-sample-rate 250 "
+        "--rotation-frequency-hz 50 --periods 10 --output r.csv",
+        "control tune --harmonics 3 --coarse-points 4 --max-evaluations 6 --gain-points 2 --delay-points 2 "
+        "--output r.csv"}) {
     TempDir dir;
     const auto r = run_cli(args, dir);
     ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
