@@ -182,7 +182,7 @@ TEST(SummaryUnits, EveryResultOfTappingHbSweepFmModesAndDemoHasItsUnit) {
   }
 }
 
-TEST(SummaryUnits, EveryResultOfControlRootsMarginChartSimulateAndTuneHasItsUnit) {
+TEST(SummaryUnits, EveryResultOfTheControlCommandsHasItsUnit) {
   // on main the flags (complete, box_is_proven, stable_at_reference, diverged, converged, ...) and the chart's counts
   // had no unit, the
   // margin map no units at all; the settings and tau0 records carry their own
@@ -195,12 +195,27 @@ TEST(SummaryUnits, EveryResultOfControlRootsMarginChartSimulateAndTuneHasItsUnit
         "control simulate --harmonics 3 --signal 0.2,1.2,0.5,-0.8,-0.4 --signal-sample-rate 250 "
         "--rotation-frequency-hz 50 --periods 10 --output r.csv",
         "control tune --harmonics 3 --coarse-points 4 --max-evaluations 6 --gain-points 2 --delay-points 2 "
-        "--output r.csv"}) {
+        "--output r.csv",
+        "control tf --harmonics 3 --points 20 --output r.csv",
+        "control tf --controller single --rotation-frequency 50 --points 20 --output r.csv"}) {
     TempDir dir;
     const auto r = run_cli(args, dir);
     ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
     EXPECT_EQ(unitless_results(dir.path / "r.csv.json"), std::vector<std::string>{}) << args;
   }
+}
+
+TEST(SummaryUnits, EveryResultOfControlExportHasItsUnit) {
+  // on main damped_pairs, undamped_pairs and real_modes had no unit (the results are printed with --json)
+  TempDir dir;
+  const auto r = run_cli("control export --harmonics 3 --rotation-frequency 314.159265 --sample-rate 10000 "
+                         "--test-vectors 4 --json --output f.h",
+                         dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto results = nlohmann::json::parse(r.out);
+  std::vector<std::string> unitless;
+  collect_unitless_results(results, &results.at("units"), "", unitless);
+  EXPECT_EQ(unitless, std::vector<std::string>{}) << r.out;
 }
 
 TEST(SummaryUnits, EveryResultOfSpectroscopyPrepareHasItsUnit) {
