@@ -113,12 +113,13 @@ struct RootRow {
 };
 
 io::TableOf<RootRow> roots_table(const control::RotationUnits& u) {
+  const ControlUnits cu(u);
   using R = RootRow;
-  return {{"real", "Omega", "Re s of the root", [u](const R& r) { return u.in_omega(r.value.real()); }},
-          {"imag", "Omega", "Im s of the root", [u](const R& r) { return u.in_omega(r.value.imag()); }},
+  return {{"real", cu.omega, "Re s of the root", [](const R& r) { return r.value.real(); }},
+          {"imag", cu.omega, "Im s of the root", [](const R& r) { return r.value.imag(); }},
           {"multiplicity", "count", "argument-principle count in a box isolating the root", &R::multiplicity},
           {"certified", "boolean (0/1)", "multiplicity confirmed by that count (1) or not counted (0)", &R::certified},
-          {"correction", "Omega", "last Newton correction |ds|", [u](const R& r) { return u.in_omega(r.correction); }},
+          {"correction", cu.omega, "last Newton correction |ds|", [](const R& r) { return r.correction; }},
           {"kind", "label",
            "root (in the certified box) | near_chain (N = inf, left of the box, Newton from the chain "
            "asymptotics) | structural (docs/theory-control.md#neutral-realisation; neutral realisation only)",
@@ -214,14 +215,15 @@ struct MarginVariant {
 };
 
 io::TableOf<MarginVariant> margin_compare_table(const control::RotationUnits& u) {
+  const ControlUnits cu(u);
   using V = MarginVariant;
   return {{"variant", "label", "controller of the row", [](const V& v) { return v.name; }},
-          {"critical_delay", "T", "upper end tau_c of the stability interval of delays (inf: no crossing)",
-           [u](const V& v) { return u.in_periods(v.margin.upper); }},
-          {"crossing_frequency", "Omega", "crossing frequency nu at the critical delay (roots at +-i nu)",
-           [u](const V& v) { return u.in_omega(v.margin.upper_frequency); }},
-          {"lower_delay", "T", "lower end of the stability interval (0 plain loop; Smith: below the model delay)",
-           [u](const V& v) { return u.in_periods(v.margin.lower); }},
+          {"critical_delay", cu.period, "upper end tau_c of the stability interval of delays (inf: no crossing)",
+           [](const V& v) { return v.margin.upper; }},
+          {"crossing_frequency", cu.omega, "crossing frequency nu at the critical delay (roots at +-i nu)",
+           [](const V& v) { return v.margin.upper_frequency; }},
+          {"lower_delay", cu.period, "lower end of the stability interval (0 plain loop; Smith: below the model delay)",
+           [](const V& v) { return v.margin.lower; }},
           {"stable_at_reference", "boolean (0/1)", "stable at the reference delay",
            [](const V& v) { return v.margin.stable_at_reference; }}};
 }
@@ -273,13 +275,14 @@ void run_margin_compare(const io::ParamSet& p, const control::ControlSettings& b
 }
 
 io::TableOf<control::DelayCrossing> crossings_table(const control::RotationUnits& u) {
+  const ControlUnits cu(u);
   using X = control::DelayCrossing;
-  return {{"frequency", "Omega", "crossing frequency nu (roots at +-i nu)",
-           [u](const X& x) { return u.in_omega(x.frequency); }},
-          {"first_delay", "T", "smallest delay with these roots on the imaginary axis",
-           [u](const X& x) { return u.in_periods(x.first_delay); }},
-          {"delay_period", "T", "2 pi/nu: the crossings repeat at first_delay + m delay_period",
-           [u](const X& x) { return u.in_periods(x.delay_period); }}};
+  return {{"frequency", cu.omega, "crossing frequency nu (roots at +-i nu)",
+           [](const X& x) { return x.frequency; }},
+          {"first_delay", cu.period, "smallest delay with these roots on the imaginary axis",
+           [](const X& x) { return x.first_delay; }},
+          {"delay_period", cu.period, "2 pi/nu: the crossings repeat at first_delay + m delay_period",
+           [](const X& x) { return x.delay_period; }}};
 }
 
 void run_margin(const io::ParamSet& p, Captured* capture) {

@@ -71,14 +71,15 @@ struct MarginMapPoint {
 // The margin map's table: the rows are the (y, x) grid, x fastest.
 io::TableOf<MarginMapPoint> margin_map_table(const control::LoopFamily& family, const control::RotationUnits& u,
                                              int nx, int ny) {
+  const ControlUnits cu(u);
   using P = MarginMapPoint;
   io::TableOf<P> table{
-      {"x", "Omega", axis_text(family, 'x'), [u](const P& p) { return u.in_omega(p.map.x[p.i]); }},
-      {"y", "Omega", axis_text(family, 'y'), [u](const P& p) { return u.in_omega(p.map.y[p.j]); }},
-      {"critical_delay", "T", "delay margin tau_c (inf: no crossing, nan: unstable at tau = 0)",
-       [u](const P& p) { return u.in_periods(p.map.critical_delay[p.k()]); }},
-      {"crossing_frequency", "Omega", "crossing frequency nu at tau_c",
-       [u](const P& p) { return u.in_omega(p.map.crossing_frequency[p.k()]); }}};
+      {"x", cu.omega, axis_text(family, 'x'), [](const P& p) { return p.map.x[p.i]; }},
+      {"y", cu.omega, axis_text(family, 'y'), [](const P& p) { return p.map.y[p.j]; }},
+      {"critical_delay", cu.period, "delay margin tau_c (inf: no crossing, nan: unstable at tau = 0)",
+       [](const P& p) { return p.map.critical_delay[p.k()]; }},
+      {"crossing_frequency", cu.omega, "crossing frequency nu at tau_c",
+       [](const P& p) { return p.map.crossing_frequency[p.k()]; }}};
   table.grid({{"y", family.y_name(), static_cast<std::size_t>(ny)}, {"x", family.x_name(), static_cast<std::size_t>(nx)}});
   return table;
 }
@@ -94,12 +95,13 @@ struct ChartPoint {
 // The charts' table: the rows are the (delay, y, x) grid, x fastest (one chart after the other).
 io::TableOf<ChartPoint> chart_table(const control::LoopFamily& family, const control::RotationUnits& u,
                                     std::size_t delays, int nx, int ny) {
+  const ControlUnits cu(u);
   using P = ChartPoint;
   io::TableOf<P> table{
-      {"x", "Omega", axis_text(family, 'x'), [u](const P& p) { return u.in_omega(p.chart.x[p.i]); }},
-      {"y", "Omega", axis_text(family, 'y'), [u](const P& p) { return u.in_omega(p.chart.y[p.j]); }},
-      {"spectral_abscissa", "Omega", "largest real part of the closed-loop roots (= -decay rate)",
-       [u](const P& p) { return u.in_omega(p.chart.abscissa[p.k()]); }},
+      {"x", cu.omega, axis_text(family, 'x'), [](const P& p) { return p.chart.x[p.i]; }},
+      {"y", cu.omega, axis_text(family, 'y'), [](const P& p) { return p.chart.y[p.j]; }},
+      {"spectral_abscissa", cu.omega, "largest real part of the closed-loop roots (= -decay rate)",
+       [](const P& p) { return p.chart.abscissa[p.k()]; }},
       {"unstable_roots", "count", "roots with Re s > 0 (region label, argument-principle count; -1: infinitely many)",
        [](const P& p) { return static_cast<long>(p.chart.unstable_roots[p.k()]); }},
       {"region", "label", "region id (connected set of grid points with equal counts, within its delay)",
@@ -147,12 +149,13 @@ struct BoundaryRow {
 };
 
 io::TableOf<BoundaryRow> boundaries_table(const control::LoopFamily& family, const control::RotationUnits& u) {
+  const ControlUnits cu(u);
   using B = BoundaryRow;
   return {{"curve", "label", "polyline id (within its delay)", &B::curve},
-          {"frequency", "Omega", "crossing frequency nu of the imaginary-axis roots on the curve (0: root at s = 0)",
-           [u](const B& b) { return u.in_omega(b.point.frequency); }},
-          {"x", "Omega", axis_text(family, 'x'), [u](const B& b) { return u.in_omega(b.point.x); }},
-          {"y", "Omega", axis_text(family, 'y'), [u](const B& b) { return u.in_omega(b.point.y); }},
+          {"frequency", cu.omega, "crossing frequency nu of the imaginary-axis roots on the curve (0: root at s = 0)",
+           [](const B& b) { return b.point.frequency; }},
+          {"x", cu.omega, axis_text(family, 'x'), [](const B& b) { return b.point.x; }},
+          {"y", cu.omega, axis_text(family, 'y'), [](const B& b) { return b.point.y; }},
           {"delay", "T", "measurement delay tau of the chart", &B::delay}};
 }
 

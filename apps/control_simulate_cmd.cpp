@@ -166,11 +166,12 @@ nlohmann::json report_notes() {
 
 /// The time series' table, one row per recorded step (u: the rotation units of the run).
 io::TableOf<control::TimeSample> simulate_table(const control::RotationUnits& u) {
+  const ControlUnits cu(u);
+  const units::Unit control_signal{"signal*Omega", 1.0, u.rotation_frequency()};  // u [signal/s] / Ω
   using S = control::TimeSample;
-  const double w = u.rotation_frequency();
-  return {{"t", "T", "time", [u](const S& r) { return u.in_periods(r.t); }},
+  return {{"t", cu.period, "time", [](const S& r) { return r.t; }},
           {"y", "signal", "plant output y", &S::y},
-          {"u", "signal*Omega", "control u", [w](const S& r) { return r.u / w; }},
+          {"u", control_signal, "control u", &S::u},
           {"m", "signal", "measurement y(t - tau)", &S::m},
           {"target", "signal", "steady state to reach: uncontrolled output without the rejected harmonics", &S::target},
           {"f_minus_f1", "signal", "disturbance f without its first harmonic", &S::f_minus_first}};

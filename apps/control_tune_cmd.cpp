@@ -42,16 +42,17 @@ struct CoarsePoint {
 
 // The coarse grid's table: the rows are the (y, x) grid of n x n points, x fastest.
 io::TableOf<CoarsePoint> coarse_grid_table(const control::LoopFamily& family, const control::RotationUnits& u, int n) {
+  const ControlUnits cu(u);
   using P = CoarsePoint;
   io::TableOf<P> table{
-      {"x", "Omega", std::string(family.x_name()) + " of the coarse grid point",
-       [u](const P& p) { return u.in_omega(p.tuning.coarse_x[p.i]); }},
-      {"y", "Omega", std::string(family.y_name()) + " of the coarse grid point",
-       [u](const P& p) { return u.in_omega(p.tuning.coarse_y[p.j]); }},
-      {"worst_decay_rate", "Omega",
+      {"x", cu.omega, std::string(family.x_name()) + " of the coarse grid point",
+       [](const P& p) { return p.tuning.coarse_x[p.i]; }},
+      {"y", cu.omega, std::string(family.y_name()) + " of the coarse grid point",
+       [](const P& p) { return p.tuning.coarse_y[p.j]; }},
+      {"worst_decay_rate", cu.omega,
        "objective: smallest decay rate -max Re s over the delays and gain ratios (tracked spectra)",
-       [u, n](const P& p) {
-         return u.in_omega(p.tuning.coarse_worst_decay[static_cast<std::size_t>(p.j) * n + p.i]);
+       [n](const P& p) {
+         return p.tuning.coarse_worst_decay[static_cast<std::size_t>(p.j) * n + p.i];
        }}};
   table.grid({{"y", family.y_name(), static_cast<std::size_t>(n)}, {"x", family.x_name(), static_cast<std::size_t>(n)}});
   return table;
