@@ -95,7 +95,8 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
                                     {"count_amplitude", "count(amplitude)", count, {}},
                                     {"count_amplitude_trapped", "count(amplitude | trapped)", count, {}}}};
   auto& [max_stable, min_stable, stable, all, trapped_orbits] = outputs;
-  for (Output& o : outputs) o.values.assign(points, o.unit.name == "count" ? 0.0 : nan);  // amplitudes: none yet
+  for (Output& o : outputs) o.values.assign(points, 0.0);                           // the counts start at 0
+  for (Output* o : {&max_stable, &min_stable}) o->values.assign(points, nan);  // no stable orbit yet: undefined
   for (std::size_t i = 0; i < points; ++i)
     for (const tapping::FoundOrbit& f : results[i].orbits) {
       const double amplitude = f.metrics.amplitude;
