@@ -19,6 +19,8 @@
 #include "commands.hpp"
 #include "control_analysis.hpp"
 #include "control_params.hpp"
+#include "control_units.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -77,26 +79,27 @@ std::string describe_family(const control::LoopFamily& f) {
 
 namespace {
 
-// τ = 0 verdicts of stability_tau0.hpp (pass-through; basis K = γ, static plant), in units of Ω.
+// τ = 0 verdicts of stability_tau0.hpp (pass-through; basis K = γ, static plant), in units of Ω: a record with its
+// own units.
 nlohmann::json tau0_summary(const control::ControlSettings& c) {
-  nlohmann::json j;
+  UnitTagged j;
   const control::ControlSettingsSi si = control::to_si(c);
   const double w = si.rotation_frequency;
   const ControllerKind inner = c.bank_kind();
   if (inner == ControllerKind::Single) {
-    j["eq13_stable"] = control::single_oscillator_stable_tau0(w, si.a, si.b, si.gain, si.plant_rate);
-    j["eq13_b_limit"] = si.plant_rate / si.gain;
-    j["units"] = {{"eq13_b_limit", "Omega"}};
+    j.add("eq13_stable", control::single_oscillator_stable_tau0(w, si.a, si.b, si.gain, si.plant_rate),
+          "boolean (0/1)")
+        .add("eq13_b_limit", si.plant_rate / si.gain, control::RotationUnits::rate_unit);  // γΩ/K in units of Ω
   } else {
     const bool inf = inner == ControllerKind::Infinite;
     const auto bc = inf ? control::critical_beta_limit(w) : control::critical_beta(c.harmonics, w);
-    j["beta_critical"] = bc.beta / w;
-    j["design_point_stable"] = inf ? control::infinite_bank_stable_tau0(w, si.alpha, si.beta)
-                                   : control::couplings_stable_tau0(c.harmonics, w, si.alpha, si.beta);
-    j["basis"] = "K = gamma, static plant, tau = 0 (stability_tau0.hpp)";
-    j["units"] = {{"beta_critical", "Omega"}};
+    j.add("beta_critical", bc.beta, ControlUnits(c.units()).omega)
+        .add("design_point_stable", inf ? control::infinite_bank_stable_tau0(w, si.alpha, si.beta)
+                                        : control::couplings_stable_tau0(c.harmonics, w, si.alpha, si.beta),
+             "boolean (0/1)")
+        .add("basis", "K = gamma, static plant, tau = 0 (stability_tau0.hpp)");
   }
-  return j;
+  return j.with_units();
 }
 
 // ------------------------------------------------------------------------------------------------ roots
@@ -110,12 +113,13 @@ struct RootRow {
 };
 
 io::TableOf<RootRow> roots_table(const control::RotationUnits& u) {
+  const ControlUnits cu(u);
   using R = RootRow;
-  return {{"real", "Omega", "Re s of the root", [u](const R& r) { return u.in_omega(r.value.real()); }},
-          {"imag", "Omega", "Im s of the root", [u](const R& r) { return u.in_omega(r.value.imag()); }},
+  return {{"real", cu.omega, "Re s of the root", [](const R& r) { return r.value.real(); }},
+          {"imag", cu.omega, "Im s of the root", [](const R& r) { return r.value.imag(); }},
           {"multiplicity", "count", "argument-principle count in a box isolating the root", &R::multiplicity},
           {"certified", "boolean (0/1)", "multiplicity confirmed by that count (1) or not counted (0)", &R::certified},
-          {"correction", "Omega", "last Newton correction |ds|", [u](const R& r) { return u.in_omega(r.correction); }},
+          {"correction", cu.omega, "last Newton correction |ds|", [](const R& r) { return r.correction; }},
           {"kind", "label",
            "root (in the certified box) | near_chain (N = inf, left of the box, Newton from the chain "
            "asymptotics) | structural (docs/theory-control.md#neutral-realisation; neutral realisation only)",
@@ -142,29 +146,38 @@ void run_roots(const io::ParamSet& p, Captured* capture) {
   if (!p.was_set("max_imag")) as_run.record_used("max_imag", u.in_omega(sp.box.imag_max));
   CommandOutput out(as_run, capture, "control roots");
 
-  nlohmann::json res;
-  res["loop"] = control::describe_in_rotation_units(loop);
-  res["settings"] = settings_json(c);
-  res["settings_si"] = settings_si_json(c);
-  res["delay_exceeds_period"] = loop.delay >= loop.period();
-  res["box"] = {{"real_min", u.in_omega(sp.box.real_min)}, {"real_max", u.in_omega(sp.box.real_max)},
-                {"imag_min", u.in_omega(sp.box.imag_min)}, {"imag_max", u.in_omega(sp.box.imag_max)}};
-  res["box_count"] = sp.box_count;
-  res["complete"] = sp.complete;
-  res["box_is_proven"] = sp.box_is_proven;
-  res["spectral_abscissa"] = u.in_omega(sp.spectral_abscissa);
-  res["decay_rate"] = -u.in_omega(sp.spectral_abscissa);
-  res["unstable_roots"] = sp.unstable_count;
-  if (sp.neutral_bound) res["neutral_bound"] = u.in_omega(*sp.neutral_bound);
-  nlohmann::json st = nlohmann::json::array();
-  for (const auto& s : sp.structural)
-    st.push_back({{"real", u.in_omega(s.value.real())}, {"imag", u.in_omega(s.value.imag())},
-                  {"multiplicity", s.multiplicity}, {"origin", s.origin}});
-  res["structural_roots"] = st;
-  res["notes"] = sp.notes;
-  res["units"] = {{"box", "Omega"}, {"box_count", "count"}, {"spectral_abscissa", "Omega"}, {"decay_rate", "Omega"},
-                  {"unstable_roots", "count"}, {"neutral_bound", "Omega"},
-                  {"structural_roots", {{"real", "Omega"}, {"imag", "Omega"}, {"multiplicity", "count"}}}};
+  const ControlUnits cu(u);
+  const auto structural_root = [&](const control::StructuralRoot& s) {
+    UnitTagged r;
+    r.add("real", s.value.real(), cu.omega)
+        .add("imag", s.value.imag(), cu.omega)
+        .add("multiplicity", s.multiplicity, "count")
+        .add("origin", s.origin);
+    return r;
+  };
+  std::vector<UnitTagged> structural;
+  for (const auto& s : sp.structural) structural.push_back(structural_root(s));
+  UnitTagged res;
+  res.add("loop", control::describe_in_rotation_units(loop))
+      .add("settings", settings_json(c))  // records with their own units
+      .add("settings_si", settings_si_json(c))
+      .add("delay_exceeds_period", loop.delay >= loop.period(), "boolean (0/1)")
+      .add("box",
+           {{"real_min", sp.box.real_min}, {"real_max", sp.box.real_max}, {"imag_min", sp.box.imag_min},
+            {"imag_max", sp.box.imag_max}},
+           cu.omega)
+      .add("box_count", sp.box_count, "count")
+      .add("complete", sp.complete, "boolean (0/1)")
+      .add("box_is_proven", sp.box_is_proven, "boolean (0/1)")
+      .add("spectral_abscissa", sp.spectral_abscissa, cu.omega)
+      .add("decay_rate", -sp.spectral_abscissa, cu.omega)
+      .add("unstable_roots", sp.unstable_count, "count")
+      .add("structural_roots", structural, structural_root(control::StructuralRoot{}))
+      .add("notes", sp.notes);
+  UnitTagged neutral;  // N = inf only; its unit listed always
+  neutral.add("neutral_bound", sp.neutral_bound.value_or(0.0), cu.omega);
+  if (sp.neutral_bound) res.merge(neutral);
+  else res.units_of(neutral);
   auto rows = out.open(roots_table(u));
   for (const auto& r : sp.roots)
     rows.add({r.value, static_cast<long>(r.multiplicity), r.certified, r.correction, "root"});
@@ -174,31 +187,25 @@ void run_roots(const io::ParamSet& p, Captured* capture) {
   }
   for (const auto& s : sp.structural)
     rows.add({s.value, static_cast<long>(s.multiplicity), true, 0.0, "structural"});
-  out.finish(res, fmt::format("{} roots in the box (argument principle: {}{}); spectral abscissa {}, {} unstable",
+  out.finish(res.with_units(), fmt::format("{} roots in the box (argument principle: {}{}); spectral abscissa {}, {} unstable",
                               sp.roots.size(), sp.box_count, sp.complete ? ", complete" : ", INCOMPLETE",
                               rate_summary(sp.spectral_abscissa, u, 10), sp.unstable_count));
 }
 
 // ------------------------------------------------------------------------------------------------ margin
-nlohmann::json margin_json(const control::DelayMargin& m, const control::RotationUnits& u) {
-  nlohmann::json j;
-  j["method"] = m.method;
-  j["reference_delay"] = u.in_periods(m.reference_delay);
-  j["stable_at_reference"] = m.stable_at_reference;
-  j["unstable_at_reference"] = m.unstable_at_reference;
-  j["critical_delay"] = u.in_periods(m.upper);
-  j["crossing_frequency"] = u.in_omega(m.upper_frequency);
-  j["lower_delay"] = u.in_periods(m.lower);
-  j["lower_crossing_frequency"] = u.in_omega(m.lower_frequency);
-  j["critical_delay_exceeds_period"] = m.upper_exceeds_period;
-  j["note"] = m.note;
+UnitTagged margin_record(const control::DelayMargin& m, const ControlUnits& u) {
+  UnitTagged j;
+  j.add("method", m.method)
+      .add("reference_delay", m.reference_delay, u.period)
+      .add("stable_at_reference", m.stable_at_reference, "boolean (0/1)")
+      .add("unstable_at_reference", m.unstable_at_reference, "count")
+      .add("critical_delay", m.upper, u.period)
+      .add("crossing_frequency", m.upper_frequency, u.omega)
+      .add("lower_delay", m.lower, u.period)
+      .add("lower_crossing_frequency", m.lower_frequency, u.omega)
+      .add("critical_delay_exceeds_period", m.upper_exceeds_period, "boolean (0/1)")
+      .add("note", m.note);
   return j;
-}
-const nlohmann::json& margin_units() {
-  static const nlohmann::json units = {{"reference_delay", "T"}, {"unstable_at_reference", "count"},
-                                       {"critical_delay", "T"}, {"crossing_frequency", "Omega"},
-                                       {"lower_delay", "T"}, {"lower_crossing_frequency", "Omega"}};
-  return units;
 }
 
 // A row of `control margin --compare`: a variant of the loop and its delay margin.
@@ -208,14 +215,15 @@ struct MarginVariant {
 };
 
 io::TableOf<MarginVariant> margin_compare_table(const control::RotationUnits& u) {
+  const ControlUnits cu(u);
   using V = MarginVariant;
   return {{"variant", "label", "controller of the row", [](const V& v) { return v.name; }},
-          {"critical_delay", "T", "upper end tau_c of the stability interval of delays (inf: no crossing)",
-           [u](const V& v) { return u.in_periods(v.margin.upper); }},
-          {"crossing_frequency", "Omega", "crossing frequency nu at the critical delay (roots at +-i nu)",
-           [u](const V& v) { return u.in_omega(v.margin.upper_frequency); }},
-          {"lower_delay", "T", "lower end of the stability interval (0 plain loop; Smith: below the model delay)",
-           [u](const V& v) { return u.in_periods(v.margin.lower); }},
+          {"critical_delay", cu.period, "upper end tau_c of the stability interval of delays (inf: no crossing)",
+           [](const V& v) { return v.margin.upper; }},
+          {"crossing_frequency", cu.omega, "crossing frequency nu at the critical delay (roots at +-i nu)",
+           [](const V& v) { return v.margin.upper_frequency; }},
+          {"lower_delay", cu.period, "lower end of the stability interval (0 plain loop; Smith: below the model delay)",
+           [](const V& v) { return v.margin.lower; }},
           {"stable_at_reference", "boolean (0/1)", "stable at the reference delay",
            [](const V& v) { return v.margin.stable_at_reference; }}};
 }
@@ -226,13 +234,12 @@ void run_margin_compare(const io::ParamSet& p, const control::ControlSettings& b
   const io::ParamSet as_run = params_as_run(p, base);
   CommandOutput out(as_run, capture, "control margin --compare");
   auto table = out.open(margin_compare_table(u));
-  nlohmann::json rows = nlohmann::json::array();
+  const ControlUnits cu(u);
+  std::vector<UnitTagged> rows;
   const auto add = [&](const std::string& name, const control::ControlSettings& c) {
     const control::DelayMargin m = control::delay_margin(control::loop_from(c));
     table.add({name, m});
-    nlohmann::json j = margin_json(m, u);
-    j["variant"] = name;
-    rows.push_back(j);
+    rows.push_back(margin_record(m, cu).add("variant", name));
   };
   control::ControlSettings c = base;
   c.controller = ControllerKind::Bank;
@@ -260,22 +267,22 @@ void run_margin_compare(const io::ParamSet& p, const control::ControlSettings& b
                     c.model_delay_value(), control::to_string(c.smith_bank)),
         c);
   }
-  nlohmann::json res;
-  res["settings"] = settings_json(base);
-  res["settings_si"] = settings_si_json(base);
-  res["variants"] = rows;
-  res["units"] = {{"variants", margin_units()}};
-  out.finish(res, fmt::format("delay margins of {} variants", out.rows()));
+  UnitTagged res;
+  res.add("settings", settings_json(base))  // records with their own units
+      .add("settings_si", settings_si_json(base))
+      .add("variants", rows, margin_record(control::DelayMargin{}, cu));
+  out.finish(res.with_units(), fmt::format("delay margins of {} variants", out.rows()));
 }
 
 io::TableOf<control::DelayCrossing> crossings_table(const control::RotationUnits& u) {
+  const ControlUnits cu(u);
   using X = control::DelayCrossing;
-  return {{"frequency", "Omega", "crossing frequency nu (roots at +-i nu)",
-           [u](const X& x) { return u.in_omega(x.frequency); }},
-          {"first_delay", "T", "smallest delay with these roots on the imaginary axis",
-           [u](const X& x) { return u.in_periods(x.first_delay); }},
-          {"delay_period", "T", "2 pi/nu: the crossings repeat at first_delay + m delay_period",
-           [u](const X& x) { return u.in_periods(x.delay_period); }}};
+  return {{"frequency", cu.omega, "crossing frequency nu (roots at +-i nu)",
+           [](const X& x) { return x.frequency; }},
+          {"first_delay", cu.period, "smallest delay with these roots on the imaginary axis",
+           [](const X& x) { return x.first_delay; }},
+          {"delay_period", cu.period, "2 pi/nu: the crossings repeat at first_delay + m delay_period",
+           [](const X& x) { return x.delay_period; }}};
 }
 
 void run_margin(const io::ParamSet& p, Captured* capture) {
@@ -296,14 +303,13 @@ void run_margin(const io::ParamSet& p, Captured* capture) {
   io::ParamSet as_run = params_as_run(p, c);
   as_run.record_used("reference_delay", u.in_periods(m.reference_delay));  // 0, or model_delay (Smith predictor)
   CommandOutput out(as_run, capture, "control margin");
-  nlohmann::json res = margin_json(m, u);
-  res["loop"] = control::describe_in_rotation_units(loop);
-  res["settings"] = settings_json(c);
-  res["settings_si"] = settings_si_json(c);
-  res["tau0"] = tau0_summary(c);
-  res["units"] = margin_units();
+  UnitTagged res = margin_record(m, ControlUnits(u));
+  res.add("loop", control::describe_in_rotation_units(loop))
+      .add("settings", settings_json(c))  // records with their own units
+      .add("settings_si", settings_si_json(c))
+      .add("tau0", tau0_summary(c));
   out.open(crossings_table(u)).add_all(m.crossings);
-  out.finish(res, m.stable_at_reference
+  out.finish(res.with_units(), m.stable_at_reference
                       ? fmt::format("critical delay tau_c = {} (crossing at {}, method {})",
                                     delay_summary(m.upper, u, 6), rate_summary(m.upper_frequency, u, 6), m.method)
                       : m.note);

@@ -18,6 +18,8 @@
 #include "command.hpp"
 #include "control_analysis.hpp"
 #include "control_params.hpp"
+#include "control_units.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -69,14 +71,15 @@ struct MarginMapPoint {
 // The margin map's table: the rows are the (y, x) grid, x fastest.
 io::TableOf<MarginMapPoint> margin_map_table(const control::LoopFamily& family, const control::RotationUnits& u,
                                              int nx, int ny) {
+  const ControlUnits cu(u);
   using P = MarginMapPoint;
   io::TableOf<P> table{
-      {"x", "Omega", axis_text(family, 'x'), [u](const P& p) { return u.in_omega(p.map.x[p.i]); }},
-      {"y", "Omega", axis_text(family, 'y'), [u](const P& p) { return u.in_omega(p.map.y[p.j]); }},
-      {"critical_delay", "T", "delay margin tau_c (inf: no crossing, nan: unstable at tau = 0)",
-       [u](const P& p) { return u.in_periods(p.map.critical_delay[p.k()]); }},
-      {"crossing_frequency", "Omega", "crossing frequency nu at tau_c",
-       [u](const P& p) { return u.in_omega(p.map.crossing_frequency[p.k()]); }}};
+      {"x", cu.omega, axis_text(family, 'x'), [](const P& p) { return p.map.x[p.i]; }},
+      {"y", cu.omega, axis_text(family, 'y'), [](const P& p) { return p.map.y[p.j]; }},
+      {"critical_delay", cu.period, "delay margin tau_c (inf: no crossing, nan: unstable at tau = 0)",
+       [](const P& p) { return p.map.critical_delay[p.k()]; }},
+      {"crossing_frequency", cu.omega, "crossing frequency nu at tau_c",
+       [](const P& p) { return p.map.crossing_frequency[p.k()]; }}};
   table.grid({{"y", family.y_name(), static_cast<std::size_t>(ny)}, {"x", family.x_name(), static_cast<std::size_t>(nx)}});
   return table;
 }
@@ -92,12 +95,13 @@ struct ChartPoint {
 // The charts' table: the rows are the (delay, y, x) grid, x fastest (one chart after the other).
 io::TableOf<ChartPoint> chart_table(const control::LoopFamily& family, const control::RotationUnits& u,
                                     std::size_t delays, int nx, int ny) {
+  const ControlUnits cu(u);
   using P = ChartPoint;
   io::TableOf<P> table{
-      {"x", "Omega", axis_text(family, 'x'), [u](const P& p) { return u.in_omega(p.chart.x[p.i]); }},
-      {"y", "Omega", axis_text(family, 'y'), [u](const P& p) { return u.in_omega(p.chart.y[p.j]); }},
-      {"spectral_abscissa", "Omega", "largest real part of the closed-loop roots (= -decay rate)",
-       [u](const P& p) { return u.in_omega(p.chart.abscissa[p.k()]); }},
+      {"x", cu.omega, axis_text(family, 'x'), [](const P& p) { return p.chart.x[p.i]; }},
+      {"y", cu.omega, axis_text(family, 'y'), [](const P& p) { return p.chart.y[p.j]; }},
+      {"spectral_abscissa", cu.omega, "largest real part of the closed-loop roots (= -decay rate)",
+       [](const P& p) { return p.chart.abscissa[p.k()]; }},
       {"unstable_roots", "count", "roots with Re s > 0 (region label, argument-principle count; -1: infinitely many)",
        [](const P& p) { return static_cast<long>(p.chart.unstable_roots[p.k()]); }},
       {"region", "label", "region id (connected set of grid points with equal counts, within its delay)",
@@ -125,16 +129,16 @@ void run_margin_map(const io::ParamSet& p, const control::ControlSettings& c, co
   progress.finish();
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) rows.add({m, i, j});
-  nlohmann::json res;
-  res["family"] = describe_family(family);
-  res["x"] = family.x_name();
-  res["y"] = family.y_name();
-  res["window"] = window_json(win);
-  res["x_points"] = nx;
-  res["y_points"] = ny;
-  res["settings"] = settings_json(c);
-  res["settings_si"] = settings_si_json(c);
-  out.finish(res, fmt::format("the {}x{} delay-margin map", nx, ny));
+  UnitTagged res;
+  res.add("family", describe_family(family))
+      .add("x", family.x_name())
+      .add("y", family.y_name())
+      .add("window", window_json(win), control::RotationUnits::rate_unit)  // given in units of Ω
+      .add("x_points", nx, "count")
+      .add("y_points", ny, "count")
+      .add("settings", settings_json(c))  // records with their own units
+      .add("settings_si", settings_si_json(c));
+  out.finish(res.with_units(), fmt::format("the {}x{} delay-margin map", nx, ny));
 }
 
 // A point of a D-subdivision boundary curve (curve: its id within its delay).
@@ -145,12 +149,13 @@ struct BoundaryRow {
 };
 
 io::TableOf<BoundaryRow> boundaries_table(const control::LoopFamily& family, const control::RotationUnits& u) {
+  const ControlUnits cu(u);
   using B = BoundaryRow;
   return {{"curve", "label", "polyline id (within its delay)", &B::curve},
-          {"frequency", "Omega", "crossing frequency nu of the imaginary-axis roots on the curve (0: root at s = 0)",
-           [u](const B& b) { return u.in_omega(b.point.frequency); }},
-          {"x", "Omega", axis_text(family, 'x'), [u](const B& b) { return u.in_omega(b.point.x); }},
-          {"y", "Omega", axis_text(family, 'y'), [u](const B& b) { return u.in_omega(b.point.y); }},
+          {"frequency", cu.omega, "crossing frequency nu of the imaginary-axis roots on the curve (0: root at s = 0)",
+           [](const B& b) { return b.point.frequency; }},
+          {"x", cu.omega, axis_text(family, 'x'), [](const B& b) { return b.point.x; }},
+          {"y", cu.omega, axis_text(family, 'y'), [](const B& b) { return b.point.y; }},
           {"delay", "T", "measurement delay tau of the chart", &B::delay}};
 }
 
@@ -190,7 +195,35 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
   auto rows = out.open(chart_table(first, u, runs.size(), nx, ny));
   io::Progress progress("control chart (grid points)", static_cast<long>(nx) * ny * static_cast<long>(runs.size()),
                         p.flag("progress"));
-  nlohmann::json charts = nlohmann::json::array();
+  const ControlUnits cu(u);
+  // a region of a chart and a chart, each number with its unit
+  const auto region_record = [&](const control::ChartRegion& r) {
+    UnitTagged j;
+    j.add("id", r.id, "label")
+        .add("unstable_roots", r.unstable_roots, "count")
+        .add("tracked_roots", r.tracked_roots, "count")
+        .add("points", r.points, "count")
+        .add("x", r.x, cu.omega)
+        .add("y", r.y, cu.omega)
+        .add("certified", r.certified, "boolean (0/1)");
+    return j;
+  };
+  const auto chart_record = [&](const control::StabilityChart& chart, double delay, const std::string& family,
+                                bool delay_exceeds_period) {
+    std::vector<UnitTagged> regions;
+    for (const auto& r : chart.regions) regions.push_back(region_record(r));
+    UnitTagged j;
+    j.add("delay", delay, control::RotationUnits::delay_unit)  // given in units of T
+        .add("family", family)
+        .add("delay_exceeds_period", delay_exceeds_period, "boolean (0/1)")
+        .add("regions", regions, region_record(control::ChartRegion{}))
+        .add("boundary_curves", chart.boundaries.size(), "count")
+        .add("mismatched_points", chart.mismatched_points, "count")
+        .add("recomputed_points", chart.recomputed_points, "count")
+        .add("lower_bound_points", chart.lower_bound_points, "count");
+    return j;
+  };
+  std::vector<UnitTagged> charts;
   long curves = 0;
   for (const control::ControlSettings& at : runs) {
     const control::LoopSpec loop = control::loop_from(at);
@@ -220,36 +253,23 @@ void run_chart(const io::ParamSet& p, Captured* capture) {
         }
       }
     curves += static_cast<long>(chart.boundaries.size());
-    nlohmann::json regions = nlohmann::json::array();
-    for (const auto& r : chart.regions)
-      regions.push_back({{"id", r.id}, {"unstable_roots", r.unstable_roots}, {"tracked_roots", r.tracked_roots},
-                         {"points", r.points}, {"x", u.in_omega(r.x)}, {"y", u.in_omega(r.y)},
-                         {"certified", r.certified}});
-    charts.push_back({{"delay", at.delay},
-                      {"family", describe_family(spec.family)},
-                      {"delay_exceeds_period", loop.delay >= loop.period()},
-                      {"regions", regions},
-                      {"boundary_curves", chart.boundaries.size()},
-                      {"mismatched_points", chart.mismatched_points},
-                      {"recomputed_points", chart.recomputed_points},
-                      {"lower_bound_points", chart.lower_bound_points}});
+    charts.push_back(chart_record(chart, at.delay, describe_family(spec.family), loop.delay >= loop.period()));
   }
   progress.finish();
-  nlohmann::json res;
-  res["x"] = first.x_name();
-  res["y"] = first.y_name();
-  res["window"] = window_json(win);
-  res["x_points"] = nx;
-  res["y_points"] = ny;
-  res["delays"] = nlohmann::json::array();
-  for (const auto& at : runs) res["delays"].push_back(at.delay);
-  res["charts"] = charts;
-  res["boundaries_file"] = bout;
-  res["settings"] = settings_json(c);
-  res["settings_si"] = settings_si_json(c);
-  res["units"] = {{"window", "Omega"}, {"delays", "T"},
-                  {"charts", {{"delay", "T"}, {"regions", {{"x", "Omega"}, {"y", "Omega"}, {"points", "count"},
-                                                           {"unstable_roots", "count"}, {"tracked_roots", "count"}}}}}};
+  nlohmann::json delays = nlohmann::json::array();  // given in units of T
+  for (const auto& at : runs) delays.push_back(at.delay);
+  UnitTagged tagged;
+  tagged.add("x", first.x_name())
+      .add("y", first.y_name())
+      .add("window", window_json(win), control::RotationUnits::rate_unit)  // given in units of Ω
+      .add("x_points", nx, "count")
+      .add("y_points", ny, "count")
+      .add("delays", delays, control::RotationUnits::delay_unit)
+      .add("charts", charts, chart_record(control::StabilityChart{}, 0.0, "", false))
+      .add("boundaries_file", bout)
+      .add("settings", settings_json(c))  // records with their own units
+      .add("settings_si", settings_si_json(c));
+  nlohmann::json res = tagged.with_units();
   if (boundaries) {
     nlohmann::json bres;
     bres["x"] = first.x_name();

@@ -22,6 +22,8 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "control_params.hpp"
+#include "control_units.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -66,22 +68,23 @@ void run_export(const io::ParamSet& p, Captured* capture) {
   const embed::ExportedDesign design(spec);  // the same design again, for the summary (deterministic)
   io::write_file_atomic(path, header);
   const embed::CoreFootprint fp = design.footprint();
-  nlohmann::json j;
-  j["output"] = path;
-  j["format"] = p.text("format");
-  j["precision"] = embed::to_string(spec.precision);
-  j["state_size"] = design.state_size();
-  j["damped_pairs"] = design.pairs();
-  j["undamped_pairs"] = design.circles();
-  j["real_modes"] = design.reals();
-  j["memory_bytes"] = {{"total", fp.total()}, {"coefficient_struct", fp.coefficient_struct},
-                       {"coefficient_arrays", fp.coefficient_arrays}, {"state", fp.state},
-                       {"filter_struct", fp.filter_struct}};
-  j["spectral_abscissa"] = design.spectral_abscissa() / spec.rotation_frequency;
-  j["smallest_decay_per_sample"] = design.smallest_decay();
-  j["test_vectors"] = samples;
-  j["units"] = {{"state_size", "count"}, {"memory_bytes", "bytes"}, {"spectral_abscissa", "Omega"},
-                {"smallest_decay_per_sample", "dimensionless"}, {"test_vectors", "count"}};
+  const ControlUnits cu(control::RotationUnits(spec.rotation_frequency));
+  UnitTagged tagged;
+  tagged.add("output", path)
+      .add("format", p.text("format"))
+      .add("precision", embed::to_string(spec.precision))
+      .add("state_size", design.state_size(), "count")
+      .add("damped_pairs", design.pairs(), "count")
+      .add("undamped_pairs", design.circles(), "count")
+      .add("real_modes", design.reals(), "count")
+      .add("memory_bytes",
+           {{"total", fp.total()}, {"coefficient_struct", fp.coefficient_struct},
+            {"coefficient_arrays", fp.coefficient_arrays}, {"state", fp.state}, {"filter_struct", fp.filter_struct}},
+           "bytes")
+      .add("spectral_abscissa", design.spectral_abscissa(), cu.omega)
+      .add("smallest_decay_per_sample", design.smallest_decay(), "dimensionless")
+      .add("test_vectors", samples, "count");
+  const nlohmann::json j = tagged.with_units();
   if (capture != nullptr) {
     capture->results = j;
     // the parameters as run: gain / model_rate / model_delay as used, the precision's input limit when 0 was given

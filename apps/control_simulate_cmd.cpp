@@ -27,6 +27,8 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "control_params.hpp"
+#include "control_units.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -112,55 +114,64 @@ int highest_order(const control::Disturbance& f) {
 }
 
 // The harmonic report in the units of the command: complex amplitudes of y in signal units, of u in signal·Ω.
-nlohmann::json report_json(const control::SimulationReport& r, const control::ClosedLoopSimulation& sim,
-                           const control::RotationUnits& u) {
-  const auto complex_json = [](std::complex<double> z) {
-    return nlohmann::json{{"re", z.real()}, {"im", z.imag()}, {"abs", std::abs(z)}};
+UnitTagged report_record(const control::SimulationReport& r, const control::ClosedLoopSimulation& sim,
+                         const control::RotationUnits& u) {
+  const ControlUnits cu(u);
+  const units::Unit signal = units::as_is("signal");
+  const units::Unit control_signal{"signal*Omega", 1.0, u.rotation_frequency()};  // u [signal/s] / Ω
+  // a complex amplitude converted by `unit`: re, im and |z| of the converted value
+  const auto complex_json = [](std::complex<double> z, const units::Unit& unit) {
+    const std::complex<double> c(unit(z.real()), unit(z.imag()));
+    return nlohmann::json{{"re", c.real()}, {"im", c.imag()}, {"abs", std::abs(c)}};
   };
-  nlohmann::json j;
-  j["method"] = control::to_string(sim.options().stepping);
-  j["step"] = u.in_periods(r.step);
-  j["steps_per_period"] = r.steps_per_period;
-  j["periods_completed"] = r.periods_completed;
-  j["diverged"] = r.diverged;
-  j["delay_exceeds_period"] = r.delay_exceeds_period;
-  j["residual_first_harmonic"] = r.residual_first_harmonic;
-  j["first_harmonic"] = complex_json(r.first_harmonic);
-  j["control_first_harmonic"] = complex_json(r.control_first_harmonic / u.rotation_frequency());
-  j["bank_max_order"] = r.bank_max_order;
-  j["max_harmonic_error"] = r.max_harmonic_error;
-  j["max_harmonic_error_above_bank"] = r.max_harmonic_error_above;
-  nlohmann::json hs = nlohmann::json::array();
-  for (const auto& h : r.harmonics)
-    hs.push_back({{"order", h.order}, {"value", complex_json(h.value)}, {"target", complex_json(h.target)},
-                  {"error", h.error}});
-  j["harmonics"] = hs;
-  j["growth_rate"] = u.in_omega(r.growth_rate);
-  j["convergence_rate"] = -u.in_omega(r.growth_rate);
-  j["fit_periods"] = {r.fit_first_period, r.fit_last_period};
-  j["envelope_first_harmonic"] = r.envelope;
-  j["units"] = {{"step", "T"}, {"steps_per_period", "count"}, {"periods_completed", "count"},
-                {"residual_first_harmonic", "signal"}, {"first_harmonic", "signal"},
-                {"control_first_harmonic", "signal*Omega"}, {"bank_max_order", "count"},
-                {"max_harmonic_error", "signal"}, {"max_harmonic_error_above_bank", "signal"},
-                {"harmonics", {{"order", "count"}, {"value", "signal"}, {"target", "signal"}, {"error", "signal"}}},
-                {"growth_rate", "Omega"}, {"convergence_rate", "Omega"}, {"fit_periods", "count"},
-                {"envelope_first_harmonic", "signal"}};
-  j["notes"] = {{"harmonics", "complex amplitudes over the last period: y = Re sum c_k exp(i k Omega t), k = 0 .. "
-                              "max_order (above bank_max_order: harmonics the controller does not model)"},
-                {"growth_rate", "slope of ln |y_1| against time, in units of Omega (ln-factor per period = 2 pi x "
-                                "growth_rate); negative = converging; comparable to the spectral abscissa of "
-                                "`control roots`"}};
+  const auto harmonic_record = [&](const control::HarmonicComparison& h) {
+    UnitTagged j;
+    j.add("order", h.order, "count")
+        .add("value", complex_json(h.value, signal), signal.name)
+        .add("target", complex_json(h.target, signal), signal.name)
+        .add("error", h.error, signal);
+    return j;
+  };
+  std::vector<UnitTagged> harmonics;
+  for (const auto& h : r.harmonics) harmonics.push_back(harmonic_record(h));
+  UnitTagged j;
+  j.add("method", control::to_string(sim.options().stepping))
+      .add("step", r.step, cu.period)
+      .add("steps_per_period", r.steps_per_period, "count")
+      .add("periods_completed", r.periods_completed, "count")
+      .add("diverged", r.diverged, "boolean (0/1)")
+      .add("delay_exceeds_period", r.delay_exceeds_period, "boolean (0/1)")
+      .add("residual_first_harmonic", r.residual_first_harmonic, signal)
+      .add("first_harmonic", complex_json(r.first_harmonic, signal), signal.name)
+      .add("control_first_harmonic", complex_json(r.control_first_harmonic, control_signal), control_signal.name)
+      .add("bank_max_order", r.bank_max_order, "count")
+      .add("max_harmonic_error", r.max_harmonic_error, signal)
+      .add("max_harmonic_error_above_bank", r.max_harmonic_error_above, signal)
+      .add("harmonics", harmonics, harmonic_record(control::HarmonicComparison{}))
+      .add("growth_rate", r.growth_rate, cu.omega)
+      .add("convergence_rate", -r.growth_rate, cu.omega)
+      .add("fit_periods", {r.fit_first_period, r.fit_last_period}, "count")
+      .add("envelope_first_harmonic", r.envelope, signal);
   return j;
+}
+
+/// What the report's entries mean (results "notes").
+nlohmann::json report_notes() {
+  return {{"harmonics", "complex amplitudes over the last period: y = Re sum c_k exp(i k Omega t), k = 0 .. max_order "
+                        "(above bank_max_order: harmonics the controller does not model)"},
+          {"growth_rate", "slope of ln |y_1| against time, in units of Omega (ln-factor per period = 2 pi x "
+                          "growth_rate); negative = converging; comparable to the spectral abscissa of `control "
+                          "roots`"}};
 }
 
 /// The time series' table, one row per recorded step (u: the rotation units of the run).
 io::TableOf<control::TimeSample> simulate_table(const control::RotationUnits& u) {
+  const ControlUnits cu(u);
+  const units::Unit control_signal{"signal*Omega", 1.0, u.rotation_frequency()};  // u [signal/s] / Ω
   using S = control::TimeSample;
-  const double w = u.rotation_frequency();
-  return {{"t", "T", "time", [u](const S& r) { return u.in_periods(r.t); }},
+  return {{"t", cu.period, "time", [](const S& r) { return r.t; }},
           {"y", "signal", "plant output y", &S::y},
-          {"u", "signal*Omega", "control u", [w](const S& r) { return r.u / w; }},
+          {"u", control_signal, "control u", &S::u},
           {"m", "signal", "measurement y(t - tau)", &S::m},
           {"target", "signal", "steady state to reach: uncontrolled output without the rejected harmonics", &S::target},
           {"f_minus_f1", "signal", "disturbance f without its first harmonic", &S::f_minus_first}};
@@ -251,21 +262,26 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
   const auto res = o.record_every > 0 ? sim.run([&](long, long) { progress.advance(); }, sink)
                                       : sim.run([&](long, long) { progress.advance(); });
   progress.finish();
-  nlohmann::json report = report_json(res.report, sim, u);
-  report["loop"] = control::describe_in_rotation_units(control::loop_from(c));
-  report["settings"] = settings_json(c);
-  report["settings_si"] = settings_si_json(c);
+  UnitTagged report = report_record(res.report, sim, u);
+  report.add("loop", control::describe_in_rotation_units(control::loop_from(c)))
+      .add("settings", settings_json(c))  // records with their own units
+      .add("settings_si", settings_si_json(c));
+  nlohmann::json notes = report_notes();
   if (from_samples) {
     const control::SampledDisturbance& d = *from_samples;
-    report["signal"] = {{"samples", signal_samples}, {"samples_per_period", d.samples_per_period},
-                        {"periods", d.periods}, {"harmonics", d.harmonics},
-                        {"harmonics_used", d.disturbance.harmonics.size()}, {"offset", d.disturbance.offset},
-                        {"rms", d.rms}, {"non_periodic_rms", d.non_periodic_rms},
-                        {"unrepresented_rms", d.unrepresented_rms}};
-    report["units"]["signal"] = {{"samples", "count"}, {"samples_per_period", "count"}, {"periods", "count"},
-                                 {"harmonics", "count"}, {"harmonics_used", "count"}, {"offset", "signal"},
-                                 {"rms", "signal"}, {"non_periodic_rms", "signal"}, {"unrepresented_rms", "signal"}};
-    report["notes"]["signal"] = "f from the samples: their period average (non_periodic_rms: what differs from "
+    const units::Unit signal = units::as_is("signal");
+    UnitTagged from;
+    from.add("samples", signal_samples, "count")
+        .add("samples_per_period", d.samples_per_period, "count")
+        .add("periods", d.periods, "count")
+        .add("harmonics", d.harmonics, "count")
+        .add("harmonics_used", d.disturbance.harmonics.size(), "count")
+        .add("offset", d.disturbance.offset, signal)
+        .add("rms", d.rms, signal)
+        .add("non_periodic_rms", d.non_periodic_rms, signal)
+        .add("unrepresented_rms", d.unrepresented_rms, signal);
+    report.add("signal", from);
+    notes["signal"] = "f from the samples: their period average (non_periodic_rms: what differs from "
                                 "period to period) as c0 + sum F_k sin(k Omega t + phi_k), k = 1 .. harmonics "
                                 "(unrepresented_rms: what these harmonics leave of the average)";
     if (d.non_periodic_rms > 1e-9 * d.rms)
@@ -278,7 +294,8 @@ void run_simulate(const io::ParamSet& p, Captured* capture) {
                                  "stopped", res.report.periods_completed));
   if (res.report.delay_exceeds_period)
     io::message_line("afmkit: warning: the delay reaches one rotation period (the paper assumes tau < T)");
-  out.finish(report, fmt::format("|y_1| over the last period = {:.3e}, max harmonic error = {:.3e} (k <= {}), {:.3e} "
+  report.add("notes", notes);
+  out.finish(report.with_units(), fmt::format("|y_1| over the last period = {:.3e}, max harmonic error = {:.3e} (k <= {}), {:.3e} "
                                  "above, growth rate = {}",
                                  res.report.residual_first_harmonic, res.report.max_harmonic_error,
                                  res.report.bank_max_order, res.report.max_harmonic_error_above,

@@ -18,6 +18,8 @@
 #include "command.hpp"
 #include "commands.hpp"
 #include "control_params.hpp"
+#include "control_units.hpp"
+#include "unit_tagged.hpp"
 #include "work_budget.hpp"
 #include "afmkit/io/progress.hpp"
 
@@ -60,9 +62,9 @@ double frequency_in(const std::string& unit, double omega, double w) {
 // τ = 0 verdicts (units of Ω): eigenvalues for finite banks (any K, plant), closed-form conditions at the design
 // point K = γ.
 nlohmann::json stability_summary(const control::ControlSettings& c) {
-  nlohmann::json j;
-  nlohmann::json units;
+  UnitTagged j;
   const control::ControlSettingsSi si = control::to_si(c);
+  const ControlUnits cu(c.units());
   const double w = si.rotation_frequency;
   const ControllerKind inner = c.bank_kind();
   const bool finite_bank = inner != ControllerKind::Infinite;
@@ -71,65 +73,62 @@ nlohmann::json stability_summary(const control::ControlSettings& c) {
     control::ControlSettings plain = c;
     plain.controller = inner;
     plain.delay = 0.0;
-    const double abscissa = control::undelayed_spectral_abscissa(control::loop_from(plain)) / w;
-    j["delay_free_spectral_abscissa"] = abscissa;
-    units["delay_free_spectral_abscissa"] = "Omega";
-    j["delay_free_stable"] = abscissa < 0.0;
-    j["delay_free_basis"] = "eigenvalues of the closed-loop state matrix with tau = 0 (roots of the delay-free "
-                            "characteristic polynomial, O(N^2))";
+    const double abscissa = control::undelayed_spectral_abscissa(control::loop_from(plain));  // rad/s
+    j.add("delay_free_spectral_abscissa", abscissa, cu.omega)
+        .add("delay_free_stable", abscissa < 0.0, "boolean (0/1)")
+        .add("delay_free_basis", "eigenvalues of the closed-loop state matrix with tau = 0 (roots of the delay-free "
+                                 "characteristic polynomial, O(N^2))");
   } else if (finite_bank) {
-    j["delay_free_spectral_abscissa"] = nullptr;
-    j["delay_free_stable"] = nullptr;
-    j["delay_free_basis"] = fmt::format("not computed for harmonics > {} (cost O(N^2)); the design-point verdict "
-                                        "below is O(N)", kMaxHarmonicsSpectra);
+    j.add("delay_free_spectral_abscissa", nullptr)
+        .add("delay_free_stable", nullptr)
+        .add("delay_free_basis", fmt::format("not computed for harmonics > {} (cost O(N^2)); the design-point verdict "
+                                             "below is O(N)",
+                                             kMaxHarmonicsSpectra));
   }
   if (inner == ControllerKind::Single) {
-    j["eq13_stable"] = control::single_oscillator_stable_tau0(w, si.a, si.b, si.gain, si.plant_rate);
-    j["eq13_b_limit"] = si.plant_rate / si.gain;  // b < γΩ/K, in units of Ω
-    units["eq13_b_limit"] = "Omega";
+    j.add("eq13_stable", control::single_oscillator_stable_tau0(w, si.a, si.b, si.gain, si.plant_rate), "boolean (0/1)")
+        .add("eq13_b_limit", si.plant_rate / si.gain, control::RotationUnits::rate_unit);  // b < γΩ/K, in units of Ω
   } else {
     const bool infinite = inner == ControllerKind::Infinite;
     const auto bc = infinite ? control::critical_beta_limit(w) : control::critical_beta(c.harmonics, w);
-    j["beta_critical"] = bc.beta / w;
-    j["beta_critical_over_omega"] = bc.beta / w;  // the same (kept for readers of earlier sidecars)
-    j["crossing_frequency"] = bc.crossing_frequency / w;
-    units["beta_critical"] = units["beta_critical_over_omega"] = units["crossing_frequency"] = "Omega";
-    j["design_point_stable"] = c.alpha > 0.0 && si.beta > bc.beta;
-    j["design_point_basis"] = infinite ? "eq. (24): alpha > 0 and beta > -Omega/4 (K = gamma, static plant, tau = 0)"
-                                       : "alpha > 0 and beta > beta_c(N) (K = gamma, static plant, tau = 0)";
+    j.add("beta_critical", bc.beta, cu.omega)
+        .add("beta_critical_over_omega", bc.beta, cu.omega)  // the same (kept for readers of earlier sidecars)
+        .add("crossing_frequency", bc.crossing_frequency, cu.omega)
+        .add("design_point_stable", c.alpha > 0.0 && si.beta > bc.beta, "boolean (0/1)")
+        .add("design_point_basis", infinite ? "eq. (24): alpha > 0 and beta > -Omega/4 (K = gamma, static plant, tau = 0)"
+                                            : "alpha > 0 and beta > beta_c(N) (K = gamma, static plant, tau = 0)");
     if (!infinite) {
       const auto nc = control::necessary_conditions(c.harmonics, w, si.alpha, si.beta);
-      j["eq40_coefficient"] = nc.coefficient_2n;
-      j["eq41_coefficient_normalised"] = nc.coefficient_1_normalised;
-      j["eq42_limit_condition"] = nc.limit_condition;
+      j.add("eq40_coefficient", nc.coefficient_2n, control::RotationUnits::si_rate_unit)  // (2N + 1) α, α in rad/s
+          .add("eq41_coefficient_normalised", nc.coefficient_1_normalised, "dimensionless")
+          .add("eq42_limit_condition", nc.limit_condition, "boolean (0/1)");
     }
   }
-  j["units"] = units;
-  return j;
+  return j.with_units();  // a record with its own units
 }
 
-nlohmann::json summary(const control::ControlSettings& c, const control::LoopSpec& loop) {
-  nlohmann::json j;
-  j["loop"] = control::describe_in_rotation_units(loop);
-  j["settings"] = settings_json(c);
-  j["settings_si"] = settings_si_json(c);
-  j["gain_ratio"] = loop.gain_ratio();
-  j["tau0"] = stability_summary(c);
-  nlohmann::json harmonics = nlohmann::json::array();
+UnitTagged summary(const control::ControlSettings& c, const control::LoopSpec& loop) {
+  const auto harmonic_record = [&](int k) {
+    const std::complex<double> s(0.0, k * loop.rotation_frequency());
+    UnitTagged h;
+    h.add("harmonic", k, "count")
+        .add("sensitivity_magnitude", std::abs(control::sensitivity(loop, s)), "dimensionless")
+        .add("closed_loop_magnitude", std::abs(control::disturbance_response(loop, s)), "dimensionless");
+    return h;
+  };
+  std::vector<UnitTagged> harmonics;
   const int kmax = c.controller == ControllerKind::Single ? 3
                                                           : std::min(c.controller == ControllerKind::Infinite ? 5
                                                                                                               : c.harmonics + 1,
                                                                      8);
-  for (int k = 1; k <= kmax; ++k) {
-    const std::complex<double> s(0.0, k * loop.rotation_frequency());
-    harmonics.push_back({{"harmonic", k},
-                         {"sensitivity_magnitude", std::abs(control::sensitivity(loop, s))},
-                         {"closed_loop_magnitude", std::abs(control::disturbance_response(loop, s))}});
-  }
-  j["at_harmonics"] = harmonics;
-  j["units"] = {{"gain_ratio", "dimensionless"},
-                {"at_harmonics", {{"harmonic", "count"}, {"sensitivity_magnitude", "dimensionless"},
-                                  {"closed_loop_magnitude", "dimensionless"}}}};
+  for (int k = 1; k <= kmax; ++k) harmonics.push_back(harmonic_record(k));
+  UnitTagged j;
+  j.add("loop", control::describe_in_rotation_units(loop))
+      .add("settings", settings_json(c))  // records with their own units
+      .add("settings_si", settings_si_json(c))
+      .add("gain_ratio", loop.gain_ratio(), "dimensionless")
+      .add("tau0", stability_summary(c))
+      .add("at_harmonics", harmonics, harmonic_record(1));
   return j;
 }
 
@@ -177,15 +176,15 @@ void run_tf(const io::ParamSet& p, Captured* capture) {
       "points", static_cast<double>(points), terms * kTermSeconds,
       fmt::format("points x (harmonics + 8) oscillator terms of about {:.2g} s each, harmonics = {}", kTermSeconds,
                   c.harmonics));
-  nlohmann::json res = summary(c, loop);
+  UnitTagged res = summary(c, loop);
   const double w = c.rotation_frequency;
   const std::string system = p.text("system");
   const std::string frequency_unit = p.text("frequency_unit");
   const ResponseUnit unit = response_unit(system, w, frequency_unit != "Omega");
   const control::LoopSystem which = system_from(system);
-  res["system"] = system;
-  res["rows"] = points;
-  res["cost"] = "O(N) per frequency (sum over the oscillators); rows streamed to the file";
+  res.add("system", system)
+      .add("rows", points, "count")
+      .add("cost", "O(N) per frequency (sum over the oscillators); rows streamed to the file");
   auto rows = out.open(tf_table(frequency_unit, w, unit));
   // each frequency is computed and its row written at once: memory is bounded by a row, not by the file
   control::PhaseUnwrapper unwrap;
@@ -200,7 +199,8 @@ void run_tf(const io::ParamSet& p, Captured* capture) {
     rows.add(point);
   }
   progress.finish();
-  out.finish(res, fmt::format("{} frequencies of the {} ({})", points, system, res["loop"].get<std::string>()));
+  out.finish(res.with_units(),
+             fmt::format("{} frequencies of the {} ({})", points, system, res.values().at("loop").get<std::string>()));
 }
 
 }  // namespace

@@ -13,6 +13,8 @@
 #include "command.hpp"
 #include "control_analysis.hpp"
 #include "control_params.hpp"
+#include "control_units.hpp"
+#include "unit_tagged.hpp"
 #include "work_budget.hpp"
 
 namespace afmkit::cli {
@@ -40,16 +42,17 @@ struct CoarsePoint {
 
 // The coarse grid's table: the rows are the (y, x) grid of n x n points, x fastest.
 io::TableOf<CoarsePoint> coarse_grid_table(const control::LoopFamily& family, const control::RotationUnits& u, int n) {
+  const ControlUnits cu(u);
   using P = CoarsePoint;
   io::TableOf<P> table{
-      {"x", "Omega", std::string(family.x_name()) + " of the coarse grid point",
-       [u](const P& p) { return u.in_omega(p.tuning.coarse_x[p.i]); }},
-      {"y", "Omega", std::string(family.y_name()) + " of the coarse grid point",
-       [u](const P& p) { return u.in_omega(p.tuning.coarse_y[p.j]); }},
-      {"worst_decay_rate", "Omega",
+      {"x", cu.omega, std::string(family.x_name()) + " of the coarse grid point",
+       [](const P& p) { return p.tuning.coarse_x[p.i]; }},
+      {"y", cu.omega, std::string(family.y_name()) + " of the coarse grid point",
+       [](const P& p) { return p.tuning.coarse_y[p.j]; }},
+      {"worst_decay_rate", cu.omega,
        "objective: smallest decay rate -max Re s over the delays and gain ratios (tracked spectra)",
-       [u, n](const P& p) {
-         return u.in_omega(p.tuning.coarse_worst_decay[static_cast<std::size_t>(p.j) * n + p.i]);
+       [n](const P& p) {
+         return p.tuning.coarse_worst_decay[static_cast<std::size_t>(p.j) * n + p.i];
        }}};
   table.grid({{"y", family.y_name(), static_cast<std::size_t>(n)}, {"x", family.x_name(), static_cast<std::size_t>(n)}});
   return table;
@@ -110,32 +113,34 @@ void run_tune(const io::ParamSet& p, Captured* capture) {
   const int n = s.coarse_points;
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) rows.add({r, i, j});
-  nlohmann::json res;
-  res["family"] = describe_family(s.family);
-  res["x"] = s.family.x_name();
-  res["y"] = s.family.y_name();
-  res["optimum"] = {{s.family.x_name(), u.in_omega(r.x)}, {s.family.y_name(), u.in_omega(r.y)}};
-  res["worst_decay_rate"] = u.in_omega(r.worst_decay);
-  res["certified_worst_decay_rate"] = u.in_omega(r.certified_worst_decay);
-  res["worst_delay"] = u.in_periods(r.worst_delay);
-  res["worst_gain_ratio"] = r.worst_gain_ratio;
-  nlohmann::json ms = nlohmann::json::array();
-  for (const auto& m : r.margins)
-    ms.push_back({{"gain_ratio", m.gain_ratio}, {"critical_delay", u.in_periods(m.critical_delay)},
-                  {"crossing_frequency", u.in_omega(m.crossing_frequency)}});
-  res["margins"] = ms;
-  res["window"] = window_json(win);
-  res["evaluations"] = r.evaluations;
-  res["converged"] = r.converged;
-  res["objective"] = "max over (x, y) of min over tau in [0, delay_max], rho in [gain_ratio_min, gain_ratio_max] "
-                     "of the decay rate -max Re s";
-  res["settings"] = settings_json(c);
-  res["settings_si"] = settings_si_json(c);
-  res["units"] = {{"optimum", "Omega"}, {"worst_decay_rate", "Omega"}, {"certified_worst_decay_rate", "Omega"},
-                  {"worst_delay", "T"}, {"worst_gain_ratio", "dimensionless"}, {"window", "Omega"},
-                  {"evaluations", "count"},
-                  {"margins", {{"gain_ratio", "dimensionless"}, {"critical_delay", "T"}, {"crossing_frequency", "Omega"}}}};
-  out.finish(res, fmt::format("robust optimum {} = {}, {} = {}: worst-case decay rate {} (certified {})",
+  const ControlUnits cu(u);
+  const auto margin_record = [&](const control::GainMargin& m) {
+    UnitTagged j;
+    j.add("gain_ratio", m.gain_ratio, "dimensionless")
+        .add("critical_delay", m.critical_delay, cu.period)
+        .add("crossing_frequency", m.crossing_frequency, cu.omega);
+    return j;
+  };
+  std::vector<UnitTagged> margins;
+  for (const auto& m : r.margins) margins.push_back(margin_record(m));
+  UnitTagged res;
+  res.add("family", describe_family(s.family))
+      .add("x", s.family.x_name())
+      .add("y", s.family.y_name())
+      .add("optimum", {{s.family.x_name(), r.x}, {s.family.y_name(), r.y}}, cu.omega)
+      .add("worst_decay_rate", r.worst_decay, cu.omega)
+      .add("certified_worst_decay_rate", r.certified_worst_decay, cu.omega)
+      .add("worst_delay", r.worst_delay, cu.period)
+      .add("worst_gain_ratio", r.worst_gain_ratio, "dimensionless")
+      .add("margins", margins, margin_record(control::GainMargin{}))
+      .add("window", window_json(win), control::RotationUnits::rate_unit)  // given in units of Ω
+      .add("evaluations", r.evaluations, "count")
+      .add("converged", r.converged, "boolean (0/1)")
+      .add("objective", "max over (x, y) of min over tau in [0, delay_max], rho in [gain_ratio_min, gain_ratio_max] "
+                        "of the decay rate -max Re s")
+      .add("settings", settings_json(c))  // records with their own units
+      .add("settings_si", settings_si_json(c));
+  out.finish(res.with_units(), fmt::format("robust optimum {} = {}, {} = {}: worst-case decay rate {} (certified {})",
                               s.family.x_name(), rate_summary(r.x, u, 5), s.family.y_name(), rate_summary(r.y, u, 5),
                               rate_summary(r.worst_decay, u, 5), rate_summary(r.certified_worst_decay, u, 5)));
 }

@@ -21,6 +21,7 @@
 #include "commands.hpp"
 #include "tapping_params.hpp"
 #include "tapping_tables.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -81,7 +82,7 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
       computed("demo: the harmonic-balance curve", [&] { return tapping::harmonic_balance_curve(model, hb_options); });
   const tapping::HarmonicBalance balance =
       computed("demo: harmonic balance", [&] { return tapping::HarmonicBalance(model); });
-  const nlohmann::json folds =  // sorted by separation, as `tapping hb`
+  const std::vector<UnitTagged> folds =  // sorted by separation, as `tapping hb`
       computed("demo: the harmonic-balance folds", [&] { return hb_fold_records(balance, u); });
 
   // 2. Approach–retract sweep, each orbit continued from the previous one (shooting).
@@ -93,13 +94,15 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
       "demo: instrument sweep", [&] { return tapping::sweep_instrument(model, l_min, l_max, points, options); });
   progress.finish();
 
-  nlohmann::json jumps = {{"approach", sweep.approach_jumps}, {"retract", sweep.retract_jumps}};
-  for (auto& side : {"approach", "retract"})
-    for (auto& v : jumps[side]) v = u.length(v.get<double>());
-  const nlohmann::json results = {{"hb_folds", folds},
-                                  {"sweep_jumps", jumps},
-                                  {"free_amplitude", u.length(model.free_amplitude())},
-                                  {"units", {{"length", u.length.name}}}};
+  // each entry with its unit, and the unit of lengths
+  UnitTagged jumps;
+  jumps.add("approach", sweep.approach_jumps, u.length).add("retract", sweep.retract_jumps, u.length);
+  UnitTagged tagged;
+  tagged.add("hb_folds", folds, hb_fold_record(tapping::HbFold{}, u))
+      .add("sweep_jumps", jumps)
+      .add("free_amplitude", model.free_amplitude(), u.length)
+      .unit("length", u.length.name);
+  const nlohmann::json results = tagged.with_units();
   const io::TableOf<tapping::HbPoint> hb_rows = hb_table(u);
   io::TableWriter hb(dir + "/demo_hb.csv", hb_rows.columns());
   for (const tapping::HbPoint& pt : curve) io::write_row(hb, hb_rows, pt);
@@ -116,18 +119,19 @@ void run_demo(const io::ParamSet& given, Captured* capture) {
     return;
   }
 
-  // lengths by magnitude in physical units, said to be normalised otherwise (docs/units.md#summaries)
+  // lengths by magnitude in physical units, said to be normalised otherwise (docs/units.md#summaries): the values
+  // written, in their unit
   const std::string& unit = u.length.name;
   fmt::print("afmkit demo: tapping cantilever, law '{}', Q = {}, drive at {} x resonance ({} units)\n",
              model.law.name(), model.cantilever.quality_factor, p.real("frequency_ratio"), p.text("units"));
-  fmt::print("  free amplitude {}\n", io::summary_value(u.length(model.free_amplitude()), unit, 6));
-  for (const auto& f : folds)
+  fmt::print("  free amplitude {}\n", io::summary_value(results.at("free_amplitude").get<double>(), unit, 6));
+  for (const auto& f : results.at("hb_folds"))
     fmt::print("  harmonic balance fold (jump point) at separation {}, amplitude {}\n",
                io::summary_value(f["separation"].get<double>(), unit, 6),
                io::summary_value(f["amplitude"].get<double>(), unit, 6));
-  for (double l : jumps["approach"])
+  for (double l : results.at("sweep_jumps").at("approach"))
     fmt::print("  sweep: approach jumped at separation {}\n", io::summary_value(l, unit, 6));
-  for (double l : jumps["retract"])
+  for (double l : results.at("sweep_jumps").at("retract"))
     fmt::print("  sweep: retract jumped at separation {}\n", io::summary_value(l, unit, 6));
   fmt::print("  wrote {}/demo_sweep.csv ({} orbits) and {}/demo_hb.csv ({} HB points); columns, units and results "
              "in the .json sidecars\n",

@@ -30,6 +30,7 @@
 #include "described_params.hpp"
 #include "python_launch.hpp"
 #include "spectroscopy_prepare.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -172,64 +173,84 @@ sp::PrepareOptions prepare_options(const io::ParamSet& p) {
   return o;
 }
 
-// SI results shown in nm, nN, nm/V (the output edge: each unit converts its values and names the unit)
-const units::Unit kNm = units::from_si("nm"), kNn = units::from_si("nN"), kNmPerVolt = units::from_si("nm/V");
+// SI results shown in nm, nN, nm/V and SI (the output edge: each unit converts its values and names the unit)
+const units::Unit kNm = units::from_si("nm"), kNn = units::from_si("nN"), kNmPerVolt = units::from_si("nm/V"),
+                  kNPerM = units::from_si("N/m"), kPa = units::from_si("Pa"), kHertzCoefficient = units::as_is("N/m^1.5");
 
-const nlohmann::json kUnits = {{"position", kNm.name},       {"distance", kNm.name},     {"force", kNn.name},
-                               {"spring_constant", "N/m"},   {"invols", kNmPerVolt.name}, {"baseline_slope", "N/m"},
-                               {"youngs_modulus", "Pa"},     {"hertz_coefficient", "N/m^1.5"},
-                               {"noise", kNn.name},          {"bin_width", kNm.name},    {"height", kNm.name}};
-
-nlohmann::json fit_json(const sp::HertzFit& f) {
-  return {{"model", sp::to_string(f.model)},
-          {"contact_point", kNm(f.contact_point)},
-          {"contact_point_error", kNm(f.contact_point_error)},
-          {"hertz_coefficient", f.coefficient},
-          {"hertz_coefficient_error", f.coefficient_error},
-          {"adhesion_offset", kNn(f.offset)},
-          {"adhesion_offset_error", kNn(f.offset_error)},
-          {"youngs_modulus", f.youngs_modulus},
-          {"youngs_modulus_error", f.youngs_modulus_error},
-          {"residual_rms", kNn(f.residual_rms)},
-          {"points", f.points},
-          {"position_from", kNm(f.position_from)},
-          {"position_to", kNm(f.position_to)},
-          {"evaluations", f.evaluations},
-          {"solver_status", f.solver_status}};
+/// The units by dimension (beside those of each entry).
+UnitTagged units_by_dimension() {
+  UnitTagged u;
+  u.unit("position", kNm.name)
+      .unit("distance", kNm.name)
+      .unit("force", kNn.name)
+      .unit("spring_constant", kNPerM.name)
+      .unit("invols", kNmPerVolt.name)
+      .unit("baseline_slope", kNPerM.name)
+      .unit("youngs_modulus", kPa.name)
+      .unit("hertz_coefficient", kHertzCoefficient.name)
+      .unit("noise", kNn.name)
+      .unit("bin_width", kNm.name)
+      .unit("height", kNm.name);
+  return u;
 }
 
-nlohmann::json curve_json(const sp::CurvePreparation& c) {
-  nlohmann::json j = {
-      {"origin", c.origin},
-      {"spring_constant", c.spring_constant},
-      {"spring_constant_source", c.spring_constant_source},
-      {"invols", kNmPerVolt(c.invols)},
-      {"invols_source", c.invols_source},
-      {"approach_samples", c.approach_samples},
-      {"retract_samples", c.retract_samples},
-      {"baseline",
-       {{"offset", kNn(c.baseline.offset)},
-        {"slope", c.baseline.slope},
-        {"noise", kNn(c.baseline.residual_rms)},
-        {"level_error", kNn(c.baseline.level_error)},
-        {"slope_error", c.baseline.slope_error},
-        {"mean_height", kNm(c.baseline.mean_height)},
-        {"points", c.baseline.points},
-        {"height_from", kNm(c.baseline.height_from)},
-        {"height_to", kNm(c.baseline.height_to)}}},
-      {"contact",
-       {{"method", sp::to_string(c.contact.method)},
-        {"position", kNm(c.contact.position)},
-        {"error", kNm(c.contact.error)},
-        {"baseline_error", kNm(c.contact.baseline_error)},
-        {"threshold_position", kNm(c.contact.threshold_position)}}},
-      {"notes", c.notes}};
-  if (c.contact.fit) j["contact"]["fit"] = fit_json(*c.contact.fit);
+UnitTagged fit_record(const sp::HertzFit& f) {
+  UnitTagged j;
+  j.add("model", sp::to_string(f.model))
+      .add("contact_point", f.contact_point, kNm)
+      .add("contact_point_error", f.contact_point_error, kNm)
+      .add("hertz_coefficient", f.coefficient, kHertzCoefficient)
+      .add("hertz_coefficient_error", f.coefficient_error, kHertzCoefficient)
+      .add("adhesion_offset", f.offset, kNn)
+      .add("adhesion_offset_error", f.offset_error, kNn)
+      .add("youngs_modulus", f.youngs_modulus, kPa)
+      .add("youngs_modulus_error", f.youngs_modulus_error, kPa)
+      .add("residual_rms", f.residual_rms, kNn)
+      .add("points", f.points, "count")
+      .add("position_from", f.position_from, kNm)
+      .add("position_to", f.position_to, kNm)
+      .add("evaluations", f.evaluations, "count")
+      .add("solver_status", f.solver_status);
   return j;
 }
 
-nlohmann::json event_json(const sp::CurveEvent& e) {
-  return {{"detected", e.detected}, {"distance", kNm(e.distance)}, {"force", kNn(e.force)}};
+UnitTagged curve_record(const sp::CurvePreparation& c) {
+  UnitTagged baseline;
+  baseline.add("offset", c.baseline.offset, kNn)
+      .add("slope", c.baseline.slope, kNPerM)
+      .add("noise", c.baseline.residual_rms, kNn)
+      .add("level_error", c.baseline.level_error, kNn)
+      .add("slope_error", c.baseline.slope_error, kNPerM)
+      .add("mean_height", c.baseline.mean_height, kNm)
+      .add("points", c.baseline.points, "count")
+      .add("height_from", c.baseline.height_from, kNm)
+      .add("height_to", c.baseline.height_to, kNm);
+  UnitTagged contact;
+  contact.add("method", sp::to_string(c.contact.method))
+      .add("position", c.contact.position, kNm)
+      .add("error", c.contact.error, kNm)
+      .add("baseline_error", c.contact.baseline_error, kNm)
+      .add("threshold_position", c.contact.threshold_position, kNm);
+  if (c.contact.fit) contact.add("fit", fit_record(*c.contact.fit));
+  else contact.unit("fit", fit_record(sp::HertzFit{}).units());  // (a fit of the hertz and dmt methods)
+  UnitTagged j;
+  j.add("origin", c.origin)
+      .add("spring_constant", c.spring_constant, kNPerM)
+      .add("spring_constant_source", c.spring_constant_source)
+      .add("invols", c.invols, kNmPerVolt)
+      .add("invols_source", c.invols_source)
+      .add("approach_samples", c.approach_samples, "count")
+      .add("retract_samples", c.retract_samples, "count")
+      .add("baseline", baseline)
+      .add("contact", contact)
+      .add("notes", c.notes);
+  return j;
+}
+
+UnitTagged event_record(const sp::CurveEvent& e) {
+  UnitTagged j;
+  j.add("detected", e.detected, "boolean (0/1)").add("distance", e.distance, kNm).add("force", e.force, kNn);
+  return j;
 }
 
 /// The law file's text, as the table writer writes it (shortest round-trip numbers, empty cells past a branch).
@@ -403,19 +424,20 @@ void run_prepare_curves(const io::ParamSet& p, const std::vector<io::curves::Raw
     check = "refused (see the note)";
   }
 
-  nlohmann::json curves_json = nlohmann::json::array();
-  for (const auto& c : r.curves) curves_json.push_back(curve_json(c));
-  nlohmann::json results = {{"status", status},
-                            {"curves", curves_json},
-                            {"noise", kNn(r.noise)},
-                            {"bin_width", kNm(r.bin_width)},
-                            {"approach_points", r.approach.size()},
-                            {"retract_points", r.retract.size()},
-                            {"trimmed_at", kNm(r.trimmed_at)},
-                            {"snap_in", event_json(r.snap_in)},
-                            {"pull_off", event_json(r.pull_off)},
-                            {"units", kUnits}};
-  if (!note.empty()) results["note"] = note;
+  std::vector<UnitTagged> curve_records;
+  for (const auto& c : r.curves) curve_records.push_back(curve_record(c));
+  UnitTagged tagged = units_by_dimension();
+  tagged.add("status", status)
+      .add("curves", curve_records, curve_record(sp::CurvePreparation{}))
+      .add("noise", r.noise, kNn)
+      .add("bin_width", r.bin_width, kNm)
+      .add("approach_points", r.approach.size(), "count")
+      .add("retract_points", r.retract.size(), "count")
+      .add("trimmed_at", r.trimmed_at, kNm)
+      .add("snap_in", event_record(r.snap_in))
+      .add("pull_off", event_record(r.pull_off));
+  if (!note.empty()) tagged.add("note", note);
+  const nlohmann::json results = tagged.with_units();
 
   CommandOutput out(as_run, capture, "spectroscopy prepare");
   out.open({{sp::law_columns[0], "nm", "approach branch: tip-sample distance (bin centre; < 0: indentation)"},

@@ -20,6 +20,7 @@
 #include "tapping_fm_params.hpp"
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -120,28 +121,26 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
   out.open(fm_table(u, base.cantilever.natural_frequency, at_gap)).add_all(r.points);
   const double wn = base.cantilever.natural_frequency;
   const long n = static_cast<long>(r.points.size()), converged = r.converged();
-  nlohmann::json results;
-  results["amplitude"] = u.t.length(setting.amplitude);
-  results["resonance_frequency"] = u.frequency(wn);
-  results["rows"] = n;
-  results["converged_rows"] = converged;
-  results["jumped_rows"] = std::count_if(r.points.begin(), r.points.end(), [](const auto& q) { return q.jumped; });
-  results["no_orbit_rows"] = n - converged;
-  results["evaluations"] = r.evaluations;
-  results["failed_attempts"] = r.failed_attempts;
-  results["seconds"] = r.seconds;
-  results["seconds_per_separation"] = n > 0 ? r.seconds / static_cast<double>(n) : kNan;
-  results["status"] = converged > 0 ? "ok" : "no_orbit";
-  results["note"] = converged == 0
-                        ? fmt::format("no FM orbit: Newton converged at none of the {} {} (from the free "
-                                      "oscillation at the largest, with up to {} bisections of each step)",
-                                      n, at_gap ? "turning-point gaps" : "separations", options.max_bisections)
-                    : converged < n ? fmt::format("no FM orbit at {} of {} separations (rows with status no_orbit)",
-                                                  n - converged, n)
-                                    : std::string();
-  results["units"] = {{"amplitude", u.t.length.name}, {"resonance_frequency", u.frequency.name}, {"rows", "count"},
-                      {"converged_rows", "count"}, {"jumped_rows", "count"}, {"no_orbit_rows", "count"}, {"evaluations", "count"},
-                      {"failed_attempts", "count"}, {"seconds", "s"}, {"seconds_per_separation", "s"}};
+  const std::string note =
+      converged == 0 ? fmt::format("no FM orbit: Newton converged at none of the {} {} (from the free oscillation at "
+                                   "the largest, with up to {} bisections of each step)",
+                                   n, at_gap ? "turning-point gaps" : "separations", options.max_bisections)
+      : converged < n ? fmt::format("no FM orbit at {} of {} separations (rows with status no_orbit)", n - converged, n)
+                      : std::string();
+  UnitTagged results;
+  results.add("amplitude", setting.amplitude, u.t.length)
+      .add("resonance_frequency", wn, u.frequency)
+      .add("rows", n, "count")
+      .add("converged_rows", converged, "count")
+      .add("jumped_rows", std::count_if(r.points.begin(), r.points.end(), [](const auto& q) { return q.jumped; }),
+           "count")
+      .add("no_orbit_rows", n - converged, "count")
+      .add("evaluations", r.evaluations, "count")
+      .add("failed_attempts", r.failed_attempts, "count")
+      .add("seconds", r.seconds, "s")
+      .add("seconds_per_separation", n > 0 ? r.seconds / static_cast<double>(n) : kNan, "s")
+      .add("status", converged > 0 ? "ok" : "no_orbit")
+      .add("note", note);
   // summary: the closest point reached
   std::string summary;
   const tapping::FmPoint* last = nullptr;
@@ -153,7 +152,8 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
     summary = fmt::format(
         "FM approach at amplitude {}: {} of {} separations converged ({} one-period simulations, {} per separation)\n"
         "closest: separation {}, turning point {}: Δf = {} (Δf/f0 = {:.4g}), drive ratio {:.6g}, dissipation {}",
-        length(setting.amplitude), converged, n, r.evaluations, io::quantity(results["seconds_per_separation"], "s"),
+        length(setting.amplitude), converged, n, r.evaluations,
+        io::quantity(results.values().at("seconds_per_separation").get<double>(), "s"),
         length(o.separation), length(o.metrics.min_gap),
         u.physical ? io::quantity(u.frequency(o.frequency_shift()), u.frequency.name)
                    : fmt::format("{:.6g} {}", u.frequency(o.frequency_shift()), u.frequency.name),
@@ -162,11 +162,11 @@ void run_fm(const io::ParamSet& p, Captured* capture) {
                                  u.energy_ev(o.tip_dissipation()), u.energy_ev.name)
                    : fmt::format("{:.6g} {}", u.energy(o.tip_dissipation()), u.energy.name));
   }
-  if (const std::string note = results["note"].get<std::string>(); !note.empty()) {
+  if (!note.empty()) {
     if (!summary.empty()) summary += '\n';
     summary += note;
   }
-  out.finish(results, summary);
+  out.finish(results.with_units(), summary);
 }
 
 }  // namespace

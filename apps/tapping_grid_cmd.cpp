@@ -80,23 +80,26 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
   progress.finish();
 
   // the outputs, as the study tapping.orbit names them (docs/study.md#outputs), each at every separation
+  // each with its unit, which converts its values (in the model's units) where the store is written
   struct Output {
     const char* name;
     const char* selector;
-    bool length;  // in the length unit, else a count
+    units::Unit unit;
     std::vector<double> values;
   };
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  std::array<Output, 5> outputs = {{{"max_amplitude_stable", "max(amplitude | stable)", true, {}},
-                                    {"min_amplitude_stable", "min(amplitude | stable)", true, {}},
-                                    {"count_amplitude_stable", "count(amplitude | stable)", false, {}},
-                                    {"count_amplitude", "count(amplitude)", false, {}},
-                                    {"count_amplitude_trapped", "count(amplitude | trapped)", false, {}}}};
+  const units::Unit count = units::as_is("count");
+  std::array<Output, 5> outputs = {{{"max_amplitude_stable", "max(amplitude | stable)", u.length, {}},
+                                    {"min_amplitude_stable", "min(amplitude | stable)", u.length, {}},
+                                    {"count_amplitude_stable", "count(amplitude | stable)", count, {}},
+                                    {"count_amplitude", "count(amplitude)", count, {}},
+                                    {"count_amplitude_trapped", "count(amplitude | trapped)", count, {}}}};
   auto& [max_stable, min_stable, stable, all, trapped_orbits] = outputs;
-  for (Output& o : outputs) o.values.assign(points, o.length ? nan : 0.0);
+  for (Output& o : outputs) o.values.assign(points, 0.0);                           // the counts start at 0
+  for (Output* o : {&max_stable, &min_stable}) o->values.assign(points, nan);  // no stable orbit yet: undefined
   for (std::size_t i = 0; i < points; ++i)
     for (const tapping::FoundOrbit& f : results[i].orbits) {
-      const double amplitude = u.length(f.metrics.amplitude);
+      const double amplitude = f.metrics.amplitude;
       all.values[i] += 1;
       if (tapping::tip_trapped(f.metrics)) trapped_orbits.values[i] += 1;
       if (!f.orbit.stable) continue;
@@ -153,11 +156,14 @@ void run_grid(const io::ParamSet& p, Captured* capture) {
   store.coordinate("separation", separations,
                    {{"units", length}, {"description", "separation l: sample surface at x = -l"}});
   const std::vector<std::size_t> shape = {points}, chunks = {std::min(points, kChunk)};
-  for (const Output& o : outputs)
-    store.variable(o.name, {"separation"}, shape, chunks, o.values,
-                   {{"units", o.length ? length : "count"},
+  for (const Output& o : outputs) {
+    std::vector<double> shown(o.values.size());
+    std::transform(o.values.begin(), o.values.end(), shown.begin(), o.unit);
+    store.variable(o.name, {"separation"}, shape, chunks, shown,
+                   {{"units", o.unit.name},
                     {"selector", o.selector},
                     {"description", std::string(o.selector) + " of afmkit tapping orbit at each point"}});
+  }
   const std::size_t chunk_count = (points + chunks[0] - 1) / chunks[0];
   store.integer_variable("chunk_done", {"chunk"}, {chunk_count}, {1}, std::vector<std::int64_t>(chunk_count, 1), "<i1",
                          {{"units", "count"}, {"description", "1 when the chunk's outputs are written"}});

@@ -4,6 +4,7 @@
 // --json prints them (with the curve when --output "" writes no file).
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -33,25 +34,6 @@ namespace {
 constexpr double kHeldRowBytes = 1024.0;
 /// Points of the curve in memory at once when it is streamed.
 constexpr std::size_t kChunkPoints = 4096;
-
-nlohmann::json point_json(const tapping::HbPoint& p, const TappingUnits& u) {
-  return {{"q", p.q},
-          {"separation", u.length(p.separation)},
-          {"amplitude", u.length(p.amplitude)},
-          {"offset", u.length(p.offset)},
-          {"phase", p.phase},
-          {"branch", tapping::branch_name(p.branch)}};
-}
-
-/// The units: by dimension, and per results key (the units of study outputs, docs/study.md#outputs).
-nlohmann::json hb_units(const TappingUnits& u) {
-  const std::string& L = u.length.name;
-  const nlohmann::json point = {{"q", "dimensionless"}, {"separation", L}, {"amplitude", L}, {"offset", L},
-                                {"phase", "rad"}, {"branch", "label"}, {"kind", "label"}};
-  return {{"length", L},       {"phase", "rad"},   {"q", "dimensionless"},
-          {"folds", point},    {"free_amplitude", L}, {"solutions_at_separation", point},
-          {"rows", "count"},   {"minimum_separation_limit", L}};
-}
 
 /// What the run found (docs/conventions.md#statuses): "ok" (a curve), "empty_curve" (no point of the curve in
 /// the q range, but solutions at `separation`), "no_solution" (neither).
@@ -96,24 +78,31 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   // the model and options are checked: what is refused from here on was computed (core/computed.hpp)
   const tapping::HarmonicBalance hb = computed("harmonic balance", [&] { return tapping::HarmonicBalance(model); });
   // folds as records sorted by separation (as `tapping sweep` reports its folds and jumps)
-  const nlohmann::json folds = computed("harmonic balance: its folds", [&] { return hb_fold_records(hb, u); });
-  nlohmann::json solutions = nlohmann::json::array();
+  const std::vector<UnitTagged> folds =
+      computed("harmonic balance: its folds", [&] { return hb_fold_records(hb, u); });
+  std::vector<UnitTagged> solutions;
   for (const tapping::HbPoint& s :
        computed("harmonic balance: the solutions at separation", [&] { return hb.solutions(model.separation); }))
-    solutions.push_back(point_json(s, u));
-  nlohmann::json results = {{"folds", folds},
-                            {"free_amplitude", u.length(hb.free_amplitude())},
-                            {"solutions_at_separation", solutions},
-                            {"rows", out.rows()},
-                            {"status", hb_status(count == 0, solutions.empty())},
-                            {"note", hb_note(count == 0, solutions.empty(), q_min, q_max,
-                                             summary_value(p.real("separation"), u.length, 6))},
-                            {"units", hb_units(u)}};
-  if (model.law.piecewise_linear() != nullptr) {  // ext. E8 is a closed-form limit of the laws (10), (11), (26)
-    if (const auto limit = tapping::minimum_separation_limit(model))
-      results["minimum_separation_limit"] = u.length(*limit);  // −∞ is written "-inf"
-  }
-  out.finish(results, fmt::format("{} fold(s), {} solution(s) at separation {}", folds.size(), solutions.size(),
+    solutions.push_back(hb_point_record(s, u));
+  // each entry with its unit (the units of study outputs, docs/study.md#outputs), and the units by dimension
+  UnitTagged results;
+  results.add("folds", folds, hb_fold_record(tapping::HbFold{}, u))
+      .add("free_amplitude", hb.free_amplitude(), u.length)
+      .add("solutions_at_separation", solutions, hb_point_record(tapping::HbPoint{}, u))
+      .add("rows", out.rows(), "count")
+      .add("status", hb_status(count == 0, solutions.empty()))
+      .add("note", hb_note(count == 0, solutions.empty(), q_min, q_max, summary_value(p.real("separation"), u.length, 6)))
+      .unit("length", u.length.name)
+      .unit("phase", "rad")
+      .unit("q", "dimensionless");
+  // ext. E8 is a closed-form limit of the laws (10), (11), (26); its unit is listed for every law
+  UnitTagged limit;
+  const auto limit_value = model.law.piecewise_linear() != nullptr ? tapping::minimum_separation_limit(model)
+                                                                    : std::nullopt;
+  limit.add("minimum_separation_limit", limit_value.value_or(0.0), u.length);  // −∞ is written "-inf"
+  if (limit_value) results.merge(limit);
+  else results.units_of(limit);
+  out.finish(results.with_units(), fmt::format("{} fold(s), {} solution(s) at separation {}", folds.size(), solutions.size(),
                                   summary_value(p.real("separation"), u.length, 6)));
 }
 

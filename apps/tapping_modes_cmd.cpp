@@ -263,28 +263,24 @@ void run_modes(const io::ParamSet& p, Captured* capture) {
     for (int i = 0; i < m; ++i) worst_residual = std::max(worst_residual, std::abs(pt.energy[i].residual()));
   // ω [rad/t] -> f (Hz, or cycles per t)
   const units::Unit frequency{physical ? "Hz" : "1/t", 1.0, 2.0 * std::numbers::pi * u.time.multiply};
-  nlohmann::json results;
-  results["modes"] = m;
-  results["drives"] = nd;
-  results["excitation"] = tapping::excitation_name(model.excitation);
-  std::vector<double> freq, quality;
+  std::vector<double> frequencies, quality, free_amplitudes;  // in the model's units
   for (int i = 0; i < m; ++i) {
-    freq.push_back(frequency(model.frequency(i)));
+    frequencies.push_back(model.frequency(i));
     quality.push_back(model.quality_factor(i));
+    free_amplitudes.push_back(std::abs(model.free_response(i, i < nd ? i : 0)));
   }
-  results["mode_frequencies"] = freq;
-  results["mode_quality_factors"] = quality;
-  std::vector<double> free_amplitudes;
-  for (int i = 0; i < m; ++i) free_amplitudes.push_back(u.length(std::abs(model.free_response(i, i < nd ? i : 0))));
-  results["free_amplitudes"] = free_amplitudes;
-  results["settle_periods"] = options.settle_periods_for(model);
-  results["rows"] = static_cast<long>(r.size());
-  results["largest_energy_residual"] = u.energy(worst_residual);
-  results["periodic_rows"] = std::count_if(r.begin(), r.end(), [](const auto& q) { return q.periodic; });
-  results["status"] = "ok";
-  results["units"] = {{"mode_frequencies", frequency.name}, {"mode_quality_factors", "dimensionless"},
-                      {"free_amplitudes", u.length.name}, {"settle_periods", "count"}, {"rows", "count"},
-                      {"largest_energy_residual", u.energy.name}, {"periodic_rows", "count"}};
+  UnitTagged results;
+  results.add("modes", m, "count")
+      .add("drives", nd, "count")
+      .add("excitation", tapping::excitation_name(model.excitation))
+      .add("mode_frequencies", frequencies, frequency)
+      .add("mode_quality_factors", quality, "dimensionless")
+      .add("free_amplitudes", free_amplitudes, u.length)
+      .add("settle_periods", options.settle_periods_for(model), "count")
+      .add("rows", static_cast<long>(r.size()), "count")
+      .add("largest_energy_residual", worst_residual, u.energy)
+      .add("periodic_rows", std::count_if(r.begin(), r.end(), [](const auto& q) { return q.periodic; }), "count")
+      .add("status", "ok");
   std::string summary = fmt::format("{} modes ({} excitation, {} drive{}), {} separations", m,
                                     tapping::excitation_name(model.excitation), nd, nd > 1 ? "s" : "", r.size());
   if (!r.empty()) {
@@ -298,7 +294,7 @@ void run_modes(const io::ParamSet& p, Captured* capture) {
                              summary_value(last.mode[1][d2].amplitude, u.length),
                              last.mode[1][d2].phase);
   }
-  out.finish(results, summary);
+  out.finish(results.with_units(), summary);
 }
 
 }  // namespace

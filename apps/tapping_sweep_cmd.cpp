@@ -26,82 +26,106 @@
 #include "tapping_sim_params.hpp"
 #include "tapping_sweep_parameter.hpp"
 #include "tapping_tables.hpp"
+#include "unit_tagged.hpp"
 #include "work_budget.hpp"
 
 namespace afmkit::cli {
 
 namespace {
 
-nlohmann::json scaled(const std::vector<double>& v, const units::Unit& u) {
-  nlohmann::json j = nlohmann::json::array();
-  for (double x : v) j.push_back(u(x));
-  return j;
-}
-std::vector<double> scaled_values(std::vector<double> v, const units::Unit& u) {
-  for (double& x : v) x = u(x);
-  return v;
-}
-
 /// "contact" when the orbit spends part of its period below the law's contact gap, else "free".
 const char* branch_of(const tapping::OrbitMetrics& m) { return m.contact_fraction > 0.0 ? "contact" : "free"; }
 
-/// Records sorted by separation (ties: in the order given).
-nlohmann::json sorted_by_separation(nlohmann::json records) {
-  std::stable_sort(records.begin(), records.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
-    return a["separation"].get<double>() < b["separation"].get<double>();
-  });
-  return records;
+/// One jump of the instrument sweep as a record, in a separation sweep (`parameter` empty: at a separation, with
+/// its tolerance, in the length unit) or in a sweep of `parameter` (at its value, in its `unit`).
+UnitTagged jump_record(const tapping::SweepJump& j, const TappingUnits& u, const std::string& parameter = {},
+                       const std::string& unit = {}) {
+  const bool separation = parameter.empty();
+  const units::Unit at = separation ? u.length : units::as_is(unit);
+  UnitTagged r;
+  r.add(separation ? "separation" : parameter, separation ? j.separation : j.parameter, at)
+      .add("tolerance", j.tolerance, at)
+      .add("direction", sweep_direction_label(j.direction, separation), "label")
+      .add("located", j.located, "boolean (0/1)")
+      .add("branch", branch_of(j.from_metrics), "label")
+      .add("amplitude_before", j.from_metrics.amplitude, u.length)
+      .add("amplitude_after", j.to_metrics.amplitude, u.length)
+      .add("landed_periodic", j.landed_periodic, "boolean (0/1)");
+  return r;
 }
 
-/// The instrument sweep's jumps as records, sorted by separation.
-nlohmann::json jump_records(const std::vector<tapping::SweepJump>& jumps, const TappingUnits& u) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const tapping::SweepJump& j : jumps)
-    out.push_back({{"separation", u.length(j.separation)},
-                   {"tolerance", u.length(j.tolerance)},
-                   {"direction", tapping::direction_name(j.direction)},
-                   {"located", j.located},
-                   {"branch", branch_of(j.from_metrics)},
-                   {"amplitude_before", u.length(j.from_metrics.amplitude)},
-                   {"amplitude_after", u.length(j.to_metrics.amplitude)},
-                   {"landed_periodic", j.landed_periodic}});
-  return sorted_by_separation(std::move(out));
+/// One fold of the continuation as a record (as `tapping hb` reports its folds): where (the separation, or the
+/// value of `parameter` in its `unit`), the orbit there (`m`: the metrics of the point nearest the fold).
+UnitTagged fold_record(const tapping::ContinuationFold& f, const tapping::OrbitMetrics& m, const TappingUnits& u,
+                       const std::string& parameter = {}, const std::string& unit = {}) {
+  const bool separation = parameter.empty();
+  UnitTagged r;
+  if (separation) r.add("separation", f.separation, u.length);
+  else r.add(parameter, f.parameter, units::as_is(unit));
+  r.add("amplitude", m.amplitude, u.length)
+      .add("offset", m.offset, u.length)
+      .add("phase", m.phase, "rad")
+      .add("branch", branch_of(m), "label")
+      .add("kind", f.separation_maximum ? "maximum" : "minimum", "label");
+  return r;
 }
 
-/// The continuation's folds as records (as `tapping hb` reports its folds), sorted by separation.
-nlohmann::json fold_records(const tapping::ContinuationResult& c, const TappingUnits& u) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const tapping::ContinuationFold& f : c.folds) {
-    const tapping::OrbitMetrics& m = c.points.at(f.point).metrics;
-    out.push_back({{"separation", u.length(f.separation)},
-                   {"amplitude", u.length(m.amplitude)},
-                   {"offset", u.length(m.offset)},
-                   {"phase", m.phase},
-                   {"branch", branch_of(m)},
-                   {"kind", f.separation_maximum ? "maximum" : "minimum"}});
-  }
-  return sorted_by_separation(std::move(out));
+/// `items` sorted by `key` (stable: ties in the order given).
+template <class T, class Key>
+std::vector<T> sorted_by(std::vector<T> items, Key key) {
+  std::stable_sort(items.begin(), items.end(), [&](const T& a, const T& b) { return key(a) < key(b); });
+  return items;
 }
 
-/// The units: by dimension, and per results key (the units of study outputs, docs/study.md#outputs).
-nlohmann::json sweep_units(const TappingUnits& u) {
-  const std::string& L = u.length.name;
-  return {{"length", L},
-          {"energy", u.energy.name},
-          {"force", u.force.name},
-          {"approach_jumps", L},
-          {"retract_jumps", L},
-          {"jump_tolerance", L},
-          {"jumps", {{"separation", L}, {"tolerance", L}, {"direction", "label"}, {"located", "boolean (0/1)"},
-                     {"branch", "label"}, {"amplitude_before", L}, {"amplitude_after", L},
-                     {"landed_periodic", "boolean (0/1)"}}},
-          {"folds", {{"separation", L}, {"amplitude", L}, {"offset", L}, {"phase", "rad"}, {"branch", "label"},
-                     {"kind", "label"}}},
-          {"grazing", L},
-          {"continuation_points", "count"},
-          {"free_amplitude", L},
-          {"trapped_rows", "count"},
-          {"rows", "count"}};
+/// The instrument sweep's results: the jumps of both directions (`down`, `up`: the keys of their locations), every
+/// jump as a record sorted by where it is, the tolerance of their locations (`tolerance`: in the unit `at`).
+/// `parameter` empty: a separation sweep (lengths); else a sweep of `parameter` in `unit`.
+UnitTagged instrument_results(const tapping::SweepResult& r, double tolerance, const TappingUnits& u,
+                              const std::string& parameter = {}, const std::string& unit = {}) {
+  const bool separation = parameter.empty();
+  const units::Unit at = separation ? u.length : units::as_is(unit);
+  std::vector<UnitTagged> jumps;
+  for (const tapping::SweepJump& j : sorted_by(r.jumps, [&](const tapping::SweepJump& j) {
+         return separation ? j.separation : j.parameter;
+       }))
+    jumps.push_back(jump_record(j, u, parameter, unit));
+  UnitTagged results;
+  results.add(separation ? "approach_jumps" : "down_jumps", r.approach_jumps, at)
+      .add(separation ? "retract_jumps" : "up_jumps", r.retract_jumps, at)
+      .add("jumps", jumps, jump_record(tapping::SweepJump{}, u, parameter, unit))
+      .add("jump_tolerance", tolerance, at);
+  return results;
+}
+
+/// The continuation's results: its folds as records sorted by where they are, where it met grazing, its points and
+/// why it stopped (as instrument_results for `parameter` and `unit`).
+UnitTagged continuation_results(const tapping::ContinuationResult& c, const TappingUnits& u,
+                                const std::string& parameter = {}, const std::string& unit = {}) {
+  const bool separation = parameter.empty();
+  std::vector<UnitTagged> folds;
+  for (const tapping::ContinuationFold& f : sorted_by(c.folds, [&](const tapping::ContinuationFold& f) {
+         return separation ? f.separation : f.parameter;
+       }))
+    folds.push_back(fold_record(f, c.points.at(f.point).metrics, u, parameter, unit));
+  UnitTagged results;
+  results
+      .add("folds", folds, fold_record(tapping::ContinuationFold{}, tapping::OrbitMetrics{}, u, parameter, unit))
+      .add("grazing", c.grazing, separation ? u.length : units::as_is(unit))
+      .add("continuation_points", c.points.size(), "count")
+      .add("continuation_stop", c.stop_reason);
+  return results;
+}
+
+/// The entries of every run: the free amplitude, the rows and those with the tip trapped, and the units by
+/// dimension of the table's columns.
+void add_common_results(UnitTagged& results, const tapping::TappingModel& base, const TappingUnits& u,
+                        std::size_t rows, long trapped) {
+  results.add("free_amplitude", base.free_amplitude(), u.length)
+      .add("rows", rows, "count")
+      .add("trapped_rows", trapped, "count")
+      .unit("length", u.length.name)
+      .unit("energy", u.energy.name)
+      .unit("force", u.force.name);
 }
 
 /// The separations of the instrument sweep (model units): the explicit list (`separations` or `separations_file`)
@@ -147,27 +171,18 @@ std::string hb_not_evaluated(const io::ParamSet& p) {
 /// The sweep's status and note from its trapped rows (docs/conventions.md#statuses): every row with the tip
 /// trapped is no tapping anywhere in the range ("tip_trapped"); some trapped rows are said in the note and summary.
 /// `what`: what one row is a value of ("separation", or "value" for a sweep in another parameter).
-void record_trapped(nlohmann::json& results, std::string& summary, std::size_t rows, long trapped,
-                    const char* what) {
+void record_trapped(UnitTagged& results, std::string& summary, std::size_t rows, long trapped, const char* what) {
   const bool all_trapped = rows > 0 && trapped == static_cast<long>(rows);
-  results["status"] = all_trapped ? "tip_trapped" : "ok";
-  results["note"] = all_trapped ? fmt::format("tip trapped: the tip sticks to the sample or stays in contact over "
-                                              "the whole period at every {} of the sweep ({} rows; column "
-                                              "trapped): no tapping",
-                                              what, rows)
-                                : trapped > 0 ? fmt::format("{} of {} rows with the tip trapped (stuck to the sample or "
-                                                            "in contact over the whole period; column trapped)",
-                                                            trapped, rows)
-                                              : std::string();
-  if (trapped > 0) summary += fmt::format("\n{}", results["note"].get<std::string>());
-}
-
-/// Records sorted by the value of `key`.
-nlohmann::json records_sorted_by(nlohmann::json records, const std::string& key) {
-  std::stable_sort(records.begin(), records.end(), [&](const nlohmann::json& a, const nlohmann::json& b) {
-    return a[key].get<double>() < b[key].get<double>();
-  });
-  return records;
+  const std::string note =
+      all_trapped ? fmt::format("tip trapped: the tip sticks to the sample or stays in contact over the whole period "
+                                "at every {} of the sweep ({} rows; column trapped): no tapping",
+                                what, rows)
+      : trapped > 0 ? fmt::format("{} of {} rows with the tip trapped (stuck to the sample or in contact over the "
+                                  "whole period; column trapped)",
+                                  trapped, rows)
+                    : std::string();
+  results.add("status", all_trapped ? "tip_trapped" : "ok").add("note", note);
+  if (trapped > 0) summary += fmt::format("\n{}", note);
 }
 
 /// A sweep in another parameter than the separation (--parameter): the same instrument sweep (down from
@@ -210,16 +225,18 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
     rows.add_all(pts);
     for (const tapping::SweepPoint& pt : pts) trapped += tapping::tip_trapped(pt.metrics) ? 1 : 0;
   };
-  nlohmann::json results = nlohmann::json::object();
-  results["parameter"] = name;
+  UnitTagged results;
+  results.add("parameter", name, "label");
   // HB beside each point where it is a closed form at each value (docs/commands.md#sweeps-in-another-parameter)
-  results["harmonic_balance"] =
-      beside && base.law.piecewise_linear()
-          ? std::string("beside each point (closed form at each point's model)")
-      : !beside ? hb_not_evaluated(p)
-          : fmt::format("not evaluated (hb_* columns nan): law = {} has no closed-form harmonic balance, and a "
-                        "describing-function curve per point costs 7 ms to 0.3 s; use tapping hb at chosen values",
-                        p.text("law"));
+  results.add("harmonic_balance",
+              beside && base.law.piecewise_linear()
+                  ? std::string("beside each point (closed form at each point's model)")
+              : !beside ? hb_not_evaluated(p)
+                        : fmt::format("not evaluated (hb_* columns nan): law = {} has no closed-form harmonic balance, "
+                                      "and a describing-function curve per point costs 7 ms to 0.3 s; use tapping hb "
+                                      "at chosen values",
+                                      p.text("law")),
+              "label");
   std::string summary;
   const double magnitude = std::max(std::abs(swept.min), std::abs(swept.max));
   if (instrument) {
@@ -239,28 +256,17 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
     progress.finish();
     write_rows(r.approach);
     write_rows(r.retract);
-    results["down_jumps"] = r.approach_jumps;
-    results["up_jumps"] = r.retract_jumps;
-    nlohmann::json jumps = nlohmann::json::array();
-    for (const tapping::SweepJump& j : r.jumps)
-      jumps.push_back({{name, j.parameter},
-                       {"tolerance", j.tolerance},
-                       {"direction", sweep_direction_label(j.direction, false)},
-                       {"located", j.located},
-                       {"branch", branch_of(j.from_metrics)},
-                       {"amplitude_before", u.length(j.from_metrics.amplitude)},
-                       {"amplitude_after", u.length(j.to_metrics.amplitude)},
-                       {"landed_periodic", j.landed_periodic}});
-    results["jumps"] = records_sorted_by(std::move(jumps), name);
     const double tolerance = options.jump_tolerance * magnitude;
-    results["jump_tolerance"] = tolerance;
-    if (!retract) results["directions"] = "approach";
+    results.merge(instrument_results(r, tolerance, u, name, unit));
+    if (!retract) results.add("directions", "approach", "label");
     summary += retract ? fmt::format("instrument sweep in {}: jumps down at {}; up at {} (located to ±{})", name,
                                      values_text(r.approach_jumps), values_text(r.retract_jumps),
                                      values_text({tolerance}))
                        : fmt::format("instrument sweep in {}: jumps down at {} (located to ±{}); no up pass "
                                      "(directions = approach)",
                                      name, values_text(r.approach_jumps), values_text({tolerance}));
+  } else {
+    results.units_of(instrument_results(tapping::SweepResult{}, 0.0, u, name, unit));
   }
   if (continuation) {
     tapping::ContinuationOptions options;
@@ -275,52 +281,19 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
       return tapping::sweep_continuation(base, swept.parameter, swept.min, swept.max, options);
     });
     write_rows(c.points);
-    nlohmann::json folds = nlohmann::json::array();
+    results.merge(continuation_results(c, u, name, unit));
     std::vector<double> at;
-    for (const tapping::ContinuationFold& f : c.folds) {
-      const tapping::OrbitMetrics& m = c.points.at(f.point).metrics;
-      folds.push_back({{name, f.parameter},
-                       {"amplitude", u.length(m.amplitude)},
-                       {"offset", u.length(m.offset)},
-                       {"phase", m.phase},
-                       {"branch", branch_of(m)},
-                       {"kind", f.separation_maximum ? "maximum" : "minimum"}});
-      at.push_back(f.parameter);
-    }
+    for (const tapping::ContinuationFold& f : c.folds) at.push_back(f.parameter);
     std::sort(at.begin(), at.end());
-    results["folds"] = records_sorted_by(std::move(folds), name);
-    results["grazing"] = c.grazing;
-    results["continuation_stop"] = c.stop_reason;
-    results["continuation_points"] = c.points.size();
     summary += fmt::format("{}continuation in {}: {} points, folds at {}; grazing at {} ({})",
                            summary.empty() ? "" : "\n", name, c.points.size(), values_text(at),
                            values_text(c.grazing), c.stop_reason);
+  } else {
+    results.units_of(continuation_results(tapping::ContinuationResult{}, u, name, unit));
   }
-  results["free_amplitude"] = u.length(base.free_amplitude());
-  results["rows"] = out.rows();
-  results["trapped_rows"] = trapped;
+  add_common_results(results, base, u, out.rows(), trapped);
   record_trapped(results, summary, out.rows(), trapped, "value");
-  const std::string& L = u.length.name;
-  results["units"] = {{"length", L},
-                      {"energy", u.energy.name},
-                      {"force", u.force.name},
-                      {"parameter", "label"},
-                      {"harmonic_balance", "label"},
-                      {"down_jumps", unit},
-                      {"up_jumps", unit},
-                      {"jump_tolerance", unit},
-                      {"jumps", {{name, unit}, {"tolerance", unit}, {"direction", "label"}, {"located", "boolean (0/1)"},
-                                 {"branch", "label"}, {"amplitude_before", L}, {"amplitude_after", L},
-                                 {"landed_periodic", "boolean (0/1)"}}},
-                      {"folds", {{name, unit}, {"amplitude", L}, {"offset", L}, {"phase", "rad"}, {"branch", "label"},
-                                 {"kind", "label"}}},
-                      {"grazing", unit},
-                      {"continuation_points", "count"},
-                      {"free_amplitude", L},
-                      {"trapped_rows", "count"},
-                      {"rows", "count"}};
-  if (results.contains("directions")) results["units"]["directions"] = "label";
-  out.finish(results, summary);
+  out.finish(results.with_units(), summary);
 }
 
 void run_sweep(const io::ParamSet& p, Captured* capture) {
@@ -359,8 +332,8 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     rows.add_all(points);
     for (const tapping::SweepPoint& pt : points) trapped += tapping::tip_trapped(pt.metrics) ? 1 : 0;
   };
-  nlohmann::json results = nlohmann::json::object();
-  if (!beside) results["harmonic_balance"] = hb_not_evaluated(p);
+  UnitTagged results;
+  if (!beside) results.add("harmonic_balance", hb_not_evaluated(p), "label");
   std::string summary;
   if (instrument) {
     io::Progress progress(retract ? "tapping sweep (approach + retract)" : "tapping sweep (approach)",
@@ -389,21 +362,21 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     transient_progress.finish();
     write_rows(r.approach);
     write_rows(r.retract);
-    results["approach_jumps"] = scaled(r.approach_jumps, u.length);
-    results["retract_jumps"] = scaled(r.retract_jumps, u.length);
-    results["jumps"] = jump_records(r.jumps, u);
-    const double tolerance = u.length(options.jump_tolerance * base.free_amplitude());
-    results["jump_tolerance"] = tolerance;
-    if (!retract) results["directions"] = "approach";
-    summary += retract
-                   ? fmt::format("instrument sweep: jumps on approach at {}; on retract at {} (located to ±{})",
-                                 io::summary_values(scaled_values(r.approach_jumps, u.length), u.length.name),
-                                 io::summary_values(scaled_values(r.retract_jumps, u.length), u.length.name),
-                                 io::summary_value(tolerance, u.length.name, 3))
-                   : fmt::format("instrument sweep: jumps on approach at {} (located to ±{}); no retract pass "
-                                 "(directions = approach)",
-                                 io::summary_values(scaled_values(r.approach_jumps, u.length), u.length.name),
-                                 io::summary_value(tolerance, u.length.name, 3));
+    const UnitTagged instrument = instrument_results(r, options.jump_tolerance * base.free_amplitude(), u);
+    results.merge(instrument);
+    if (!retract) results.add("directions", "approach", "label");
+    // the summary says the values written (in their unit)
+    const auto written = [&](const char* key) { return instrument.values().at(key).get<std::vector<double>>(); };
+    const std::string& L = u.length.name;
+    const std::string tolerance = io::summary_value(instrument.values().at("jump_tolerance").get<double>(), L, 3);
+    summary += retract ? fmt::format("instrument sweep: jumps on approach at {}; on retract at {} (located to ±{})",
+                                     io::summary_values(written("approach_jumps"), L),
+                                     io::summary_values(written("retract_jumps"), L), tolerance)
+                       : fmt::format("instrument sweep: jumps on approach at {} (located to ±{}); no retract pass "
+                                     "(directions = approach)",
+                                     io::summary_values(written("approach_jumps"), L), tolerance);
+  } else {
+    results.units_of(instrument_results(tapping::SweepResult{}, 0.0, u));
   }
   if (continuation) {
     tapping::ContinuationOptions options;
@@ -417,25 +390,21 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
     const tapping::ContinuationResult c =
         computed("branch continuation", [&] { return tapping::sweep_continuation(base, l_min, l_max, options); });
     write_rows(c.points);
-    results["folds"] = fold_records(c, u);
-    results["grazing"] = scaled(c.grazing, u.length);
-    results["continuation_stop"] = c.stop_reason;
-    results["continuation_points"] = c.points.size();
+    const UnitTagged continued = continuation_results(c, u);
+    results.merge(continued);
     std::vector<double> folds;
-    for (const auto& f : results["folds"]) folds.push_back(f["separation"].get<double>());
+    for (const auto& f : continued.values().at("folds")) folds.push_back(f.at("separation").get<double>());
+    const std::string& L = u.length.name;
     summary += fmt::format("{}continuation: {} points, folds at {}; grazing at {} ({})", summary.empty() ? "" : "\n",
-                           c.points.size(), io::summary_values(folds, u.length.name),
-                           io::summary_values(scaled_values(c.grazing, u.length), u.length.name),
+                           c.points.size(), io::summary_values(folds, L),
+                           io::summary_values(continued.values().at("grazing").get<std::vector<double>>(), L),
                            c.stop_reason);
+  } else {
+    results.units_of(continuation_results(tapping::ContinuationResult{}, u));
   }
-  results["free_amplitude"] = u.length(base.free_amplitude());
-  results["rows"] = out.rows();
-  results["trapped_rows"] = trapped;
+  add_common_results(results, base, u, out.rows(), trapped);
   record_trapped(results, summary, out.rows(), trapped, "separation");
-  results["units"] = sweep_units(u);
-  for (const char* key : {"harmonic_balance", "directions"})  // present only where an option turned something off
-    if (results.contains(key)) results["units"][key] = "label";
-  out.finish(results, summary);
+  out.finish(results.with_units(), summary);
 }
 
 }  // namespace

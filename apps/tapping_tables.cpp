@@ -17,20 +17,30 @@ io::TableOf<tapping::HbPoint> hb_table(const TappingUnits& u) {
            [](const P& p) { return tapping::branch_name(p.branch); }}};
 }
 
-nlohmann::json hb_fold_records(const tapping::HarmonicBalance& hb, const TappingUnits& u) {
+UnitTagged hb_point_record(const tapping::HbPoint& p, const TappingUnits& u) {
+  UnitTagged j;
+  j.add("q", p.q, "dimensionless")
+      .add("separation", p.separation, u.length)
+      .add("amplitude", p.amplitude, u.length)
+      .add("offset", p.offset, u.length)
+      .add("phase", p.phase, "rad")
+      .add("branch", tapping::branch_name(p.branch), "label");
+  return j;
+}
+
+UnitTagged hb_fold_record(const tapping::HbFold& f, const TappingUnits& u) {
+  UnitTagged j = hb_point_record(f.point, u);
+  j.add("kind", f.separation_maximum ? "maximum" : "minimum", "label");
+  return j;
+}
+
+std::vector<UnitTagged> hb_fold_records(const tapping::HarmonicBalance& hb, const TappingUnits& u) {
   std::vector<tapping::HbFold> sorted = hb.folds();
   std::stable_sort(sorted.begin(), sorted.end(), [](const tapping::HbFold& a, const tapping::HbFold& b) {
     return a.point.separation < b.point.separation;
   });
-  nlohmann::json out = nlohmann::json::array();
-  for (const tapping::HbFold& f : sorted)
-    out.push_back({{"q", f.point.q},
-                   {"separation", u.length(f.point.separation)},
-                   {"amplitude", u.length(f.point.amplitude)},
-                   {"offset", u.length(f.point.offset)},
-                   {"phase", f.point.phase},
-                   {"branch", tapping::branch_name(f.point.branch)},
-                   {"kind", f.separation_maximum ? "maximum" : "minimum"}});
+  std::vector<UnitTagged> out;
+  for (const tapping::HbFold& f : sorted) out.push_back(hb_fold_record(f, u));
   return out;
 }
 
@@ -61,7 +71,9 @@ io::TableOf<tapping::SweepPoint> sweep_table(const TappingUnits& u, bool separat
           {"periodic", "boolean (0/1)", "0: the transient did not settle (metrics describe one period of it)",
            &P::periodic},
           {"jumped", "boolean (0/1)", "1: the response jumped to another branch at this point", &P::jumped},
-          {"arclength", L.name, "pseudo-arclength of the continuation (state scaled by the amplitude; 0 in instrument sweeps)",
+          {"arclength", L,
+           "pseudo-arclength of the continuation: length of the branch so far in (x(0), ẋ(0)/ω, s·p), a length "
+           "(s·p = l in separation sweeps; 0 in instrument sweeps)",
            &P::arclength},
           {"harmonic_2", L, "amplitude of the 2nd harmonic of x(t)",
            [](const P& p) { return p.metrics.harmonics[0]; }},

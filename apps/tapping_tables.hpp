@@ -12,6 +12,7 @@
 #include "afmkit/tapping/units.hpp"
 #include "command.hpp"
 #include "tapping_params.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -19,9 +20,13 @@ namespace afmkit::cli {
 /// `scales`), one row per HbPoint.
 io::TableOf<tapping::HbPoint> hb_table(const TappingUnits& units);
 
-/// The folds of harmonic balance as records (q, separation, amplitude, offset, phase, branch, kind = maximum or
-/// minimum of l(q)) sorted by separation — as `tapping hb` and `demo` report them.
-nlohmann::json hb_fold_records(const tapping::HarmonicBalance& hb, const TappingUnits& units);
+/// One harmonic-balance solution as a record (q, separation, amplitude, offset, phase, branch) with its units.
+UnitTagged hb_point_record(const tapping::HbPoint& point, const TappingUnits& units);
+/// A fold as a record: the solution there and its kind (maximum or minimum of l(q)).
+UnitTagged hb_fold_record(const tapping::HbFold& fold, const TappingUnits& units);
+/// The folds of harmonic balance as records (hb_fold_record) sorted by separation — as `tapping hb` and `demo`
+/// report them.
+std::vector<UnitTagged> hb_fold_records(const tapping::HarmonicBalance& hb, const TappingUnits& units);
 
 /// Direction label of a row: approach / retract in separation sweeps, down / up in sweeps of another parameter
 /// (the values visited from the largest down, then back up); continuation either way.

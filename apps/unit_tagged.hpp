@@ -34,8 +34,23 @@ class UnitTagged {
     units_[key] = unit.name;
     return *this;
   }
+  /// Named numbers converted by `unit`, one JSON object (a box's edges); one unit for all of them.
+  UnitTagged& add(const std::string& key, const std::vector<std::pair<std::string, double>>& named,
+                  const units::Unit& unit) {
+    nlohmann::json o = nlohmann::json::object();
+    for (const auto& [name, v] : named) o[name] = unit(v);
+    values_[key] = std::move(o);
+    units_[key] = unit.name;
+    return *this;
+  }
   /// A value shown as computed (counts, flags, rad, dimensionless numbers) and its unit.
   UnitTagged& add(const std::string& key, nlohmann::json value, const char* unit) {
+    values_[key] = std::move(value);
+    units_[key] = unit;
+    return *this;
+  }
+  /// The same with a unit named at run time (the unit of a swept parameter, "label").
+  UnitTagged& add(const std::string& key, nlohmann::json value, const std::string& unit) {
     values_[key] = std::move(value);
     units_[key] = unit;
     return *this;
@@ -51,6 +66,28 @@ class UnitTagged {
     units_[key] = nested.units_;
     return *this;
   }
+  /// Records of one kind under `key` (an array of their values), with the units of `prototype`: a record made by
+  /// the same function (of a default value, so that it names every field and the units are there when the list is
+  /// empty).
+  UnitTagged& add(const std::string& key, const std::vector<UnitTagged>& records, const UnitTagged& prototype) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const UnitTagged& r : records) a.push_back(r.values_);
+    values_[key] = std::move(a);
+    units_[key] = prototype.units_;
+    return *this;
+  }
+  /// `other`'s entries (values and units) beside these.
+  UnitTagged& merge(const UnitTagged& other) {
+    for (const auto& [key, value] : other.values_.items()) values_[key] = value;
+    return units_of(other);
+  }
+  /// The units of `other`'s entries without their values: the entries of a part this run did not compute (a mode
+  /// or pass not run), declared by the code that writes them when it runs (the units list every key a command
+  /// can write).
+  UnitTagged& units_of(const UnitTagged& other) {
+    for (const auto& [key, unit] : other.units_.items()) units_[key] = unit;
+    return *this;
+  }
   /// A unit without a value here (an entry whose values are listed elsewhere, e.g. in the rows of an array).
   UnitTagged& unit(const std::string& key, nlohmann::json unit) {
     units_[key] = std::move(unit);
@@ -58,6 +95,12 @@ class UnitTagged {
   }
 
   const nlohmann::json& values() const& { return values_; }
+  /// The values with their units under "units" (a command's results).
+  nlohmann::json with_units() const {
+    nlohmann::json j = values_;
+    j["units"] = units_;
+    return j;
+  }
   const nlohmann::json& units() const& { return units_; }
 
  private:

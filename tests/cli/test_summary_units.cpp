@@ -5,11 +5,15 @@
 // full-precision values (their declared units), not against the printed text.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <numbers>
 #include <regex>
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -113,4 +117,157 @@ TEST(SummaryUnits, EveryNumberOfATappingOrbitRecordHasItsUnit) {
   for (const auto& h : results.at("harmonic_balance"))
     EXPECT_EQ(summary_units_missing(h, results.at("units").at("harmonic_balance")), std::vector<std::string>{})
         << h.dump();
+}
+
+// Units at one edge (issue 26 §1): every number, flag and array of numbers a command writes in its results has its
+// unit in the results' `units` (a unit string covers what is below it; an object of units is followed key by key,
+// into every record of a list). The tapping hb, sweep, fm, modes, demo and spectroscopy prepare results were written
+// value by value beside a hand-written units object: demo named only "length", tapping modes had no unit for
+// `modes` and `drives`, spectroscopy prepare only units by dimension (its curves, snap_in, pull_off had none).
+namespace {
+void collect_unitless_results(const nlohmann::json& value, const nlohmann::json* units, const std::string& path,
+                              std::vector<std::string>& out) {
+  if (units != nullptr && units->is_string()) return;
+  if (value.is_number() || value.is_boolean()) {
+    out.push_back(path);
+  } else if (value.is_array()) {
+    for (std::size_t i = 0; i < value.size(); ++i)
+      collect_unitless_results(value[i], units, path + "/" + std::to_string(i), out);
+  } else if (value.is_object()) {
+    // a record may carry its own units (control: settings, tau0)
+    const nlohmann::json* own = value.contains("units") && value.at("units").is_object() ? &value.at("units") : nullptr;
+    for (const auto& [key, v] : value.items()) {
+      if (key == "units" && (path.empty() || own != nullptr)) continue;
+      const nlohmann::json* u = units != nullptr && units->is_object() && units->contains(key) ? &units->at(key)
+                                : own != nullptr && own->contains(key)                        ? &own->at(key)
+                                                                                              : nullptr;
+      collect_unitless_results(v, u, path + "/" + key, out);
+    }
+  }
+}
+/// The results paths of `sidecar` (a command's JSON sidecar) holding a number without a unit.
+std::vector<std::string> unitless_results(const std::filesystem::path& sidecar) {
+  const auto results = nlohmann::json::parse(slurp(sidecar)).at("results");
+  std::vector<std::string> out;
+  if (!results.contains("units")) return {"(no units)"};
+  collect_unitless_results(results, &results.at("units"), "", out);
+  return out;
+}
+}  // namespace
+
+TEST(SummaryUnits, EveryResultOfTappingHbSweepFmModesAndDemoHasItsUnit) {
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"tapping hb --units physical --points 400 --output r.csv", "r.csv.json"},
+      {"tapping hb --law attractive --approach-adhesion 1 --departure-adhesion 2 --separation 6 --points 400 "
+       "--output r.csv",
+       "r.csv.json"},
+      // jumps, folds and grazing present (their records checked), then a mode without them (their units listed)
+      {"tapping sweep --units physical --law attractive --adhesion-approach 40 --adhesion-departure 80 "
+       "--separation-min 12 --separation-max 26 --points 30 --mode both --quiet --output r.csv",
+       "r.csv.json"},
+      {"tapping sweep --points 10 --directions approach --hb-beside off --quiet --output r.csv", "r.csv.json"},
+      {"tapping sweep --parameter drive_frequency --parameter-min 0.98 --parameter-max 1.04 --points 12 --mode both "
+       "--law attractive --approach-adhesion 1 --departure-adhesion 2 --separation 14 --quiet --output r.csv",
+       "r.csv.json"},
+      {"tapping fm --units physical --quiet --output r.csv", "r.csv.json"},
+      {"tapping modes --units physical --modes 3 --points 2 --settle-periods 20 --lockin-periods 5 --quiet --output r.csv",
+       "r.csv.json"},
+      {"demo --units physical --points 20 --output-dir d", "d/demo_hb.csv.json"},
+      {"demo --points 20 --output-dir d", "d/demo_sweep.csv.json"}};
+  for (const auto& [args, sidecar] : runs) {
+    TempDir dir;
+    const auto r = run_cli(args, dir);
+    ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
+    EXPECT_EQ(unitless_results(dir.path / sidecar), std::vector<std::string>{}) << args;
+  }
+}
+
+TEST(SummaryUnits, EveryResultOfTheControlCommandsHasItsUnit) {
+  // on main the flags (complete, box_is_proven, stable_at_reference, diverged, converged, ...) and the chart's counts
+  // had no unit, the
+  // margin map no units at all; the settings and tau0 records carry their own
+  for (const char* args :
+       {"control roots --harmonics 3 --output r.csv", "control roots --controller infinite --output r.csv",
+        "control margin --harmonics 3 --output r.csv", "control margin --controller single --output r.csv",
+        "control margin --compare --harmonics 3 --output r.csv",
+        "control chart --harmonics 3 --x-points 8 --y-points 8 --delays 0.1,0.2 --output r.csv",
+        "control chart --harmonics 3 --quantity margin --x-points 6 --y-points 6 --output r.csv",
+        "control simulate --harmonics 3 --signal 0.2,1.2,0.5,-0.8,-0.4 --signal-sample-rate 250 "
+        "--rotation-frequency-hz 50 --periods 10 --output r.csv",
+        "control tune --harmonics 3 --coarse-points 4 --max-evaluations 6 --gain-points 2 --delay-points 2 "
+        "--output r.csv",
+        "control tf --harmonics 3 --points 20 --output r.csv",
+        "control tf --controller single --rotation-frequency 50 --points 20 --output r.csv"}) {
+    TempDir dir;
+    const auto r = run_cli(args, dir);
+    ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
+    EXPECT_EQ(unitless_results(dir.path / "r.csv.json"), std::vector<std::string>{}) << args;
+  }
+}
+
+TEST(SummaryUnits, EveryResultOfControlExportHasItsUnit) {
+  // on main damped_pairs, undamped_pairs and real_modes had no unit (the results are printed with --json)
+  TempDir dir;
+  const auto r = run_cli("control export --harmonics 3 --rotation-frequency 314.159265 --sample-rate 10000 "
+                         "--test-vectors 4 --json --output f.h",
+                         dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto results = nlohmann::json::parse(r.out);
+  std::vector<std::string> unitless;
+  collect_unitless_results(results, &results.at("units"), "", unitless);
+  EXPECT_EQ(unitless, std::vector<std::string>{}) << r.out;
+}
+
+TEST(SummaryUnits, EveryResultOfSpectroscopyPrepareHasItsUnit) {
+  const std::string file =
+      std::string(AFMKIT_SOURCE_DIR) + "/../shared/data/force-curves/jpk_spot3-0192.jpk-force";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "no measured curve at " << file;
+  TempDir dir;
+  // a DMT fit: the contact record holds its fit
+  const auto r = run_cli("spectroscopy prepare '" + file + "' --contact-method dmt --tip-radius 20 --output p.csv", dir);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(unitless_results(dir.path / "p.csv.json"), std::vector<std::string>{});
+  const auto results = nlohmann::json::parse(slurp(dir.path / "p.csv.json")).at("results");
+  ASSERT_TRUE(results.at("curves").at(0).at("contact").contains("fit"));
+  EXPECT_EQ(results.at("units").at("curves").at("contact").at("fit").at("contact_point"), "nm");
+}
+
+TEST(SummaryUnits, TheSweepArclengthIsALengthInTheSeparationsUnit) {
+  // the continuation's arclength is the length of the branch in (x(0), ẋ(0)/ω, l): a length, in the unit of the
+  // separation (nm or L), that grows along the branch at least by the change of l between two points
+  for (const char* units : {"physical", "normalised"}) {
+    TempDir dir;
+    const std::string args = std::string("tapping sweep --units ") + units +
+                             " --separation-min 12 --separation-max 26 --mode continuation --quiet --output s.csv";
+    const auto r = run_cli(args, dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto sidecar = nlohmann::json::parse(slurp(dir.path / "s.csv.json"));
+    std::map<std::string, std::string> unit;
+    std::vector<std::string> names;
+    for (const auto& c : sidecar.at("columns")) {
+      unit[c.at("name")] = c.at("unit");
+      names.push_back(c.at("name"));
+    }
+    EXPECT_EQ(unit.at("arclength"), unit.at("separation")) << units;
+    EXPECT_EQ(unit.at("separation"), std::string(units) == "physical" ? "nm" : "L");
+    const auto column = [&](const std::string& name) {
+      return static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+    };
+    std::istringstream csv(slurp(dir.path / "s.csv"));
+    std::string line;
+    std::getline(csv, line);  // the header
+    std::vector<std::pair<double, double>> points;  // (separation, arclength)
+    while (std::getline(csv, line)) {
+      std::vector<std::string> cells;
+      std::stringstream cellstream(line);
+      for (std::string cell; std::getline(cellstream, cell, ',');) cells.push_back(cell);
+      if (cells.at(column("direction")) != "continuation") continue;
+      points.emplace_back(std::stod(cells.at(column("separation"))), std::stod(cells.at(column("arclength"))));
+    }
+    ASSERT_GT(points.size(), 10u) << units;
+    for (std::size_t i = 1; i < points.size(); ++i)
+      EXPECT_GE(points[i].second - points[i - 1].second,
+                std::abs(points[i].first - points[i - 1].first) * (1.0 - 1e-9))
+          << units << " point " << i;
+  }
 }

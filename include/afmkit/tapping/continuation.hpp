@@ -19,7 +19,7 @@
 namespace afmkit::tapping {
 
 struct ContinuationOptions {
-  double initial_step = 0.02;  // arclength step (model length units; u is scaled by the orbit amplitude)
+  double initial_step = 0.02;  // arclength step (model length units: x(0), ẋ(0)/ω and s·p are lengths)
   double min_step = 1e-7;
   double max_step = 0.2;
   int max_points = 5000;

@@ -74,7 +74,7 @@ struct SweepPoint {
   /// without a fold (see follow_branch).
   bool jumped = false;
   bool periodic = true;  // false: the transient did not settle (metrics then describe one period of it)
-  double arclength = 0.0;  // pseudo-arclength (continuation only)
+  double arclength = 0.0;  // pseudo-arclength (continuation only): a length in model units (ContinuationOptions)
   // Nearest harmonic-balance solution at the same l (NaN when none / not applicable).
   double hb_amplitude = std::numeric_limits<double>::quiet_NaN();
   double hb_offset = std::numeric_limits<double>::quiet_NaN();
