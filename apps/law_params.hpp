@@ -3,6 +3,7 @@
 // (docs/force-laws.md): `law`, `force_curve`, `allow_energy_gain` and every law parameter with its unit.
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "afmkit/impact/law_registry.hpp"
@@ -14,6 +15,18 @@ namespace afmkit::cli {
 /// command key -> registry key. The command key's value (given or default) is passed whenever the chosen law
 /// reads the registry key.
 using LawKeyAliases = std::map<std::string, std::string>;
+
+/// How a command that takes a registry key outside add_law_params (in its own unit system or role) differs from the
+/// registry's declaration of it; unset fields are the registry's.
+struct LawKeyForm {
+  std::string help;                  // empty: "[laws] " + the registry's help
+  std::optional<double> default_value;
+  std::optional<io::Range> range;    // unset: the registry's range
+  std::string unit;                  // empty: the registry's unit
+};
+/// Declares the registry key `key` on `p` (the one declaration of every law key, also add_law_params'), in `form`.
+void add_law_key_param(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& key,
+                       const LawKeyForm& form = {});
 
 /// Declares `law` (default `default_law`), `force_curve`, `allow_energy_gain` and every registry key not in
 /// `skip` (keys the command declares itself). Every law key, alias and skipped key, and `force_curve`, applies
