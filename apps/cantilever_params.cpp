@@ -27,7 +27,7 @@ void add_cantilever_param(io::ParamSet& p, CantileverKey key, CantileverDefault 
   const CantileverKeyDeclaration d = cantilever_key_declaration(key);
   using Kind = CantileverDefault::Kind;
   const io::Range range = how.kind == Kind::value      ? io::Range{0.0, d.upper, true, false}
-                          : how.kind == Kind::required ? io::Range::non_negative()
+                          : how.kind == Kind::required ? io::Range::closed(0.0, d.upper)
                                                        : io::Range::any();
   p.real(d.key, how.value, help, range).unit(d.unit != nullptr ? d.unit : length_unit);
   if (how.kind == Kind::required) p.default_text("required");

@@ -21,7 +21,7 @@ enum class CantileverKey {
 struct CantileverDefault {
   enum class Kind {
     value,     // a default, in the key's range (0, upper]
-    required,  // 0 until given (--help: "required"); >= 0 here, the command refuses 0 naming the key
+    required,  // 0 until given (--help: "required"); in [0, upper] here, the command refuses 0 naming the key
     the_files  // the input file's unless given (--help: "the file's"); any number here, the reader checks it
   };
   Kind kind = Kind::value;
