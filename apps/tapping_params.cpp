@@ -125,9 +125,10 @@ void add_tapping_model_params(io::ParamSet& p) {
       .real("drive_amplitude", 0.2, "[normalised] drive Γ (per unit mass)", below(1e12))
       .unit("L/t^2");
   // the hysteresis law's keys per unit mass (the registry's keys, in normalised units: add_law_params skips them)
-  const impact::LawRegistry& registry = impact::LawRegistry::builtin();
+  const impact::LawRegistry registry = impact::LawRegistry::builtin();
   const auto per_unit_mass = [&](const char* key, const char* unit, const char* help) {
-    add_law_key_param(p, registry, key, {.help = help, .default_value = {}, .range = Range::closed(0.0, 1e12), .unit = unit});
+    add_law_key_param(p, registry, key,
+                      {.help = help, .default_value = {}, .range = Range::closed(0.0, 1e12), .unit = unit});
   };
   per_unit_mass("approach_stiffness", "1/t^2", "[normalised] K_a, sample stiffness while approaching (per unit mass)");
   per_unit_mass("departure_stiffness", "1/t^2", "[normalised] K_b, sample stiffness while departing (per unit mass)");
