@@ -29,8 +29,9 @@ void add_law_key_param(io::ParamSet& p, const impact::LawRegistry& registry, con
                        const LawKeyForm& form = {});
 
 /// Declares `law` (default `default_law`), `force_curve`, `allow_energy_gain` and every registry key not in
-/// `skip` (keys the command declares itself, in its own form: add_law_key_param). Every law key, alias and skipped key, and `force_curve`, applies
-/// only to the laws that read it (ParamSet::applies_when): the records list the keys of the law in use.
+/// `skip` (keys the command declares itself, in its own form: add_law_key_param). Every law key, alias and skipped
+/// key, and `force_curve`, applies only to the laws that read it (ParamSet::applies_when): the records list the
+/// keys of the law in use.
 /// `aliases`: the command keys that stand for registry keys (law_from_params), so that an alternative given
 /// (restitution) leaves the command key it replaces out of the records too.
 void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& default_law,

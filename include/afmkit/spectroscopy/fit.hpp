@@ -112,9 +112,9 @@ struct FitOptions {
   double correlation_limit = 0.99;
   double condition_limit = 1e10;
   double flat_column = 1e-3;  // a parameter whose weighted Jacobian column is shorter is flat (not identifiable)
-  /// Accuracy of the orbits: the integrator's relative tolerance and the shooting tolerance (tapping::ShootingOptions::
-  /// tolerance, declared by its describe_tolerance(); the sweep's defaults are 1e-10 and 1e-11: a fit to data with
-  /// noise ~1e-3 needs less).
+  /// Accuracy of the orbits: the integrator's relative tolerance and the shooting tolerance (the tolerance of
+  /// tapping::ShootingOptions, declared by its describe_tolerance(); the sweep's defaults are 1e-10 and 1e-11: a fit
+  /// to data with noise ~1e-3 needs less).
   double integrator_tolerance = 1e-9;
   double shooting_tolerance = 1e-10;
   bool parallel = true;          // the orbits of a warm-started evaluation in parallel (OpenMP)

@@ -23,7 +23,8 @@ struct ShootingOptions {
   template <class Archive, class Self>
   static void describe(Archive& a, Self& o) {
     SimulationOptions::describe(a, o.simulation);
-    describe_tolerance(a, o.tolerance, "Newton convergence of periodic orbits |P(y) - y| / |y|", Range::open(0.0, 1.0));
+    describe_tolerance(a, o.tolerance, "Newton convergence of periodic orbits |P(y) - y| / |y|",
+                       Range::open(0.0, 1.0));
     a.integer("max_newton_iterations", o.max_iterations, "Newton iterations per shooting solve", 1, 1000);
     a.real("time_budget", o.time_budget_seconds, "wall-clock budget of one shooting solve", "s", Range::positive());
   }
