@@ -21,6 +21,10 @@ void add_coupling_alpha(io::ParamSet& p) { p.real("alpha", 0.1, "coupling alpha 
 
 void add_coupling_beta(io::ParamSet& p) { p.real("beta", -0.1, "coupling beta of eq. (20)").unit("Omega"); }
 
+void add_harmonics_param(io::ParamSet& p, long max_harmonics, const std::string& help) {
+  p.integer("harmonics", 10, help, 1, max_harmonics);
+}
+
 void add_threads_param(io::ParamSet& p) { p.integer("threads", 0, "OpenMP threads (0: default)", 0, 1024); }
 
 void add_progress_flag(io::ParamSet& p) { p.flag("progress", true, "show progress on stderr"); }
@@ -34,12 +38,11 @@ void add_control_params(io::ParamSet& p, long max_harmonics) {
                                        "in units of T = 2 pi/Omega", Range{0.0, 1e12, true, false})
       .unit("rad/s");
   add_si_alternative(p, "rotation_frequency", SiUnit::Hz, Range::positive());
-  p.integer("harmonics", 10,
-            max_harmonics == kMaxHarmonicsTf
-                ? "number N of oscillators of the bank (eq. 15); cost O(N) per frequency"
-                : "number N of oscillators of the bank (eq. 15); cost O(N) per characteristic evaluation, "
-                  "O(N^2) per spectrum / per simulated period",
-            1, max_harmonics);
+  add_harmonics_param(p, max_harmonics,
+                      max_harmonics == kMaxHarmonicsTf
+                          ? "number N of oscillators of the bank (eq. 15); cost O(N) per frequency"
+                          : "number N of oscillators of the bank (eq. 15); cost O(N) per characteristic evaluation, "
+                            "O(N^2) per spectrum / per simulated period");
   add_coupling_alpha(p);
   add_si_alternative(p, "alpha");
   add_coupling_beta(p);

@@ -32,6 +32,9 @@ void add_control_params(io::ParamSet& params, long max_harmonics = kMaxHarmonics
 /// The couplings alpha and beta of the bank (eq. 20), in units of Omega: shared by the control commands and scan.
 void add_coupling_alpha(io::ParamSet& params);
 void add_coupling_beta(io::ParamSet& params);
+/// The bank's number N of oscillators (eq. 15), `harmonics`: default 10, in [1, max_harmonics] (each command's
+/// bound: its cost in N), `help` saying what N costs there; shared by the control commands and scan.
+void add_harmonics_param(io::ParamSet& params, long max_harmonics, const std::string& help);
 /// `threads` (OpenMP threads of a grid computation) and the `progress` flag, shared by chart and tune.
 void add_threads_param(io::ParamSet& params);
 void add_progress_flag(io::ParamSet& params);

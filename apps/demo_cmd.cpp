@@ -152,16 +152,17 @@ void register_demo(CLI::App& app) {
         p.set_default("approach_adhesion", fmt::format("{}", demo_approach_adhesion));
         p.set_default("departure_adhesion", fmt::format("{}", demo_departure_adhesion));
         p.set_default("frequency_ratio", "0.99");
-        p.group("Sweep")
-            .real("separation_min", demo_separation_min, "smallest separation of the sweep", io::Range::any())
-            .unit(kLengthUnit)
-            .default_text("7 normalised; physical: the same case scaled to free_amplitude")
-            .real("separation_max", demo_separation_max, "largest separation of the sweep (> separation_min)",
-                  io::Range::any())
-            .unit(kLengthUnit)
-            .default_text("12 normalised; physical: the same case scaled to free_amplitude")
-            .integer("points", 101, "separations per direction (>= 2)", 2, 1000000)
-            .group("Output")
+        p.group("Sweep");
+        // any finite value: the physical defaults scale with the cantilever (with_demo_defaults)
+        add_separation_range_params(
+            p, demo_separation_min, demo_separation_max,
+            {.min_help = "smallest separation of the sweep",
+             .max_help = "largest separation of the sweep (> separation_min)",
+             .range = io::Range::any(),
+             .min_default_text = "7 normalised; physical: the same case scaled to free_amplitude",
+             .max_default_text = "12 normalised; physical: the same case scaled to free_amplitude"});
+        add_separation_points_param(p, 101, 2, 1000000, "separations per direction (>= 2)");
+        p.group("Output")
             .file("output_dir", "out", "folder for demo_sweep.csv and demo_hb.csv (+ .json sidecars)")
             .writes([](const std::string& dir) {
               std::vector<io::WrittenPath> files = io::table_and_sidecar(dir + "/demo_sweep.csv");

@@ -1,6 +1,7 @@
 #include "law_params.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -8,6 +9,19 @@
 #include "afmkit/core/error.hpp"
 
 namespace afmkit::cli {
+
+void add_law_key_param(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& key,
+                       const LawKeyForm& form) {
+  const auto& keys = registry.keys();
+  const auto found = std::find_if(keys.begin(), keys.end(), [&](const impact::LawKey& k) { return k.key == key; });
+  if (found == keys.end()) throw std::logic_error("add_law_key_param: '" + key + "' is no key of the law registry");
+  const impact::LawKey& k = *found;
+  const std::string help =
+      form.help.empty() ? fmt::format("[{}] {}", fmt::join(registry.laws_using(k.key), ", "), k.help) : form.help;
+  const io::Range range = form.range.value_or(io::Range{k.lower, std::min(k.upper, 1e308), k.lower_open, false});
+  const std::string unit = !form.unit.empty() ? form.unit : k.unit.empty() ? "dimensionless" : k.unit;
+  p.real(k.key, form.default_value.value_or(k.default_value), help, range).unit(unit);
+}
 
 void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& default_law,
                     const std::vector<std::string>& skip, const LawKeyAliases& aliases) {
@@ -39,9 +53,7 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
       p.applies_when(k.key, "law", registry.laws_using(k.key));
       continue;
     }
-    const std::string laws = fmt::format("[{}] ", fmt::join(registry.laws_using(k.key), ", "));
-    io::Range range{k.lower, std::min(k.upper, 1e308), k.lower_open, false};
-    p.real(k.key, k.default_value, laws + k.help, range).unit(k.unit.empty() ? "dimensionless" : k.unit);
+    add_law_key_param(p, registry, k.key);
     p.applies_when(k.key, "law", registry.laws_using(k.key));
     if (!k.follows.empty()) p.follows(k.follows);  // recorded with the value it takes (params.hpp)
     if (k.only_if_given) {  // an alternative: recorded only when given, then instead of the key it replaces

@@ -3,6 +3,7 @@
 // (docs/force-laws.md): `law`, `force_curve`, `allow_energy_gain` and every law parameter with its unit.
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "afmkit/impact/law_registry.hpp"
@@ -15,9 +16,22 @@ namespace afmkit::cli {
 /// reads the registry key.
 using LawKeyAliases = std::map<std::string, std::string>;
 
+/// How a command that takes a registry key outside add_law_params (in its own unit system or role) differs from the
+/// registry's declaration of it; unset fields are the registry's.
+struct LawKeyForm {
+  std::string help;                  // empty: "[laws] " + the registry's help
+  std::optional<double> default_value;
+  std::optional<io::Range> range;    // unset: the registry's range
+  std::string unit;                  // empty: the registry's unit
+};
+/// Declares the registry key `key` on `p` (the one declaration of every law key, also add_law_params'), in `form`.
+void add_law_key_param(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& key,
+                       const LawKeyForm& form = {});
+
 /// Declares `law` (default `default_law`), `force_curve`, `allow_energy_gain` and every registry key not in
-/// `skip` (keys the command declares itself). Every law key, alias and skipped key, and `force_curve`, applies
-/// only to the laws that read it (ParamSet::applies_when): the records list the keys of the law in use.
+/// `skip` (keys the command declares itself, in its own form: add_law_key_param). Every law key, alias and skipped
+/// key, and `force_curve`, applies only to the laws that read it (ParamSet::applies_when): the records list the
+/// keys of the law in use.
 /// `aliases`: the command keys that stand for registry keys (law_from_params), so that an alternative given
 /// (restitution) leaves the command key it replaces out of the records too.
 void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& default_law,

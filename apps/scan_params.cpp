@@ -205,8 +205,8 @@ void add_scan_params(io::ParamSet& p) {
       .unit("m")
       .integer("noise_seed", 1, "seed of the detector noise", 0, 4294967295L)
       .group("Controller (seed 2, eqs. 15, 6, 20)")
-      .text("control", "on", "the harmonic-rejection controller in the loop", {"on", "off"})
-      .integer("harmonics", 10, "oscillators N of the bank (N x spindle_frequency below sample_rate / 2)", 1, 10000);
+      .text("control", "on", "the harmonic-rejection controller in the loop", {"on", "off"});
+  add_harmonics_param(p, 10000, "oscillators N of the bank (N x spindle_frequency below sample_rate / 2)");
   add_coupling_alpha(p);  // as the control commands declare them (control_params.hpp)
   add_coupling_beta(p);
   p.real("gain", 0.0, "controller gain K (0: the design rule K = bandwidth)", non_negative)

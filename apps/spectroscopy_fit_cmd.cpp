@@ -20,6 +20,7 @@
 #include "afmkit/io/quantity.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
 #include "afmkit/spectroscopy/fit_input.hpp"
+#include "cantilever_params.hpp"
 #include "command.hpp"
 #include "commands.hpp"
 #include "described_params.hpp"
@@ -366,24 +367,15 @@ void register_spectroscopy_fit(CLI::App& spectroscopy) {
                             "frequency shift and (optionally) dissipation (FM), with units in the header "
                             "(docs/fitting.md#input)")
             .positional()
-            .default_text("required")
-            .real("spring_constant", 0.0, "cantilever spring constant k (required)", io::Range::non_negative())
-            .unit("N/m")
-            .default_text("required")
-            .real("resonance_frequency", 0.0, "resonance frequency f0 (required)", io::Range::non_negative())
-            .unit("kHz")
-            .default_text("required")
-            .real("quality_factor", 0.0, "quality factor Q (required)", io::Range::non_negative())
-            .unit("dimensionless")
-            .default_text("required")
-            .real("free_amplitude", 0.0, "AM: free amplitude A0 at the drive frequency (required)",
-                  io::Range::non_negative())
-            .unit("nm")
-            .default_text("required")
-            .real("amplitude", 0.0, "FM: oscillation amplitude A held by the amplitude loop (required)",
-                  io::Range::non_negative())
-            .unit("nm")
             .default_text("required");
+        const auto required = CantileverDefault::required();
+        add_cantilever_param(p, CantileverKey::spring_constant, required, "cantilever spring constant k (required)");
+        add_cantilever_param(p, CantileverKey::resonance_frequency, required, "resonance frequency f0 (required)");
+        add_cantilever_param(p, CantileverKey::quality_factor, required, "quality factor Q (required)");
+        add_cantilever_param(p, CantileverKey::free_amplitude, required,
+                             "AM: free amplitude A0 at the drive frequency (required)");
+        add_cantilever_param(p, CantileverKey::amplitude, required,
+                             "FM: oscillation amplitude A held by the amplitude loop (required)");
         add_drive_frequency_param(p);
         p.text("direction", "approach", "the branch the curve is: approach (from the largest distance down) or "
                                            "retract (after the approach down to the smallest distance)",

@@ -25,9 +25,11 @@
 #include "afmkit/io/params.hpp"
 #include "afmkit/io/quantity.hpp"
 #include "afmkit/spectroscopy/prepare.hpp"
+#include "cantilever_params.hpp"
 #include "command.hpp"
 #include "commands.hpp"
 #include "described_params.hpp"
+#include "law_params.hpp"
 #include "python_launch.hpp"
 #include "spectroscopy_prepare.hpp"
 #include "unit_tagged.hpp"
@@ -73,11 +75,10 @@ void add_prepare_params(io::ParamSet& p) {
             "text exports: the height column grows away from the sample (a height) or towards it (an extension, "
             "negated); auto: the preset's",
             {"auto", "away", "towards"});
-  p.group("Calibration")
-      .real("spring_constant", 0.0, "cantilever spring constant k (> 0); not given: the file's", Range::any())
-      .unit("N/m")
-      .default_text("the file's")
-      .real("invols", 0.0,
+  p.group("Calibration");
+  add_cantilever_param(p, CantileverKey::spring_constant, CantileverDefault::the_files(),
+                       "cantilever spring constant k (> 0); not given: the file's");
+  p.real("invols", 0.0,
             "inverse optical lever sensitivity (> 0), for a deflection recorded in volts; not given: the file's",
             Range::any())
       .unit("nm/V")
@@ -94,11 +95,14 @@ void add_prepare_params(io::ParamSet& p) {
             {"hertz", "dmt", "threshold"})
       .real("noise_multiple", 3.0, "half-width of the noise band in units of the baseline's noise sigma",
             Range::positive())
-      .unit("dimensionless")
-      .real("tip_radius", 0.0, "tip radius R of the paraboloid Hertz fit; 0: no Young's modulus reported",
-            Range::non_negative())
-      .unit("nm")
-      .real("poisson_ratio", 0.5, "Poisson's ratio of the sample in the Hertz fit", Range::closed(0.0, 0.5))
+      .unit("dimensionless");
+  // the tip radius of the laws (nm), here of the Hertz fit, where 0 stands for none
+  add_law_key_param(p, impact::LawRegistry::builtin(), "tip_radius",
+                    {.help = "tip radius R of the paraboloid Hertz fit; 0: no Young's modulus reported",
+                     .default_value = 0.0,
+                     .range = Range::non_negative(),
+                     .unit = {}});
+  p.real("poisson_ratio", 0.5, "Poisson's ratio of the sample in the Hertz fit", Range::closed(0.0, 0.5))
       .unit("dimensionless");
   p.group("Table")
       .real("bin_width", 0.0,

@@ -16,6 +16,7 @@
 #include "afmkit/spectroscopy/reconstruct_fm.hpp"
 #include "afmkit/spectroscopy/reconstruct_input.hpp"
 #include "afmkit/spectroscopy/reconstruct_law.hpp"
+#include "cantilever_params.hpp"
 #include "command.hpp"
 #include "commands.hpp"
 #include "described_params.hpp"
@@ -259,8 +260,6 @@ void run_reconstruct(const io::ParamSet& p, Captured* capture) {
   }
 }
 
-io::Range positive_below(double hi) { return {0.0, hi, true, false}; }
-
 }  // namespace
 
 void register_spectroscopy_reconstruct(CLI::App& spectroscopy) {
@@ -282,21 +281,18 @@ void register_spectroscopy_reconstruct(CLI::App& spectroscopy) {
             .text("phase_convention", "lag",
                   "AM phase: lag (afmkit's: 90° free at resonance, above 90° attractive) or mirrored (180° − phase)",
                   {"lag", "mirrored"});
-        p.group("Cantilever")
-            .real("spring_constant", 40.0, "cantilever spring constant k", positive_below(1e6))
-            .unit("N/m")
-            .real("resonance_frequency", 300.0, "resonance frequency f0", positive_below(1e7))
-            .unit("kHz")
-            .real("amplitude", 1.0, "FM: oscillation amplitude A (required for FM curves)", positive_below(1e6))
-            .unit("nm")
-            .real("free_amplitude", 10.0, "AM: free amplitude A0 at the drive frequency (required for AM curves)",
-                  positive_below(1e6))
-            .unit("nm")
-            .real("quality_factor", 400.0,
-                  "quality factor Q (AM: required; FM: of the cantilever of the exact round trip, which Δf hardly "
-                  "depends on)",
-                  positive_below(1e9))
-            .unit("dimensionless");
+        p.group("Cantilever");
+        add_cantilever_param(p, CantileverKey::spring_constant, CantileverDefault::of(40.0),
+                             "cantilever spring constant k");
+        add_cantilever_param(p, CantileverKey::resonance_frequency, CantileverDefault::of(300.0),
+                             "resonance frequency f0");
+        add_cantilever_param(p, CantileverKey::amplitude, CantileverDefault::of(1.0),
+                             "FM: oscillation amplitude A (required for FM curves)");
+        add_cantilever_param(p, CantileverKey::free_amplitude, CantileverDefault::of(10.0),
+                             "AM: free amplitude A0 at the drive frequency (required for AM curves)");
+        add_cantilever_param(p, CantileverKey::quality_factor, CantileverDefault::of(400.0),
+                             "quality factor Q (AM: required; FM: of the cantilever of the exact round trip, which Δf "
+                             "hardly depends on)");
         add_drive_frequency_param(p);
         p.group("Reconstruction")
             .integer("noise_realisations", 8, "FM: synthetic noise realisations for the force uncertainty (0: none)",

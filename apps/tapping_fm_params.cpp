@@ -8,6 +8,7 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/number_list.hpp"
+#include "cantilever_params.hpp"
 #include "tapping_params.hpp"
 
 namespace afmkit::cli {
@@ -29,13 +30,12 @@ const std::vector<std::pair<const char*, const char*>>& keys_not_for_fm() {
 void add_tapping_fm_params(io::ParamSet& p) {
   // refused when given (reject_keys_not_for_fm): never in the records
   for (const auto& [key, why] : keys_not_for_fm()) p.recorded_only_if_given(key);
-  p.group("FM-AFM")
-      .real("amplitude", 5.0, "oscillation amplitude A held by the amplitude controller (first harmonic of the "
-                              "deflection)",
-            {0.0, 1e6, true, false})
-      .unit(kLengthUnit);
+  p.group("FM-AFM");
+  add_cantilever_param(p, CantileverKey::amplitude, CantileverDefault::of(5.0),
+                       "oscillation amplitude A held by the amplitude controller (first harmonic of the deflection)",
+                       kLengthUnit);
   add_separation_range_params(p, 3.0, 10.0);
-  p.integer("points", 71, "separations of the approach (>= 2)", 2, 10000000);
+  add_separation_points_param(p, 71, 2, 10000000, "separations of the approach (>= 2)");
   add_separation_list_params(p, "explicit separations instead of the uniform grid (any order; run from the largest)");
   p.text("axis", "separation",
             "what separation_min, separation_max and separations set: separation (the rest position l, stepped as an "

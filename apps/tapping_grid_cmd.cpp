@@ -191,7 +191,8 @@ void register_tapping_grid(CLI::App& tapping) {
         add_tapping_sim_params(p);
         p.group("Grid");
         add_separation_range_params(p, 5.0, 15.0);
-        p.integer("points", 41, "separations, equally spaced from separation_min to separation_max", 2, 100000000);
+        add_separation_points_param(p, 41, 2, 100000000,
+                                    "separations, equally spaced from separation_min to separation_max");
         p.group("Output")
             .file("store", "out/tapping_grid.zarr",
                   "Zarr store the grid is written to (a folder, complete or not at all; an existing afmkit store "

@@ -68,13 +68,12 @@ void add_modes_params(io::ParamSet& p) {
       .unit("dimensionless")
       .group("Approach");
   add_separation_range_params(p, 5.0, 12.0);
-  p.integer("points", 8, "separations of the approach (1: separation_max only)", 1, 10000000)
-      .integer("settle_periods", 0,
-               "drive periods simulated at each separation before the lock-in (0: automatic, 2 Q_i f_drive/f_i at "
-               "least: every transient decays by exp(-2 pi))",
-               0, 100000000)
-      .integer("lockin_periods", 20, "drive periods of the lock-in window (whole periods of each drive)", 1,
-               10000000)
+  add_separation_points_param(p, 8, 1, 10000000, "separations of the approach (1: separation_max only)");
+  p.integer("settle_periods", 0,
+            "drive periods simulated at each separation before the lock-in (0: automatic, 2 Q_i f_drive/f_i at "
+            "least: every transient decays by exp(-2 pi))",
+            0, 100000000)
+      .integer("lockin_periods", 20, "drive periods of the lock-in window (whole periods of each drive)", 1, 10000000)
       .flag("periodic", false,
             "after the settling, solve the periodic orbit by shooting and measure on it (the drives must be "
             "commensurate: one drive, or f_b/f_a = n2/n1 with n1, n2 <= 64)");

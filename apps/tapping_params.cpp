@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "cantilever_params.hpp"
 #include "law_params.hpp"
 
 namespace afmkit::cli {
@@ -95,22 +96,24 @@ void add_separation_list_params(io::ParamSet& p, const std::string& help) {
       .only_if_given(uniform_grid_keys());
 }
 
-void add_separation_range_params(io::ParamSet& p, double min_default, double max_default) {
-  p.real("separation_min", min_default, "smallest separation (rest position to the surface) of the range visited",
-         Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit)
-      .real("separation_max", max_default,
-            "largest separation of the range visited, where an approach starts (not below separation_min)",
-            Range::closed(-1e6, 1e6))
-      .unit(kLengthUnit);
+void add_separation_range_params(io::ParamSet& p, double min_default, double max_default,
+                                 const SeparationRangeForm& form) {
+  p.real("separation_min", min_default, form.min_help, form.range).unit(kLengthUnit);
+  if (!form.min_default_text.empty()) p.default_text(form.min_default_text);
+  p.real("separation_max", max_default, form.max_help, form.range).unit(kLengthUnit);
+  if (!form.max_default_text.empty()) p.default_text(form.max_default_text);
+}
+
+void add_separation_points_param(io::ParamSet& p, long points_default, long min_points, long max_points,
+                                 const std::string& help) {
+  p.integer("points", points_default, help, min_points, max_points);
 }
 
 void add_tapping_model_params(io::ParamSet& p) {
   p.group("Model");
-  p.text("units", "normalised", "unit system of the model parameters and results", {"normalised", "physical"})
-      .real("quality_factor", 100.0, "quality factor Q = 1/(2ξ)", below(1e9))
-      .unit("dimensionless")
-      .real("frequency_ratio", 1.0, "drive frequency over natural frequency ω/ω_n", below(1e3))
+  p.text("units", "normalised", "unit system of the model parameters and results", {"normalised", "physical"});
+  add_cantilever_param(p, CantileverKey::quality_factor, CantileverDefault::of(100.0), "quality factor Q = 1/(2ξ)");
+  p.real("frequency_ratio", 1.0, "drive frequency over natural frequency ω/ω_n", below(1e3))
       .unit("dimensionless")
       .real("separation", 10.0, "separation l: sample surface at x = -l", Range::closed(-1e6, 1e6))
       .unit(kLengthUnit)
@@ -120,28 +123,28 @@ void add_tapping_model_params(io::ParamSet& p) {
       .real("natural_frequency", 1.0, "[normalised] natural frequency ω_n", below(1e12))
       .unit("rad/t")
       .real("drive_amplitude", 0.2, "[normalised] drive Γ (per unit mass)", below(1e12))
-      .unit("L/t^2")
-      .real("approach_stiffness", 10.0, "[normalised] K_a, sample stiffness while approaching (per unit mass)",
-            Range::closed(0.0, 1e12))
-      .unit("1/t^2")
-      .real("departure_stiffness", 8.0, "[normalised] K_b, sample stiffness while departing (per unit mass)",
-            Range::closed(0.0, 1e12))
-      .unit("1/t^2")
-      .real("approach_adhesion", 0.0, "[normalised] F_a >= 0, attraction at contact while approaching (per unit mass)",
-            Range::closed(0.0, 1e12))
-      .unit("L/t^2")
-      .real("departure_adhesion", 0.0, "[normalised] F_b >= F_a, attraction at contact while departing (per unit mass)",
-            Range::closed(0.0, 1e12))
-      .unit("L/t^2")
-      // physical units
-      .group("Model in physical units (--units physical)", "units", "physical")
-      .real("spring_constant", 40.0, "[physical] cantilever spring constant k", below(1e6))
-      .unit("N/m")
-      .real("resonance_frequency", 300.0, "[physical] resonance frequency f0", below(1e7))
-      .unit("kHz")
-      .real("free_amplitude", 20.0, "[physical] free amplitude at the drive frequency", below(1e6))
-      .unit("nm")
-      .real("sample_stiffness_approach", 400.0, "[physical] contact stiffness while approaching", Range::closed(0.0, 1e9))
+      .unit("L/t^2");
+  // the hysteresis law's keys per unit mass (the registry's keys, in normalised units: add_law_params skips them)
+  const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  const auto per_unit_mass = [&](const char* key, const char* unit, const char* help) {
+    add_law_key_param(p, registry, key,
+                      {.help = help, .default_value = {}, .range = Range::closed(0.0, 1e12), .unit = unit});
+  };
+  per_unit_mass("approach_stiffness", "1/t^2", "[normalised] K_a, sample stiffness while approaching (per unit mass)");
+  per_unit_mass("departure_stiffness", "1/t^2", "[normalised] K_b, sample stiffness while departing (per unit mass)");
+  per_unit_mass("approach_adhesion", "L/t^2",
+                "[normalised] F_a >= 0, attraction at contact while approaching (per unit mass)");
+  per_unit_mass("departure_adhesion", "L/t^2",
+                "[normalised] F_b >= F_a, attraction at contact while departing (per unit mass)");
+  // physical units
+  p.group("Model in physical units (--units physical)", "units", "physical");
+  add_cantilever_param(p, CantileverKey::spring_constant, CantileverDefault::of(40.0),
+                       "[physical] cantilever spring constant k");
+  add_cantilever_param(p, CantileverKey::resonance_frequency, CantileverDefault::of(300.0),
+                       "[physical] resonance frequency f0");
+  add_cantilever_param(p, CantileverKey::free_amplitude, CantileverDefault::of(20.0),
+                       "[physical] free amplitude at the drive frequency");
+  p.real("sample_stiffness_approach", 400.0, "[physical] contact stiffness while approaching", Range::closed(0.0, 1e9))
       .unit("N/m")
       .real("sample_stiffness_departure", 320.0, "[physical] contact stiffness while departing", Range::closed(0.0, 1e9))
       .unit("N/m")
@@ -150,7 +153,7 @@ void add_tapping_model_params(io::ParamSet& p) {
       .real("adhesion_departure", 0.0, "[physical] attraction at contact while departing", Range::closed(0.0, 1e9))
       .unit("nN")
       ;
-  add_law_params(p, impact::LawRegistry::builtin(), "hysteresis",
+  add_law_params(p, registry, "hysteresis",
                  {"approach_stiffness", "departure_stiffness", "approach_adhesion", "departure_adhesion"},
                  physical_aliases);
 }

@@ -22,9 +22,23 @@ inline std::vector<std::string> uniform_grid_keys() { return {"separation_min", 
 /// (uniform_grid_keys) in the records; shared by tapping sweep and tapping fm.
 void add_separation_list_params(io::ParamSet& p, const std::string& help);
 
+/// What a command that visits a range of separations says of it, where it differs from the others: the demo's
+/// defaults are its demonstration case, scaled in physical units to the cantilever (any finite value).
+struct SeparationRangeForm {
+  std::string min_help = "smallest separation (rest position to the surface) of the range visited";
+  std::string max_help = "largest separation of the range visited, where an approach starts (not below "
+                         "separation_min)";
+  io::Range range = io::Range::closed(-1e6, 1e6);  // like every separation
+  std::string min_default_text, max_default_text;  // empty: the defaults' values
+};
 /// separation_min and separation_max of the commands that visit a range of separations (tapping sweep, grid, fm,
-/// modes), each with its defaults; in [-1e6, 1e6] like every separation (each command checks their order).
-void add_separation_range_params(io::ParamSet& p, double min_default, double max_default);
+/// modes, demo), each with its defaults (each command checks their order).
+void add_separation_range_params(io::ParamSet& p, double min_default, double max_default,
+                                 const SeparationRangeForm& form = {});
+/// `points`: the number of separations on [separation_min, separation_max] of the same commands, each with its
+/// default, bounds (its cost per point) and help.
+void add_separation_points_param(io::ParamSet& p, long points_default, long min_points, long max_points,
+                                 const std::string& help);
 
 /// units, cantilever, drive, force law, separation.
 void add_tapping_model_params(io::ParamSet& p);

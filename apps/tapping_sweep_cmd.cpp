@@ -420,7 +420,7 @@ void register_tapping_sweep(CLI::App& tapping) {
         add_tapping_sim_params(p);
         p.group("Sweep");
         add_separation_range_params(p, 5.0, 15.0);
-        p.integer("points", 200, "separations per direction of the instrument sweep (>= 2)", 2, 10000000);
+        add_separation_points_param(p, 200, 2, 10000000, "separations per direction of the instrument sweep (>= 2)");
         add_separation_list_params(p, "explicit separations of the instrument sweep instead of the uniform grid (any "
                                       "order, e.g. 20,18,16,15.5); the continuation runs between the smallest and the "
                                       "largest");

@@ -30,6 +30,7 @@
 
 #include "afmkit/core/cancellation.hpp"
 #include "afmkit/core/describe.hpp"
+#include "afmkit/tapping/shooting.hpp"
 
 namespace afmkit::spectroscopy {
 
@@ -111,8 +112,9 @@ struct FitOptions {
   double correlation_limit = 0.99;
   double condition_limit = 1e10;
   double flat_column = 1e-3;  // a parameter whose weighted Jacobian column is shorter is flat (not identifiable)
-  /// Accuracy of the orbits: the integrator's relative tolerance and the shooting tolerance (tapping/shooting.hpp;
-  /// the sweep's defaults are 1e-10 and 1e-11: a fit to data with noise ~1e-3 needs less).
+  /// Accuracy of the orbits: the integrator's relative tolerance and the shooting tolerance (the tolerance of
+  /// tapping::ShootingOptions, declared by its describe_tolerance(); the sweep's defaults are 1e-10 and 1e-11: a fit
+  /// to data with noise ~1e-3 needs less).
   double integrator_tolerance = 1e-9;
   double shooting_tolerance = 1e-10;
   bool parallel = true;          // the orbits of a warm-started evaluation in parallel (OpenMP)
@@ -135,8 +137,8 @@ struct FitOptions {
            Range::closed(1e-15, 0.1));
     a.real("integrator_tolerance", o.integrator_tolerance, "relative tolerance of the orbits' integrator",
            "dimensionless", Range::closed(1e-14, 1e-4));
-    a.real("shooting_tolerance", o.shooting_tolerance, "tolerance of the orbits' Newton shooting", "dimensionless",
-           Range::closed(1e-14, 1e-4));
+    tapping::ShootingOptions::describe_tolerance(a, o.shooting_tolerance, "tolerance of the orbits' Newton shooting",
+                                                 Range::closed(1e-14, 1e-4));
     a.real("correlation_limit", o.correlation_limit, "warn when |correlation| of two parameters exceeds this",
            "dimensionless", Range::open(0.0, 1.0));
     a.real("condition_limit", o.condition_limit, "warn when the condition number of the scaled JᵀWJ exceeds this",

@@ -23,12 +23,19 @@ struct ShootingOptions {
   template <class Archive, class Self>
   static void describe(Archive& a, Self& o) {
     SimulationOptions::describe(a, o.simulation);
-    a.real("shooting_tolerance", o.tolerance, "Newton convergence of periodic orbits |P(y) - y| / |y|",
-           "dimensionless", Range::open(0.0, 1.0));
+    describe_tolerance(a, o.tolerance, "Newton convergence of periodic orbits |P(y) - y| / |y|",
+                       Range::open(0.0, 1.0));
     a.integer("max_newton_iterations", o.max_iterations, "Newton iterations per shooting solve", 1, 1000);
     a.real("time_budget", o.time_budget_seconds, "wall-clock budget of one shooting solve", "s", Range::positive());
   }
   void validate() const;  // InvalidParameter naming the key (the ranges of describe())
+
+  /// `shooting_tolerance` (the `tolerance` above), declared once for every options struct whose orbits are shot
+  /// (spectroscopy::FitOptions too), each with its help and range: a fit's orbits need less than a sweep's.
+  template <class Archive, class Tolerance>
+  static void describe_tolerance(Archive& a, Tolerance& tolerance, const char* help, Range range) {
+    a.real("shooting_tolerance", tolerance, help, "dimensionless", range);
+  }
 };
 
 /// A periodic orbit of period n·T (T = 2π/ω), given by its state at t = 0 (drive Γ cos ωt at phase 0).
