@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -67,6 +69,11 @@ Grid image_grid(const InstrumentSpec& instrument, long resolution) {
   return Grid{resolution, resolution, 2.0 * r, 2.0 * r, -r, -r};
 }
 
+SpiralImager scan_imager(const InstrumentSpec& instrument, const Grid& grid) {
+  const double per_turn = std::clamp(std::round(instrument.spiral.samples_per_turn()), 16.0, 4194304.0);
+  return SpiralImager(grid, {"m", "m", "m", "m"}, static_cast<int>(per_turn));
+}
+
 void check_scan_geometry(const InstrumentSpec& instrument, const Surface& surface, const Grid& grid) {
   const SpiralSpec& s = instrument.spiral;
   const double pixel = std::min(grid.x_size / static_cast<double>(grid.x_resolution),
@@ -92,8 +99,19 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   check_scan_geometry(instrument, surface, grid);
   const SpiralSpec& spiral = instrument.spiral;
 
-  const auto per_turn = static_cast<int>(std::clamp(std::round(spiral.samples_per_turn()), 16.0, 4194304.0));
-  SpiralImager imager(grid, {"m", "m", "m", "m"}, per_turn);
+  std::optional<SpiralImager> own;
+  if (options.imager) {
+    const SpiralImager& given = *options.imager;
+    const auto per_turn = static_cast<int>(std::clamp(std::round(spiral.samples_per_turn()), 16.0, 4194304.0));
+    const Grid& g = given.grid();
+    if (given.samples() != 0 || given.channels() != 4 || given.angular_samples() != per_turn ||
+        g.x_resolution != grid.x_resolution || g.y_resolution != grid.y_resolution || g.x_size != grid.x_size ||
+        g.y_size != grid.y_size || g.x_offset != grid.x_offset || g.y_offset != grid.y_offset)
+      throw std::invalid_argument("run_virtual_scan: options.imager is not scan_imager(instrument, grid) unused");
+  } else {
+    own.emplace(scan_imager(instrument, grid));
+  }
+  SpiralImager& imager = options.imager ? *options.imager : *own;
   ImagingObserver imaging(imager);
   std::int64_t turns = 0;
   TurnMetrics metrics(surface.tilt().slope(), [&](const TurnRecord& r) {
