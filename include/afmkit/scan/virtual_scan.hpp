@@ -39,9 +39,11 @@ Grid image_grid(const InstrumentSpec& instrument, long resolution);
 SpiralImager scan_imager(const InstrumentSpec& instrument, const Grid& grid);
 
 struct VirtualScanOptions {
-  bool compare_without_control = true;  ///< run the second, uncontrolled scan for the saturation radius
+  /// run the second, uncontrolled scan for the saturation radius (on a third thread beside the main run when
+  /// imaging_thread is true)
+  bool compare_without_control = true;
   /// image on a second thread, a batch behind the simulation (observer_thread.hpp); false: everything on the
-  /// calling thread (the same results)
+  /// calling thread, the comparison run too (the same results)
   bool imaging_thread = true;
   /// also receives every sample of the main run (e.g. a time-series writer); called, like on_turn, on the imaging
   /// thread when there is one, never concurrently with itself or on_turn
