@@ -4,6 +4,7 @@
 // on request, the time series (CSV) and the raw point cloud (GXYZF). With `recorded`, a recorded spiral (CSV) is
 // filtered offline instead (scan_recorded.cpp).
 #include <cmath>
+#include <future>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -62,9 +63,19 @@ double loop_spectral_abscissa(const scan::InstrumentSpec& s) {
 void run_simulated(const io::ParamSet& p, Captured* capture) {
   const scan::InstrumentSpec instrument = instrument_from(p);
   require_scan_memory(p, false);  // before the sample map and the images are allocated
-  const scan::Surface surface = surface_from(p);
   const scan::Grid grid = scan::image_grid(instrument, p.integer("image_resolution"));
-  scan::check_scan_geometry(instrument, surface, grid);
+  // the sample is made on a second thread while this one builds the imager (its pixel centres sorted by radius);
+  // the imager's tables stay in this thread's heap, where the images and the files are made after the scan
+  std::future<scan::Surface> sample = std::async(std::launch::async, [&p] { return surface_from(p); });
+  std::optional<scan::SpiralImager> imager;
+  try {
+    imager.emplace(scan::scan_imager(instrument, grid));
+  } catch (...) {
+    sample.wait();  // the thread reads p: let it finish before the error unwinds
+    throw;
+  }
+  std::optional<scan::Surface> surface(sample.get());
+  scan::check_scan_geometry(instrument, *surface, grid);
   const std::int64_t total = instrument.spiral.samples();
   const std::string series_path = p.text("series_output"), points_path = p.text("points_output"), prefix = p.text("image_output");
   const long series_every = p.integer("series_every"), points_every = p.integer("points_every");
@@ -105,8 +116,11 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
     reported = done;
   };
   options.compare_without_control = instrument.controller.enabled;
+  options.imager = &*imager;
   options.cancellation = cancellation_of(capture);
-  const scan::VirtualScan result = scan::run_virtual_scan(instrument, surface, grid, options);
+  const scan::VirtualScan result = scan::run_virtual_scan(instrument, *surface, grid, options);
+  imager.reset();  // the spent imager and the sample map are not needed for the files: their memory goes first
+  surface.reset();
   progress.finish();
 
   const bool inverse = result.method == scan::Reconstruction::inverse;

@@ -2,6 +2,7 @@
 #include "scan_outputs.hpp"
 
 #include <cmath>
+#include <deque>
 #include <future>
 
 #include <fmt/format.h>
@@ -80,34 +81,50 @@ constexpr const char* image_channels[] = {"deflection", "topography", "topograph
 
 std::vector<std::string> stage_images(const std::string& prefix, const std::vector<NamedImage>& images,
                                       io::OutputSet& set) {
+  // each image's preview (levelling, grey levels, PNG compression: the costly part) is encoded on its own thread,
+  // two at a time, while this one packs the GSF files; the files are staged (written to their temporaries and
+  // synced to disk) one after the other, in order, on threads of their own, at most two behind the packing. The
+  // same bytes; at most two previews and two files' contents waiting in memory (the futures wait in their
+  // destructors if an error unwinds)
+  constexpr std::size_t kPreviewsInFlight = 2, kWritesInFlight = 1;
+  std::vector<std::future<std::string>> previews(images.size());
+  const auto start_preview = [&](std::size_t k) {
+    if (k >= images.size()) return;
+    previews[k] = std::async(std::launch::async, [&image = images[k]] {
+      const scan::HeightMap& shown =
+          image.level_preview && image.map->valid_count() >= 3 ? scan::level(*image.map) : *image.map;
+      return scan::format_png16(scan::to_grey16(shown));
+    });
+  };
+  std::deque<std::shared_future<void>> writes;
+  const auto stage = [&](const std::string& path, std::string content) {
+    for (; writes.size() >= kWritesInFlight; writes.pop_front()) writes.front().get();
+    std::shared_future<void> previous = writes.empty() ? std::shared_future<void>() : writes.back();
+    writes.push_back(std::async(std::launch::async, [&set, previous, path, content = std::move(content)] {
+                       if (previous.valid()) previous.get();  // in order (and not after a failed one)
+                       set.add(path, content);
+                     }).share());
+  };
+  for (std::size_t k = 0; k < kPreviewsInFlight; ++k) start_preview(k);
   std::vector<std::string> written;
-  for (const NamedImage& image : images) {
+  for (std::size_t k = 0; k < images.size(); ++k) {
+    const NamedImage& image = images[k];
     const std::string gsf = prefix + "_" + image.name + ".gsf", png = prefix + "_" + image.name + ".png";
     try {
-      // the preview (levelling, grey levels, PNG compression) is encoded on another thread while this one packs and
-      // stages the GSF files: the same bytes, one image's encodings in memory at a time as before
-      auto preview = std::async(std::launch::async, [&image] {
-        const scan::HeightMap& shown =
-            image.level_preview && image.map->valid_count() >= 3 ? scan::level(*image.map) : *image.map;
-        return scan::format_png16(scan::to_grey16(shown));
-      });
-      try {
-        set.add(gsf, scan::format_gsf(*image.map, image.title));
-        written.push_back(gsf);
-        if (image.map->has_mask()) {
-          set.add(scan::gsf_mask_path(gsf), scan::format_gsf_mask(*image.map, image.title));
-          written.push_back(scan::gsf_mask_path(gsf));
-        }
-      } catch (...) {
-        preview.wait();  // the thread reads the image: let it finish before the error unwinds
-        throw;
+      stage(gsf, scan::format_gsf(*image.map, image.title));
+      written.push_back(gsf);
+      if (image.map->has_mask()) {
+        stage(scan::gsf_mask_path(gsf), scan::format_gsf_mask(*image.map, image.title));
+        written.push_back(scan::gsf_mask_path(gsf));
       }
-      set.add(png, preview.get());
+      stage(png, previews[k].get());
       written.push_back(png);
     } catch (const InvalidParameter& e) {  // a value the file format cannot hold: name the file and the image
       throw InputError(fmt::format("cannot write the {} image '{}': {}", image.name, gsf, e.what()));
     }
+    start_preview(k + kPreviewsInFlight);
   }
+  for (; !writes.empty(); writes.pop_front()) writes.front().get();
   return written;
 }
 

@@ -11,13 +11,20 @@ process and its threads), peak RSS, the medians, the ratios old/new, the machine
 and after), and whether every output file is byte-identical to the baseline's (the sidecar compared with its output
 paths replaced, which name the folders).
 
-    python3 bench/scan_end_to_end.py build/bin/afmkit [--baseline /tmp/afmkit_old] [--runs 5]
+    python3 bench/scan_end_to_end.py build/bin/afmkit [--baseline /tmp/afmkit_old] [--runs 5] [--profile]
+
+On a loaded machine the wall says little: --profile also runs each program once under `perf record -e cpu-clock`
+(the CPU time of every thread, whatever the load) and prints, per phase (start and sample / simulation / after the
+scan / files: cut where the main thread first and last simulates and first packs a GSF file), the CPU of its threads
+and a lower bound of its wall on an idle 2-core machine: at least the busiest thread's CPU and half the total
+(waits — disk syncs — and the order the threads depend on each other are not counted).
 """
 import argparse
 import filecmp
 import json
 import os
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -38,6 +45,39 @@ def run_once(program, folder):
     if os.waitstatus_to_exitcode(status) != 0:
         sys.exit(f"{argv} exited {os.waitstatus_to_exitcode(status)}")
     return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024.0
+
+
+def phase_profile(program, folder, rate=4000):
+    """Per-phase CPU of each thread from a perf cpu-clock profile; returns lines to print."""
+    data = os.path.join(folder, "perf.data")
+    argv = [program] + ARGS + ["--image-output", os.path.join(folder, "scan"),
+                               "--output", os.path.join(folder, "turns.csv")]
+    subprocess.run(["perf", "record", "-q", "-e", "cpu-clock", "-F", str(rate), "-o", data, "--"] + argv,
+                   check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    script = subprocess.run(["perf", "script", "-i", data, "-F", "tid,time,ip,sym"], check=True,
+                            capture_output=True, text=True).stdout
+    os.remove(data)
+    rows = []
+    for line in script.splitlines():
+        p = line.split()
+        if len(p) >= 3:
+            rows.append((p[0], float(p[1].rstrip(":")), " ".join(p[3:])))
+    main = rows[0][0]
+    sim = [t for tid, t, sym in rows if tid == main and "simulate_scan" in sym]
+    gsf = [t for tid, t, sym in rows if tid == main and "format_gsf" in sym]
+    cuts = [min(sim), max(sim), min(gsf)]
+    per = [{} for _ in range(4)]
+    for tid, t, _ in rows:
+        k = sum(t >= c for c in cuts)
+        per[k][tid] = per[k].get(tid, 0) + 1
+    out, bound = [], 0.0
+    for name, threads in zip(["start and sample", "simulation", "after the scan", "files"], per):
+        cpu, busiest = sum(threads.values()) / rate, max(threads.values(), default=0) / rate
+        bound += max(busiest, cpu / 2)
+        out.append(f"  {name}: CPU {cpu:.3f} s over {len(threads)} threads, busiest {busiest:.3f} s "
+                   f"-> >= {max(busiest, cpu / 2):.3f} s")
+    out.append(f"  idle 2-core wall >= {bound:.3f} s (CPU {len(rows) / rate:.3f} s)")
+    return out
 
 
 def sidecar_without_paths(path, folder):
@@ -79,6 +119,7 @@ def main():
     ap.add_argument("program")
     ap.add_argument("--baseline", help="the old program, run interleaved with the new one")
     ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument("--profile", action="store_true", help="per-phase CPU of each program from perf (see above)")
     a = ap.parse_args()
     programs = [("new", os.path.abspath(a.program))]
     if a.baseline:
@@ -95,6 +136,11 @@ def main():
                 results[name].append((wall, cpu, rss))
                 print(f"run {run} {name}: wall {wall:.3f} s, CPU {cpu:.3f} s, peak RSS {rss:.1f} MB", flush=True)
         agreement = compare(folders["new"], folders["old"]) if a.baseline else None
+        if a.profile:
+            for name, program in programs:
+                print(f"{name}, phases (perf cpu-clock):")
+                for line in phase_profile(program, folders[name]):
+                    print(line)
     load_after = os.getloadavg()[0]
     med = {name: [statistics.median(r[k] for r in rows) for k in range(3)] for name, rows in results.items()}
     for name, (wall, cpu, rss) in med.items():

@@ -1,6 +1,7 @@
 #include "afmkit/scan/sample_generators.hpp"
 
 #include <algorithm>
+#include <future>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -210,21 +211,47 @@ HeightMap rough(const Grid& grid, const RoughSpec& spec) {
   const long half_y = static_cast<long>(kernel_y.size() / 2);
 
   // Pass 1: row by row of the padded noise field ((columns + 2 half_x) × (rows + 2 half_y), drawn in row-major
-  // order), convolve along x into `smoothed_rows` (columns × (rows + 2 half_y)).
+  // order), convolve along x into the smoothed rows (columns each, rows + 2 half_y of them). Pass 2, as the smoothed
+  // rows arrive: out[j][i] = Σ_m k[m] · smoothed[j + m][i]. The smoothed rows live in windows of the 2 half_y rows
+  // the next output row needs plus a block of `block` more: when one is full, its block of output rows is computed
+  // on another thread while the next window (starting with its last 2 half_y rows) fills here. The same sums as over
+  // all the smoothed rows at once, without holding them: two windows of 2 half_y + block rows instead of
+  // rows + 2 half_y.
   std::mt19937_64 generator(spec.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   const long padded_rows = rows + 2 * half_y;
   const long padded_columns = columns + 2 * half_x;
+  constexpr long block = 64;
+  const long overlap = 2 * half_y;
   std::vector<double> noise_row(static_cast<std::size_t>(padded_columns));
-  std::vector<double> smoothed_rows(static_cast<std::size_t>(padded_rows * columns));
+  std::vector<double> windows[2];
+  for (auto& w : windows) w.resize(static_cast<std::size_t>((overlap + block) * columns));
+  std::future<void> columns_pass;  // the previous window's block (waits in its destructor if a draw throws)
+  int current = 0;
+  long filled = 0;     // smoothed rows in the current window
+  long first_out = 0;  // output row of its first row
   for (long j = 0; j < padded_rows; ++j) {
+    std::vector<double>& window = windows[current];
     for (double& w : noise_row) w = normal(generator);
     // target[i] = Σ_m k[m] · noise at column i − half_x + m
-    detail::convolve_along_row(noise_row.data(), kernel_x.data(), kernel_x.size(),
-                               smoothed_rows.data() + j * columns, columns);
+    detail::convolve_along_row(noise_row.data(), kernel_x.data(), kernel_x.size(), window.data() + filled * columns,
+                               columns);
+    ++filled;
+    if (filled == overlap + block || j + 1 == padded_rows) {
+      const long ready = filled - overlap;  // output rows whose taps are all in the window
+      if (columns_pass.valid()) columns_pass.get();  // the other window is free again
+      std::vector<double>& next = windows[1 - current];
+      std::copy(window.begin() + ready * columns, window.begin() + filled * columns, next.begin());
+      double* target = out.data() + first_out * columns;
+      columns_pass = std::async(std::launch::async, [&window, columns, ready, &kernel_y, target] {
+        detail::convolve_down_columns(window.data(), columns, ready, kernel_y.data(), kernel_y.size(), target);
+      });
+      first_out += ready;
+      filled = overlap;
+      current = 1 - current;
+    }
   }
-  // Pass 2: convolve along y: out[j][i] = Σ_m k[m] · smoothed_rows[j + m][i].
-  detail::convolve_down_columns(smoothed_rows.data(), columns, rows, kernel_y.data(), kernel_y.size(), out.data());
+  if (columns_pass.valid()) columns_pass.get();
   // Remove the mean, scale to the RMS (two passes for accuracy).
   double mean = 0.0;
   for (const double z : out) mean += z;

@@ -296,6 +296,20 @@ std::vector<HeightMap> SpiralImager::finish() {
     for (std::size_t k = 0; k < data.size(); ++k) valid[k] = std::isfinite(data[k]) ? 1 : 0;
     out.emplace_back(grid_, std::move(data), units_[c], std::move(valid));
   }
+  // the imager is spent: release its pixel table and turn tables now (a caller may keep the object alive)
+  pixel_radius_ = {};
+  pixel_angle_ = {};
+  pixel_index_ = {};
+  images_ = {};
+  lower_ = {};
+  upper_ = {};
+  // the imager is spent: release its pixel table and turn tables now (a caller may keep the object alive)
+  pixel_radius_ = {};
+  pixel_angle_ = {};
+  pixel_index_ = {};
+  images_ = {};
+  lower_ = {};
+  upper_ = {};
   return out;
 }
 

@@ -3,7 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <limits>
+#include <tuple>
+#include <utility>
+#include <optional>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -67,6 +72,11 @@ Grid image_grid(const InstrumentSpec& instrument, long resolution) {
   return Grid{resolution, resolution, 2.0 * r, 2.0 * r, -r, -r};
 }
 
+SpiralImager scan_imager(const InstrumentSpec& instrument, const Grid& grid) {
+  const double per_turn = std::clamp(std::round(instrument.spiral.samples_per_turn()), 16.0, 4194304.0);
+  return SpiralImager(grid, {"m", "m", "m", "m"}, static_cast<int>(per_turn));
+}
+
 void check_scan_geometry(const InstrumentSpec& instrument, const Surface& surface, const Grid& grid) {
   const SpiralSpec& s = instrument.spiral;
   const double pixel = std::min(grid.x_size / static_cast<double>(grid.x_resolution),
@@ -92,8 +102,19 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   check_scan_geometry(instrument, surface, grid);
   const SpiralSpec& spiral = instrument.spiral;
 
-  const auto per_turn = static_cast<int>(std::clamp(std::round(spiral.samples_per_turn()), 16.0, 4194304.0));
-  SpiralImager imager(grid, {"m", "m", "m", "m"}, per_turn);
+  std::optional<SpiralImager> own;
+  if (options.imager) {
+    const SpiralImager& given = *options.imager;
+    const auto per_turn = static_cast<int>(std::clamp(std::round(spiral.samples_per_turn()), 16.0, 4194304.0));
+    const Grid& g = given.grid();
+    if (given.samples() != 0 || given.channels() != 4 || given.angular_samples() != per_turn ||
+        g.x_resolution != grid.x_resolution || g.y_resolution != grid.y_resolution || g.x_size != grid.x_size ||
+        g.y_size != grid.y_size || g.x_offset != grid.x_offset || g.y_offset != grid.y_offset)
+      throw std::invalid_argument("run_virtual_scan: options.imager is not scan_imager(instrument, grid) unused");
+  } else {
+    own.emplace(scan_imager(instrument, grid));
+  }
+  SpiralImager& imager = options.imager ? *options.imager : *own;
   ImagingObserver imaging(imager);
   std::int64_t turns = 0;
   TurnMetrics metrics(surface.tilt().slope(), [&](const TurnRecord& r) {
@@ -105,6 +126,15 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   ObserverChain observers(chain);
   // the imaging, the per-turn metrics and the extra observer run on a second thread, a batch behind the simulation
   // (none of them stops the scan: the samples and the images are those of the direct chain)
+  // the uncontrolled comparison (simulated only where it can saturate: uncontrolled_saturation.hpp) needs nothing
+  // of the main run: on its own thread beside it (its future waits in its destructor if the main run throws), or
+  // after it on this thread when everything runs here (imaging_thread = false)
+  std::future<UncontrolledSaturation> uncontrolled;
+  if (options.compare_without_control)
+    uncontrolled = std::async(options.imaging_thread ? std::launch::async : std::launch::deferred,
+                              [&instrument, &surface, &options] {
+      return first_uncontrolled_saturation(instrument, surface, options.cancellation);
+    });
   ScanRun run;
   if (options.imaging_thread) {
     ObserverThread behind(observers);
@@ -132,10 +162,9 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   out.max_radius_without_control = kNaN;
   out.scan_area_gain = kNaN;
   if (options.compare_without_control) {
-    // simulated only where it can saturate (uncontrolled_saturation.hpp)
-    const UncontrolledSaturation uncontrolled = first_uncontrolled_saturation(instrument, surface, options.cancellation);
-    out.saturates_without_control = uncontrolled.saturates;
-    out.max_radius_without_control = uncontrolled.radius;
+    const UncontrolledSaturation without = uncontrolled.get();
+    out.saturates_without_control = without.saturates;
+    out.max_radius_without_control = without.radius;
     if (out.saturates_without_control && out.max_radius_without_control > r0) {
       out.scan_area_gain = annulus(out.max_radius_with_control, r0) / annulus(out.max_radius_without_control, r0);
       out.scan_area_gain_is_lower_bound = !out.saturates_with_control;
@@ -146,6 +175,16 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   };
   const HeightMap& lagged = inverse ? out.alternative : out.topography;
   const HeightMap& inverted = inverse ? out.topography : out.alternative;
+  // the budget's two image differences (the sampled truth against the truth, the inverse against the sampled truth)
+  // on a second thread beside the others (read-only on the same images)
+  const HeightMap& sampled_truth = images.at(kSampledTruthChannel);
+  std::future<std::pair<double, double>> budget_errors =
+      std::async(options.imaging_thread ? std::launch::async : std::launch::deferred, [&] {
+        const double imaging = error_of(sampled_truth);
+        const double reconstruction =
+            inverted.valid_count() >= 3 ? levelled_rms_difference(inverted, sampled_truth) : kNaN;
+        return std::pair{imaging, reconstruction};
+      });
   out.lagged_rms_error = error_of(lagged);
   out.inverse_rms_error = error_of(inverted);
   out.sample_rms_height = kNaN;
@@ -168,12 +207,7 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   // the budget of the inverse reconstruction (plant_inverse.hpp)
   const PlantInverse model(instrument.assumed_bandwidth(), spiral.sample_rate);
   ErrorBudget& b = out.budget;
-  const HeightMap& sampled_truth = images.at(kSampledTruthChannel);
-  b.imaging = error_of(sampled_truth);
-  const auto against_samples = [&](const HeightMap& image) {
-    return image.valid_count() >= 3 ? levelled_rms_difference(image, sampled_truth) : kNaN;
-  };
-  b.reconstruction = against_samples(inverted);
+  std::tie(b.imaging, b.reconstruction) = budget_errors.get();
   b.plant_mismatch = instrument.assumed_bandwidth() / instrument.plant.bandwidth - 1.0;
   b.plant = std::abs(instrument.plant.bandwidth / instrument.assumed_bandwidth() - 1.0) * out.lagged_rms_error;
   b.noise_gain = model.noise_gain();

@@ -312,9 +312,12 @@ std::vector<double> rough_by_plain_loops(const Grid& g, const RoughSpec& spec) {
 }  // namespace
 
 TEST(Rough, BlockedFilterGivesThePlainLoopsDoublesBitForBit) {
-  // sizes that leave partial blocks (16 along a row, 8 × 4 down the columns) and a kernel longer than the map side
+  // sizes that leave partial blocks (16 along a row, 8 × 4 down the columns) and a kernel longer than the map side;
+  // the column pass runs over a window of 64 output rows at a time: 70, 128 and 200 rows take 2, 2 and 4 windows
+  // (the last one partial or full)
   for (const auto& [nx, ny, pixel, xi] : {std::tuple{37L, 23L, 50e-9, 300e-9}, std::tuple{64L, 8L, 20e-9, 150e-9},
-                                          std::tuple{5L, 70L, 100e-9, 200e-9}}) {
+                                          std::tuple{5L, 70L, 100e-9, 200e-9}, std::tuple{19L, 128L, 50e-9, 150e-9},
+                                          std::tuple{23L, 200L, 50e-9, 600e-9}}) {
     const Grid g = centred(nx, ny, pixel);
     const RoughSpec spec{2e-9, xi, 7};
     const std::vector<double> fast = rough(g, spec).data(), plain = rough_by_plain_loops(g, spec);

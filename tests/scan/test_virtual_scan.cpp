@@ -276,6 +276,33 @@ TEST(ImagingFloor, ASmoothSampleFallsAsTheSquareOfTheAngularStep) {
   EXPECT_LT(floors[0] / floors[1], 20.0);
 }
 
+TEST(VirtualScanPreparedImager, AnImagerBuiltAheadGivesTheSameScanAndAWrongOneIsRefused) {
+  const InstrumentSpec s = small_scan();
+  const Surface surface = rough_tilted(4.1e-3, 0.05);
+  const Grid grid = image_grid(s, 48);
+  const VirtualScan here = run_virtual_scan(s, surface, grid);
+  SpiralImager ahead = scan_imager(s, grid);
+  VirtualScanOptions given;
+  given.imager = &ahead;
+  const VirtualScan there = run_virtual_scan(s, surface, grid, given);
+  ASSERT_EQ(here.topography.size(), there.topography.size());
+  for (std::size_t k = 0; k < here.topography.size(); ++k)
+    if (std::isfinite(here.topography.data()[k]) || std::isfinite(there.topography.data()[k]))
+      ASSERT_EQ(here.topography.data()[k], there.topography.data()[k]) << k;
+  EXPECT_EQ(here.inverse_rms_error, there.inverse_rms_error);
+  EXPECT_EQ(here.budget.imaging, there.budget.imaging);
+  // spent (it has seen the samples), another grid, another table size: refused
+  EXPECT_THROW(run_virtual_scan(s, surface, grid, given), std::invalid_argument);
+  SpiralImager other_grid = scan_imager(s, image_grid(s, 32));
+  given.imager = &other_grid;
+  EXPECT_THROW(run_virtual_scan(s, surface, grid, given), std::invalid_argument);
+  InstrumentSpec denser = s;
+  denser.spiral.sample_rate *= 2;
+  SpiralImager other_table = scan_imager(denser, grid);
+  given.imager = &other_table;
+  EXPECT_THROW(run_virtual_scan(s, surface, grid, given), std::invalid_argument);
+}
+
 TEST(ObserverThread, TheScanImagedOnASecondThreadIsTheScanImagedDirectly) {
   const InstrumentSpec s = small_scan();
   const Surface surface = rough_tilted(4.1e-3, 0.05);

@@ -20,7 +20,9 @@
 
 namespace afmkit::scan {
 
-/// The spindle and the spiral.
+/// The spindle and the spiral. The defaults here are a quick scan (5·10⁵ samples); `afmkit scan` samples denser by
+/// default (radial_speed 150e-6 m/s, sample_rate 300e3 Hz: 8·10⁶ samples, the grating within 1 % of its RMS height,
+/// docs/scan.md#reconstruction).
 struct SpiralSpec {
   double spindle_frequency = 50.0;  ///< f_rot [Hz], > 0
   double start_radius = 0.0;        ///< r_0 [m], >= 0

@@ -86,7 +86,8 @@ class SpiralImager {
   void add(double angle, double radius, std::span<const double> values);
 
   /// After the last sample: one HeightMap per channel on `grid` (with its unit and a mask); pixels inside the
-  /// scanned region filled, others invalid (NaN + mask 0). Call once (std::logic_error otherwise).
+  /// scanned region filled, others invalid (NaN + mask 0). Call once (std::logic_error otherwise); releases the
+  /// imager's pixel and turn tables.
   std::vector<HeightMap> finish();
 
   long samples() const { return samples_; }

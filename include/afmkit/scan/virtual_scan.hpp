@@ -24,6 +24,7 @@
 
 #include "afmkit/scan/height_map.hpp"
 #include "afmkit/scan/plant_inverse.hpp"
+#include "afmkit/scan/spiral_imager.hpp"
 #include "afmkit/scan/spiral_scan.hpp"
 #include "afmkit/scan/turn_metrics.hpp"
 
@@ -32,10 +33,17 @@ namespace afmkit::scan {
 /// The square grid of `resolution`² pixels centred on the spindle axis that covers the scanned disc [−r_end, r_end]².
 Grid image_grid(const InstrumentSpec& instrument, long resolution);
 
+/// The main run's imager for this instrument and image grid (channels deflection, lagged, inverse and the true
+/// height at the samples; a table of about the samples per turn): what run_virtual_scan builds when
+/// VirtualScanOptions::imager is null.
+SpiralImager scan_imager(const InstrumentSpec& instrument, const Grid& grid);
+
 struct VirtualScanOptions {
-  bool compare_without_control = true;  ///< run the second, uncontrolled scan for the saturation radius
+  /// run the second, uncontrolled scan for the saturation radius (on a third thread beside the main run when
+  /// imaging_thread is true)
+  bool compare_without_control = true;
   /// image on a second thread, a batch behind the simulation (observer_thread.hpp); false: everything on the
-  /// calling thread (the same results)
+  /// calling thread, the comparison run too (the same results)
   bool imaging_thread = true;
   /// also receives every sample of the main run (e.g. a time-series writer); called, like on_turn, on the imaging
   /// thread when there is one, never concurrently with itself or on_turn
@@ -43,6 +51,10 @@ struct VirtualScanOptions {
   std::function<void(const TurnRecord&)> on_turn;  ///< each complete turn of the main run (on that thread)
   std::function<void(std::int64_t, std::int64_t)> progress;  ///< (samples done, total) of the main run
   Cancellation cancellation;  ///< checked every 65536 samples of both runs (core/cancellation.hpp)
+  /// the main run's imager, prepared by scan_imager(instrument, grid) with the same instrument and grid (e.g. on
+  /// another thread while the sample is generated: its construction sorts the pixel centres) and given no sample;
+  /// null: built here. std::invalid_argument if it is not such an imager.
+  SpiralImager* imager = nullptr;
 };
 
 /// What the inverse reconstruction's image error is made of (plant_inverse.hpp, docs/scan.md#reconstruction).
