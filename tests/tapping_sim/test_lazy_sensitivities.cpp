@@ -72,6 +72,34 @@ TEST(LazySensitivities, ShootNearFindsTheOrbitWithTheMonodromyAtIt) {
   check(testing::attractive_model(17.0), testing::attractive_model(16.9), "attractive hysteresis, closed form");
 }
 
+// A guess sent straight to the run with sensitivities (evaluate_guess false, as a sweep does where the last guess
+// converged): at the orbit it is that one run (no iteration) with the monodromy there; off the orbit, Newton goes
+// on from that run's step to the same orbit.
+TEST(LazySensitivities, GuessSentStraightToTheSensitivityRunIsTheOrbit) {
+  const TappingModel near_model = lazy_dmt_model(6.0), model = lazy_dmt_model(5.9);
+  const PeriodicOrbit near = shoot(near_model, free_response_state(near_model), 1);
+  const auto eager = try_shoot(model, near.initial, 1, lazy_tight());
+  ASSERT_TRUE(eager);
+  const double scale = std::hypot(eager->initial.position, eager->initial.velocity);
+  const auto distance = [&](const PeriodicOrbit& o) {
+    return std::hypot(o.initial.position - eager->initial.position, o.initial.velocity - eager->initial.velocity);
+  };
+  const auto at = try_shoot_near(model, eager->initial, near, lazy_tight(), false);
+  ASSERT_TRUE(at);
+  EXPECT_EQ(at->iterations, 0);
+  EXPECT_LT(distance(*at), 1e-9 * scale);
+  const Eigen::Matrix2d fd = lazy_difference_monodromy(model, at->initial);
+  EXPECT_LT((at->monodromy - fd).norm(), 1e-5 * fd.norm());
+  TipState off = eager->initial;
+  off.position += 1e-4 * scale;
+  const auto from_off = try_shoot_near(model, off, near, lazy_tight(), false);
+  ASSERT_TRUE(from_off);
+  EXPECT_GE(from_off->iterations, 1);
+  EXPECT_LT(distance(*from_off), 1e-9 * scale);
+  EXPECT_LT((from_off->monodromy - fd).norm(), 1e-5 * fd.norm());
+  EXPECT_EQ(from_off->stable, eager->stable);
+}
+
 // The lazy sweep `a` of `model` against the eager one: the same jumps, amplitudes to 1e-8, stability, jump flags.
 void lazy_compare_sweeps(const TappingModel& model, double l_min, double l_max, int points, SweepResult& a) {
   SweepOptions eager;

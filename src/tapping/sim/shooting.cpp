@@ -157,7 +157,7 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
 }
 
 std::optional<PeriodicOrbit> try_shoot_near(const TappingModel& model, TipState guess, const PeriodicOrbit& near,
-                                            const ShootingOptions& options) {
+                                            const ShootingOptions& options, bool evaluate_guess) {
   options.validate();
   validate::finite("position", guess.position);
   validate::finite("velocity", guess.velocity);
@@ -173,27 +173,87 @@ std::optional<PeriodicOrbit> try_shoot_near(const TappingModel& model, TipState 
     return Eigen::Vector2d(m.state.position - at.x(), m.state.velocity - at.y());
   };
   bool same_memory = true;
-  Eigen::Vector2d r = residual(y, same_memory);
-  double norm = scaled_norm(r, y, omega);
+  Eigen::Vector2d r = Eigen::Vector2d::Zero();
+  double norm = 0.0;
+  if (evaluate_guess) {
+    r = residual(y, same_memory);
+    norm = scaled_norm(r, y, omega);
+  }
   // Newton–Broyden on the map without sensitivities, from the Jacobian of the nearby orbit (Broyden's "good"
-  // update J += (Δr − JΔy)Δyᵀ/|Δy|²); any step that does not reduce the residual hands over to try_shoot
+  // update J += (Δr − JΔy)Δyᵀ/|Δy|²); any step that does not reduce the residual hands over to try_shoot.
+  // Once the residual is within the tolerance, the next step is not evaluated on the cheap map: it goes straight
+  // to the run with sensitivities, which judges it as try_shoot judges its first evaluation. (Taking a step the
+  // rate seen so far says is the last one untested as well changed a jump in a period-doubling cascade,
+  // LocatedJumps: Broyden's check that each step reduces the residual stays.)
   Eigen::Matrix2d jac = near.monodromy - Eigen::Matrix2d::Identity();
   int iterations = 0;
-  while (same_memory && norm > tolerance && iterations < options.max_iterations) {
+  bool untested = !evaluate_guess;  // y is not evaluated on the cheap map
+  Eigen::Vector2d tested = y;  // the last iterate evaluated (where try_shoot starts when the untested step fails)
+  while (!untested && same_memory && iterations < options.max_iterations) {
     const Eigen::FullPivLU<Eigen::Matrix2d> lu(jac);
     if (!lu.isInvertible()) break;
     const Eigen::Vector2d step = -lu.solve(r);
     if (!step.allFinite()) break;
     const Eigen::Vector2d trial = y + step;
+    if (norm <= tolerance) {
+      y = trial;
+      untested = true;  // (not counted: `iterations` 0 says the guess was within the tolerance, as try_shoot's)
+      break;
+    }
     bool trial_memory = true;
     const Eigen::Vector2d rt = residual(trial, trial_memory);
     const double nt = scaled_norm(rt, trial, omega);
     if (!trial_memory || !(nt < norm)) break;
     jac += ((rt - r) - jac * step) * step.transpose() / step.squaredNorm();
     y = trial;
+    tested = y;
     r = rt;
     norm = nt;
     ++iterations;
+  }
+  if (untested && n == 1) {
+    // try_shoot's first evaluation and acceptance (a period-n orbit, n > 1, is left to try_shoot: it checks the
+    // divisors of n)
+    SimulationOptions o = options.simulation;
+    o.sensitivity = true;
+    const SimulationResult m = simulate(model, 0.0, {y.x(), y.y(), memory}, n * model.period(), o);
+    const Eigen::Vector2d rs(m.state.position - y.x(), m.state.velocity - y.y());
+    const double ns = scaled_norm(rs, y, omega);
+    if (m.state.contact == memory && ns <= tolerance) {
+      const Eigen::Matrix2d monodromy = m.sensitivity.topLeftCorner<2, 2>();
+      // the last Newton step, as try_shoot takes it
+      Eigen::Vector2d start = y;
+      const Eigen::FullPivLU<Eigen::Matrix2d> lu(monodromy - Eigen::Matrix2d::Identity());
+      if (lu.isInvertible()) {
+        const Eigen::Vector2d step = -lu.solve(rs);
+        if (step.allFinite() && scaled_norm(step, y, omega) <= 1e3 * tolerance) start += step;
+      }
+      PeriodicOrbit orbit;
+      orbit.separation = model.separation;
+      orbit.period_multiple = n;
+      orbit.initial = {start.x(), start.y(), memory};
+      orbit.monodromy = monodromy;
+      orbit.separation_sensitivity = m.sensitivity.topRightCorner<2, 1>();
+      orbit.residual = ns;
+      orbit.iterations = iterations;
+      orbit.stats = m.stats;
+      set_floquet(orbit);
+      return orbit;
+    }
+    // not within the tolerance: Newton goes on from the step this run gives (try_shoot's next iterate), else
+    // try_shoot starts at the last iterate tested on the cheap map
+    ++iterations;
+    if (m.state.contact == memory && rs.allFinite()) {
+      const Eigen::FullPivLU<Eigen::Matrix2d> lu(m.sensitivity.topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity());
+      const Eigen::Vector2d step = lu.isInvertible() ? Eigen::Vector2d(-lu.solve(rs)) : Eigen::Vector2d::Constant(NAN);
+      if (step.allFinite() && scaled_norm(step, y, omega) < 1.0) {
+        if (auto orbit = try_shoot(model, {y.x() + step.x(), y.y() + step.y(), memory}, n, options)) {
+          orbit->iterations += iterations;
+          return orbit;
+        }
+      }
+    }
+    y = tested;  // (the guess itself when it was not evaluated: try_shoot from there, with its damping)
   }
   auto orbit = try_shoot(model, {y.x(), y.y(), memory}, n, options);
   if (orbit) orbit->iterations += iterations;

@@ -179,6 +179,7 @@ namespace {
 struct BranchBehind {
   Eigen::Vector2d z;
   double at = 0.0;
+  Eigen::Matrix2d monodromy = Eigen::Matrix2d::Identity();  // its M (the Jacobian of Newton's start, extrapolated)
 };
 
 /// follow_stable_branch along any parameter: `from` is an orbit at p = l_from, l_to the value to reach.
@@ -201,14 +202,21 @@ namespace {
 /// curvature of the branch seen from the orbit behind (the quadratic through both with the tangent at z, O(Δl³)
 /// off a smooth branch instead of O(Δl²)); the tangent prediction where the quadratic term is not the smaller one
 /// (a corner or a fold between: the curvature says nothing there).
+/// `monodromy` (M of the orbit at z on entry): with the quadratic guess, the Jacobian Newton starts from at l_next,
+/// extrapolated linearly in l through both orbits' M (O(Δl²) off instead of O(Δl): at high Q, M − I is nearly
+/// singular and magnifies the Jacobian's error, so Broyden's iterations from M(l) alone were most of the cost of a
+/// coarse grid).
 Eigen::Vector2d starting_guess(const Eigen::Vector2d& predicted, const Eigen::Vector2d& z, const Eigen::Vector2d& slope,
-                               double at, double l_next, const std::optional<BranchBehind>& behind) {
+                               double at, double l_next, const std::optional<BranchBehind>& behind,
+                               Eigen::Matrix2d& monodromy) {
   if (!behind) return predicted;
   const double back = behind->at - at, ahead = l_next - at;
   if (!(back != 0.0) || (back > 0) == (ahead > 0)) return predicted;  // the orbit behind must lie behind
   const Eigen::Vector2d curvature = (behind->z - z - back * slope) / (back * back);
   const Eigen::Vector2d quadratic = ahead * ahead * curvature;
   if (!quadratic.allFinite() || quadratic.norm() > 0.5 * std::abs(ahead) * slope.norm()) return predicted;
+  const Eigen::Matrix2d extrapolated = monodromy + (ahead / back) * (behind->monodromy - monodromy);
+  if (extrapolated.allFinite()) monodromy = extrapolated;
   return predicted + quadratic;
 }
 
@@ -250,6 +258,11 @@ BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit
     slope.reset();  // no derivative of the map: no branch to follow from here
   }
   double h = span;  // try the whole step first
+  // Whether Newton's starting guess is expected within the tolerance (as the last one was): then the map is
+  // evaluated with its sensitivities at once (one run where it is), else Broyden's iterations on the cheap map
+  // come first (try_shoot_near). Either way the sensitivities of the orbit are those at it.
+  // (`iterations` 0: the first evaluation at the guess was within the tolerance, on either path)
+  bool guess_converges = from.iterations == 0;
   for (int k = 0; k < options.max_substeps; ++k) {
     const double remaining = l_to - at;
     if (remaining == 0.0) break;
@@ -269,8 +282,10 @@ BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit
       std::optional<PeriodicOrbit> o;
       try {
         if (lazy) {
-          const Eigen::Vector2d start = starting_guess(predicted, z, *slope, at, l_next, behind);
-          o = try_shoot_near(at_next, {start.x(), start.y() * omega, current.initial.contact}, current, quick);
+          PeriodicOrbit near = current;  // its Jacobian, extrapolated to l_next with the quadratic guess
+          const Eigen::Vector2d start = starting_guess(predicted, z, *slope, at, l_next, behind, near.monodromy);
+          o = try_shoot_near(at_next, {start.x(), start.y() * omega, current.initial.contact}, near, quick,
+                             !guess_converges);
           if (!o && start != predicted)
             o = try_shoot_near(at_next, {predicted.x(), predicted.y() * omega, current.initial.contact}, current, quick);
         } else {
@@ -339,12 +354,13 @@ BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit
       judge(false);
     }
     if (accepted) {
-      behind = BranchBehind{z, at};
+      behind = BranchBehind{z, at, current.monodromy};
       current = *next;
       at = l_next;
       slope = slope_next;
       out.last = current;
       out.last_parameter = at;
+      guess_converges = next->iterations == 0;
       h *= 2.0;  // grow again after a successful sub-step
       continue;
     }
@@ -449,7 +465,8 @@ SweepPoint continue_point(const detail::ParameterPath& path, double l_to, const 
     std::optional<BranchBehind> behind;
     if (pass == 0 && before && before->periodic && before->orbit.stable && !previous.jumped &&
         before->orbit.period_multiple == orbit.period_multiple && before->orbit.initial.contact == orbit.initial.contact)
-      behind = BranchBehind{scaled(before->orbit.initial, path.base.drive.frequency), before->parameter};
+      behind = BranchBehind{scaled(before->orbit.initial, path.base.drive.frequency), before->parameter,
+                            before->orbit.monodromy};
     const BranchFollow f = follow_along(path, orbit, l_at, l_to, options, behind);
     if (f.reached) {
       SweepPoint p;
