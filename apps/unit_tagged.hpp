@@ -7,6 +7,10 @@
 //        .add("stable", o.stable, "boolean (0/1)")           // shown as computed, with its unit
 //        .add("source", "hb_plus");                           // a label: no unit
 //   summary["orbit"] = orbit.values();  units["orbit"] = orbit.units();
+// A record that is one row of an array (whose units are listed once for all rows) is built without its units:
+// UnitTagged row(UnitTagged::values_only) (the same declarations; add() then records no unit). Records used once
+// are moved out (std::move(record).values(), add(key, std::move(nested)), std::move(record).summary()): a summary
+// of hundreds of values is copied in as much time as a short computation takes (bench/command_layer.py).
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,10 +24,15 @@ namespace afmkit::cli {
 
 class UnitTagged {
  public:
+  /// A record of values without units (a row of an array whose units are given once beside it).
+  enum ValuesOnly { values_only };
+  UnitTagged() = default;
+  explicit UnitTagged(ValuesOnly) : with_units_(false) {}
+
   /// A number converted by `unit`.
   UnitTagged& add(const std::string& key, double value, const units::Unit& unit) {
     values_[key] = unit(value);
-    units_[key] = unit.name;
+    if (with_units_) units_[key] = unit.name;
     return *this;
   }
   /// Numbers converted by `unit`, one JSON array.
@@ -31,13 +40,13 @@ class UnitTagged {
     nlohmann::json a = nlohmann::json::array();
     for (double v : values) a.push_back(unit(v));
     values_[key] = std::move(a);
-    units_[key] = unit.name;
+    if (with_units_) units_[key] = unit.name;
     return *this;
   }
   /// A value shown as computed (counts, flags, rad, dimensionless numbers) and its unit.
   UnitTagged& add(const std::string& key, nlohmann::json value, const char* unit) {
     values_[key] = std::move(value);
-    units_[key] = unit;
+    if (with_units_) units_[key] = unit;
     return *this;
   }
   /// A value without a unit (a label, a text).
@@ -48,21 +57,34 @@ class UnitTagged {
   /// A nested record: its values and its units under `key`.
   UnitTagged& add(const std::string& key, const UnitTagged& nested) {
     values_[key] = nested.values_;
-    units_[key] = nested.units_;
+    if (with_units_) units_[key] = nested.units_;
+    return *this;
+  }
+  UnitTagged& add(const std::string& key, UnitTagged&& nested) {
+    values_[key] = std::move(nested.values_);
+    if (with_units_) units_[key] = std::move(nested.units_);
     return *this;
   }
   /// A unit without a value here (an entry whose values are listed elsewhere, e.g. in the rows of an array).
   UnitTagged& unit(const std::string& key, nlohmann::json unit) {
-    units_[key] = std::move(unit);
+    if (with_units_) units_[key] = std::move(unit);
     return *this;
   }
 
   const nlohmann::json& values() const& { return values_; }
   const nlohmann::json& units() const& { return units_; }
+  nlohmann::json values() && { return std::move(values_); }
+  nlohmann::json units() && { return std::move(units_); }
+  /// A command's summary document: the values, with the units under "units".
+  nlohmann::json summary() && {
+    values_["units"] = std::move(units_);
+    return std::move(values_);
+  }
 
  private:
   nlohmann::json values_ = nlohmann::json::object();
   nlohmann::json units_ = nlohmann::json::object();
+  bool with_units_ = true;
 };
 
 /// A length, time, force or energy of a summary line, converted by `unit` and printed in it (io::summary_value).
