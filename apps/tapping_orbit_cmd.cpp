@@ -58,6 +58,7 @@ UnitTagged search_record(const tapping::OrbitSearchReport& r, const TappingUnits
     converged[name] = r.converged_by_kind[k];
   }
   nlohmann::json seeds = nlohmann::json::array();
+  seeds.get_ref<nlohmann::json::array_t&>().reserve(r.seeds.size());
   for (const tapping::SearchSeed& seed : r.seeds)
     seeds.push_back(seed_record(UnitTagged(UnitTagged::values_only), seed, u).values());
   UnitTagged j;

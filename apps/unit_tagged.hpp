@@ -12,6 +12,7 @@
 // are moved out (std::move(record).values(), add(key, std::move(nested)), std::move(record).summary()): a summary
 // of hundreds of values is copied in as much time as a short computation takes (bench/command_layer.py).
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -30,13 +31,13 @@ class UnitTagged {
   explicit UnitTagged(ValuesOnly) : with_units_(false) {}
 
   /// A number converted by `unit`.
-  UnitTagged& add(const std::string& key, double value, const units::Unit& unit) {
+  UnitTagged& add(std::string_view key, double value, const units::Unit& unit) {
     values_[key] = unit(value);
     if (with_units_) units_[key] = unit.name;
     return *this;
   }
   /// Numbers converted by `unit`, one JSON array.
-  UnitTagged& add(const std::string& key, const std::vector<double>& values, const units::Unit& unit) {
+  UnitTagged& add(std::string_view key, const std::vector<double>& values, const units::Unit& unit) {
     nlohmann::json a = nlohmann::json::array();
     for (double v : values) a.push_back(unit(v));
     values_[key] = std::move(a);
@@ -44,29 +45,29 @@ class UnitTagged {
     return *this;
   }
   /// A value shown as computed (counts, flags, rad, dimensionless numbers) and its unit.
-  UnitTagged& add(const std::string& key, nlohmann::json value, const char* unit) {
+  UnitTagged& add(std::string_view key, nlohmann::json value, const char* unit) {
     values_[key] = std::move(value);
     if (with_units_) units_[key] = unit;
     return *this;
   }
   /// A value without a unit (a label, a text).
-  UnitTagged& add(const std::string& key, nlohmann::json value) {
+  UnitTagged& add(std::string_view key, nlohmann::json value) {
     values_[key] = std::move(value);
     return *this;
   }
   /// A nested record: its values and its units under `key`.
-  UnitTagged& add(const std::string& key, const UnitTagged& nested) {
+  UnitTagged& add(std::string_view key, const UnitTagged& nested) {
     values_[key] = nested.values_;
     if (with_units_) units_[key] = nested.units_;
     return *this;
   }
-  UnitTagged& add(const std::string& key, UnitTagged&& nested) {
+  UnitTagged& add(std::string_view key, UnitTagged&& nested) {
     values_[key] = std::move(nested.values_);
     if (with_units_) units_[key] = std::move(nested.units_);
     return *this;
   }
   /// A unit without a value here (an entry whose values are listed elsewhere, e.g. in the rows of an array).
-  UnitTagged& unit(const std::string& key, nlohmann::json unit) {
+  UnitTagged& unit(std::string_view key, nlohmann::json unit) {
     if (with_units_) units_[key] = std::move(unit);
     return *this;
   }

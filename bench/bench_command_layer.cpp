@@ -3,6 +3,8 @@
 //   * Library:       tapping::find_orbits on a model and options built once (the computation alone);
 //   * Command:       the command's run on a ParamSet as the Python module builds it (declare, defaults, resolve,
 //                    the keyword values, checks), the table and summary captured (no process start, nothing printed);
+//   * CommandReused: the same with the parameters declared once and their values reset per call
+//                    (ParamSet::reset_values), as the Python module runs a command again;
 //   * CommandFiles:  the same writing the CSV table and its JSON sidecar (what the command line does; no process).
 // bench/command_layer.py runs this program and afmkit.tapping.orbit in one run and prints the ratios.
 //   build/bin/bench_command_layer --benchmark_min_time=1
@@ -40,11 +42,15 @@ const cli::CommandSpec& orbit_spec() {
 
 /// The ParamSet of a run as the Python module builds it (python/src/params_from_python.cpp): declared, the table
 /// kept in memory (output = "", json), resolved, then the given values.
-io::ParamSet orbit_params(const std::string& output) {
+io::ParamSet declared_params(const std::string& output) {
   io::ParamSet p;
   orbit_spec().declare(p);
   p.set_default("output", output);
   p.set_default("json", "true");
+  return p;
+}
+io::ParamSet orbit_params(const std::string& output) {
+  io::ParamSet p = declared_params(output);
   p.resolve();
   for (const auto& [k, v] : orbit_case()) p.set_from_string(k, v);
   p.check_files();
@@ -80,6 +86,27 @@ void Command(benchmark::State& state) {
   state.counters["orbits"] = static_cast<double>(rows);
 }
 BENCHMARK(Command)->Unit(benchmark::kMicrosecond);
+
+// Command with the declarations made once (as the Python module does: python/src/params_from_python.cpp), the values
+// reset and given again per call.
+void CommandReused(benchmark::State& state) {
+  const cli::CommandSpec& spec = orbit_spec();
+  const io::ParamSet declared = declared_params("");
+  io::ParamSet p = declared;
+  std::size_t rows = 0;
+  for (auto _ : state) {
+    p.reset_values(declared);
+    p.resolve();
+    for (const auto& [k, v] : orbit_case()) p.set_from_string(k, v);
+    p.check_files();
+    cli::Captured captured;
+    spec.run(p, &captured);
+    rows = captured.rows.size();
+    benchmark::DoNotOptimize(captured);
+  }
+  state.counters["orbits"] = static_cast<double>(rows);
+}
+BENCHMARK(CommandReused)->Unit(benchmark::kMicrosecond);
 
 // The part of Command that builds the ParamSet (declare, defaults, resolve, values, checks).
 void Params(benchmark::State& state) {
