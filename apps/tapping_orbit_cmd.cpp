@@ -37,9 +37,9 @@ nlohmann::json seeds_by_kind(const std::vector<int>& seeds, const tapping::Orbit
   return j;
 }
 
-/// One seed of the search: how it started and which orbits it converged to.
-UnitTagged seed_record(const tapping::SearchSeed& seed, const TappingUnits& u) {
-  UnitTagged j;
+/// One seed of the search: how it started and which orbits it converged to (into `j`: a row of the seeds'
+/// array is built without units, UnitTagged::values_only; their units are those of a grid seed with every field).
+UnitTagged seed_record(UnitTagged j, const tapping::SearchSeed& seed, const TappingUnits& u) {
   j.add("kind", tapping::seed_kind_name(seed.kind))
       .add("initial_position", seed.start.position, u.length)
       .add("initial_velocity", seed.start.velocity, u.velocity)
@@ -58,34 +58,40 @@ UnitTagged search_record(const tapping::OrbitSearchReport& r, const TappingUnits
     converged[name] = r.converged_by_kind[k];
   }
   nlohmann::json seeds = nlohmann::json::array();
-  for (const tapping::SearchSeed& seed : r.seeds) seeds.push_back(seed_record(seed, u).values());
+  seeds.get_ref<nlohmann::json::array_t&>().reserve(r.seeds.size());
+  for (const tapping::SearchSeed& seed : r.seeds)
+    seeds.push_back(seed_record(UnitTagged(UnitTagged::values_only), seed, u).values());
   UnitTagged j;
-  j.add("seeds_by_kind", by_kind, "count")
-      .add("converged_by_kind", converged, "count")
+  j.add("seeds_by_kind", std::move(by_kind), "count")
+      .add("converged_by_kind", std::move(converged), "count")
       .add("seeds_total", r.seeds.size(), "count")
       .add("continuation_runs", r.continuation_runs, "count")
       .add("continuation_bracket", std::vector<double>{r.bracket_min, r.bracket_max}, u.length)
       .add("seconds", r.seconds, "s")
-      .add("seeds", seeds)
-      .unit("seeds", seed_record(tapping::SearchSeed{}, u).units());  // a grid seed: every field
+      .add("seeds", std::move(seeds))
+      .unit("seeds", seed_record(UnitTagged(), tapping::SearchSeed{}, u).units());  // a grid seed: every field
   return j;
 }
 
-UnitTagged orbit_record(const tapping::FoundOrbit& f, const tapping::OrbitSearchReport& report,
+/// One orbit found (into `j`: UnitTagged::values_only for a row of the orbits' array).
+UnitTagged orbit_record(UnitTagged j, const tapping::FoundOrbit& f, const tapping::OrbitSearchReport& report,
                         const TappingUnits& u) {
   const auto& m = f.metrics;
   const auto& o = f.orbit;
-  UnitTagged j;
+  nlohmann::json multipliers = nlohmann::json::array();  // [{"im", "re"}, ...] of the first two
+  for (int k = 0; k < 2; ++k) {
+    nlohmann::json z = nlohmann::json::object();
+    z["im"] = o.floquet_multipliers[k].imag();
+    z["re"] = o.floquet_multipliers[k].real();
+    multipliers.push_back(std::move(z));
+  }
   j.add("source", tapping::orbit_source_name(f.source))
       .add("found_by", seeds_by_kind(f.seeds, report), "count")
       .add("seeds", f.seeds, "count")
       .add("period_multiple", o.period_multiple, "count")
       .add("stable", o.stable, "boolean (0/1)")
       .add("floquet_max", o.floquet_max, "dimensionless")
-      .add("floquet_multipliers",
-           {{{"re", o.floquet_multipliers[0].real()}, {"im", o.floquet_multipliers[0].imag()}},
-            {{"re", o.floquet_multipliers[1].real()}, {"im", o.floquet_multipliers[1].imag()}}},
-           "dimensionless")
+      .add("floquet_multipliers", std::move(multipliers), "dimensionless")
       .add("amplitude", m.amplitude, u.length)
       .add("offset", m.offset, u.length)
       .add("phase", m.phase, "rad")
@@ -105,8 +111,7 @@ UnitTagged orbit_record(const tapping::FoundOrbit& f, const tapping::OrbitSearch
   return j;
 }
 
-UnitTagged hb_record(const tapping::HbPoint& h, const TappingUnits& u) {
-  UnitTagged j;
+UnitTagged hb_record(UnitTagged j, const tapping::HbPoint& h, const TappingUnits& u) {
   j.add("branch", tapping::branch_name(h.branch))
       .add("q", h.q, "dimensionless")
       .add("amplitude", h.amplitude, u.length)
@@ -115,8 +120,7 @@ UnitTagged hb_record(const tapping::HbPoint& h, const TappingUnits& u) {
   return j;
 }
 
-UnitTagged transient_record(const tapping::TransientOutcome& t) {
-  UnitTagged j;
+UnitTagged transient_record(UnitTagged j, const tapping::TransientOutcome& t) {
   j.add("kind", tapping::response_kind_name(t.kind)).add("periods_simulated", t.periods_simulated, "count");
   if (t.orbit) j.add("period_multiple", t.orbit->period_multiple, "count");
   if (!t.message.empty()) j.add("message", t.message);
@@ -203,12 +207,14 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   const OrbitStatus status = orbit_status(r, p.real("separation"), u.length);
 
   // every entry with its unit (the sidecar's "units", per results key: docs/study.md#outputs)
+  // the rows of each array without units (UnitTagged::values_only), moved into the document (no copies)
+  const auto row = [] { return UnitTagged(UnitTagged::values_only); };
   nlohmann::json orbits = nlohmann::json::array();
-  for (const tapping::FoundOrbit& f : r.orbits) orbits.push_back(orbit_record(f, r.report, u).values());
+  for (const tapping::FoundOrbit& f : r.orbits) orbits.push_back(orbit_record(row(), f, r.report, u).values());
   nlohmann::json hb = nlohmann::json::array();
-  for (const tapping::HbPoint& h : r.harmonic_balance) hb.push_back(hb_record(h, u).values());
+  for (const tapping::HbPoint& h : r.harmonic_balance) hb.push_back(hb_record(row(), h, u).values());
   nlohmann::json transients = nlohmann::json::array();
-  for (const tapping::TransientOutcome& t : r.transients) transients.push_back(transient_record(t).values());
+  for (const tapping::TransientOutcome& t : r.transients) transients.push_back(transient_record(row(), t).values());
   // the units of the rows of each array: those of a record with every field
   const tapping::FoundOrbit any_orbit{};
   tapping::TransientOutcome any_transient;
@@ -216,12 +222,12 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   UnitTagged results;
   results.add("separation", p.real("separation"), u.length)
       .add("free_amplitude", model.free_amplitude(), u.length)
-      .add("harmonic_balance", hb)
-      .unit("harmonic_balance", hb_record(tapping::HbPoint{}, u).units())
-      .add("orbits", orbits)
-      .unit("orbits", orbit_record(any_orbit, r.report, u).units())
-      .add("transients", transients)
-      .unit("transients", transient_record(any_transient).units())
+      .add("harmonic_balance", std::move(hb))
+      .unit("harmonic_balance", hb_record(UnitTagged(), tapping::HbPoint{}, u).units())
+      .add("orbits", std::move(orbits))
+      .unit("orbits", orbit_record(UnitTagged(), any_orbit, r.report, u).units())
+      .add("transients", std::move(transients))
+      .unit("transients", transient_record(UnitTagged(), any_transient).units())
       .add("search", search_record(r.report, u))
       .add("status", status.status)
       .add("note", status.note)
@@ -233,8 +239,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
       .unit("time", u.time.name)
       .unit("phase", "rad")
       .unit("seconds", "s");
-  nlohmann::json summary = results.values();
-  summary["units"] = results.units();
+  const nlohmann::json summary = std::move(results).summary();
   CommandOutput out(p, capture, "tapping orbit");
   out.open(orbit_table(u)).add_all(r.orbits);
   if (p.flag("json")) {
@@ -244,7 +249,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
   // lengths by magnitude in physical units, said to be normalised otherwise (docs/units.md#summaries)
   const auto len = [&](double model_length) { return summary_value(model_length, u.length, 6); };
   fmt::print("separation {}: {} HB solution(s), {} periodic orbit(s); phases in rad\n", len(p.real("separation")),
-             hb.size(), r.orbits.size());
+             r.harmonic_balance.size(), r.orbits.size());
   for (const tapping::HbPoint& h : r.harmonic_balance)
     fmt::print("  HB {:5s} amplitude {}  offset {}  phase {:.6g} rad\n", tapping::branch_name(h.branch),
                len(h.amplitude), len(h.offset), h.phase);

@@ -7,7 +7,12 @@
 //        .add("stable", o.stable, "boolean (0/1)")           // shown as computed, with its unit
 //        .add("source", "hb_plus");                           // a label: no unit
 //   summary["orbit"] = orbit.values();  units["orbit"] = orbit.units();
+// A record that is one row of an array (whose units are listed once for all rows) is built without its units:
+// UnitTagged row(UnitTagged::values_only) (the same declarations; add() then records no unit). Records used once
+// are moved out (std::move(record).values(), add(key, std::move(nested)), std::move(record).summary()): a summary
+// of hundreds of values is copied in as much time as a short computation takes (bench/command_layer.py).
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -20,18 +25,23 @@ namespace afmkit::cli {
 
 class UnitTagged {
  public:
+  /// A record of values without units (a row of an array whose units are given once beside it).
+  enum ValuesOnly { values_only };
+  UnitTagged() = default;
+  explicit UnitTagged(ValuesOnly) : with_units_(false) {}
+
   /// A number converted by `unit`.
-  UnitTagged& add(const std::string& key, double value, const units::Unit& unit) {
+  UnitTagged& add(std::string_view key, double value, const units::Unit& unit) {
     values_[key] = unit(value);
-    units_[key] = unit.name;
+    if (with_units_) units_[key] = unit.name;
     return *this;
   }
   /// Numbers converted by `unit`, one JSON array.
-  UnitTagged& add(const std::string& key, const std::vector<double>& values, const units::Unit& unit) {
+  UnitTagged& add(std::string_view key, const std::vector<double>& values, const units::Unit& unit) {
     nlohmann::json a = nlohmann::json::array();
     for (double v : values) a.push_back(unit(v));
     values_[key] = std::move(a);
-    units_[key] = unit.name;
+    if (with_units_) units_[key] = unit.name;
     return *this;
   }
   /// Named numbers converted by `unit`, one JSON object (a box's edges); one unit for all of them.
@@ -44,9 +54,9 @@ class UnitTagged {
     return *this;
   }
   /// A value shown as computed (counts, flags, rad, dimensionless numbers) and its unit.
-  UnitTagged& add(const std::string& key, nlohmann::json value, const char* unit) {
+  UnitTagged& add(std::string_view key, nlohmann::json value, const char* unit) {
     values_[key] = std::move(value);
-    units_[key] = unit;
+    if (with_units_) units_[key] = unit;
     return *this;
   }
   /// The same with a unit named at run time (the unit of a swept parameter, "label").
@@ -56,14 +66,19 @@ class UnitTagged {
     return *this;
   }
   /// A value without a unit (a label, a text).
-  UnitTagged& add(const std::string& key, nlohmann::json value) {
+  UnitTagged& add(std::string_view key, nlohmann::json value) {
     values_[key] = std::move(value);
     return *this;
   }
   /// A nested record: its values and its units under `key`.
-  UnitTagged& add(const std::string& key, const UnitTagged& nested) {
+  UnitTagged& add(std::string_view key, const UnitTagged& nested) {
     values_[key] = nested.values_;
-    units_[key] = nested.units_;
+    if (with_units_) units_[key] = nested.units_;
+    return *this;
+  }
+  UnitTagged& add(std::string_view key, UnitTagged&& nested) {
+    values_[key] = std::move(nested.values_);
+    if (with_units_) units_[key] = std::move(nested.units_);
     return *this;
   }
   /// Records of one kind under `key` (an array of their values), with the units of `prototype`: a record made by
@@ -89,8 +104,8 @@ class UnitTagged {
     return *this;
   }
   /// A unit without a value here (an entry whose values are listed elsewhere, e.g. in the rows of an array).
-  UnitTagged& unit(const std::string& key, nlohmann::json unit) {
-    units_[key] = std::move(unit);
+  UnitTagged& unit(std::string_view key, nlohmann::json unit) {
+    if (with_units_) units_[key] = std::move(unit);
     return *this;
   }
 
@@ -102,10 +117,18 @@ class UnitTagged {
     return j;
   }
   const nlohmann::json& units() const& { return units_; }
+  nlohmann::json values() && { return std::move(values_); }
+  nlohmann::json units() && { return std::move(units_); }
+  /// A command's summary document: the values, with the units under "units".
+  nlohmann::json summary() && {
+    values_["units"] = std::move(units_);
+    return std::move(values_);
+  }
 
  private:
   nlohmann::json values_ = nlohmann::json::object();
   nlohmann::json units_ = nlohmann::json::object();
+  bool with_units_ = true;
 };
 
 /// A length, time, force or energy of a summary line, converted by `unit` and printed in it (io::summary_value).

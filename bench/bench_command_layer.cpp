@@ -1,8 +1,11 @@
 // Cost of the command layer (issue 26: "the command layer adds <= 5 % to a 1 ms command"): `tapping orbit` at a
 // setting where the orbit search takes about a millisecond, run
 //   * Library:       tapping::find_orbits on a model and options built once (the computation alone);
-//   * Command:       the command's run on a ParamSet as the Python module builds it (declare, defaults, resolve,
-//                    the keyword values, checks), the table and summary captured (no process start, nothing printed);
+//   * Command:       the command's run on a ParamSet (declare, defaults, resolve, the keyword values, checks), the
+//                    table captured and the summary document handed over as to the Python module (take_results:
+//                    read where it is made, not copied; no process start, nothing printed);
+//   * CommandReused: the same with the parameters declared once and their values reset per call
+//                    (ParamSet::reset_values), as the Python module runs a command again;
 //   * CommandFiles:  the same writing the CSV table and its JSON sidecar (what the command line does; no process).
 // bench/command_layer.py runs this program and afmkit.tapping.orbit in one run and prints the ratios.
 //   build/bin/bench_command_layer --benchmark_min_time=1
@@ -12,6 +15,7 @@
 #include <string>
 
 #include <benchmark/benchmark.h>
+#include <nlohmann/json.hpp>
 
 #include "afmkit/tapping/orbit.hpp"
 #include "command.hpp"
@@ -31,6 +35,17 @@ const std::map<std::string, std::string>& orbit_case() {
   return kw;
 }
 
+/// A capture as the Python module makes it: the summary document handed over (its values counted) where the
+/// command makes it, not copied into the capture.
+cli::Captured handed_over(std::size_t& values) {
+  cli::Captured c;
+  c.take_results = [&values](const nlohmann::json& document) {
+    values = 0;
+    for (const auto& item : document.items()) values += item.value().size();
+  };
+  return c;
+}
+
 const cli::CommandSpec& orbit_spec() {
   static const std::vector<cli::CommandSpec> specs = cli::command_specs();
   for (const cli::CommandSpec& s : specs)
@@ -40,11 +55,15 @@ const cli::CommandSpec& orbit_spec() {
 
 /// The ParamSet of a run as the Python module builds it (python/src/params_from_python.cpp): declared, the table
 /// kept in memory (output = "", json), resolved, then the given values.
-io::ParamSet orbit_params(const std::string& output) {
+io::ParamSet declared_params(const std::string& output) {
   io::ParamSet p;
   orbit_spec().declare(p);
   p.set_default("output", output);
   p.set_default("json", "true");
+  return p;
+}
+io::ParamSet orbit_params(const std::string& output) {
+  io::ParamSet p = declared_params(output);
   p.resolve();
   for (const auto& [k, v] : orbit_case()) p.set_from_string(k, v);
   p.check_files();
@@ -70,16 +89,40 @@ BENCHMARK(Library)->Unit(benchmark::kMicrosecond);
 void Command(benchmark::State& state) {
   const cli::CommandSpec& spec = orbit_spec();
   std::size_t rows = 0;
+  std::size_t values = 0;
   for (auto _ : state) {
     const io::ParamSet p = orbit_params("");
-    cli::Captured captured;
+    cli::Captured captured = handed_over(values);
     spec.run(p, &captured);
     rows = captured.rows.size();
     benchmark::DoNotOptimize(captured);
   }
+  benchmark::DoNotOptimize(values);
   state.counters["orbits"] = static_cast<double>(rows);
 }
 BENCHMARK(Command)->Unit(benchmark::kMicrosecond);
+
+// Command with the declarations made once (as the Python module does: python/src/params_from_python.cpp), the values
+// reset and given again per call.
+void CommandReused(benchmark::State& state) {
+  const cli::CommandSpec& spec = orbit_spec();
+  const io::ParamSet declared = declared_params("");
+  io::ParamSet p = declared;
+  std::size_t rows = 0, values = 0;
+  for (auto _ : state) {
+    p.reset_values(declared);
+    p.resolve();
+    for (const auto& [k, v] : orbit_case()) p.set_from_string(k, v);
+    p.check_files();
+    cli::Captured captured = handed_over(values);
+    spec.run(p, &captured);
+    rows = captured.rows.size();
+    benchmark::DoNotOptimize(captured);
+  }
+  benchmark::DoNotOptimize(values);
+  state.counters["orbits"] = static_cast<double>(rows);
+}
+BENCHMARK(CommandReused)->Unit(benchmark::kMicrosecond);
 
 // The part of Command that builds the ParamSet (declare, defaults, resolve, values, checks).
 void Params(benchmark::State& state) {

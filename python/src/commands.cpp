@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -45,52 +46,80 @@ py::object value_to_python(const io::ParamSet::Value& v) {
 
 /// `j` as Python objects (dict, list, str, int, float, bool, None), built with the C API directly: a summary
 /// document holds hundreds of values (the orbit search's seeds), and pybind11's accessors per item cost as much as
-/// a short computation (bench/command_layer.py). Dict keys in the document's order (nlohmann's: sorted).
-PyObject* json_to_object(const nlohmann::json& j) {
-  switch (j.type()) {
-    case nlohmann::json::value_t::boolean: return PyBool_FromLong(j.get<bool>() ? 1 : 0);
-    case nlohmann::json::value_t::number_integer: return PyLong_FromLongLong(j.get<std::int64_t>());
-    case nlohmann::json::value_t::number_unsigned: return PyLong_FromUnsignedLongLong(j.get<std::uint64_t>());
-    case nlohmann::json::value_t::number_float: return PyFloat_FromDouble(j.get<double>());
-    case nlohmann::json::value_t::string: {
-      const std::string& t = j.get_ref<const std::string&>();
-      return PyUnicode_FromStringAndSize(t.data(), static_cast<Py_ssize_t>(t.size()));
-    }
-    case nlohmann::json::value_t::array: {
-      PyObject* l = PyList_New(static_cast<Py_ssize_t>(j.size()));
-      if (l == nullptr) return nullptr;
-      Py_ssize_t i = 0;
-      for (const auto& x : j) {
-        PyObject* v = json_to_object(x);
-        if (v == nullptr) {
-          Py_DECREF(l);
-          return nullptr;
-        }
-        PyList_SET_ITEM(l, i++, v);  // steals v
+/// a short computation (bench/command_layer.py). Dict keys in the document's order (nlohmann's: sorted). The
+/// records of an array mostly have the same keys: a key equal to the previous record's at the same place is the same
+/// str object (made and hashed once), as Python shares the names of attributes.
+class JsonToPython {
+ public:
+  /// A new reference, or nullptr with a Python error set.
+  PyObject* convert(const nlohmann::json& j) { return convert(j, nullptr); }
+
+ private:
+  /// The keys of the previous record of an array, in order: its text and its str (borrowed: its dict holds it).
+  using Keys = std::vector<std::pair<const std::string*, PyObject*>>;
+
+  /// `previous`: the keys of the previous record of the array `j` is in (nullptr: not in an array); updated to
+  /// those of `j` when it is a record.
+  PyObject* convert(const nlohmann::json& j, Keys* previous) {
+    switch (j.type()) {
+      case nlohmann::json::value_t::boolean: return PyBool_FromLong(j.get<bool>() ? 1 : 0);
+      case nlohmann::json::value_t::number_integer: return PyLong_FromLongLong(j.get<std::int64_t>());
+      case nlohmann::json::value_t::number_unsigned: return PyLong_FromUnsignedLongLong(j.get<std::uint64_t>());
+      case nlohmann::json::value_t::number_float: return PyFloat_FromDouble(j.get<double>());
+      case nlohmann::json::value_t::string: {
+        const std::string& t = j.get_ref<const std::string&>();
+        return PyUnicode_FromStringAndSize(t.data(), static_cast<Py_ssize_t>(t.size()));
       }
-      return l;
-    }
-    case nlohmann::json::value_t::object: {
-      PyObject* d = PyDict_New();
-      if (d == nullptr) return nullptr;
-      for (const auto& [k, x] : j.items()) {
-        PyObject* key = PyUnicode_FromStringAndSize(k.data(), static_cast<Py_ssize_t>(k.size()));
-        PyObject* v = key == nullptr ? nullptr : json_to_object(x);
-        const int failed = v == nullptr ? -1 : PyDict_SetItem(d, key, v);
-        Py_XDECREF(key);
-        Py_XDECREF(v);
-        if (failed != 0) {
-          Py_DECREF(d);
-          return nullptr;
+      case nlohmann::json::value_t::array: {
+        PyObject* l = PyList_New(static_cast<Py_ssize_t>(j.size()));
+        if (l == nullptr) return nullptr;
+        Keys keys;  // of the records in this array
+        Py_ssize_t i = 0;
+        for (const auto& x : j) {
+          PyObject* v = convert(x, &keys);
+          if (v == nullptr) {
+            Py_DECREF(l);
+            return nullptr;
+          }
+          PyList_SET_ITEM(l, i++, v);  // steals v
         }
+        return l;
       }
-      return d;
+      case nlohmann::json::value_t::object: {
+        PyObject* d = PyDict_New();
+        if (d == nullptr) return nullptr;
+        std::size_t at = 0;
+        for (const auto& [k, x] : j.get_ref<const nlohmann::json::object_t&>()) {
+          PyObject* key = nullptr;
+          if (previous != nullptr && at < previous->size() && *(*previous)[at].first == k) {
+            key = (*previous)[at].second;
+            Py_INCREF(key);
+          } else {
+            key = PyUnicode_FromStringAndSize(k.data(), static_cast<Py_ssize_t>(k.size()));
+          }
+          PyObject* v = key == nullptr ? nullptr : convert(x, nullptr);
+          const int failed = v == nullptr ? -1 : PyDict_SetItem(d, key, v);
+          if (failed == 0 && previous != nullptr) {  // the dict holds the key now
+            if (at < previous->size()) (*previous)[at] = {&k, key};
+            else previous->emplace_back(&k, key);
+          }
+          Py_XDECREF(key);
+          Py_XDECREF(v);
+          if (failed != 0) {
+            Py_DECREF(d);
+            return nullptr;
+          }
+          ++at;
+        }
+        return d;
+      }
+      default: Py_RETURN_NONE;  // null (and discarded/binary, which a summary never holds)
     }
-    default: Py_RETURN_NONE;  // null (and discarded/binary, which a summary never holds)
   }
-}
+};
+
 py::object json_to_python(const nlohmann::json& j) {
-  PyObject* o = json_to_object(j);
+  PyObject* o = JsonToPython().convert(j);
   if (o == nullptr) throw py::error_already_set();
   return py::reinterpret_steal<py::object>(o);
 }
@@ -208,7 +237,8 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
     given = py::dict();
     for (const auto& [k, v] : kwargs) given[k] = py::str(k).cast<std::string>() == "law" ? py::str("python") : v;
   }
-  const io::ParamSet p = params_from_python(path, name, given);
+  const RunParams run_params(path, name, given);  // a set this command's runs reuse
+  const io::ParamSet& p = run_params.get();
   SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
   captured.cancellation = interrupts.cancellation();
   // progress lines to sys.stderr (Jupyter), not to descriptor 2
@@ -237,7 +267,7 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   // a table declared as a grid (io::TableOf::grid): its dims, shape and coordinates (None otherwise)
   out["grid"] = json_to_python(captured.grid);
   // the parameters as the run used them (computed defaults filled in), as its sidecar records them
-  nlohmann::json params = captured.parameters.is_null() ? p.to_json() : captured.parameters;
+  nlohmann::json params = captured.parameters.is_null() ? p.to_json() : std::move(captured.parameters);
   params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)
   out["params"] = json_to_python(params);
   return out;

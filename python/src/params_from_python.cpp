@@ -70,8 +70,14 @@ io::ParamSet::Value value_from_python(const std::string& name, const io::ParamSe
     throw py::type_error(name + "(): " + d.key + " must be " + want + ", not " +
                          std::string(py::str(py::type::of(obj).attr("__name__"))));
   };
+  // a plain float, int, bool or str has neither dtype nor ndim (asking costs an AttributeError each)
+  const auto plain = [](const py::handle& x) {
+    return PyFloat_CheckExact(x.ptr()) || PyLong_CheckExact(x.ptr()) || PyBool_Check(x.ptr()) ||
+           PyUnicode_CheckExact(x.ptr());
+  };
   const bool is_bool = py::isinstance<py::bool_>(obj) ||
-                       (py::hasattr(obj, "dtype") && py::str(obj.attr("dtype").attr("kind")).cast<std::string>() == "b");
+                       (!plain(obj) && py::hasattr(obj, "dtype") &&
+                        py::str(obj.attr("dtype").attr("kind")).cast<std::string>() == "b");
   if (d.kind == "flag") {
     if (!is_bool) fail("True or False");
     return py::bool_(py::reinterpret_borrow<py::object>(obj)).cast<bool>();
@@ -83,8 +89,9 @@ io::ParamSet::Value value_from_python(const std::string& name, const io::ParamSe
   }
   auto number = [&](const py::handle& x) -> double {
     const bool b = py::isinstance<py::bool_>(x) ||
-                   (py::hasattr(x, "dtype") && py::str(x.attr("dtype").attr("kind")).cast<std::string>() == "b");
-    const bool array = py::hasattr(x, "ndim") && py::int_(x.attr("ndim")).cast<int>() != 0;  // not a scalar
+                   (!plain(x) && py::hasattr(x, "dtype") &&
+                    py::str(x.attr("dtype").attr("kind")).cast<std::string>() == "b");
+    const bool array = !plain(x) && py::hasattr(x, "ndim") && py::int_(x.attr("ndim")).cast<int>() != 0;  // not a scalar
     const char* want = d.kind == "reals" ? "a sequence of real numbers" : "a real number";
     if (b || array || py::isinstance<py::str>(x) || !PyNumber_Check(x.ptr()) || PyComplex_Check(x.ptr())) fail(want);
     const double v = PyFloat_AsDouble(x.ptr());
@@ -104,7 +111,7 @@ io::ParamSet::Value value_from_python(const std::string& name, const io::ParamSe
                                         (d.allowed.starts_with("integer") ? "an " : "") + d.allowed);
     return v;
   };
-  const bool scalar = !py::hasattr(obj, "ndim") || py::int_(obj.attr("ndim")).cast<int>() == 0;  // not an array
+  const bool scalar = plain(obj) || !py::hasattr(obj, "ndim") || py::int_(obj.attr("ndim")).cast<int>() == 0;  // not an array
   if (d.kind == "integer") {
     if (is_bool || !scalar || !PyIndex_Check(obj.ptr())) fail("an int");
     return whole(obj);
@@ -142,14 +149,22 @@ const cli::CommandSpec& command_spec(const std::string& path) {
   throw py::value_error("no afmkit command '" + path + "'");
 }
 
-namespace {
-/// A command's parameters with Python's defaults, declared once per process (a command's declaration is fixed: its
-/// keys, defaults and ranges do not depend on the run) and copied for each call: declaring them and describing them
-/// again on every call cost more than a short computation (bench/command_layer.py).
+namespace detail {
 struct Prototype {
   io::ParamSet params;
   std::vector<io::ParamSet::Description> described;
+  /// Copies of `params` that runs gave back (RunParams), reused with their values reset (ParamSet::reset_values):
+  /// a copy allocates hundreds of strings (help texts, choices), as much work as a short run's summary.
+  mutable std::mutex spare_mutex;
+  mutable std::vector<std::unique_ptr<io::ParamSet>> spare;
 };
+}  // namespace detail
+
+namespace {
+using detail::Prototype;
+/// A command's parameters with Python's defaults, declared once per process (a command's declaration is fixed: its
+/// keys, defaults and ranges do not depend on the run) and reused by each call (RunParams): declaring them and
+/// describing them again on every call cost more than a short computation (bench/command_layer.py).
 const Prototype& prototype(const cli::CommandSpec& spec) {
   static std::mutex mutex;  // callers hold the GIL; the lock keeps the cache sound without it
   static std::map<std::string, std::unique_ptr<const Prototype>> cache;
@@ -164,7 +179,10 @@ const Prototype& prototype(const cli::CommandSpec& spec) {
       if (d.key == "json" && d.kind == "flag") p.set_default("json", "true");
     }
     std::vector<io::ParamSet::Description> described = p.describe();
-    slot = std::make_unique<const Prototype>(Prototype{std::move(p), std::move(described)});
+    auto made = std::make_unique<Prototype>();
+    made->params = std::move(p);
+    made->described = std::move(described);
+    slot = std::move(made);
   }
   return *slot;
 }
@@ -174,8 +192,39 @@ io::ParamSet python_params(const cli::CommandSpec& spec) { return prototype(spec
 
 io::ParamSet params_from_python(const std::string& path, const std::string& name, const py::dict& kwargs,
                                 const std::vector<std::string>& hidden) {
-  const Prototype& declared = prototype(command_spec(path));
-  io::ParamSet p = declared.params;
+  return RunParams(path, name, kwargs, hidden).get();
+}
+
+namespace {
+/// At most this many spare sets per command (as many as calls that ran at once, e.g. from Python threads).
+constexpr std::size_t kSpareSets = 4;
+}  // namespace
+
+RunParams::RunParams(const std::string& path, const std::string& name, const py::dict& kwargs,
+                     const std::vector<std::string>& hidden)
+    : prototype_(&prototype(command_spec(path))) {
+  const Prototype& declared = *prototype_;
+  {
+    const std::lock_guard<std::mutex> lock(declared.spare_mutex);
+    if (!declared.spare.empty()) {
+      params_ = std::move(declared.spare.back());
+      declared.spare.pop_back();
+    }
+  }
+  if (params_) params_->reset_values(declared.params);
+  else params_ = std::make_unique<io::ParamSet>(declared.params);
+  fill(name, kwargs, hidden);
+}
+
+RunParams::~RunParams() {
+  if (!params_) return;
+  const std::lock_guard<std::mutex> lock(prototype_->spare_mutex);
+  if (prototype_->spare.size() < kSpareSets) prototype_->spare.push_back(std::move(params_));
+}
+
+void RunParams::fill(const std::string& name, const py::dict& kwargs, const std::vector<std::string>& hidden) {
+  const Prototype& declared = *prototype_;
+  io::ParamSet& p = *params_;
   const std::vector<io::ParamSet::Description>& described = declared.described;
   auto visible = [&](const std::string& key) {
     return key != "json" && std::find(hidden.begin(), hidden.end(), key) == hidden.end();
@@ -204,7 +253,6 @@ io::ParamSet params_from_python(const std::string& path, const std::string& name
     p.set_value(key, value_from_python(name, *d, v));
   }
   p.check_files();  // the keyword arguments came after resolve(): no output may replace an input
-  return p;
 }
 
 }  // namespace afmkit::python

@@ -1,6 +1,7 @@
 #pragma once
 // Keyword arguments → the parameters of one command (io::ParamSet): the same keys, types, ranges and messages as
 // the TOML file and the flags of the `afmkit` program.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,5 +28,25 @@ io::ParamSet python_params(const cli::CommandSpec& spec);
 /// `hidden` (and `json`) are refused like unknown ones (they mean nothing to this caller).
 io::ParamSet params_from_python(const std::string& path, const std::string& name, const pybind11::dict& kwargs,
                                 const std::vector<std::string>& hidden = {});
+
+namespace detail {
+struct Prototype;
+}
+/// params_from_python's parameters for one run, in a set the command's runs reuse (its values reset: no copy of the
+/// declarations per call); given back when this goes out of scope.
+class RunParams {
+ public:
+  RunParams(const std::string& path, const std::string& name, const pybind11::dict& kwargs,
+            const std::vector<std::string>& hidden = {});
+  RunParams(const RunParams&) = delete;
+  RunParams& operator=(const RunParams&) = delete;
+  ~RunParams();
+  const io::ParamSet& get() const& { return *params_; }
+
+ private:
+  void fill(const std::string& name, const pybind11::dict& kwargs, const std::vector<std::string>& hidden);
+  const detail::Prototype* prototype_;
+  std::unique_ptr<io::ParamSet> params_;
+};
 
 }  // namespace afmkit::python

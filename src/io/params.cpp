@@ -427,6 +427,22 @@ void ParamSet::set_value(const std::string& key, Value value, const std::string&
   check(key, e, origin);
 }
 
+void ParamSet::reset_values(const ParamSet& declared) {
+  if (entries_.size() != declared.entries_.size())
+    throw std::logic_error("ParamSet::reset_values: another set of parameters");
+  auto from = declared.entries_.begin();
+  for (auto& [key, e] : entries_) {
+    if (key != from->first) throw std::logic_error("ParamSet::reset_values: another set of parameters");
+    const Entry& d = from->second;
+    e.value = d.value;  // a text keeps its buffer
+    e.set = d.set;
+    e.cli_text = d.cli_text;
+    e.used = d.used;
+    ++from;
+  }
+  config_path_ = declared.config_path_;
+}
+
 std::vector<ParamSet::Description> ParamSet::describe() const {
   std::vector<Description> out;
   for (const auto& key : order_) {

@@ -230,6 +230,24 @@ TEST(UnitsAtOneEdge, AColumnConvertsItsValueIntoTheUnitItNames) {
   EXPECT_DOUBLE_EQ(afmkit::units::degrees_from_radians()(std::acos(-1.0)), 180.0);
 }
 
+TEST(UnitsAtOneEdge, ARowRecordHoldsTheValuesOfItsDeclarationsAndASummaryMovesValuesAndUnitsOut) {
+  // rows of an array are built without units (UnitTagged::values_only: the array's units are given once); the same
+  // declarations give the same values; a record moved into a document keeps its values and units
+  const afmkit::units::Unit nm = afmkit::units::from_si("nm");
+  const auto record = [&](afmkit::cli::UnitTagged j) { return j.add("gap", 2e-9, nm).add("count", 3, "count"); };
+  afmkit::cli::UnitTagged full = record(afmkit::cli::UnitTagged());
+  const nlohmann::json row = record(afmkit::cli::UnitTagged(afmkit::cli::UnitTagged::values_only)).values();
+  EXPECT_EQ(row, (nlohmann::json{{"gap", 2.0}, {"count", 3}}));
+  EXPECT_EQ(row, full.values());
+  EXPECT_TRUE(record(afmkit::cli::UnitTagged(afmkit::cli::UnitTagged::values_only)).units().empty());
+  afmkit::cli::UnitTagged document;
+  document.add("rows", nlohmann::json::array({row})).unit("rows", full.units()).add("nested", std::move(full));
+  const nlohmann::json summary = std::move(document).summary();
+  EXPECT_EQ(summary["nested"], row);
+  EXPECT_EQ(summary["units"]["rows"], (nlohmann::json{{"gap", "nm"}, {"count", "count"}}));
+  EXPECT_EQ(summary["units"]["nested"], summary["units"]["rows"]);
+}
+
 TEST(UnitsAtOneEdge, TappingOrbitInPhysicalUnitsIsTheNormalisedOrbitScaledOnce) {
   // the same model (law attractive) run in physical units (k = 2 N/m, f0 = 1 kHz, A_free = 10 nm, Q = 50,
   // ω/ω_n = 1) and in its normalised form (ω_n = 1, Γ = A_free |1 - r^2 + i r/Q| = A_free/Q, stiffnesses and

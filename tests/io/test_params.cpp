@@ -277,3 +277,28 @@ TEST(ParamSetRecords, AFollowedChainResolvesToTheFirstGivenValue) {
   EXPECT_EQ(p.real("c"), 5.0);
   EXPECT_EQ(p.to_json()["c"].get<double>(), 5.0);
 }
+
+TEST(ParamSetResetValues, GivesTheDeclaredValuesAgainKeepingTheDeclarations) {
+  const ParamSet declared = make();
+  ParamSet p = declared;
+  CLI::App app;
+  p.add_options(app);
+  app.parse(std::vector<std::string>{"20", "--points"});  // CLI11 takes the arguments in reverse order
+  p.set_config_path("missing.toml");
+  p.set_value("quality_factor", 5.0);
+  p.set_value("law", std::string("linear"));
+  p.record_used("amplitudes", std::vector<double>{2.0});
+  p.reset_values(declared);
+  EXPECT_NO_THROW(p.resolve());  // neither the config file nor the flag given before
+  EXPECT_EQ(p.real("quality_factor"), 100.0);
+  EXPECT_EQ(p.integer("points"), 10);
+  EXPECT_EQ(p.text("law"), "hysteresis");
+  EXPECT_EQ(p.reals("amplitudes"), (std::vector<double>{1.0, 0.5}));
+  EXPECT_FALSE(p.was_set("quality_factor"));
+  EXPECT_EQ(p.to_json(), declared.to_json());
+  EXPECT_EQ(p.unit_of("amplitudes"), "nm");  // declarations kept
+  EXPECT_THROW(p.set_value("quality_factor", -1.0), InvalidParameter);
+  ParamSet other;
+  other.real("quality_factor", 1.0, "Q");
+  EXPECT_THROW(p.reset_values(other), std::logic_error);
+}

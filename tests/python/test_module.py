@@ -84,6 +84,21 @@ def test_result_equals_the_command_lines_table_bit_for_bit(command, args):
         assert r.units[col] == doc["columns"][i]["unit"] and r.meaning[col] == doc["columns"][i]["description"]
 
 
+def test_orbit_results_equal_the_command_lines_document():
+    # the summary reaches Python through the C API (records of an array share their key objects): the same document
+    # as the command line's --json, value for value (the search's own duration aside)
+    args = {"quality_factor": 2.0, "separation": 5.0}
+    r = afmkit.tapping.orbit(**args)
+    doc = cli_table("tapping", "orbit", *[x for k, v in args.items() for x in ("--" + k.replace("_", "-"), repr(v))])
+    del doc["table"]
+    got = json.loads(json.dumps(r.results))
+    for d in (doc, got):
+        d["search"]["seconds"] = 0.0
+    assert got == doc
+    assert len(got["search"]["seeds"]) > 10 and {"kind", "orbits"} <= set(got["search"]["seeds"][-1])
+    assert got["units"]["search"]["seeds"]["initial_position"] == "L"
+
+
 def test_numpy_scalars_are_accepted():
     a = afmkit.tapping.hb(quality_factor=np.float64(150), points=np.int64(300))
     b = afmkit.tapping.hb(quality_factor=150.0, points=300)

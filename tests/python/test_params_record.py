@@ -198,3 +198,30 @@ def test_a_call_leaves_the_next_calls_defaults_alone():
     default = afmkit.tapping.hb(**kw)
     assert given.params["quality_factor"] == other
     assert default.params["quality_factor"] == declared["quality_factor"]
+
+
+def test_a_reused_parameter_set_starts_from_the_declaration(tmp_path):
+    # the module reuses a command's parameter sets, their values reset per call (ParamSet::reset_values): a config
+    # file, a call refused half-way through its keywords or calls running at once must not reach another call
+    spec = next(s for s in _afmkit.commands() if s["path"] == "tapping orbit")
+    declared = {p["key"]: p["default"] for p in spec["params"]}
+    kw = dict(quality_factor=2.0, max_period_multiple=1)  # about a millisecond per call
+    config = tmp_path / "orbit.toml"
+    config.write_text("separation = 6.5\nfrequency_ratio = 1.01\n")
+    for calls in range(3):  # one call after another: each takes the set the previous one gave back
+        assert afmkit.tapping.orbit(**kw, config=config).params["frequency_ratio"] == 1.01
+        with pytest.raises(afmkit.InvalidParameter, match="drive_amplitude"):  # after separation was applied
+            afmkit.tapping.orbit(**kw, separation=3.5, drive_amplitude=-1.0)
+        assert afmkit.tapping.orbit(**kw, config=config).params["separation"] == 6.5
+        assert afmkit.tapping.orbit(**kw, separation=3.0, drive_amplitude=0.3).params["separation"] == 3.0
+        r = afmkit.tapping.orbit(**kw)
+        assert r.params["separation"] == declared["separation"] not in (3.0, 3.5, 6.5)
+        assert r.params["frequency_ratio"] == declared["frequency_ratio"] != 1.01
+        assert r.params["drive_amplitude"] == declared["drive_amplitude"] != 0.3
+
+    from concurrent.futures import ThreadPoolExecutor  # the computation runs without the GIL: sets in use at once
+    separations = [4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 4.5, 5.5]
+    with ThreadPoolExecutor(4) as pool:
+        runs = list(pool.map(lambda s: afmkit.tapping.orbit(**kw, separation=s), separations))
+    assert [r.params["separation"] for r in runs] == separations
+    assert [r.results["separation"] for r in runs] == separations  # normalised units: as given

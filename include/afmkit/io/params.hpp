@@ -131,6 +131,11 @@ class ParamSet {
   void set_value(const std::string& key, Value value, const std::string& origin = "");
   /// A TOML file to load at resolve() (what --config does).
   void set_config_path(const std::string& path) { config_path_ = path; }
+  /// The values of `declared` again (as given, defaults, config path), the declarations kept: what copying
+  /// `declared` gives when this set has its declarations (a copy of it reused), without copying hundreds of help
+  /// texts, choices and ranges again (the Python module reuses a command's sets: bench/command_layer.py).
+  /// std::logic_error when the declared keys differ.
+  void reset_values(const ParamSet& declared);
 
   /// One parameter as --help describes it, for other front ends (Python signatures and docstrings).
   struct Description {
