@@ -303,13 +303,6 @@ std::vector<HeightMap> SpiralImager::finish() {
   images_ = {};
   lower_ = {};
   upper_ = {};
-  // the imager is spent: release its pixel table and turn tables now (a caller may keep the object alive)
-  pixel_radius_ = {};
-  pixel_angle_ = {};
-  pixel_index_ = {};
-  images_ = {};
-  lower_ = {};
-  upper_ = {};
   return out;
 }
 

@@ -54,6 +54,33 @@ double newton_tolerance(const TappingModel& model, const ShootingOptions& option
              : options.tolerance;
 }
 
+/// The orbit accepted at y: the map from y (end state within `tolerance`, residual r of size `norm`) has the
+/// sensitivities `sensitivity` and `stats`. The last Newton step, from the map already evaluated, takes the state from
+/// a residual of size `norm` to one of size O(norm²): without it the fixed point is off by (M − I)⁻¹ r, large when a
+/// multiplier is near 1 (high Q).
+PeriodicOrbit accepted_orbit(const TappingModel& model, Eigen::Vector2d y, bool memory, int period_multiple,
+                             const Eigen::Vector2d& r, double norm, const Eigen::Matrix3d& sensitivity,
+                             const SimulationStats& stats, int iterations, double tolerance) {
+  const double omega = model.drive.frequency;
+  const Eigen::Matrix2d monodromy = sensitivity.topLeftCorner<2, 2>();
+  const Eigen::FullPivLU<Eigen::Matrix2d> last(monodromy - Eigen::Matrix2d::Identity());
+  if (last.isInvertible()) {
+    const Eigen::Vector2d step = -last.solve(r);
+    if (step.allFinite() && scaled_norm(step, y, omega) <= 1e3 * tolerance) y += step;
+  }
+  PeriodicOrbit orbit;
+  orbit.separation = model.separation;
+  orbit.period_multiple = period_multiple;
+  orbit.initial = {y.x(), y.y(), memory};
+  orbit.monodromy = monodromy;
+  orbit.separation_sensitivity = sensitivity.topRightCorner<2, 1>();
+  orbit.residual = norm;
+  orbit.iterations = iterations;
+  orbit.stats = stats;
+  set_floquet(orbit);
+  return orbit;
+}
+
 }  // namespace
 
 std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess, int period_multiple,
@@ -93,24 +120,9 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
       norm = scaled_norm(r, y, omega);
     }
     if (norm <= tolerance && map.end.contact == memory) {
-      // the last Newton step, from the map already evaluated, takes the state from a residual of size `norm` to
-      // one of size O(norm²): without it the fixed point is off by (M − I)⁻¹ r, large when a multiplier is
-      // near 1 (high Q)
-      const Eigen::FullPivLU<Eigen::Matrix2d> last(map.sensitivity.topLeftCorner<2, 2>() - Eigen::Matrix2d::Identity());
-      if (last.isInvertible()) {
-        const Eigen::Vector2d step = -last.solve(r);
-        if (step.allFinite() && scaled_norm(step, y, omega) <= 1e3 * tolerance) y += step;
-      }
-      PeriodicOrbit orbit;
-      orbit.separation = model.separation;
-      orbit.period_multiple = period_multiple;
-      orbit.initial = {y.x(), y.y(), memory};
-      orbit.monodromy = map.sensitivity.topLeftCorner<2, 2>();
-      orbit.separation_sensitivity = map.sensitivity.topRightCorner<2, 1>();
-      orbit.residual = norm;
-      orbit.iterations = it;
-      orbit.stats = map.stats;
-      set_floquet(orbit);
+      PeriodicOrbit orbit =
+          accepted_orbit(model, y, memory, period_multiple, r, norm, map.sensitivity, map.stats, it, tolerance);
+      y = {orbit.initial.position, orbit.initial.velocity};
       // a period-n solution that repeats after a divisor m of n is reported with its minimal period
       for (int m = 1; m < period_multiple; ++m) {
         if (period_multiple % m != 0) continue;
@@ -219,27 +231,8 @@ std::optional<PeriodicOrbit> try_shoot_near(const TappingModel& model, TipState 
     const SimulationResult m = simulate(model, 0.0, {y.x(), y.y(), memory}, n * model.period(), o);
     const Eigen::Vector2d rs(m.state.position - y.x(), m.state.velocity - y.y());
     const double ns = scaled_norm(rs, y, omega);
-    if (m.state.contact == memory && ns <= tolerance) {
-      const Eigen::Matrix2d monodromy = m.sensitivity.topLeftCorner<2, 2>();
-      // the last Newton step, as try_shoot takes it
-      Eigen::Vector2d start = y;
-      const Eigen::FullPivLU<Eigen::Matrix2d> lu(monodromy - Eigen::Matrix2d::Identity());
-      if (lu.isInvertible()) {
-        const Eigen::Vector2d step = -lu.solve(rs);
-        if (step.allFinite() && scaled_norm(step, y, omega) <= 1e3 * tolerance) start += step;
-      }
-      PeriodicOrbit orbit;
-      orbit.separation = model.separation;
-      orbit.period_multiple = n;
-      orbit.initial = {start.x(), start.y(), memory};
-      orbit.monodromy = monodromy;
-      orbit.separation_sensitivity = m.sensitivity.topRightCorner<2, 1>();
-      orbit.residual = ns;
-      orbit.iterations = iterations;
-      orbit.stats = m.stats;
-      set_floquet(orbit);
-      return orbit;
-    }
+    if (m.state.contact == memory && ns <= tolerance)  // accepted as try_shoot accepts (its last Newton step)
+      return accepted_orbit(model, y, memory, n, rs, ns, m.sensitivity, m.stats, iterations, tolerance);
     // not within the tolerance: Newton goes on from the step this run gives (try_shoot's next iterate), else
     // try_shoot starts at the last iterate tested on the cheap map
     ++iterations;
