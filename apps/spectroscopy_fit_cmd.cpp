@@ -132,59 +132,59 @@ units::Unit shown(const std::string& si_unit) {
   return units::as_is(si_unit);
 }
 
-/// The summary's and the sidecar's account of the estimates, shared by the modes; returns the summary's lines.
-std::string estimates_of(const spectroscopy::FitResult& r, nlohmann::json& results, nlohmann::json& units) {
-  nlohmann::json estimates = nlohmann::json::object();
+/// The summary's and the sidecar's account of the estimates, shared by the modes (each entry with its unit; an
+/// estimate's value, standard error and initial value in the parameter's unit, its `identifiable` flag its own);
+/// returns the summary's lines.
+std::string estimates_of(const spectroscopy::FitResult& r, UnitTagged& results) {
+  UnitTagged estimates;
   std::vector<std::string> names;
   std::string summary;
   for (std::size_t j = 0; j < r.parameters.size(); ++j) {
     const auto& info = r.parameters[j];
     const units::Unit u = shown(info.unit);
     names.push_back(info.name);
-    estimates[info.name] = {{"value", u(r.estimates[j])},
-                            {"standard_error", u(r.standard_errors[j])},
-                            {"initial", u(info.initial)},
-                            {"identifiable", r.identifiable[j]},
-                            {"transform", spectroscopy::transform_name(info.transform)}};
-    units[info.name] = u.name;
+    UnitTagged estimate;
+    estimate.add("value", r.estimates[j], u)
+        .add("standard_error", r.standard_errors[j], u)
+        .add("initial", info.initial, u)
+        .add("identifiable", static_cast<bool>(r.identifiable[j]), "boolean (0/1)")
+        .add("transform", spectroscopy::transform_name(info.transform));
+    estimates.add(info.name, std::move(estimate));
     summary += fmt::format("\n  {} = {} ± {}", info.name, io::quantity(u(r.estimates[j]), u.name),
                            io::quantity(u(r.standard_errors[j]), u.name));
   }
-  results["mode"] = spectroscopy::fit_mode_name(r.mode);
-  results["status"] = spectroscopy::fit_status_name(r.status);
-  results["note"] = r.status == spectroscopy::FitStatus::ok
-                        ? std::string()
-                        : fmt::format("the fit did not converge: {} (estimates at the best point found)",
-                                      r.solver_status);
-  results["solver_status"] = r.solver_status;
-  results["estimates"] = estimates;
-  results["parameters"] = names;
-  results["correlation"] = r.correlation;
-  results["warnings"] = r.warnings;
-  results["condition_number"] = r.condition_number;
-  results["reduced_chi2"] = r.reduced_chi2;
-  results["iterations"] = r.iterations;
-  results["curve_evaluations"] = r.curve_evaluations;
-  results["orbit_evaluations"] = r.orbit_evaluations;
-  results["failed_evaluations"] = r.failed_evaluations;
-  results["seconds"] = r.seconds;
-  nlohmann::json law = nlohmann::json::object(), law_units = nlohmann::json::object();
-  for (const auto& [k, v] : r.law_values) law[k] = v;  // SI
+  UnitTagged law;  // every law value used, SI
   {
     const impact::LawRegistry registry = impact::LawRegistry::builtin();
-    for (const auto& k : registry.keys())
-      if (law.contains(k.key)) law_units[k.key] = spectroscopy::law_si_unit(k.unit);
+    for (const auto& [k, v] : r.law_values) {
+      bool known = false;  // a key of the registry: its SI unit
+      for (const auto& key : registry.keys())
+        if (key.key == k && !known) {
+          law.add(k, v, units::as_is(spectroscopy::law_si_unit(key.unit)));
+          known = true;
+        }
+      if (!known) law.add(k, v);
+    }
   }
-  results["law_values"] = law;
-  units["law_values"] = law_units;
-  units["correlation"] = "dimensionless";
-  units["condition_number"] = "dimensionless";
-  units["reduced_chi2"] = "dimensionless";
-  units["seconds"] = "s";
-  units["curve_evaluations"] = "count";
-  units["orbit_evaluations"] = "count";
-  units["failed_evaluations"] = "count";
-  units["iterations"] = "count";
+  results.add("mode", spectroscopy::fit_mode_name(r.mode))
+      .add("status", spectroscopy::fit_status_name(r.status))
+      .add("note", r.status == spectroscopy::FitStatus::ok
+                       ? std::string()
+                       : fmt::format("the fit did not converge: {} (estimates at the best point found)",
+                                     r.solver_status))
+      .add("solver_status", r.solver_status)
+      .add("estimates", std::move(estimates))
+      .add("parameters", names)
+      .add("correlation", r.correlation, "dimensionless")
+      .add("warnings", r.warnings)
+      .add("condition_number", r.condition_number, "dimensionless")
+      .add("reduced_chi2", r.reduced_chi2, "dimensionless")
+      .add("iterations", r.iterations, "count")
+      .add("curve_evaluations", r.curve_evaluations, "count")
+      .add("orbit_evaluations", r.orbit_evaluations, "count")
+      .add("failed_evaluations", r.failed_evaluations, "count")
+      .add("seconds", r.seconds, "s")
+      .add("law_values", std::move(law));
   return summary;
 }
 
@@ -242,23 +242,20 @@ void run_fm_fit(const io::ParamSet& p, Captured* capture, const spectroscopy::Fm
                      [&r](I i) { return static_cast<bool>(r.jumped[i]); }});
   auto rows = out.open(io::TableOf<I>(std::move(columns)));
   for (I i = 0; i < r.distance.size(); ++i) rows.add(i);
-  nlohmann::json results = nlohmann::json::object(), units = nlohmann::json::object();
+  UnitTagged results;
   std::string summary = fmt::format("fit of law {} to {} points (FM-AFM frequency shift{}, {}): status {} ({})",
                                     options.law, r.distance.size(), diss ? " and dissipation" : "",
                                     p.text("direction"), spectroscopy::fit_status_name(r.status), r.solver_status);
-  summary += estimates_of(r, results, units);
+  summary += estimates_of(r, results);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  results["rms_frequency_shift"] = r.rms_frequency_shift;
-  results["rms_dissipation"] = diss ? eV(r.rms_dissipation) : nan;
-  results["frequency_shift_noise"] = r.frequency_shift_noise;
-  results["dissipation_noise"] = diss ? eV(r.dissipation_noise) : nan;
-  results["noise_estimated"] = {{"frequency_shift", r.noise_estimated_frequency_shift},
-                                {"dissipation", r.noise_estimated_dissipation}};
-  units["rms_frequency_shift"] = "Hz";
-  units["rms_dissipation"] = eV.name;
-  units["frequency_shift_noise"] = "Hz";
-  units["dissipation_noise"] = eV.name;
-  results["units"] = units;
+  UnitTagged noise_estimated;
+  noise_estimated.add("frequency_shift", r.noise_estimated_frequency_shift, "boolean (0/1)")
+      .add("dissipation", r.noise_estimated_dissipation, "boolean (0/1)");
+  results.add("rms_frequency_shift", r.rms_frequency_shift, Hz)
+      .add("rms_dissipation", diss ? r.rms_dissipation : nan, eV)
+      .add("frequency_shift_noise", r.frequency_shift_noise, Hz)
+      .add("dissipation_noise", diss ? r.dissipation_noise : nan, eV)
+      .add("noise_estimated", std::move(noise_estimated));
   summary += fmt::format("\n  residual RMS: {}{}; noise σ: {}{}{}", io::quantity(r.rms_frequency_shift, "Hz"),
                          diss ? ", " + io::quantity(eV(r.rms_dissipation), eV.name) : std::string(),
                          io::quantity(r.frequency_shift_noise, "Hz"),
@@ -267,7 +264,7 @@ void run_fm_fit(const io::ParamSet& p, Captured* capture, const spectroscopy::Fm
                                             r.noise_estimated_dissipation ? " (estimated)" : "")
                               : std::string());
   summary += closing_lines(r);
-  out.finish(results, summary);
+  out.finish(std::move(results).summary(), summary);
   draw_plot(p);
 }
 
@@ -328,20 +325,19 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
   auto rows = out.open(io::TableOf<I>(std::move(columns)));
   for (I i = 0; i < r.distance.size(); ++i) rows.add(i);
 
-  nlohmann::json results = nlohmann::json::object(), units = nlohmann::json::object();
+  UnitTagged results;
   std::string summary = fmt::format("fit of law {} to {} points ({}): status {} ({})", options.law, r.distance.size(),
                                     p.text("direction"), spectroscopy::fit_status_name(r.status), r.solver_status);
-  summary += estimates_of(r, results, units);
-  results["rms_amplitude"] = r.rms_amplitude;
-  results["rms_phase"] = phase ? deg(r.rms_phase) : std::numeric_limits<double>::quiet_NaN();
-  results["amplitude_noise"] = r.amplitude_noise;
-  results["phase_noise"] = phase ? deg(r.phase_noise) : std::numeric_limits<double>::quiet_NaN();
-  results["noise_estimated"] = {{"amplitude", r.noise_estimated_amplitude}, {"phase", r.noise_estimated_phase}};
-  units["rms_amplitude"] = "dimensionless (A/A0)";
-  units["rms_phase"] = deg.name;
-  units["amplitude_noise"] = "dimensionless (A/A0)";
-  units["phase_noise"] = deg.name;
-  results["units"] = units;
+  summary += estimates_of(r, results);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  UnitTagged noise_estimated;
+  noise_estimated.add("amplitude", r.noise_estimated_amplitude, "boolean (0/1)")
+      .add("phase", r.noise_estimated_phase, "boolean (0/1)");
+  results.add("rms_amplitude", r.rms_amplitude, "dimensionless (A/A0)")
+      .add("rms_phase", phase ? r.rms_phase : nan, deg)
+      .add("amplitude_noise", r.amplitude_noise, "dimensionless (A/A0)")
+      .add("phase_noise", phase ? r.phase_noise : nan, deg)
+      .add("noise_estimated", std::move(noise_estimated));
   summary += fmt::format("\n  residual RMS: {:.4g} (A/A0){}; noise σ: {:.3g} (A/A0{}){}", r.rms_amplitude,
                          phase ? fmt::format(", {:.4g} deg", deg(r.rms_phase)) : std::string(), r.amplitude_noise,
                          r.noise_estimated_amplitude ? ", estimated" : "",
@@ -349,7 +345,7 @@ void run_fit(const io::ParamSet& p, Captured* capture) {
                                              r.noise_estimated_phase ? " (estimated)" : "")
                                : std::string());
   summary += closing_lines(r);
-  out.finish(results, summary);
+  out.finish(std::move(results).summary(), summary);
   draw_plot(p);
 }
 

@@ -332,8 +332,8 @@ def plot_table(table: str, path: str) -> str:
         sidecar = json.load(f)
     data = np.genfromtxt(table, delimiter=",", names=True)
     results = sidecar["results"]
-    units = results.get("units", {})
-    title = "\n".join(f"{n} = {e['value']:.4g} ± {e['standard_error']:.2g} {units.get(n, '')}"
+    units = results.get("units", {}).get("estimates", {})  # per estimate: the unit of its value
+    title = "\n".join(f"{n} = {e['value']:.4g} ± {e['standard_error']:.2g} {units.get(n, {}).get('value', '')}"
                        for n, e in results["estimates"].items())
     columns = data.dtype.names
     if "frequency_shift" in columns:

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <numbers>
 #include <regex>
@@ -269,5 +270,39 @@ TEST(SummaryUnits, TheSweepArclengthIsALengthInTheSeparationsUnit) {
       EXPECT_GE(points[i].second - points[i - 1].second,
                 std::abs(points[i].first - points[i - 1].first) * (1.0 - 1e-9))
           << units << " point " << i;
+  }
+}
+
+TEST(SummaryUnits, EveryResultOfSpectroscopyFitHasItsUnit) {
+  // on main the estimates' units were listed beside `estimates` (units.hamaker: one string for value, errors and the
+  // `identifiable` flag, under no key of the results) and noise_estimated's flags had none: AM with and without a
+  // phase column, FM (a curve far from the surface: distance_offset not identifiable, its flag false)
+  TempDir dir;
+  std::ofstream(dir.path / "am.csv") << "distance (nm), amplitude (nm), phase (deg)\n40, 10, 90.1\n38, 10, 90.3\n"
+                                        "36, 10, 89.9\n34, 10, 90.2\n";
+  std::ofstream(dir.path / "am_np.csv") << "distance (nm), amplitude (nm)\n40, 10\n38, 9.9\n36, 9.7\n34, 9.5\n32, 9.2\n";
+  std::ofstream(dir.path / "fm.csv") << "distance (nm), frequency shift (Hz)\n10.0, 0.5846\n9.9177, 0.7734\n"
+                                        "9.8354, 0.8\n9.7531, 0.83\n9.6708, 0.86\n";
+  for (const char* args :
+       {"spectroscopy fit am.csv --spring-constant 40 --resonance-frequency 300 --quality-factor 100 "
+        "--free-amplitude 10 --parameters phase_offset --output r.csv",
+        "spectroscopy fit am_np.csv --spring-constant 40 --resonance-frequency 300 --quality-factor 100 "
+        "--free-amplitude 10 --parameters distance_offset --output r.csv",
+        "spectroscopy fit fm.csv --spring-constant 40 --resonance-frequency 300 --quality-factor 400 --amplitude 5 "
+        "--parameters distance_offset,frequency_shift_offset --output r.csv"}) {
+    const auto r = run_cli(args, dir);
+    ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
+    EXPECT_EQ(unitless_results(dir.path / "r.csv.json"), std::vector<std::string>{}) << args;
+    const auto results = nlohmann::json::parse(slurp(dir.path / "r.csv.json")).at("results");
+    ASSERT_FALSE(results.at("estimates").empty()) << args;
+    for (const auto& [name, estimate] : results.at("estimates").items()) {
+      const auto& unit = results.at("units").at("estimates").at(name);
+      EXPECT_EQ(unit.at("identifiable"), "boolean (0/1)") << name;
+      EXPECT_EQ(unit.at("value"), unit.at("standard_error")) << name;
+      EXPECT_EQ(unit.at("value"), name == "distance_offset" ? "nm" : name == "phase_offset" ? "deg"
+                                  : name == "hamaker"        ? "J"
+                                                             : "Hz")
+          << name;
+    }
   }
 }
