@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -25,6 +26,7 @@
 #include "commands.hpp"
 #include "described_params.hpp"
 #include "law_params.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -42,11 +44,6 @@ std::vector<io::Column> history_columns() {
           {"x2", "nm", "position of body 2"},
           {"v2", "nm/s", "velocity of body 2"}};
 }
-
-/// Units of the result values (JSON "units" and the summary).
-const nlohmann::json result_units = {{"time", "s"},   {"gap", "nm"},      {"gap_rate", "nm/s"}, {"force", "nN"},
-                                     {"energy", "aJ"}, {"mass", "kg"},     {"velocity", "nm/s"},
-                                     {"restitution", "dimensionless"},     {"steps", "count"}};
 
 void add_impact_params(io::ParamSet& p) {
   p.group("Bodies");
@@ -102,47 +99,54 @@ impact::ImpactProblem problem_from(const io::ParamSet& p, const Captured* captur
   return {{m1, -m2 / total * gap, v1}, {m2, m1 / total * gap, v2}, law_from_params(p, impact::LawRegistry::builtin(), {}, law_object_of(capture)), ext};
 }
 
-nlohmann::json body_json(const impact::Body& b) {
-  return {{"mass", b.mass}, {"position", b.position}, {"velocity", b.velocity}};
+/// A body after the impact (mass in kg, position in nm, velocity in nm/s: the units the problem was given in).
+UnitTagged body_record(const impact::Body& b) {
+  UnitTagged j;
+  j.add("mass", b.mass, "kg").add("position", b.position, "nm").add("velocity", b.velocity, "nm/s");
+  return j;
 }
 
+/// The results, each with its unit (the problem's units: nm, nN, kg, nm/s, s, aJ = nN·nm; values as computed).
 nlohmann::json result_json(const impact::ImpactResult& r, const impact::ForceLaw& law) {
-  nlohmann::json j = {{"outcome", impact::to_string(r.outcome)},
-                      {"method", r.method},
-                      {"law", law.name()},
-                      {"reduced_mass", r.reduced_mass},
-                      {"start_time", r.start_time},
-                      {"minimum_time", r.minimum_time},
-                      {"end_time", r.end_time},
-                      {"reference_gap", r.reference_gap},
-                      {"minimum_gap", r.minimum_gap},
-                      {"contact_gap", r.contact_gap},
-                      {"max_penetration", r.max_penetration},
-                      {"contact", r.contact},
-                      {"contact_start", r.contact_start},
-                      {"contact_end", r.contact_end},
-                      {"contact_duration", r.contact_duration},
-                      {"approach_gap_rate", r.approach_gap_rate},
-                      {"departure_gap_rate", r.departure_gap_rate},
-                      {"restitution", r.restitution},
-                      {"restitution_deficit", r.restitution_deficit},
-                      {"kinetic_energy_before", r.kinetic_energy_before},
-                      {"kinetic_energy_after", r.kinetic_energy_after},
-                      {"kinetic_energy_loss", r.kinetic_energy_loss},
-                      {"energy_loss_restitution", r.energy_loss_restitution},
-                      {"energy_loss_area", r.energy_loss_area},
-                      {"energy_balance_residual", r.energy_balance_residual},
-                      {"peak_force", r.peak_force},
-                      {"min_force", r.min_force},
-                      {"body1_after", body_json(r.body1_after)},
-                      {"body2_after", body_json(r.body2_after)},
-                      {"steps", r.steps}};
-  if (r.outcome == impact::ImpactOutcome::captured) j["capture_reason"] = r.capture_reason;
+  UnitTagged j;
+  j.add("outcome", impact::to_string(r.outcome))
+      .add("method", r.method)
+      .add("law", law.name())
+      .add("reduced_mass", r.reduced_mass, "kg")
+      .add("start_time", r.start_time, "s")
+      .add("minimum_time", r.minimum_time, "s")
+      .add("end_time", r.end_time, "s")
+      .add("reference_gap", r.reference_gap, "nm")
+      .add("minimum_gap", r.minimum_gap, "nm")
+      .add("contact_gap", r.contact_gap, "nm")
+      .add("max_penetration", r.max_penetration, "nm")
+      .add("contact", r.contact, "boolean (0/1)")
+      .add("contact_start", r.contact_start, "s")
+      .add("contact_end", r.contact_end, "s")
+      .add("contact_duration", r.contact_duration, "s")
+      .add("approach_gap_rate", r.approach_gap_rate, "nm/s")
+      .add("departure_gap_rate", r.departure_gap_rate, "nm/s")
+      .add("restitution", r.restitution, "dimensionless")
+      .add("restitution_deficit", r.restitution_deficit, "dimensionless")
+      .add("kinetic_energy_before", r.kinetic_energy_before, "aJ")
+      .add("kinetic_energy_after", r.kinetic_energy_after, "aJ")
+      .add("kinetic_energy_loss", r.kinetic_energy_loss, "aJ")
+      .add("energy_loss_restitution", r.energy_loss_restitution, "aJ")
+      .add("energy_loss_area", r.energy_loss_area, "aJ")
+      .add("energy_balance_residual", r.energy_balance_residual, "aJ")
+      .add("peak_force", r.peak_force, "nN")
+      .add("min_force", r.min_force, "nN")
+      .add("body1_after", body_record(r.body1_after))
+      .add("body2_after", body_record(r.body2_after))
+      .add("steps", r.steps, "count")
+      // written for a linear law without adhesion only (below); its unit listed always
+      .unit("restitution_impulsive_limit", "dimensionless");
+  if (r.outcome == impact::ImpactOutcome::captured) j.add("capture_reason", r.capture_reason);
   if (const auto* lin = law.piecewise_linear();
       lin && lin->approach_stiffness > 0 && lin->approach_adhesion == 0 && lin->departure_adhesion == 0)
-    j["restitution_impulsive_limit"] = std::sqrt(lin->departure_stiffness / lin->approach_stiffness);  // ext. E0
-  j["units"] = result_units;
-  return j;  // NaN (undefined quantities) is written as null
+    j.add("restitution_impulsive_limit", std::sqrt(lin->departure_stiffness / lin->approach_stiffness),  // ext. E0
+          "dimensionless");
+  return std::move(j).summary();  // NaN (undefined quantities) is written as null
 }
 
 /// Refuse (exit 2) before any work when the CSV would not fit on the disk: each row holds 8 numbers of at

@@ -114,15 +114,13 @@ void run_fm(const io::ParamSet& p, Captured* capture, const spectroscopy::Measur
       .add("law_output", law_path)
       .add("status", "ok")
       .add("notes", notes_json(r.notes));
-  nlohmann::json results = tagged.values();
-  results["units"] = tagged.units();
   const std::string summary = fmt::format(
       "FM reconstruction ({}, {} points): largest attraction {}; round trip ({}): residual {} rms, {} max; noise "
       "{}{}",
       r.method, r.distance.size(), io::quantity(f_min, "N"), o.exact_round_trip ? "exact FM orbits" : "first-order formula",
       io::quantity(r.residual_rms, "Hz"),
       io::quantity(r.residual_max, "Hz"), io::quantity(r.noise, "Hz"), notes_text(r.notes));
-  out.finish(results, summary);
+  out.finish(std::move(tagged).summary(), summary);
 }
 
 void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurve m) {
@@ -223,14 +221,12 @@ void run_am(const io::ParamSet& p, Captured* capture, spectroscopy::MeasuredCurv
       .add("law_output", law_path)
       .add("status", "ok")
       .add("notes", notes_json(r.notes));
-  nlohmann::json results = tagged.values();
-  results["units"] = tagged.units();
   const std::string summary = fmt::format(
       "AM reconstruction ({}, {} of {} points used): largest attraction {}, largest dissipation {} per cycle; round "
       "trip (exact orbits): A/A0 {:.2g} rms, phase {:.3g}° rms{}",
       r.method, r.gap.size(), r.separation.size(), io::quantity(f_min, "N"), io::quantity(e_max, "J"),
       r.rms_amplitude_ratio, deg(r.rms_phase), notes_text(r.notes));
-  out.finish(results, summary);
+  out.finish(std::move(tagged).summary(), summary);
 }
 
 void run_reconstruct(const io::ParamSet& p, Captured* capture) {

@@ -306,3 +306,29 @@ TEST(SummaryUnits, EveryResultOfSpectroscopyFitHasItsUnit) {
     }
   }
 }
+
+TEST(SummaryUnits, EveryResultOfImpactAndSpectroscopyReconstructHasItsUnit) {
+  // impact: on main its units were by dimension (time, gap, energy, ...), naming no key of the results; each result
+  // (the bodies' after-impact records, the contact flag) has its own now. reconstruct was already complete: kept so
+  // while its results are built on UnitTagged (FM here; the AM round trip takes seconds)
+  const std::string configs = std::string(AFMKIT_SOURCE_DIR) + "/examples/configs/";
+  for (const std::string& args :
+       {std::string("impact --output r.csv --points 20"),
+        std::string("impact --law dmt --hamaker 1e-19 --mass1 1e-11 --mass2 1 --velocity 1e6 --gap 2 --points 20 "
+                    "--output r.csv"),
+        "spectroscopy reconstruct --input '" + configs + "fm_curve_dmt.csv' --method sader_jarvis --tail zero "
+        "--spring-constant 40 --resonance-frequency 300 --amplitude 2 --law-output '' --output r.csv"}) {
+    TempDir dir;
+    const auto r = run_cli(args, dir);
+    ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
+    EXPECT_EQ(unitless_results(dir.path / "r.csv.json"), std::vector<std::string>{}) << args;
+  }
+  // the linear law without adhesion writes restitution_impulsive_limit; the units name it (dimensionless) also when
+  // a law does not
+  TempDir dir;
+  ASSERT_EQ(run_cli("impact --points 20 --output r.csv", dir).status, 0);
+  const auto results = nlohmann::json::parse(slurp(dir.path / "r.csv.json")).at("results");
+  ASSERT_TRUE(results.contains("restitution_impulsive_limit"));
+  EXPECT_EQ(results.at("units").at("restitution_impulsive_limit"), "dimensionless");
+  EXPECT_EQ(results.at("units").at("body1_after").at("velocity"), "nm/s");
+}

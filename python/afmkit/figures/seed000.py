@@ -575,7 +575,7 @@ def fig_impact(out=None, *, approach_stiffness: float = IMPACT_KA, departure_rat
     gb, fb = gap[inside & (rate > 0)], force[inside & (rate > 0)]
     oa, ob = np.argsort(ga), np.argsort(gb)
     ax.fill_between(ga[oa], np.interp(ga[oa], gb[ob], fb[ob]), fa[oa], color="0.8",
-                    label=f"lost energy (eq. 6) = {loop.results['energy_loss_area']:.4g} {loop.results['units']['energy']}")
+                    label=f"lost energy (eq. 6) = {loop.results['energy_loss_area']:.4g} {loop.results['units']['energy_loss_area']}")
     ax.set_xlabel(f"gap d ({loop.units['gap']})")
     ax.set_ylabel(f"contact force H ({loop.units['force']})")
     ax.set_title(f"(a) one impact, K_a = {_fmt(ka)} N/m, K_b = {_fmt(loop_r * ka)} N/m",
@@ -618,7 +618,7 @@ def fig_impact(out=None, *, approach_stiffness: float = IMPACT_KA, departure_rat
         ("max |e_sim − √(K_b/K_a)| over all runs", f"{worst_e:.2e}",
          f"impact, {len(ratios) * len(body_list)} runs (integrator)"),
         (f"energy loss, K_b/K_a = {_fmt(loop_r)}: kinetic (eq. 3) vs area (eq. 6)",
-         f"{loop.results['kinetic_energy_loss']:.6g} vs {loop.results['energy_loss_area']:.6g} {u['energy']}",
+         f"{loop.results['kinetic_energy_loss']:.6g} vs {loop.results['energy_loss_area']:.6g} {u['energy_loss_area']}",
          "impact kinetic_energy_loss, energy_loss_area"),
         ("max relative |ΔE_kin − (1 − e²)μḋ²/2| (eq. 3)", f"{worst_de:.2e}", "impact, all runs"),
         ("max relative energy-balance residual of the integrator", f"{worst_res:.2e}",
@@ -629,8 +629,8 @@ def fig_impact(out=None, *, approach_stiffness: float = IMPACT_KA, departure_rat
                f"{_masses(body_list[0])}, approach speed "
                f"{_fmt(body_list[0]['velocity'])} nm/s, K_b = {_fmt(loop_r)} K_a): the bodies approach on the K_a branch "
                f"and leave on the K_b branch; the area between them is the energy lost, "
-               f"{loop.results['energy_loss_area']:.4g} {u['energy']} against the kinetic-energy loss "
-               f"{loop.results['kinetic_energy_loss']:.4g} {u['energy']}. (b) The simulated coefficient of restitution "
+               f"{loop.results['energy_loss_area']:.4g} {u['energy_loss_area']} against the kinetic-energy loss "
+               f"{loop.results['kinetic_energy_loss']:.4g} {u['kinetic_energy_loss']}. (b) The simulated coefficient of restitution "
                f"for K_b/K_a from {_fmt(min(ratios))} to {_fmt(max(ratios))} and "
                f"{['one', 'two', 'three', 'four'][len(body_list) - 1]} mass/speed pair{'s' if len(body_list) > 1 else ''} "
                f"agrees with e = √(K_b/K_a) to {worst_e:.1e}, independent of masses and speed.")
