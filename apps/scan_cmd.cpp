@@ -9,6 +9,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -25,6 +26,7 @@
 #include "scan_outputs.hpp"
 #include "scan_params.hpp"
 #include "scan_recorded.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -152,53 +154,45 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
     n_points = points->stage(points_path, out.outputs());
     files.push_back(points_path);
   }
-  const nlohmann::json results = {
-      {"samples", result.run.samples},
-      {"turns", result.turns},
-      {"pitch", instrument.spiral.pitch()},
-      {"saturated_fraction", result.saturated_fraction},
-      {"saturates_with_control", result.saturates_with_control},
-      {"max_radius_with_control", result.max_radius_with_control},
-      {"saturates_without_control", result.saturates_without_control},
-      {"max_radius_without_control", result.max_radius_without_control},
-      {"scan_area_gain", result.scan_area_gain},
-      {"scan_area_gain_is_lower_bound", result.scan_area_gain_is_lower_bound},
-      {"reconstruction", method},
-      {"topography_rms_error", result.topography_rms_error},
-      {"topography_relative_error", relative(result.topography_rms_error)},
-      {"inverse_rms_error", result.inverse_rms_error},
-      {"lagged_rms_error", result.lagged_rms_error},
-      {"sample_rms_height", result.sample_rms_height},
-      {"error_budget",
-       {{"imaging", budget.imaging},
-        {"imaging_relative", relative(budget.imaging)},
-        {"reconstruction", budget.reconstruction},
-        {"reconstruction_relative", relative(budget.reconstruction)},
-        {"plant_mismatch", budget.plant_mismatch},
-        {"plant", budget.plant},
-        {"noise_gain", budget.noise_gain},
-        {"image_noise_gain", budget.image_noise_gain},
-        {"noise", budget.noise},
-        {"predicted", budget.predicted},
-        {"pole", budget.pole},
-        {"settle_samples", budget.settle_samples},
-        {"units", {{"imaging", "m"}, {"imaging_relative", "dimensionless"}, {"reconstruction", "m"}, {"reconstruction_relative", "dimensionless"}, {"plant_mismatch", "dimensionless"}, {"plant", "m"},
-                   {"noise_gain", "dimensionless"}, {"image_noise_gain", "dimensionless"},
-                   {"noise", "m"}, {"predicted", "m"}, {"pole", "dimensionless"},
-                   {"settle_samples", "count"}}}}},
-      {"deflection_rms", result.deflection_rms},
-      {"valid_pixels", result.topography.valid_count()},
-      {"loop_spectral_abscissa", abscissa},
-      {"filter_skipped_samples", result.run.filter_skipped},
-      {"point_cloud_points", n_points},
-      {"files", files},
-      {"units", {{"pitch", "m"}, {"saturated_fraction", "dimensionless"}, {"max_radius_with_control", "m"},
-                 {"max_radius_without_control", "m"}, {"scan_area_gain", "dimensionless"},
-                 {"topography_rms_error", "m"}, {"topography_relative_error", "dimensionless"},
-                 {"inverse_rms_error", "m"}, {"lagged_rms_error", "m"}, {"sample_rms_height", "m"},
-                 {"deflection_rms", "m"}, {"valid_pixels", "count"},
-                 {"loop_spectral_abscissa", "1/s"}, {"samples", "count"}, {"turns", "count"},
-                 {"filter_skipped_samples", "count"}, {"point_cloud_points", "count"}}}};
+  // SI results (m, 1/s), each with its unit; the error budget's terms under error_budget (docs/scan.md)
+  UnitTagged error_budget;
+  error_budget.add("imaging", budget.imaging, "m")
+      .add("imaging_relative", relative(budget.imaging), "dimensionless")
+      .add("reconstruction", budget.reconstruction, "m")
+      .add("reconstruction_relative", relative(budget.reconstruction), "dimensionless")
+      .add("plant_mismatch", budget.plant_mismatch, "dimensionless")
+      .add("plant", budget.plant, "m")
+      .add("noise_gain", budget.noise_gain, "dimensionless")
+      .add("image_noise_gain", budget.image_noise_gain, "dimensionless")
+      .add("noise", budget.noise, "m")
+      .add("predicted", budget.predicted, "m")
+      .add("pole", budget.pole, "dimensionless")
+      .add("settle_samples", budget.settle_samples, "count");
+  UnitTagged tagged;
+  tagged.add("samples", result.run.samples, "count")
+      .add("turns", result.turns, "count")
+      .add("pitch", instrument.spiral.pitch(), "m")
+      .add("saturated_fraction", result.saturated_fraction, "dimensionless")
+      .add("saturates_with_control", result.saturates_with_control, "boolean (0/1)")
+      .add("max_radius_with_control", result.max_radius_with_control, "m")
+      .add("saturates_without_control", result.saturates_without_control, "boolean (0/1)")
+      .add("max_radius_without_control", result.max_radius_without_control, "m")
+      .add("scan_area_gain", result.scan_area_gain, "dimensionless")
+      .add("scan_area_gain_is_lower_bound", result.scan_area_gain_is_lower_bound, "boolean (0/1)")
+      .add("reconstruction", method)
+      .add("topography_rms_error", result.topography_rms_error, "m")
+      .add("topography_relative_error", relative(result.topography_rms_error), "dimensionless")
+      .add("inverse_rms_error", result.inverse_rms_error, "m")
+      .add("lagged_rms_error", result.lagged_rms_error, "m")
+      .add("sample_rms_height", result.sample_rms_height, "m")
+      .add("error_budget", std::move(error_budget))
+      .add("deflection_rms", result.deflection_rms, "m")
+      .add("valid_pixels", result.topography.valid_count(), "count")
+      .add("loop_spectral_abscissa", abscissa, "1/s")
+      .add("filter_skipped_samples", result.run.filter_skipped, "count")
+      .add("point_cloud_points", n_points, "count")
+      .add("files", files);
+  const nlohmann::json results = std::move(tagged).summary();
   if (series) series->stage(io::make_sidecar("scan (time series)", as_run, results), out.outputs());
   const std::string gain =
       std::isnan(result.scan_area_gain)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,7 @@
 #include "command.hpp"
 #include "scan_outputs.hpp"
 #include "scan_params.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -73,22 +75,20 @@ void run_recorded(const io::ParamSet& p, Captured* capture) {
     files.push_back(points_path);
   }
   const scan::RecordedSurvey& s = result.survey;
-  const nlohmann::json results = {
-      {"samples", s.samples},
-      {"turns", result.turns},
-      {"dropped_samples", s.dropped_samples},
-      {"sample_rate", s.sample_rate},
-      {"spindle_frequency", s.rotation_frequency / (2.0 * std::numbers::pi)},
-      {"max_radius", s.max_radius},
-      {"max_pitch", s.max_pitch},
-      {"uses_index_pulse", s.uses_index_pulse},
-      {"valid_pixels", result.tilt_free.valid_count()},
-      {"filter_skipped_samples", result.filter_skipped},
-      {"point_cloud_points", n_points},
-      {"files", files},
-      {"units", {{"samples", "count"}, {"turns", "count"}, {"dropped_samples", "count"}, {"sample_rate", "Hz"},
-                 {"spindle_frequency", "Hz"}, {"max_radius", "m"}, {"max_pitch", "m"}, {"valid_pixels", "count"},
-                 {"filter_skipped_samples", "count"}, {"point_cloud_points", "count"}}}};
+  UnitTagged tagged;  // SI results, each with its unit
+  tagged.add("samples", s.samples, "count")
+      .add("turns", result.turns, "count")
+      .add("dropped_samples", s.dropped_samples, "count")
+      .add("sample_rate", s.sample_rate, "Hz")
+      .add("spindle_frequency", s.rotation_frequency / (2.0 * std::numbers::pi), "Hz")
+      .add("max_radius", s.max_radius, "m")
+      .add("max_pitch", s.max_pitch, "m")
+      .add("uses_index_pulse", s.uses_index_pulse, "boolean (0/1)")
+      .add("valid_pixels", result.tilt_free.valid_count(), "count")
+      .add("filter_skipped_samples", result.filter_skipped, "count")
+      .add("point_cloud_points", n_points, "count")
+      .add("files", files);
+  const nlohmann::json results = std::move(tagged).summary();
   if (series) series->stage(io::make_sidecar("scan (recorded, time series)", p, results), out.outputs());
   out.finish(results, fmt::format("afmkit scan (recorded {}): {} samples, {} turns at {} spindle, {} sampling, "
                                   "radius up to {}; {} samples dropped outside the index pulses{}",

@@ -58,7 +58,7 @@ TEST(ScanCli, WritesImagesGwyddionOpensAndTheControllerBuysArea) {
   EXPECT_DOUBLE_EQ(printed["error_budget"]["imaging_relative"].get<double>(),
                    printed["error_budget"]["imaging"].get<double>() / printed["sample_rms_height"].get<double>());
   EXPECT_GT(printed["lagged_rms_error"].get<double>(), 3 * printed["inverse_rms_error"].get<double>());  // 15 vs 3.5 nm
-  EXPECT_EQ(printed["error_budget"]["units"]["noise_gain"], "dimensionless");
+  EXPECT_EQ(printed["units"]["error_budget"]["noise_gain"], "dimensionless");  // a record's units under `units`
 
   const std::string thumbnailer = gwyddion_client::find_thumbnailer();
   ASSERT_FALSE(thumbnailer.empty()) << gwyddion_client::missing_thumbnailer_message;

@@ -332,3 +332,20 @@ TEST(SummaryUnits, EveryResultOfImpactAndSpectroscopyReconstructHasItsUnit) {
   EXPECT_EQ(results.at("units").at("restitution_impulsive_limit"), "dimensionless");
   EXPECT_EQ(results.at("units").at("body1_after").at("velocity"), "nm/s");
 }
+
+TEST(SummaryUnits, EveryResultOfScanHasItsUnit) {
+  // on main the flags (saturates_with_control, saturates_without_control, scan_area_gain_is_lower_bound; recorded:
+  // uses_index_pulse) had no unit; the error budget's units, inside the record, are under units.error_budget now
+  const std::string recorded = std::string(AFMKIT_SOURCE_DIR) + "/examples/recorded/spiral.csv";
+  for (const std::string& args :
+       {std::string("scan --sample-rate 20000 --radial-speed 1e-3 --image-resolution 128 --sample-resolution 512 "
+                    "--image-output '' --output r.csv"),
+        std::string("scan --sample-rate 20000 --radial-speed 1e-3 --image-resolution 128 --sample-resolution 512 "
+                    "--control off --image-output '' --output r.csv"),
+        "scan --recorded '" + recorded + "' --image-resolution 64 --image-output '' --output r.csv"}) {
+    TempDir dir;
+    const auto r = run_cli(args, dir);
+    ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
+    EXPECT_EQ(unitless_results(dir.path / "r.csv.json"), std::vector<std::string>{}) << args;
+  }
+}
