@@ -280,7 +280,8 @@ TEST(SummaryUnits, EveryResultOfSpectroscopyFitHasItsUnit) {
   TempDir dir;
   std::ofstream(dir.path / "am.csv") << "distance (nm), amplitude (nm), phase (deg)\n40, 10, 90.1\n38, 10, 90.3\n"
                                         "36, 10, 89.9\n34, 10, 90.2\n";
-  std::ofstream(dir.path / "am_np.csv") << "distance (nm), amplitude (nm)\n40, 10\n38, 9.9\n36, 9.7\n34, 9.5\n32, 9.2\n";
+  std::ofstream(dir.path / "am_np.csv") << "distance (nm), amplitude (nm)\n40, 10\n38, 9.9\n36, 9.7\n34, 9.5\n"
+                                           "32, 9.2\n";
   std::ofstream(dir.path / "fm.csv") << "distance (nm), frequency shift (Hz)\n10.0, 0.5846\n9.9177, 0.7734\n"
                                         "9.8354, 0.8\n9.7531, 0.83\n9.6708, 0.86\n";
   for (const char* args :
