@@ -1,7 +1,8 @@
 #pragma once
 // The cantilever's keys, declared once for every command that takes them (tests/cli/test_declared_once.cpp): the
-// tapping commands (physical units), spectroscopy prepare, fit and reconstruct. The key, its unit and the range of a
-// value it is given with are declared here; each command says how it takes the key (its default, required, or the
+// tapping commands (physical units), spectroscopy prepare, fit and reconstruct. The key and its unit are declared
+// here, the range of a value it is given with by the library (afmkit/tapping/cantilever_limits.hpp, in SI: the
+// library's settings check the same range); each command says how it takes the key (its default, required, or the
 // input file's) and its help (what the key means there: AM only, FM only, required for AM curves, …).
 #include <string>
 

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "afmkit/core/error.hpp"
+#include "afmkit/tapping/cantilever_limits.hpp"
 
 namespace afmkit::spectroscopy {
 
@@ -71,19 +72,21 @@ CalibratedCurve calibrate(const io::curves::RawCurve& raw, const Calibration& us
 
   // k: needed always (F = k·d, or d = F/k); InvOLS: only for a segment with the detector signal alone
   const bool user_k = std::isfinite(user.spring_constant), user_s = std::isfinite(user.invols);
-  if (!std::isnan(user.spring_constant) && !(user.spring_constant > 0 && std::isfinite(user.spring_constant)))
-    throw InvalidParameter("spring_constant", fmt::format("spring_constant = {} N/m is out of range: must be > 0",
-                                                          user.spring_constant));
+  // the range of tapping/cantilever_limits.hpp (the command line and the fit's settings take the same)
+  if (!std::isnan(user.spring_constant))
+    tapping::check_cantilever_setting("spring_constant", tapping::CantileverSetting::spring_constant,
+                                      user.spring_constant);
   if (!std::isnan(user.invols) && !(user.invols > 0 && std::isfinite(user.invols)))
     throw InvalidParameter("invols", fmt::format("invols = {} m/V is out of range: must be > 0", user.invols));
   const double k = user_k ? user.spring_constant : raw.metadata.spring_constant;
   if (std::isnan(k))
     throw InvalidParameter("spring_constant", fmt::format("{}: the file gives no spring constant: give it with "
                                                           "--spring-constant (N/m)", out.origin));
-  if (!(k > 0) || !std::isfinite(k))
+  const double k_max = tapping::cantilever_limit(tapping::CantileverSetting::spring_constant).upper;
+  if (!(k > 0) || !(k <= k_max))
     throw InvalidParameter("spring_constant", fmt::format("{}: the file's spring constant {} N/m is out of range "
-                                                          "(must be > 0): give the right one with --spring-constant",
-                                                          out.origin, k));
+                                                          "(must be > 0 and <= {:g} N/m): give the right one with "
+                                                          "--spring-constant", out.origin, k, k_max));
   out.spring_constant = k;
   out.spring_constant_source = user_k ? "option" : "file";
 

@@ -14,6 +14,7 @@
 #include "afmkit/impact/law_registry.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
 #include "afmkit/spectroscopy/fit_model.hpp"
+#include "afmkit/tapping/cantilever_limits.hpp"
 
 namespace afmkit::spectroscopy {
 
@@ -113,19 +114,24 @@ void FmFitCurve::validate() const {
   require_distinct(distance);
 }
 
+// The cantilever's settings: the ranges of tapping/cantilever_limits.hpp (the command line declares the same).
 void FmFitSettings::validate() const {
-  validate::positive("spring_constant", spring_constant);
-  validate::positive("resonance_frequency", resonance_frequency);
-  validate::positive("quality_factor", quality_factor);
-  validate::positive("amplitude", amplitude);
+  using tapping::CantileverSetting;
+  tapping::check_cantilever_setting("spring_constant", CantileverSetting::spring_constant, spring_constant);
+  tapping::check_cantilever_setting("resonance_frequency", CantileverSetting::resonance_frequency, resonance_frequency);
+  tapping::check_cantilever_setting("quality_factor", CantileverSetting::quality_factor, quality_factor);
+  tapping::check_cantilever_setting("amplitude", CantileverSetting::amplitude, amplitude);
 }
 
 void FitSettings::validate() const {
-  validate::positive("spring_constant", spring_constant);
-  validate::positive("resonance_frequency", resonance_frequency);
-  validate::positive("quality_factor", quality_factor);
-  validate::positive("free_amplitude", free_amplitude);
-  validate::non_negative("drive_frequency", drive_frequency);
+  using tapping::CantileverSetting;
+  tapping::check_cantilever_setting("spring_constant", CantileverSetting::spring_constant, spring_constant);
+  tapping::check_cantilever_setting("resonance_frequency", CantileverSetting::resonance_frequency, resonance_frequency);
+  tapping::check_cantilever_setting("quality_factor", CantileverSetting::quality_factor, quality_factor);
+  tapping::check_cantilever_setting("free_amplitude", CantileverSetting::amplitude, free_amplitude);
+  // 0: at f0; otherwise a drive frequency, in the resonance frequency's range
+  if (drive_frequency != 0.0)
+    tapping::check_cantilever_setting("drive_frequency", CantileverSetting::resonance_frequency, drive_frequency);
 }
 
 void FitOptions::validate() const {

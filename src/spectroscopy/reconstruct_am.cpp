@@ -14,6 +14,7 @@
 #include "afmkit/io/quantity.hpp"
 #include "afmkit/spectroscopy/reconstruct_law.hpp"
 #include "reconstruct_am_round_trip.hpp"
+#include "afmkit/tapping/cantilever_limits.hpp"
 #include "reconstruct_checks.hpp"
 
 namespace afmkit::spectroscopy {
@@ -36,11 +37,12 @@ AmMethod am_method_from(const std::string& name) {
 AmSettings::AmSettings(double k, double f0, double q, double a0, double f)
     : spring_constant(k), resonance_frequency(f0), quality_factor(q), free_amplitude(a0),
       drive_frequency(f == 0.0 ? f0 : f) {
-  detail::require_positive("spring_constant", k, "N/m");
-  detail::require_positive("resonance_frequency", f0, "Hz");
-  detail::require_positive("quality_factor", q, "");
-  detail::require_positive("free_amplitude", a0, "m");
-  detail::require_positive("drive_frequency", drive_frequency, "Hz");
+  tapping::check_cantilever_setting("spring_constant", tapping::CantileverSetting::spring_constant, k);
+  tapping::check_cantilever_setting("resonance_frequency", tapping::CantileverSetting::resonance_frequency, f0);
+  tapping::check_cantilever_setting("quality_factor", tapping::CantileverSetting::quality_factor, q);
+  tapping::check_cantilever_setting("free_amplitude", tapping::CantileverSetting::amplitude, a0);
+  tapping::check_cantilever_setting("drive_frequency", tapping::CantileverSetting::resonance_frequency,
+                                    drive_frequency);
 }
 
 namespace {

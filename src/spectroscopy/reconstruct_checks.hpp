@@ -12,11 +12,6 @@
 
 namespace afmkit::spectroscopy::detail {
 
-inline void require_positive(const char* key, double v, const char* unit) {
-  if (!(v > 0.0) || !std::isfinite(v) || v > 1e12)
-    throw InvalidParameter(key, fmt::format("{} = {} {} is out of range: must be > 0 and finite", key, v, unit));
-}
-
 inline void require_finite(const char* key, const std::vector<double>& v) {
   for (std::size_t i = 0; i < v.size(); ++i)
     if (!std::isfinite(v[i]))

@@ -16,6 +16,7 @@
 #include "afmkit/spectroscopy/reconstruct_law.hpp"
 #include "afmkit/tapping/fm.hpp"
 #include "afmkit/tapping/units.hpp"
+#include "afmkit/tapping/cantilever_limits.hpp"
 #include "reconstruct_checks.hpp"
 
 namespace afmkit::spectroscopy {
@@ -36,9 +37,9 @@ TailModel tail_model_from(const std::string& name) {
 }
 
 FmSettings::FmSettings(double k, double f0, double a) : spring_constant(k), resonance_frequency(f0), amplitude(a) {
-  detail::require_positive("spring_constant", k, "N/m");
-  detail::require_positive("resonance_frequency", f0, "Hz");
-  detail::require_positive("amplitude", a, "m");
+  tapping::check_cantilever_setting("spring_constant", tapping::CantileverSetting::spring_constant, k);
+  tapping::check_cantilever_setting("resonance_frequency", tapping::CantileverSetting::resonance_frequency, f0);
+  tapping::check_cantilever_setting("amplitude", tapping::CantileverSetting::amplitude, a);
 }
 
 double exponential_force_frequency_shift(double z, double f0_force, double lambda, const FmSettings& s) {
@@ -144,6 +145,9 @@ FmReconstruction reconstruct_fm(const FmCurve& curve, const FmSettings& s, const
   detail::require_finite("frequency_shift", curve.frequency_shift);
   if (options.noise_realisations < 0 || options.noise_realisations > 1000)
     throw InvalidParameter("noise_realisations", "noise_realisations must be in [0, 1000]");
+  // the round trip's cantilever: the user's Q, in the range the command line declares (not an internal failure)
+  tapping::check_cantilever_setting("quality_factor", tapping::CantileverSetting::quality_factor,
+                                    options.quality_factor);
   const auto order = detail::monotone_order("distance", curve.distance);
 
   FmReconstruction r;

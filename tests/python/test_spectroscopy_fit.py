@@ -3,6 +3,7 @@ with known parameters and noise (fixed seed) are fitted back within their standa
 do not depend on is reported; bad input raises InvalidParameter naming the parameter; the plot is a PNG."""
 import inspect
 import os
+import re
 import subprocess
 
 import numpy as np
@@ -143,3 +144,40 @@ def test_a_law_object_stands_for_its_name_and_its_values_in_si():
         sf.fit(z, by_hand["amplitude"], law=law, fixed={"tip_radius": 8e-9}, **SETTINGS)
     with pytest.raises(TypeError, match="law: a law written in Python"):
         sf.fit(z, by_hand["amplitude"], law=afmkit.laws.Python(approach=lambda d: 0 * d), **SETTINGS)
+
+
+def _command_line_upper_si(key):
+    """The upper end of `key`'s range as `afmkit spectroscopy fit --help` states it, in SI (its unit: kHz, nm)."""
+    out = subprocess.run([os.environ.get("AFMKIT_CLI", "afmkit"), "spectroscopy", "fit", "--help"],
+                         capture_output=True, text=True, check=True).stdout
+    line = next(l for l in out.splitlines() if l.strip().startswith("--" + key.replace("_", "-") + " "))
+    unit = re.search(r"unit: ([^;\]]+)", line).group(1).strip()
+    upper = float(re.search(r"in \[0, ([^\]]+)\]", line).group(1))
+    return upper * {"N/m": 1.0, "kHz": 1e3, "dimensionless": 1.0, "nm": 1e-9}[unit]
+
+
+@pytest.mark.parametrize("fm", [False, True])
+def test_every_cantilever_setting_out_of_its_range_is_refused_like_the_command_line(fm):
+    # the Python (SI) path and the command line (kHz, nm) take one declaration of the ranges: a value just above the
+    # command line's bound, in SI, is refused naming the key and the range; the bound itself is the command line's
+    z = np.linspace(30e-9, 20e-9, 5)
+    length = "amplitude" if fm else "free_amplitude"
+    settings = dict(spring_constant=40.0, resonance_frequency=300e3, quality_factor=400.0)
+    settings[length] = 5e-9 if fm else 20e-9
+    expected_unit = {"spring_constant": " N/m", "resonance_frequency": " Hz", "quality_factor": "", length: " m"}
+    for key, unit in expected_unit.items():
+        upper = _command_line_upper_si(key)
+        assert upper == pytest.approx({"spring_constant": 1e6, "resonance_frequency": 1e10, "quality_factor": 1e9,
+                                       length: 1e-3}[key], rel=1e-12)
+        for bad in (upper * 1.001, 1e300, float("inf"), float("nan"), 0.0, -1.0):
+            message = rf"{key} = \S+{unit} is out of range: must be > 0 and <= {re.escape(f'{upper:g}')}{unit}$"
+            with pytest.raises(afmkit.InvalidParameter, match=message):
+                if fm:
+                    sf.fit_fm(z, np.full(5, -1.0), **dict(settings, **{key: bad}))
+                else:
+                    sf.fit(z, np.full(5, 10e-9), None, **dict(settings, **{key: bad}))
+    if not fm:  # the forward model takes the same settings
+        with pytest.raises(afmkit.InvalidParameter, match=r"quality_factor = 2000000000 is out of range"):
+            sf.predict(z, **dict(settings, quality_factor=2e9))
+        with pytest.raises(afmkit.InvalidParameter, match=r"drive_frequency = 20000000000 Hz is out of range"):
+            sf.fit(z, np.full(5, 10e-9), None, drive_frequency=2e10, **settings)

@@ -265,3 +265,14 @@ def test_the_vendor_hertz_fit_of_the_jpk_file():
     # the cell unloads stiffer than it loads: the table law continues the retract below the measured depth with
     # the approach's slope (docs/force-laws.md), so the prepared curve is a law as it is
     assert r.status == "ok"
+
+
+def test_a_spring_constant_out_of_the_cantilever_range_is_refused_naming_it():
+    # the range the fit's settings and the command line take (0, 1e6] N/m: a value above it, as the option or on
+    # the command line, is the user's error naming the key and the range (no bound before: 1e300 N/m was prepared)
+    z, v, seg = hertz_curve(n=300)
+    for bad in (2e6, 1e300, -1.0):
+        with pytest.raises(afmkit.InvalidParameter,
+                           match=r"spring_constant = \S+ N/m is out of range: must be > 0 and <= 1e\+06 N/m"):
+            afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=bad, invols=INVOLS)
+    afmkit.spectroscopy.prepare(z, deflection_volts=v, segment=seg, spring_constant=1e6, invols=INVOLS)  # the bound

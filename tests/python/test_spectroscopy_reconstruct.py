@@ -1,6 +1,7 @@
 """afmkit.spectroscopy_reconstruct: force reconstruction on NumPy arrays (docs/reconstruction.md)."""
 import math
 import os
+import re
 import subprocess
 
 import numpy as np
@@ -136,3 +137,27 @@ def test_fm_round_trip_through_the_exact_orbits_of_tapping_fm():
                           tail="exponential", round_trip_model="first_order")
     assert "first-order" in g.round_trip_model
     assert np.max(np.abs(g.round_trip_frequency_shift[visited] - r.round_trip_frequency_shift[visited])) > 0
+
+
+def test_cantilever_settings_out_of_the_command_lines_range_are_refused_naming_it():
+    # the reconstructions take the ranges of the fit and the command line (SI here: N/m, Hz, m); before, anything
+    # up to 1e12 in any unit passed (a 1 km amplitude, Q = 1e11)
+    z, df = _exponential_curve(1e-9, 20)
+    fm = dict(spring_constant=K, resonance_frequency=F0_HZ, amplitude=1e-9)
+    for key, bad, upper in (("spring_constant", 2e6, "1e+06 N/m"), ("resonance_frequency", 2e10, "1e+10 Hz"),
+                            ("amplitude", 2e-3, "0.001 m")):
+        with pytest.raises(afmkit.InvalidParameter, match=rf"{key} = [^:]+ is out of range: must be > 0 and <= "
+                                                          + re.escape(upper)):
+            sr.reconstruct_fm(z, df, round_trip=False, **dict(fm, **{key: bad}))
+    for q in (2e9, -1.0):  # the exact round trip's Q: was an internal failure (exit-1 class) at -1, ran at 2e9
+        with pytest.raises(afmkit.InvalidParameter, match=r"quality_factor = [^:]+ is out of range: must be > 0 and "
+                                                          r"<= 1e\+09"):
+            sr.reconstruct_fm(z, df, quality_factor=q, **fm)
+    l = np.linspace(12e-9, 6e-9, 20)
+    a, phi = l * 0.8, np.full(20, 1.2)
+    am = dict(spring_constant=40.0, resonance_frequency=300e3, quality_factor=400.0, free_amplitude=10e-9)
+    for key, bad, upper in (("quality_factor", 2e9, "1e+09"), ("free_amplitude", 1.0, "0.001 m"),
+                            ("drive_frequency", 1e11, "1e+10 Hz")):
+        with pytest.raises(afmkit.InvalidParameter, match=rf"{key} = [^:]+ is out of range: must be > 0 and <= "
+                                                          + re.escape(upper)):
+            sr.reconstruct_am(l, a, phi, round_trip=False, **dict(am, **{key: bad}))

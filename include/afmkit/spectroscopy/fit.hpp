@@ -51,7 +51,8 @@ struct FitSettings {
   double quality_factor = 0.0;       // Q > 0
   double free_amplitude = 0.0;       // A0 [m] > 0, free amplitude at the drive frequency
   double drive_frequency = 0.0;      // [Hz] > 0 (0: at f0)
-  void validate() const;             // InvalidParameter naming the setting
+  /// InvalidParameter naming the setting: each in the range of tapping/cantilever_limits.hpp (the command line's)
+  void validate() const;
 };
 
 /// A measured FM-AFM curve, SI units: the frequency shift Δf = f − f0 at constant amplitude A versus distance, and
@@ -71,7 +72,8 @@ struct FmFitSettings {
   double resonance_frequency = 0.0;  // f0 [Hz] > 0, the free resonance
   double quality_factor = 0.0;       // Q > 0
   double amplitude = 0.0;            // A [m] > 0, the oscillation amplitude the amplitude loop holds
-  void validate() const;             // InvalidParameter naming the setting
+  /// InvalidParameter naming the setting: each in the range of tapping/cantilever_limits.hpp (the command line's)
+  void validate() const;
 };
 
 /// Which measurement a fit is of: AM-AFM amplitude/phase (fit_am_curve) or FM-AFM frequency shift (fit_fm_curve).

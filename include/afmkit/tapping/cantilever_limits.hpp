@@ -1,0 +1,39 @@
+#pragma once
+// The ranges of a cantilever's measured settings (spring constant, resonance frequency, quality factor, an
+// oscillation amplitude), declared once for the library and the command line: the library's settings
+// (spectroscopy::FitSettings, FmFitSettings, the spring constant of spectroscopy prepare) check a value given in SI
+// with check_cantilever_setting(), the command line declares its cantilever keys with cantilever_limit() in its own
+// units (apps/cantilever_params.cpp: kHz, nm). A value is in (0, upper]: wide but finite, so that the model's scales
+// stay far inside the double range (real cantilevers lie decades inside).
+
+namespace afmkit::tapping {
+
+/// What a cantilever setting measures.
+enum class CantileverSetting {
+  spring_constant,      // k [N/m], in (0, 1e6]
+  resonance_frequency,  // f0 [Hz], in (0, 1e10] (1e7 kHz)
+  quality_factor,       // Q, dimensionless, in (0, 1e9]
+  amplitude             // a free or held oscillation amplitude [m], in (0, 1e-3] (1e6 nm)
+};
+
+/// The SI unit of a setting and the largest value it may take in that unit (the smallest: > 0).
+struct CantileverLimit {
+  const char* si_unit;  // "N/m", "Hz", "dimensionless", "m"
+  double upper;         // in si_unit
+};
+
+constexpr CantileverLimit cantilever_limit(CantileverSetting s) {
+  switch (s) {
+    case CantileverSetting::spring_constant: return {"N/m", 1e6};
+    case CantileverSetting::resonance_frequency: return {"Hz", 1e10};
+    case CantileverSetting::quality_factor: return {"dimensionless", 1e9};
+    case CantileverSetting::amplitude: return {"m", 1e-3};
+  }
+  return {"", 0.0};  // unreachable: every setting is listed above
+}
+
+/// `value` (SI) when it is in (0, upper] of `setting`; otherwise InvalidParameter naming `key`, the value and the
+/// range with their unit ("free_amplitude = 1e+300 m is out of range: must be > 0 and <= 0.001 m").
+double check_cantilever_setting(const char* key, CantileverSetting setting, double value);
+
+}  // namespace afmkit::tapping
