@@ -31,6 +31,7 @@
 #include "scan_params.hpp"
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
+#include "unit_tagged.hpp"
 
 namespace afmkit::cli {
 
@@ -51,6 +52,35 @@ std::vector<io::WrittenPath> tapping_image_files(const std::string& prefix) {
     for (const char* d : {"trace", "retrace"}) add(fmt::format("{}_{}", c, d));
   add("truth");
   return paths;
+}
+
+// One scan of the set-point sweep (results: setpoint_sweep): SI values (m, N), each with its unit.
+UnitTagged setpoint_sweep_record(double setpoint, double engaged_separation, const ti::ImagingMetrics& m,
+                                 double apparent_height, double truth_height) {
+  UnitTagged r;
+  r.add("setpoint", setpoint, "dimensionless")
+      .add("engaged_separation", engaged_separation, "m")
+      .add("trace_height_rms_error", m.trace_height_rms_error, "m")
+      .add("apparent_height", apparent_height, "m")
+      .add("truth_height", truth_height, "m")
+      .add("fraction_attractive", m.fraction_attractive, "dimensionless")
+      .add("fraction_repulsive", m.fraction_repulsive, "dimensionless")
+      .add("regime_switches_per_line", m.switches_per_line, "count")
+      .add("max_peak_force", m.max_peak_force, "N");
+  return r;
+}
+
+// A branch of the orbit map that holds the set-point (results: branches_at_setpoint): separation [m], phase [deg],
+// peak force [N].
+UnitTagged branch_at_setpoint_record(std::size_t branch, double separation, const std::string& regime,
+                                     double phase_deg, double peak_force) {
+  UnitTagged r;
+  r.add("branch", branch, "count")
+      .add("separation", separation, "m")
+      .add("regime", regime)
+      .add("phase", phase_deg, "deg")
+      .add("peak_force", peak_force, "N");
+  return r;
 }
 
 void declare_tapping_image(io::ParamSet& p) {
@@ -305,7 +335,7 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
   // shared, read-only map and sample): computed in parallel (OpenMP), each exactly as alone; the first failure in
   // the list's order is the one reported, as in a serial run
   const std::vector<double>& setpoints = p.reals("setpoint_sweep");
-  std::vector<std::optional<nlohmann::json>> swept(setpoints.size());
+  std::vector<std::optional<UnitTagged>> swept(setpoints.size());
   std::vector<std::exception_ptr> sweep_errors(setpoints.size());
 #pragma omp parallel for schedule(dynamic) if (setpoints.size() > 1)
   for (std::size_t k = 0; k < setpoints.size(); ++k) {
@@ -324,20 +354,12 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
         }
       }();
       const ti::ImagingMetrics ms = ti::imaging_metrics(rs);
-      swept[k] = nlohmann::json{{"setpoint", sp},
-                                {"engaged_separation", rs.engaged_separation},
-                                {"trace_height_rms_error", ms.trace_height_rms_error},
-                                {"apparent_height", range_of(rs.trace.height)},
-                                {"truth_height", truth_range},
-                                {"fraction_attractive", ms.fraction_attractive},
-                                {"fraction_repulsive", ms.fraction_repulsive},
-                                {"regime_switches_per_line", ms.switches_per_line},
-                                {"max_peak_force", ms.max_peak_force}};
+      swept[k] = setpoint_sweep_record(sp, rs.engaged_separation, ms, range_of(rs.trace.height), truth_range);
     } catch (...) {
       sweep_errors[k] = std::current_exception();
     }
   }
-  nlohmann::json setpoint_sweep = nlohmann::json::array();
+  std::vector<UnitTagged> setpoint_sweep;
   for (std::size_t k = 0; k < setpoints.size(); ++k) {
     if (sweep_errors[k]) std::rethrow_exception(sweep_errors[k]);
     setpoint_sweep.push_back(std::move(*swept[k]));
@@ -393,73 +415,58 @@ void run_tapping_image(const io::ParamSet& p, Captured* capture) {
   }
 
   // the branches that hold the set-point: where the loop can sit, and the height change between them
-  nlohmann::json at_setpoint = nlohmann::json::array();
+  std::vector<UnitTagged> at_setpoint;
   const double a_sp_model = fb.setpoint * model.free_amplitude();
   for (std::size_t b = 0; b < orbit_map.branches().size(); ++b)
     for (double l : orbit_map.separations_at_amplitude(static_cast<int>(b), a_sp_model)) {
       if (!orbit_map.contains(static_cast<int>(b), l)) continue;
       const ti::SteadyState s = orbit_map.at(static_cast<int>(b), l);
-      at_setpoint.push_back({{"branch", b},
-                             {"separation", l * scales.length * nm},
-                             {"regime", ti::regime_name(ti::regime_of(s.in_phase_force, orbit_map.drive_amplitude()))},
-                             {"phase", s.phase() * 180.0 / std::numbers::pi},
-                             {"peak_force", s.peak_force * scales.force * nm}});
+      at_setpoint.push_back(branch_at_setpoint_record(
+          b, l * scales.length * nm, ti::regime_name(ti::regime_of(s.in_phase_force, orbit_map.drive_amplitude())),
+          s.phase() * 180.0 / std::numbers::pi, s.peak_force * scales.force * nm));
     }
   const double a_sp = r.setpoint_amplitude;
-  const nlohmann::json results = {
-      {"engine", p.text("engine")},
-      {"cycles_per_pixel", raster.pixel_time() * f_drive},
-      {"drive_cycles", time_domain ? static_cast<double>(dynamic_cast<const ti::TimeDomainEngine&>(*engine).cycles())
-                                   : 2.0 * static_cast<double>(raster.pixels * raster.lines) * raster.pixel_time() * f_drive},
-      {"free_amplitude", a0_nm * nm},
-      {"setpoint_amplitude", a_sp},
-      {"drive_frequency", f_drive},
-      {"cantilever_time_constant", time_constant},
-      {"lockin_time_constant", fb.lockin_bandwidth > 0 ? 1.0 / (2.0 * std::numbers::pi * fb.lockin_bandwidth) : 0.0},
-      {"tip_speed", raster.tip_speed},
-      {"pixel_time", raster.pixel_time()},
-      {"updates", r.updates},
-      {"engaged_separation", r.engaged_separation},
-      {"trace_height_rms_error", m.trace_height_rms_error},
-      {"retrace_height_rms_error", m.retrace_height_rms_error},
-      {"truth_rms_height", m.truth_rms_height},
-      {"fraction_free", m.fraction_free},
-      {"fraction_attractive", m.fraction_attractive},
-      {"fraction_repulsive", m.fraction_repulsive},
-      {"regime_switches_per_line", m.switches_per_line},
-      {"max_regime_switches_per_line", m.max_switches_per_line},
-      {"branch_jumps_per_line", m.jumps_per_line},
-      {"max_peak_force", m.max_peak_force},
-      {"max_amplitude_error", m.max_abs_error},
-      {"beyond_map_updates", r.beyond_map_updates},
-      {"z_limited_updates", r.z_limited_updates},
-      {"map_branches", orbit_map.branches().size()},
-      {"map_jumps", orbit_map.jumps()},
-      {"map_non_periodic_points", orbit_map.non_periodic_points()},
-      {"branches_at_setpoint", at_setpoint},
-      {"apparent_height", range_of(r.trace.height)},
-      {"truth_height", truth_range},
-      {"setpoint_sweep", setpoint_sweep},
-      {"scan_seconds", r.seconds},
-      {"files", files},
-      {"units",
-       {{"free_amplitude", "m"}, {"setpoint_amplitude", "m"}, {"drive_frequency", "Hz"},
-        {"cantilever_time_constant", "s"}, {"lockin_time_constant", "s"}, {"tip_speed", "m/s"}, {"pixel_time", "s"},
-        {"cycles_per_pixel", "count"}, {"drive_cycles", "count"},
-        {"updates", "count"}, {"engaged_separation", "m"}, {"trace_height_rms_error", "m"},
-        {"retrace_height_rms_error", "m"}, {"truth_rms_height", "m"}, {"fraction_free", "dimensionless"},
-        {"fraction_attractive", "dimensionless"}, {"fraction_repulsive", "dimensionless"},
-        {"regime_switches_per_line", "count"}, {"max_regime_switches_per_line", "count"},
-        {"branch_jumps_per_line", "count"}, {"max_peak_force", "N"}, {"max_amplitude_error", "m"},
-        {"beyond_map_updates", "count"}, {"z_limited_updates", "count"}, {"map_branches", "count"},
-        {"map_jumps", "count"}, {"map_non_periodic_points", "count"},
-        {"branches_at_setpoint", {{"separation", "m"}, {"phase", "deg"}, {"peak_force", "N"}}},
-        {"apparent_height", "m"}, {"truth_height", "m"},
-        {"setpoint_sweep", {{"setpoint", "dimensionless"}, {"engaged_separation", "m"}, {"trace_height_rms_error", "m"},
-                            {"apparent_height", "m"}, {"truth_height", "m"}, {"fraction_attractive", "dimensionless"},
-                            {"fraction_repulsive", "dimensionless"}, {"regime_switches_per_line", "count"},
-                            {"max_peak_force", "N"}}},
-        {"scan_seconds", "s"}}}};
+  // SI results (m, s, Hz, N), each with its unit; the records of the lists with the units of their prototypes
+  UnitTagged tagged;
+  tagged.add("engine", p.text("engine"))
+      .add("cycles_per_pixel", raster.pixel_time() * f_drive, "count")
+      .add("drive_cycles",
+           time_domain ? static_cast<double>(dynamic_cast<const ti::TimeDomainEngine&>(*engine).cycles())
+                       : 2.0 * static_cast<double>(raster.pixels * raster.lines) * raster.pixel_time() * f_drive,
+           "count")
+      .add("free_amplitude", a0_nm * nm, "m")
+      .add("setpoint_amplitude", a_sp, "m")
+      .add("drive_frequency", f_drive, "Hz")
+      .add("cantilever_time_constant", time_constant, "s")
+      .add("lockin_time_constant",
+           fb.lockin_bandwidth > 0 ? 1.0 / (2.0 * std::numbers::pi * fb.lockin_bandwidth) : 0.0, "s")
+      .add("tip_speed", raster.tip_speed, "m/s")
+      .add("pixel_time", raster.pixel_time(), "s")
+      .add("updates", r.updates, "count")
+      .add("engaged_separation", r.engaged_separation, "m")
+      .add("trace_height_rms_error", m.trace_height_rms_error, "m")
+      .add("retrace_height_rms_error", m.retrace_height_rms_error, "m")
+      .add("truth_rms_height", m.truth_rms_height, "m")
+      .add("fraction_free", m.fraction_free, "dimensionless")
+      .add("fraction_attractive", m.fraction_attractive, "dimensionless")
+      .add("fraction_repulsive", m.fraction_repulsive, "dimensionless")
+      .add("regime_switches_per_line", m.switches_per_line, "count")
+      .add("max_regime_switches_per_line", m.max_switches_per_line, "count")
+      .add("branch_jumps_per_line", m.jumps_per_line, "count")
+      .add("max_peak_force", m.max_peak_force, "N")
+      .add("max_amplitude_error", m.max_abs_error, "m")
+      .add("beyond_map_updates", r.beyond_map_updates, "count")
+      .add("z_limited_updates", r.z_limited_updates, "count")
+      .add("map_branches", orbit_map.branches().size(), "count")
+      .add("map_jumps", orbit_map.jumps(), "count")
+      .add("map_non_periodic_points", orbit_map.non_periodic_points(), "count")
+      .add("branches_at_setpoint", at_setpoint, branch_at_setpoint_record(0, 0.0, "", 0.0, 0.0))
+      .add("apparent_height", range_of(r.trace.height), "m")
+      .add("truth_height", truth_range, "m")
+      .add("setpoint_sweep", setpoint_sweep, setpoint_sweep_record(0.0, 0.0, ti::ImagingMetrics{}, 0.0, 0.0))
+      .add("scan_seconds", r.seconds, "s")
+      .add("files", files);
+  const nlohmann::json results = std::move(tagged).summary();
   if (r.beyond_map_updates > 0)
     io::message_line(fmt::format("afmkit tapping image: warning: {} of {} controller updates had the separation "
                                  "outside the orbit map [{}, {}] (clamped): widen map_separation_min/max",

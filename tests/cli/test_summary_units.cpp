@@ -350,3 +350,21 @@ TEST(SummaryUnits, EveryResultOfScanHasItsUnit) {
     EXPECT_EQ(unitless_results(dir.path / "r.csv.json"), std::vector<std::string>{}) << args;
   }
 }
+
+TEST(SummaryUnits, EveryResultOfTappingImageHasItsUnit) {
+  // on main the branches at the set-point had no unit for their `branch` (an index of the orbit map's branches); the
+  // results are built on UnitTagged now, and the lists' units are there also when a list is empty (no sweep)
+  for (const char* args : {"tapping image --pixels 8 --lines 4 --map-points 60 --setpoint-sweep 0.7,0.9 --quiet "
+                           "--image-output '' --output r.csv",
+                           "tapping image --pixels 8 --lines 4 --map-points 60 --quiet --image-output '' "
+                           "--output r.csv"}) {
+    TempDir dir;
+    const auto r = run_cli(args, dir);
+    ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
+    EXPECT_EQ(unitless_results(dir.path / "r.csv.json"), std::vector<std::string>{}) << args;
+    const auto results = nlohmann::json::parse(slurp(dir.path / "r.csv.json")).at("results");
+    ASSERT_FALSE(results.at("branches_at_setpoint").empty()) << args;
+    EXPECT_EQ(results.at("units").at("branches_at_setpoint").at("branch"), "count");
+    EXPECT_EQ(results.at("units").at("setpoint_sweep").at("engaged_separation"), "m");
+  }
+}
