@@ -10,7 +10,9 @@
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/core/memory.hpp"
+#include "afmkit/core/units.hpp"
 #include "afmkit/io/quantity.hpp"
+#include "unit_tagged.hpp"
 #include "work_budget.hpp"
 
 namespace afmkit::cli {
@@ -280,55 +282,44 @@ control::ControlSettings control_settings_from(const io::ParamSet& p) {
 }
 
 namespace {
-nlohmann::json settings_common(const control::ControlSettings& c, double rate, double delay) {
-  nlohmann::json j;
-  j["controller"] = control::to_string(c.controller);
-  j["rotation_frequency"] = c.rotation_frequency;
-  j["harmonics"] = c.harmonics;
-  j["alpha"] = c.alpha * rate;
-  j["beta"] = c.beta * rate;
-  j["a"] = c.a * rate;
-  j["b"] = c.b * rate;
-  j["rejected"] = c.rejected;
-  j["gain"] = c.gain_value() * rate;
-  j["plant"] = control::to_string(c.plant);
-  j["plant_rate"] = c.plant_rate * rate;
-  j["delay"] = c.delay * delay;
-  if (c.controller == control::ControllerKind::Smith) {
-    j["smith_bank"] = control::to_string(c.smith_bank);
-    j["smith_structure"] = control::to_string(c.smith_structure);
-    j["model_plant"] = control::to_string(c.model_plant_value());
-    j["model_rate"] = c.model_rate_value() * rate;
-    j["model_delay"] = c.model_delay_value() * delay;
-  }
+// The resolved settings, each number with its unit: rates (alpha, beta, a, b, gain, plant_rate, model_rate) in
+// `rate`, delays in `delay` (Omega and T as given, or rad/s and s: value x rate.multiply); labels without a unit.
+UnitTagged settings_record(const control::ControlSettings& c, const units::Unit& rate, const units::Unit& delay) {
+  UnitTagged j;
+  j.add("controller", control::to_string(c.controller))
+      .add("rotation_frequency", c.rotation_frequency, "rad/s")
+      .add("harmonics", c.harmonics, "count")
+      .add("alpha", c.alpha, rate)
+      .add("beta", c.beta, rate)
+      .add("a", c.a, rate)
+      .add("b", c.b, rate)
+      .add("rejected", c.rejected, "count")
+      .add("gain", c.gain_value(), rate)
+      .add("plant", control::to_string(c.plant))
+      .add("plant_rate", c.plant_rate, rate)
+      .add("delay", c.delay, delay);
+  if (c.controller == control::ControllerKind::Smith)
+    j.add("smith_bank", control::to_string(c.smith_bank))
+        .add("smith_structure", control::to_string(c.smith_structure))
+        .add("model_plant", control::to_string(c.model_plant_value()))
+        .add("model_rate", c.model_rate_value(), rate)
+        .add("model_delay", c.model_delay_value(), delay);
   return j;
-}
-nlohmann::json settings_units(const control::ControlSettings& c, const char* rate, const char* delay) {
-  nlohmann::json u = {{"rotation_frequency", "rad/s"}, {"harmonics", "count"}, {"alpha", rate}, {"beta", rate},
-                      {"a", rate}, {"b", rate}, {"rejected", "count"}, {"gain", rate}, {"plant_rate", rate},
-                      {"delay", delay}};
-  if (c.controller == control::ControllerKind::Smith) {
-    u["model_rate"] = rate;
-    u["model_delay"] = delay;
-  }
-  return u;
 }
 }  // namespace
 
 nlohmann::json settings_json(const control::ControlSettings& c) {
-  nlohmann::json j = settings_common(c, 1.0, 1.0);
-  j["units"] = settings_units(c, control::RotationUnits::rate_unit, control::RotationUnits::delay_unit);
-  return j;
+  return settings_record(c, units::as_is(control::RotationUnits::rate_unit),
+                         units::as_is(control::RotationUnits::delay_unit))
+      .with_units();
 }
 
 nlohmann::json settings_si_json(const control::ControlSettings& c) {
   const control::RotationUnits u = c.units();
-  nlohmann::json j = settings_common(c, u.rotation_frequency(), u.period());
-  j["period"] = u.period();
-  nlohmann::json units = settings_units(c, control::RotationUnits::si_rate_unit, control::RotationUnits::si_delay_unit);
-  units["period"] = control::RotationUnits::si_delay_unit;
-  j["units"] = units;
-  return j;
+  UnitTagged j = settings_record(c, {control::RotationUnits::si_rate_unit, u.rotation_frequency(), 1.0},
+                                 {control::RotationUnits::si_delay_unit, u.period(), 1.0});
+  j.add("period", u.period(), control::RotationUnits::si_delay_unit);
+  return j.with_units();
 }
 
 io::ParamSet params_as_run(const io::ParamSet& p, const control::ControlSettings& c,
