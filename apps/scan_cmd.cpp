@@ -165,6 +165,12 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       .add("noise_gain", budget.noise_gain, "dimensionless")
       .add("image_noise_gain", budget.image_noise_gain, "dimensionless")
       .add("noise", budget.noise, "m")
+      .add("inverse", nlohmann::json(budget.wiener ? "wiener" : "exact"))
+      .add("exact_image_noise_gain", budget.exact_image_noise_gain, "dimensionless")
+      .add("prior_increment", budget.prior_increment, "m")
+      .add("cutoff", budget.cutoff, "Hz")
+      .add("filter_taps", budget.filter_taps, "count")
+      .add("resolution", budget.resolution, "m")
       .add("predicted", budget.predicted, "m")
       .add("pole", budget.pole, "dimensionless")
       .add("settle_samples", budget.settle_samples, "count");
@@ -207,7 +213,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       "error {} (levelled; {} reconstruction; {}; {} reconstruction: {}); error "
       "budget of the inverse: imaging {} ({} against the real truth: the sampling's floor), reconstruction {} ({} "
       "against the truth imaged through the same sampling), plant knowledge {} (assumed rate {:+.3g} %), "
-      "noise {} (gain {:.4g} at the samples, {:.4g} in the image), predicted {}{}",
+      "noise {} (gain {:.4g} at the samples, {:.4g} in the image{}), predicted {}{}",
       result.run.samples, result.turns, instrument.controller.enabled ? "on" : "off",
       100.0 * result.saturated_fraction, io::quantity(result.max_radius_with_control, "m"),
       result.saturates_with_control ? "" : " (never saturated)",
@@ -220,7 +226,12 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       io::quantity(budget.imaging, "m"), percent(budget.imaging), io::quantity(budget.reconstruction, "m"),
       percent(budget.reconstruction),
       io::quantity(budget.plant, "m"), 100.0 * budget.plant_mismatch,
-      io::quantity(budget.noise, "m"), budget.noise_gain, budget.image_noise_gain, io::quantity(budget.predicted, "m"),
+      io::quantity(budget.noise, "m"), budget.noise_gain, budget.image_noise_gain,
+      budget.wiener ? fmt::format("; Wiener low-pass: cutoff {}, {} taps, exact inverse's image gain {:.4g}; "
+                                  "resolution {}", io::quantity(budget.cutoff, "Hz"), budget.filter_taps,
+                                  budget.exact_image_noise_gain, io::quantity(budget.resolution, "m"))
+                    : std::string(),
+      io::quantity(budget.predicted, "m"),
       files.empty() ? std::string() : fmt::format("; wrote {} files with prefix {}", files.size(), prefix));
   out.finish(results, summary);
 }

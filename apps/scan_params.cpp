@@ -220,7 +220,16 @@ void add_scan_params(io::ParamSet& p) {
       .real("reconstruction_bandwidth", 0.0,
             "plant rate gamma the reconstruction and the actuator model assume (0: the true bandwidth)", non_negative)
       .unit("rad/s")
-      .follows("bandwidth");  // recorded as the rate used
+      .follows("bandwidth")  // recorded as the rate used
+      .text("inverse", "wiener",
+            "how the inverse treats detector noise: wiener (the exact inverse followed by the Wiener low-pass along "
+            "the turn, from detector_noise, the plant and the sample's prior; the exact inverse when detector_noise "
+            "= 0) or exact",
+            {"wiener", "exact"})
+      .real("prior_increment", 0.0,
+            "RMS height change between consecutive samples the Wiener prior assumes (0: from the sample map along "
+            "the spiral)", non_negative)
+      .unit("m");
 }
 
 namespace {
@@ -293,7 +302,7 @@ const std::vector<std::string>& simulation_only_keys() {
       "rough_rms", "rough_correlation_length", "tilt_angle", "tilt_azimuth", "spindle_frequency", "start_radius",
       "end_radius", "radial_speed", "sample_rate", "bandwidth", "delay", "delay_drift", "delay_drift_period",
       "gain_error", "detector_range", "detector_noise", "noise_seed", "control", "gain", "reconstruction",
-      "reconstruction_bandwidth"};
+      "reconstruction_bandwidth", "inverse", "prior_increment"};
   return keys;
 }
 
@@ -337,6 +346,9 @@ scan::InstrumentSpec instrument_from(const io::ParamSet& p) {
       p.text("reconstruction") == "lagged" ? scan::Reconstruction::lagged : scan::Reconstruction::inverse;
   // not given: 0, the true bandwidth (the record shows that value: follows("bandwidth"))
   s.reconstruction.assumed_bandwidth = p.was_set("reconstruction_bandwidth") ? p.real("reconstruction_bandwidth") : 0.0;
+  s.reconstruction.inverse_filter =
+      p.text("inverse") == "exact" ? scan::InverseFilter::exact : scan::InverseFilter::wiener;
+  s.reconstruction.prior_increment = p.real("prior_increment");
   s.validate();
   return s;
 }

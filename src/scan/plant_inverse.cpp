@@ -8,7 +8,10 @@
 
 namespace afmkit::scan {
 
-void ReconstructionSpec::validate() const { validate::non_negative("reconstruction_bandwidth", assumed_bandwidth); }
+void ReconstructionSpec::validate() const {
+  validate::non_negative("reconstruction_bandwidth", assumed_bandwidth);
+  validate::non_negative("prior_increment", prior_increment);
+}
 
 PlantInverse::PlantInverse(double bandwidth, double sample_rate) {
   validate::positive("reconstruction_bandwidth", bandwidth);

@@ -13,6 +13,7 @@
 
 #include "afmkit/control/realtime_filter.hpp"
 #include "afmkit/core/error.hpp"
+#include "afmkit/scan/wiener_inverse.hpp"
 
 namespace afmkit::scan {
 
@@ -44,6 +45,74 @@ inline double relax(double y, double target, double e) { return target + (y - ta
 inline double relax_ramp(double y, double g_start, double g_end, double lag, double e) {
   return g_end - lag + (y - g_start + lag) * e;
 }
+
+// The Wiener low-pass (wiener_inverse.hpp) on the inverse channel, applied as the samples stream: each sample is
+// handed on K samples late, its inverse replaced by Σ g_|j−c| f̂_j over the window j = c − K … c + K. Where the
+// window reaches past the scan's ends or holds non-finite values (saturated or settling samples) the finite taps
+// are renormalised (NaN when their weights sum below 1/2, or when f̂_c itself is NaN).
+class DelayedLowPass {
+ public:
+  DelayedLowPass(const WienerLowPass& filter, std::int64_t first)
+      : taps_(filter.taps()), k_(filter.half_width()), first_(first), next_(first), last_(first - 1) {
+    const auto size = std::bit_ceil(static_cast<std::uint64_t>(2 * k_ + 2));
+    mask_ = size - 1;
+    samples_.resize(size);
+    values_.resize(size);
+  }
+
+  /// Stores s (the next sample); true with `out` = the sample K back, filtered, when there is one.
+  bool push(const ScanSample& s, ScanSample& out) {
+    const std::int64_t n = s.index;
+    const std::int64_t leaving = n - 2 * k_ - 1;
+    if (leaving >= first_ && !std::isfinite(values_[slot(leaving)])) --bad_;
+    samples_[slot(n)] = s;
+    values_[slot(n)] = s.inverse;
+    if (!std::isfinite(s.inverse)) ++bad_;
+    last_ = n;
+    if (n - k_ < next_) return false;
+    emit(out);
+    return true;
+  }
+  /// After the last sample: the ones still held, in order (false when none is left).
+  bool pop(ScanSample& out) {
+    if (next_ > last_) return false;
+    emit(out);
+    return true;
+  }
+
+ private:
+  std::uint64_t slot(std::int64_t n) const { return static_cast<std::uint64_t>(n) & mask_; }
+  void emit(ScanSample& out) {
+    const std::int64_t c = next_++;
+    out = samples_[slot(c)];
+    const double centre = values_[slot(c)];
+    if (!std::isfinite(centre)) return;  // NaN stays NaN
+    const std::int64_t lo = std::max(first_, c - k_), hi = std::min(last_, c + k_);
+    if (bad_ == 0 && lo == c - k_ && hi == c + k_) {
+      double sum = taps_[0] * centre;
+      for (std::int64_t k = 1; k <= k_; ++k)
+        sum += taps_[static_cast<std::size_t>(k)] * (values_[slot(c - k)] + values_[slot(c + k)]);
+      out.inverse = sum;
+      return;
+    }
+    double sum = 0.0, weights = 0.0;
+    for (std::int64_t j = lo; j <= hi; ++j) {
+      const double v = values_[slot(j)];
+      if (!std::isfinite(v)) continue;
+      const double g = taps_[static_cast<std::size_t>(j > c ? j - c : c - j)];
+      sum += g * v;
+      weights += g;
+    }
+    out.inverse = weights >= 0.5 ? sum / weights : std::numeric_limits<double>::quiet_NaN();
+  }
+
+  std::vector<double> taps_;
+  std::int64_t k_, first_, next_, last_;
+  std::uint64_t mask_ = 0;
+  std::vector<ScanSample> samples_;
+  std::vector<double> values_;
+  std::int64_t bad_ = 0;  // non-finite values among the last 2K + 1 pushed
+};
 
 }  // namespace
 
@@ -80,6 +149,10 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
   const DelaySplit actual = DelaySplit::of(plant.delay, fs, gamma);      // the plant at the nominal delay
   const DelaySplit nominal = DelaySplit::of(plant.delay, fs, gamma_hat);  // the calibrated actuator model
   PlantInverse inverse(gamma_hat, fs);
+  std::optional<DelayedLowPass> low_pass;  // the noise-aware inverse's low-pass (none: the exact inverse as it is)
+  if (const std::optional<WienerLowPass> filter = noise_aware_filter(instrument, surface))
+    low_pass.emplace(*filter, first_sample);
+  ScanSample delayed{};
   const bool drifts = plant.delay_drift > 0.0;
   const double drift_rate = 2.0 * std::numbers::pi / plant.delay_drift_period;
   const double actuator_gain = (1.0 + plant.gain_error) / gamma;  // y* = f + (1 + ε) u / γ
@@ -127,7 +200,7 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
     const double w = d - y_hat;
     const double f_hat = inverse.step(saturated ? std::numeric_limits<double>::quiet_NaN() : w);
     const ScanSample s{n, t, theta, r, f, d, u, -y_hat, w, f_hat, saturated};
-    if (!observer.sample(s)) {
+    if (low_pass ? low_pass->push(s, delayed) && !observer.sample(delayed) : !observer.sample(s)) {
       run.stopped_early = true;
       break;
     }
@@ -152,6 +225,12 @@ ScanRun simulate_scan(const InstrumentSpec& instrument, const Surface& surface, 
       if (progress) progress(n + 1, total);
     }
   }
+  if (low_pass && !run.stopped_early)
+    while (low_pass->pop(delayed))
+      if (!observer.sample(delayed)) {
+        run.stopped_early = true;
+        break;
+      }
   if (filter) run.filter_skipped = filter->skipped_samples();
   if (progress) progress(run.samples, total);
   return run;

@@ -31,6 +31,7 @@ UncontrolledSaturation run_uncontrolled_from(const InstrumentSpec& off, const Su
 InstrumentSpec with_control_off(const InstrumentSpec& instrument) {
   InstrumentSpec off = instrument;
   off.controller.enabled = false;
+  off.reconstruction.inverse_filter = InverseFilter::exact;  // only the deflection matters here
   off.validate();
   return off;
 }

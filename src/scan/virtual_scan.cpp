@@ -5,6 +5,7 @@
 #include <cmath>
 #include <future>
 #include <limits>
+#include <numbers>
 #include <tuple>
 #include <utility>
 #include <optional>
@@ -17,6 +18,7 @@
 #include "afmkit/scan/observer_thread.hpp"
 #include "afmkit/scan/spiral_imager.hpp"
 #include "afmkit/scan/uncontrolled_saturation.hpp"
+#include "afmkit/scan/wiener_inverse.hpp"
 
 namespace afmkit::scan {
 
@@ -210,10 +212,22 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   std::tie(b.imaging, b.reconstruction) = budget_errors.get();
   b.plant_mismatch = instrument.assumed_bandwidth() / instrument.plant.bandwidth - 1.0;
   b.plant = std::abs(instrument.plant.bandwidth / instrument.assumed_bandwidth() - 1.0) * out.lagged_rms_error;
+  b.exact_image_noise_gain = model.image_noise_gain();
   b.noise_gain = model.noise_gain();
   b.image_noise_gain = model.image_noise_gain();
+  b.cutoff = 0.5 * spiral.sample_rate;
+  b.filter_taps = 1;
+  if (const std::optional<WienerLowPass> low_pass = noise_aware_filter(instrument, surface)) {  // as simulate_scan
+    b.wiener = true;
+    b.noise_gain = low_pass->noise_gain();
+    b.image_noise_gain = low_pass->image_noise_gain();
+    b.prior_increment = low_pass->prior_increment();
+    b.cutoff = low_pass->cutoff() * spiral.sample_rate / (2.0 * std::numbers::pi);
+    b.filter_taps = 2 * low_pass->half_width() + 1;
+    b.resolution = low_pass->resolution();
+  }
   b.noise = b.image_noise_gain * instrument.detector.noise;
-  b.predicted = std::sqrt(b.imaging * b.imaging + b.plant * b.plant + b.noise * b.noise);
+  b.predicted = std::sqrt(b.imaging * b.imaging + b.plant * b.plant + b.noise * b.noise + b.resolution * b.resolution);
   b.pole = model.pole();
   b.settle_samples = model.settle_samples();
   if (out.topography.valid_count() >= 3) {

@@ -32,11 +32,20 @@ enum class Reconstruction {
   lagged,   ///< w = d + z_a: deflection plus calibrated actuator displacement (the plant's lag left in)
 };
 
+/// How the inverse treats detector noise (wiener_inverse.hpp, docs/scan.md#noise-aware-inverse).
+enum class InverseFilter {
+  wiener,  ///< the exact inverse followed by the Wiener low-pass along the turn (none when σ_d = 0); the default
+  exact,   ///< the exact inverse alone (noise gain PlantInverse::noise_gain)
+};
+
 /// The instrument's model of its own plant for the reconstruction.
 struct ReconstructionSpec {
   Reconstruction method = Reconstruction::inverse;
   double assumed_bandwidth = 0.0;  ///< γ̂ [rad/s] the reconstruction (and z_a) assume; 0 = the true bandwidth γ
-  void validate() const;           ///< InvalidParameter("reconstruction_bandwidth") unless finite and >= 0
+  InverseFilter inverse_filter = InverseFilter::wiener;
+  double prior_increment = 0.0;    ///< √A [m] of the Wiener prior; 0 = from the sample (prior_increment())
+  /// InvalidParameter("reconstruction_bandwidth" / "prior_increment") unless finite and >= 0
+  void validate() const;
 };
 
 /// The exact discrete inverse of the first-order lag for first-order-hold input (above), one sample at a time.

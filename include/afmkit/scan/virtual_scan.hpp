@@ -66,10 +66,18 @@ struct ErrorBudget {
                                 ///< what the reconstruction itself adds, whatever the sampling
   double plant_mismatch = 0.0;  ///< γ̂/γ − 1 [dimensionless]: how wrong the assumed plant rate is
   double plant = 0.0;           ///< first-order plant-knowledge term |γ/γ̂ − 1| × lagged_rms_error
-  double noise_gain = 0.0;      ///< G of the inverse [dimensionless] (white noise on w comes out × G at the samples)
-  double image_noise_gain = 0.0;  ///< the same in the image (PlantInverse::image_noise_gain) [dimensionless]
+  /// G of the inverse as applied [dimensionless] (white noise on w comes out × G at the samples): the exact
+  /// inverse's (PlantInverse::noise_gain) or, with the Wiener low-pass, G_W (WienerLowPass::noise_gain)
+  double noise_gain = 0.0;
+  double image_noise_gain = 0.0;  ///< the same in the image (…::image_noise_gain) [dimensionless]
   double noise = 0.0;           ///< image_noise_gain · σ_d: the detector noise through the inverse and the imaging
-  double predicted = 0.0;       ///< √(imaging² + plant² + noise²), to compare with inverse_rms_error
+  bool wiener = false;          ///< the Wiener low-pass is applied (inverse_filter wiener and σ_d > 0)
+  double exact_image_noise_gain = 0.0;  ///< PlantInverse::image_noise_gain, what the exact inverse would pass
+  double prior_increment = 0.0;  ///< √A of the Wiener prior [m] (0 without the low-pass)
+  double cutoff = 0.0;          ///< frequency where the low-pass's gain is 1/2 [Hz] (f_s/2 without it)
+  std::int64_t filter_taps = 0;  ///< 2K + 1 taps of the low-pass (1 without it)
+  double resolution = 0.0;      ///< the height the low-pass removes for a sample of the prior (WienerLowPass) [m]
+  double predicted = 0.0;       ///< √(imaging² + plant² + noise² + resolution²), to compare with inverse_rms_error
   double pole = 0.0;            ///< p = −b0/b1 of the inverse recursion [dimensionless]
   std::int64_t settle_samples = 0;  ///< samples left out after each saturated stretch
 };
