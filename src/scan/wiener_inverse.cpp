@@ -33,6 +33,14 @@ WienerLowPass::WienerLowPass(const PlantInverse& inverse, double noise, double p
     difference[i] = 2.0 * (1.0 - std::cos(omega[i]));                  // |D|²
     weight[i] = 1.0 / (1.0 + ratio * power[i] * difference[i]);         // W(ω)
   }
+  // W within 1e−6 of 1 everywhere (σ²/A → 0): the exact inverse, as it is
+  if (*std::min_element(weight.begin(), weight.end()) > 1.0 - 1e-6) {
+    taps_ = {1.0};
+    noise_gain_ = inverse.noise_gain();
+    correlation_ = inverse.noise_correlation();
+    cutoff_ = std::numbers::pi;
+    return;
+  }
   // taps g_k = (1/π)∫₀^π W cos kω dω by the midpoint rule, until they stay below 1e−7 g_0 for 8 in a row
   std::vector<double> g;
   int below = 0;
@@ -99,7 +107,9 @@ std::optional<WienerLowPass> noise_aware_filter(const InstrumentSpec& instrument
   if (instrument.reconstruction.inverse_filter == InverseFilter::exact || !(noise > 0.0)) return std::nullopt;
   const double stated = instrument.reconstruction.prior_increment;
   const double prior = std::max(stated > 0.0 ? stated : prior_increment(instrument, surface), 1e-6 * noise);
-  return WienerLowPass(PlantInverse(instrument.assumed_bandwidth(), instrument.spiral.sample_rate), noise, prior);
+  WienerLowPass filter(PlantInverse(instrument.assumed_bandwidth(), instrument.spiral.sample_rate), noise, prior);
+  if (filter.half_width() == 0) return std::nullopt;  // transparent: the exact inverse
+  return filter;
 }
 
 }  // namespace afmkit::scan

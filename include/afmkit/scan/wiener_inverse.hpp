@@ -16,7 +16,8 @@
 // A = E[(f_{n+1} − f_n)²], the mean squared height change between consecutive samples, is the sample's: taken from
 // the sample map along the scan's spiral (prior_increment below), or stated (ReconstructionSpec::prior_increment).
 //
-// The filter is applied as the symmetric FIR g_k = (1/π)∫₀^π W(ω) cos kω dω, |k| ≤ K (the taps beyond K below
+// When W stays within 1e−6 of 1 at every frequency the filter is the identity (one tap: the exact inverse as it is).
+// Otherwise it is applied as the symmetric FIR g_k = (1/π)∫₀^π W(ω) cos kω dω, |k| ≤ K (the taps beyond K below
 // 1e−7 g_0; at most kMaxHalfWidth, Hann-tapered when cut there), normalised to Σ g = 1 (a plane passes unchanged).
 // Its error budget, for the taps as applied (G(ω) = g_0 + 2 Σ g_k cos kω), in closed form (integrals over ω):
 //   noise:       σ² G_W² = σ² (1/π)∫₀^π |H|² G² dω   (white noise through the inverse and the low-pass)
@@ -60,7 +61,8 @@ class WienerLowPass {
 double prior_increment(const InstrumentSpec& instrument, const Surface& surface);
 
 /// The low-pass the instrument's reconstruction applies after the exact inverse on this surface: none when
-/// reconstruction.inverse_filter is `exact` or the detector has no noise (σ_d = 0: the exact inverse, unchanged).
+/// reconstruction.inverse_filter is `exact`, the detector has no noise (σ_d = 0) or the filter is the identity
+/// (above): the exact inverse, unchanged.
 /// The prior: reconstruction.prior_increment when > 0, else prior_increment(instrument, surface), at least
 /// 1e−6 σ_d (a flat topography: the widest filter).
 std::optional<WienerLowPass> noise_aware_filter(const InstrumentSpec& instrument, const Surface& surface);
