@@ -129,9 +129,10 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
   if (inverse && result.inverse_rms_error > result.lagged_rms_error)
     fmt::print(stderr, "afmkit scan: warning: the lagged reconstruction is closer to the truth in this run ({} against "
                        "{} for the inverse, whose image noise gain {:.4g} turns detector_noise into {}): see "
-                       "--reconstruction lagged (docs/scan.md#reconstruction)\n",
+                       "--reconstruction lagged{} (docs/scan.md#reconstruction)\n",
                io::quantity(result.lagged_rms_error, "m"), io::quantity(result.inverse_rms_error, "m"),
-               result.budget.image_noise_gain, io::quantity(result.budget.noise, "m"));
+               result.budget.image_noise_gain, io::quantity(result.budget.noise, "m"),
+               !result.budget.wiener && instrument.detector.noise > 0.0 ? " or --inverse wiener" : "");
   const std::string method = inverse ? "inverse" : "lagged", other = inverse ? "lagged" : "inverse";
   const scan::ErrorBudget& budget = result.budget;
   // errors relative to the sample's RMS height; a truth that levels to a plane (sample = flat: rounding, ~1e-19 m)
@@ -171,6 +172,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       .add("cutoff", budget.cutoff, "Hz")
       .add("filter_taps", budget.filter_taps, "count")
       .add("resolution", budget.resolution, "m")
+      .add("resolution_prior", budget.resolution_prior, "m")
       .add("predicted", budget.predicted, "m")
       .add("pole", budget.pole, "dimensionless")
       .add("settle_samples", budget.settle_samples, "count");

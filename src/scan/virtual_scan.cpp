@@ -224,7 +224,8 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
     b.prior_increment = low_pass->prior_increment();
     b.cutoff = low_pass->cutoff() * spiral.sample_rate / (2.0 * std::numbers::pi);
     b.filter_taps = 2 * low_pass->half_width() + 1;
-    b.resolution = low_pass->resolution();
+    b.resolution = sampled_resolution(instrument, surface, *low_pass);
+    b.resolution_prior = low_pass->resolution();
   }
   b.noise = b.image_noise_gain * instrument.detector.noise;
   b.predicted = std::sqrt(b.imaging * b.imaging + b.plant * b.plant + b.noise * b.noise + b.resolution * b.resolution);

@@ -102,6 +102,35 @@ double prior_increment(const InstrumentSpec& instrument, const Surface& surface)
   return std::sqrt(sum / static_cast<double>(pairs));
 }
 
+double sampled_resolution(const InstrumentSpec& instrument, const Surface& surface, const WienerLowPass& filter) {
+  const SpiralSpec& s = instrument.spiral;
+  const std::int64_t total = s.samples(), k_max = filter.half_width();
+  const std::int64_t length = std::min<std::int64_t>(2048, total);
+  if (length <= 2 * k_max) return 0.0;
+  const std::int64_t stretches = std::min<std::int64_t>(64, std::max<std::int64_t>(1, total / length));
+  const double h = 1.0 / s.sample_rate, omega = s.rotation_frequency();
+  const std::vector<double>& g = filter.taps();
+  std::vector<double> f(static_cast<std::size_t>(length));
+  double sum = 0.0;
+  std::int64_t count = 0;
+  for (std::int64_t j = 0; j < stretches; ++j) {
+    const std::int64_t first = j * (total - length) / std::max<std::int64_t>(1, stretches - 1);
+    for (std::int64_t i = 0; i < length; ++i) {
+      const double t = static_cast<double>(first + i) * h, r = s.start_radius + s.radial_speed * t;
+      f[static_cast<std::size_t>(i)] = surface(r * std::cos(omega * t), r * std::sin(omega * t));
+    }
+    for (std::int64_t c = k_max; c < length - k_max; ++c) {
+      double v = g[0] * f[static_cast<std::size_t>(c)];
+      for (std::int64_t k = 1; k <= k_max; ++k)
+        v += g[static_cast<std::size_t>(k)] * (f[static_cast<std::size_t>(c - k)] + f[static_cast<std::size_t>(c + k)]);
+      const double e = v - f[static_cast<std::size_t>(c)];
+      sum += e * e;
+      ++count;
+    }
+  }
+  return std::sqrt(sum / static_cast<double>(count));
+}
+
 std::optional<WienerLowPass> noise_aware_filter(const InstrumentSpec& instrument, const Surface& surface) {
   const double noise = instrument.detector.noise;
   if (instrument.reconstruction.inverse_filter == InverseFilter::exact || !(noise > 0.0)) return std::nullopt;

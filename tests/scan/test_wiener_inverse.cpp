@@ -4,6 +4,7 @@
 // inverse or the lagged reconstruction.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -210,8 +211,14 @@ TEST(WienerInverseScan, ANoisyScanIsImagedFarBetterThanByTheExactInverseOrTheLag
   EXPECT_EQ(w.lagged_rms_error, e.lagged_rms_error);  // the lagged reconstruction is not filtered
   const double noise_measured = levelled_rms_difference(w.topography, w2.topography) / std::sqrt(2.0);
   EXPECT_NEAR(noise_measured / w.budget.noise, 1.0, 0.15);
+  // the rest of the reconstruction term is the height the low-pass removes: against the budget's resolution term,
+  // measured on the sample along the spiral before any imaging
+  const double bias_measured = std::sqrt(std::max(0.0, w.budget.reconstruction * w.budget.reconstruction -
+                                                           noise_measured * noise_measured));
+  EXPECT_NEAR(bias_measured / w.budget.resolution, 1.0, 0.3);
   EXPECT_NEAR(w.inverse_rms_error / w.budget.predicted, 1.0, 0.15);
   EXPECT_GT(w.budget.resolution, 0.0);
+  EXPECT_GT(w.budget.resolution_prior, 0.0);
   EXPECT_GT(w.budget.prior_increment, 0.0);
   EXPECT_LT(w.budget.image_noise_gain, 0.2 * w.budget.exact_image_noise_gain);
 }

@@ -76,7 +76,9 @@ struct ErrorBudget {
   double prior_increment = 0.0;  ///< √A of the Wiener prior [m] (0 without the low-pass)
   double cutoff = 0.0;          ///< frequency where the low-pass's gain is 1/2 [Hz] (f_s/2 without it)
   std::int64_t filter_taps = 0;  ///< 2K + 1 taps of the low-pass (1 without it)
-  double resolution = 0.0;      ///< the height the low-pass removes for a sample of the prior (WienerLowPass) [m]
+  /// the height the low-pass removes from this sample along the spiral (sampled_resolution) [m]
+  double resolution = 0.0;
+  double resolution_prior = 0.0;  ///< the same for a sample of the prior, closed form (WienerLowPass) [m]
   double predicted = 0.0;       ///< √(imaging² + plant² + noise² + resolution²), to compare with inverse_rms_error
   double pole = 0.0;            ///< p = −b0/b1 of the inverse recursion [dimensionless]
   std::int64_t settle_samples = 0;  ///< samples left out after each saturated stretch

@@ -60,6 +60,12 @@ class WienerLowPass {
 /// consecutive samples of the instrument's spiral, from 65536 pairs of samples spread evenly over the scan.
 double prior_increment(const InstrumentSpec& instrument, const Surface& surface);
 
+/// The height the taps remove from this sample along the instrument's spiral [m]: RMS(g * f − f) over 64 stretches
+/// of 2048 consecutive samples spread evenly over the scan (the true heights f, tilt included, at the sample
+/// positions; the filter's full window only) — the resolution term of the budget for the sample itself, where
+/// WienerLowPass::resolution() is that of the prior.
+double sampled_resolution(const InstrumentSpec& instrument, const Surface& surface, const WienerLowPass& filter);
+
 /// The low-pass the instrument's reconstruction applies after the exact inverse on this surface: none when
 /// reconstruction.inverse_filter is `exact`, the detector has no noise (σ_d = 0) or the filter is the identity
 /// (above): the exact inverse, unchanged.
