@@ -66,18 +66,27 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
   const scan::InstrumentSpec instrument = instrument_from(p);
   require_scan_memory(p, false);  // before the sample map and the images are allocated
   const scan::Grid grid = scan::image_grid(instrument, p.integer("image_resolution"));
-  // the sample is made on a second thread while this one builds the imager (its pixel centres sorted by radius);
-  // the imager's tables stay in this thread's heap, where the images and the files are made after the scan
-  std::future<scan::Surface> sample = std::async(std::launch::async, [&p] { return surface_from(p); });
+  std::optional<scan::Surface> surface;
   std::optional<scan::SpiralImager> imager;
-  try {
+  if (p.text("sample") == "file") {
+    // a sample file is read and checked first, its geometry too: a bad file is reported before the imager is built
+    // (25 ms at 512² pixels, seconds at 16384²)
+    surface.emplace(surface_from(p));
+    scan::check_scan_geometry(instrument, *surface, grid);
     imager.emplace(scan::scan_imager(instrument, grid));
-  } catch (...) {
-    sample.wait();  // the thread reads p: let it finish before the error unwinds
-    throw;
+  } else {
+    // a generated sample is made on a second thread while this one builds the imager (its pixel centres sorted by
+    // radius); the imager's tables stay in this thread's heap, where the images and the files are made after the scan
+    std::future<scan::Surface> sample = std::async(std::launch::async, [&p] { return surface_from(p); });
+    try {
+      imager.emplace(scan::scan_imager(instrument, grid));
+    } catch (...) {
+      sample.wait();  // the thread reads p: let it finish before the error unwinds
+      throw;
+    }
+    surface.emplace(sample.get());
+    scan::check_scan_geometry(instrument, *surface, grid);
   }
-  std::optional<scan::Surface> surface(sample.get());
-  scan::check_scan_geometry(instrument, *surface, grid);
   const std::int64_t total = instrument.spiral.samples();
   const std::string series_path = p.text("series_output"), points_path = p.text("points_output"), prefix = p.text("image_output");
   const long series_every = p.integer("series_every"), points_every = p.integer("points_every");
