@@ -63,6 +63,18 @@ HeightMap truth_on(const HeightMap& image, const Surface& surface) {
 
 double annulus(double outer, double inner) { return outer * outer - inner * inner; }
 
+// The levelled RMS difference of two images; NaN when fewer than three pixels valid in both (or only collinear
+// ones) leave no plane to level by — a degenerate image (e.g. a detector saturated nearly everywhere), reported as
+// a NaN error (null in the sidecar), not as an error of the user's input.
+double levelled_error(const HeightMap& image, const HeightMap& truth) {
+  if (image.valid_count() < 3 || truth.valid_count() < 3) return kNaN;
+  try {
+    return levelled_rms_difference(image, truth);
+  } catch (const InvalidParameter&) {  // the plane fit's degenerate case (the grids are the same by construction)
+    return kNaN;
+  }
+}
+
 }  // namespace
 
 Grid image_grid(const InstrumentSpec& instrument, long resolution) {
@@ -172,9 +184,7 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
       out.scan_area_gain_is_lower_bound = !out.saturates_with_control;
     }
   }
-  const auto error_of = [&](const HeightMap& image) {
-    return image.valid_count() >= 3 ? levelled_rms_difference(image, out.truth) : kNaN;
-  };
+  const auto error_of = [&](const HeightMap& image) { return levelled_error(image, out.truth); };
   const HeightMap& lagged = inverse ? out.alternative : out.topography;
   const HeightMap& inverted = inverse ? out.topography : out.alternative;
   // the budget's two image differences (the sampled truth against the truth, the inverse against the sampled truth)
@@ -183,8 +193,7 @@ VirtualScan run_virtual_scan(const InstrumentSpec& instrument, const Surface& su
   std::future<std::pair<double, double>> budget_errors =
       std::async(options.imaging_thread ? std::launch::async : std::launch::deferred, [&] {
         const double imaging = error_of(sampled_truth);
-        const double reconstruction =
-            inverted.valid_count() >= 3 ? levelled_rms_difference(inverted, sampled_truth) : kNaN;
+        const double reconstruction = levelled_error(inverted, sampled_truth);
         return std::pair{imaging, reconstruction};
       });
   out.lagged_rms_error = error_of(lagged);

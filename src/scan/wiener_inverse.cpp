@@ -131,12 +131,22 @@ double sampled_resolution(const InstrumentSpec& instrument, const Surface& surfa
   return std::sqrt(sum / static_cast<double>(count));
 }
 
+double prior_increment_floor(const PlantInverse& inverse, double noise, int harmonics, double turns_per_sample) {
+  // W(ω_p) = 0.99 at ω_p = 2π (N + 1) f_rot/f_s: (σ²/A)|H|²|D|² = 1/0.99 − 1
+  const double omega = std::min(std::numbers::pi, 2.0 * std::numbers::pi * (harmonics + 1) * turns_per_sample);
+  return noise * std::sqrt(inverse_power(inverse, omega) * 2.0 * (1.0 - std::cos(omega)) / (1.0 / 0.99 - 1.0));
+}
+
 std::optional<WienerLowPass> noise_aware_filter(const InstrumentSpec& instrument, const Surface& surface) {
   const double noise = instrument.detector.noise;
   if (instrument.reconstruction.inverse_filter == InverseFilter::exact || !(noise > 0.0)) return std::nullopt;
+  const SpiralSpec& spiral = instrument.spiral;
+  const PlantInverse inverse(instrument.assumed_bandwidth(), spiral.sample_rate);
   const double stated = instrument.reconstruction.prior_increment;
-  const double prior = std::max(stated > 0.0 ? stated : prior_increment(instrument, surface), 1e-6 * noise);
-  WienerLowPass filter(PlantInverse(instrument.assumed_bandwidth(), instrument.spiral.sample_rate), noise, prior);
+  const double prior = std::max(stated > 0.0 ? stated : prior_increment(instrument, surface),
+                                prior_increment_floor(inverse, noise, instrument.controller.harmonics,
+                                                      spiral.spindle_frequency / spiral.sample_rate));
+  WienerLowPass filter(inverse, noise, prior);
   if (filter.half_width() == 0) return std::nullopt;  // transparent: the exact inverse
   return filter;
 }

@@ -223,4 +223,50 @@ TEST(WienerInverseScan, ANoisyScanIsImagedFarBetterThanByTheExactInverseOrTheLag
   EXPECT_LT(w.budget.image_noise_gain, 0.2 * w.budget.exact_image_noise_gain);
 }
 
+TEST(WienerInverseScan, AFlatSamplesTiltAndTheRotationsHarmonicsPassTheLowPass) {
+  // a flat topography has no height change of its own (A = 0): the prior's floor keeps W ≥ 0.99 up to the rotation's
+  // harmonic N + 1, so the tilt passes and the image of the (levelled) flat sample is noise only — below the lagged
+  // image's error, where a prior of 0 filtered the tilt's first harmonic away (nanometres)
+  InstrumentSpec s = wiener_test_scan();
+  s.detector.noise = 1e-10;
+  const double half = 2.05e-3;
+  const Surface surface(HeightMap(Grid{64, 64, 2 * half, 2 * half, -half, -half}, std::vector<double>(64 * 64, 0.0)),
+                        Tilt(0.05 * std::numbers::pi / 180, 0));
+  EXPECT_EQ(prior_increment(s, surface), 0.0);
+  const std::optional<WienerLowPass> filter = noise_aware_filter(s, surface);
+  ASSERT_TRUE(filter.has_value());
+  const double omega = 2 * std::numbers::pi * (s.controller.harmonics + 1) * s.spiral.spindle_frequency /
+                       s.spiral.sample_rate;
+  double response = filter->taps()[0];
+  for (std::size_t k = 1; k < filter->taps().size(); ++k)
+    response += 2 * filter->taps()[k] * std::cos(static_cast<double>(k) * omega);
+  EXPECT_NEAR(response, 0.99, 0.005);
+  const VirtualScan v = run_virtual_scan(s, surface, image_grid(s, 64));
+  EXPECT_LT(v.inverse_rms_error, v.lagged_rms_error);
+  EXPECT_LT(v.inverse_rms_error, 2 * v.budget.noise);
+}
+
+TEST(WienerInverseScan, ADetectorSaturatedByItsNoiseLeavesNaNErrorsNotAnInputError) {
+  // σ_d = 1 µm against a ±2 µm range: 4.7 % of the samples saturate, scattered; the inverse images (exact and
+  // Wiener) keep a handful of pixels, too few (or too few in common with the lagged image) to level: the errors are
+  // NaN (null in the sidecar) instead of an InvalidParameter("map") thrown from the levelling
+  InstrumentSpec s;
+  s.spiral.sample_rate = 20e3;
+  s.spiral.radial_speed = 1e-3;
+  s.detector.noise = 1e-6;
+  const double half = 4.08e-3;
+  const Surface surface(grating(Grid{512, 512, 2 * half, 2 * half, -half, -half}, GratingSpec{800e-6, 50e-9, 0.5, 0.0}),
+                        Tilt(0.05 * std::numbers::pi / 180, 0));
+  VirtualScanOptions options;
+  options.compare_without_control = false;
+  const VirtualScan v = run_virtual_scan(s, surface, image_grid(s, 128), options);
+  EXPECT_GT(v.saturated_fraction, 0.01);
+  EXPECT_LT(v.topography.valid_count(), 1000u);
+  for (const double e : {v.topography_rms_error, v.inverse_rms_error, v.lagged_rms_error})
+    EXPECT_TRUE(std::isnan(e) || e > 0.0);
+  if (v.topography.valid_count() < 3) {
+    EXPECT_TRUE(std::isnan(v.topography_rms_error));
+  }
+}
+
 }  // namespace

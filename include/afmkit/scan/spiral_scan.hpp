@@ -37,7 +37,9 @@ struct ScanSample {
   double control;      ///< controller output u_n [m/s] (0 with the controller off)
   double actuator;     ///< calibrated actuator displacement z_a = −ŷ_u(t_n) [m]
   double topography;   ///< lagged reconstruction w_n = d_n + z_a [m]
-  double inverse;      ///< inverse reconstruction f̂_n [m] (NaN when saturated and while settling after it)
+  /// inverse reconstruction f̂_n [m] (NaN when saturated and while settling after it); with detector noise and the
+  /// Wiener low-pass (ReconstructionSpec::inverse_filter, wiener_inverse.hpp) the filtered one
+  double inverse;
   bool saturated;      ///< |y + noise| > R_d at this sample
 };
 
@@ -71,7 +73,8 @@ struct ScanRun {
 };
 
 /// Runs the scan of `surface` by `instrument` (validated first: InvalidParameter naming the field), calling
-/// `observer` for every sample. `progress(done, total)` (may be empty) is called about every 2^16 samples.
+/// `observer` for every sample, in order (with the Wiener low-pass of the inverse, noise_aware_filter(), each sample
+/// is handed on K samples late, when the window after it has been simulated; the last K after the loop). `progress(done, total)` (may be empty) is called about every 2^16 samples.
 /// `cancellation` is checked every 65536 samples (core/cancellation.hpp).
 /// `first_sample` > 0 starts the scan at that sample (a multiple of 4096, where the tip's angle is computed exactly,
 /// so every later tip position is the full run's to the bit; InvalidParameter "first_sample" otherwise, or when it is

@@ -66,11 +66,16 @@ double prior_increment(const InstrumentSpec& instrument, const Surface& surface)
 /// WienerLowPass::resolution() is that of the prior.
 double sampled_resolution(const InstrumentSpec& instrument, const Surface& surface, const WienerLowPass& filter);
 
+/// The least √A [m] for which W ≥ 0.99 up to the rotation's harmonic N + 1 (ω = 2π (N + 1) f_rot/f_s, `harmonics`
+/// N of the controller): the harmonics the tilt and the controller put into w pass whatever the prior (a flat
+/// topography has A = 0, which would filter them away with the noise).
+double prior_increment_floor(const PlantInverse& inverse, double noise, int harmonics, double turns_per_sample);
+
 /// The low-pass the instrument's reconstruction applies after the exact inverse on this surface: none when
 /// reconstruction.inverse_filter is `exact`, the detector has no noise (σ_d = 0) or the filter is the identity
 /// (above): the exact inverse, unchanged.
 /// The prior: reconstruction.prior_increment when > 0, else prior_increment(instrument, surface), at least
-/// 1e−6 σ_d (a flat topography: the widest filter).
+/// prior_increment_floor.
 std::optional<WienerLowPass> noise_aware_filter(const InstrumentSpec& instrument, const Surface& surface);
 
 }  // namespace afmkit::scan
