@@ -131,6 +131,26 @@ class Dop853 {
     }
   }
 
+  /// The last accepted step's stages with nonzero weight b_j: visit(t_j, h b_j, Y_j), Y_j = y_old + h Σ_l a_jl k_l
+  /// the stage state (no evaluation of the field: the stages' k are kept until the next step).
+  template <class Visit>
+  void visit_stages(Visit&& visit) const {
+    using namespace dop853;
+    const double h = h_used_;
+    visit(t_old_, h * b[0], y_old_);
+    for (int j = 5; j < 12; ++j) {  // b_1..b_4 = 0
+      State y = y_old_;
+      const double h0 = h * a[j][0];
+      for (std::size_t i = 0; i < N; ++i) y[i] += h0 * k0_old_[i];
+      for (int l = 1; l < j; ++l) {
+        if (a[j][l] == 0.0) continue;
+        const double hw = h * a[j][l];
+        for (std::size_t i = 0; i < N; ++i) y[i] += hw * k_[l][i];
+      }
+      visit(t_old_ + c[j] * h, h * b[j], y);
+    }
+  }
+
   double current_time() const { return t_; }
   double current_time_step() const { return h_; }
   const State& current_state() const { return y_; }
