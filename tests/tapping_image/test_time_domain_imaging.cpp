@@ -4,6 +4,7 @@
 // name their parameter. (The regime switch inside the bistable window: test_quasi_static_imaging.cpp, on its sweep.)
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "afmkit/core/error.hpp"
 #include "afmkit/impact/force_law.hpp"
 #include "afmkit/scan/sample_generators.hpp"
+#include "afmkit/tapping/image/cycle_integrals.hpp"
 #include "afmkit/tapping/image/quasi_static.hpp"
 #include "afmkit/tapping/image/time_domain.hpp"
 #include "afmkit/tapping/units.hpp"
@@ -180,6 +182,63 @@ TEST(TimeDomainImaging, CyclesRunInPiecesStartFromTheStepTheLastOneEndedWith) {
   } catch (const InvalidParameter& e) {
     EXPECT_EQ(e.parameter(), "initial_step");
   }
+}
+
+TEST(TimeDomainImaging, CycleIntegralsUseTheStepsOwnStagesAndMatchTheDrivenOscillator) {
+  // Far from the sample (separation 1e6 nm: the vdW force 3e-12 of the amplitude) the motion from the steady state
+  // x = Re(Z e^{iωt}), Z = Γ/(ω_n² − ω² + icω), is the linear oscillator's: over one period ∫ x e^{−iωt} dt = T Z/2
+  // and ∫ ẋ² dt = ω²|Z|² T/2. Every step of DOP853 offers its own stages (weights summing to the step); the segments
+  // cut by an event (in contact, separation 7 nm: two a cycle) do not, and are integrated on the dense output.
+  struct TdimgStageCount final : TrajectoryObserver {
+    CycleIntegrals integrals;
+    long whole = 0, cut = 0;
+    double weights = 0.0, length = 0.0;
+    explicit TdimgStageCount(double period) : integrals(period) {}
+    void on_segment(const TappingSystem& system, const Segment& segment) override {
+      struct Sum final : StageVisitor {
+        double w = 0.0;
+        void node(double, double weight, const TipState&) override { w += weight; }
+      } sum;
+      if (segment.stage_quadrature(sum)) {
+        ++whole;
+        weights += sum.w;
+        length += segment.t_end() - segment.t_begin();
+      } else {
+        ++cut;
+      }
+      integrals.on_segment(system, segment);
+    }
+  };
+  TappingModel model = tdimg_model();
+  model.separation = 1e6;
+  TappingSystem sys(model);
+  SimulationOptions o;
+  o.integrator = Integrator::adaptive;
+  o.relative_tolerance = 1e-8;
+  o.absolute_tolerance = 1e-10;
+  o.max_step_fraction = TimeDomainEngine::kCycleMaxStepFraction;
+  const double w = model.drive.frequency, period = model.period(), c = sys.damping(), k = sys.stiffness();
+  const std::complex<double> z = model.drive.amplitude / std::complex<double>(k - w * w, c * w);
+  const TipState start{z.real(), -w * z.imag()};
+  TdimgStageCount free(period);
+  const SimulationResult r = simulate(sys, 0.0, start, period, o, &free);
+  EXPECT_EQ(r.stats.events, 0);
+  EXPECT_EQ(free.cut, 0);
+  EXPECT_EQ(free.whole, r.stats.steps);
+  EXPECT_NEAR(free.weights, period, 1e-13 * period);
+  EXPECT_NEAR(free.length, period, 1e-13 * period);
+  const std::complex<double> expected = 0.5 * period * z;
+  EXPECT_LT(std::abs(free.integrals.first_harmonic - expected), 1e-8 * std::abs(expected));  // measured 1.3e-9
+  const double square = 0.5 * period * w * w * std::norm(z);
+  EXPECT_NEAR(free.integrals.velocity_square, square, 1e-8 * square);  // measured 3.0e-9
+
+  sys.set_separation(7.0);
+  TdimgStageCount contact(period);
+  const SimulationResult e = simulate(sys, 0.0, start, 3.0 * period, o, &contact);
+  EXPECT_GT(e.stats.events, 0);
+  EXPECT_EQ(contact.cut, e.stats.events);
+  EXPECT_EQ(contact.whole + contact.cut, e.stats.steps);
+  EXPECT_NEAR(contact.weights, contact.length, 1e-12 * period);
 }
 
 TEST(TimeDomainImaging, BadLockInOptionsNameTheirParameter) {

@@ -13,6 +13,15 @@ namespace afmkit::tapping {
 
 class TappingSystem;
 
+/// The nodes of a quadrature rule over a segment: node(t, weight, state) for each (Segment::stage_quadrature).
+class StageVisitor {
+ public:
+  virtual void node(double t, double weight, const TipState& state) = 0;
+
+ protected:
+  ~StageVisitor() = default;
+};
+
 /// A smooth piece of the trajectory in one mode over [t_begin, t_end].
 class Segment {
  public:
@@ -23,6 +32,11 @@ class Segment {
   Mode mode() const { return mode_; }
   /// State at t ∈ [t_begin, t_end] (exact for the closed-form flow, dense output for the adaptive one).
   virtual TipState state(double t) const = 0;
+  /// When the segment is one whole step of the adaptive integrator's DOP853: visits its stages with nonzero weight
+  /// (t_j, h b_j, state Y_j) and returns true — Σ h b_j g(t_j, Y_j) is ∫ g(t, state) dt over the step to the
+  /// method's order 8 (the quadrature the method applies to g as one more component of the ODE), without building
+  /// the dense output. Otherwise (closed-form flow, Dopri5, a step cut by an event) false and no visit.
+  virtual bool stage_quadrature(StageVisitor& /*visitor*/) const { return false; }
 
  protected:
   Segment(const Segment&) = default;

@@ -2,6 +2,7 @@
 // What the tapping system is (independent of how it is integrated): for a TappingModel, the modes, the smooth
 // vector field of each mode, the guards that end a mode and the rules that pick the next mode at an event.
 //   ẍ = Γ cos(ωt) − 2ξω_n ẋ − ω_n² x − h_branch(x),   h_branch(x) = −H_branch(x + l)   (seed-1 eq. 8)
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -71,7 +72,10 @@ class TappingSystem {
   double interaction_with_slope(ContactBranch branch, double x, double velocity, int region, double& slope) const;
   /// Γ cos ωt − 2ξω_n ẋ − ω_n² x − h(x, ẋ) with the drive term Γ cos ωt given (any branch, sticking included;
   /// acceleration(mode, …) answers 0 in the sticking mode) (integrators that advance the drive phase themselves).
-  double acceleration_given_drive(const Mode& mode, double drive_term, TipState s) const;
+  double acceleration_given_drive(const Mode& mode, double drive_term, TipState s) const {
+    return drive_term - damping_ * s.velocity - stiffness_ * s.position -
+           interaction(mode.branch, s.position, s.velocity, mode.region);
+  }
   double drive_frequency() const { return omega_; }
   /// ẍ with the given branch's force in `region`.
   double acceleration(ContactBranch branch, int region, double t, TipState s) const;
@@ -130,13 +134,21 @@ class TappingSystem {
   std::optional<impact::PiecewiseLinearLaw> linear_;
   bool has_damping_ = false;
   double elastic_interaction(ContactBranch branch, double x, int region) const;
-  double clamp_gap(double gap, int region) const;  // scaled coefficients when piecewise linear
+  /// the gap clamped into the region (open upper end: just below its switching gap)
+  double clamp_gap(double gap, int region) const {
+    double dc = std::max(gap, region_lo(region));
+    const double hi = region_hi(region);
+    if (dc >= hi) dc = std::nextafter(hi, -afmkit_infinity());
+    return dc;
+  }
   double damping_;    // 2ξω_n
   double stiffness_;  // ω_n²
   double omega_;      // ω
   double gamma_;      // Γ
-  double region_lo(int region) const;
-  double region_hi(int region) const;
+  double region_lo(int region) const { return region == 0 ? -afmkit_infinity() : switching()[region - 1]; }
+  double region_hi(int region) const {
+    return region >= static_cast<int>(switching().size()) ? afmkit_infinity() : switching()[region];
+  }
   static double afmkit_infinity() { return std::numeric_limits<double>::infinity(); }
   /// The terms of a multi-mode model (modes.hpp), effective (medium applied).
   struct ModalTerms {

@@ -11,6 +11,23 @@
 
 namespace afmkit::tapping::image {
 
+namespace {
+/// e^{iu} for the stage nodes' rotations from the step's middle, |u| <= ω h/2 (π/12 at the cycles' largest step):
+/// Taylor to degree 12/13 in u (error below 1e-19 for |u| <= 0.27; beyond it std::polar).
+std::complex<double> node_phasor(double u) {
+  if (!(std::abs(u) <= 0.27)) return std::polar(1.0, u);
+  const double u2 = u * u;
+  double c = 1.0 / 479001600.0, s = 1.0 / 6227020800.0;  // 1/12!, 1/13!
+  constexpr double even[6] = {1.0 / 3628800.0, 1.0 / 40320.0, 1.0 / 720.0, 1.0 / 24.0, 1.0 / 2.0, 1.0};
+  constexpr double odd[6] = {1.0 / 39916800.0, 1.0 / 362880.0, 1.0 / 5040.0, 1.0 / 120.0, 1.0 / 6.0, 1.0};
+  for (int k = 0; k < 6; ++k) {
+    c = even[k] - u2 * c;
+    s = odd[k] - u2 * s;
+  }
+  return {c, u * s};
+}
+}  // namespace
+
 void CycleIntegrals::force_at(const TappingSystem& system, const Mode& m, const TipState& s) {
   peak_force = std::max(peak_force, 0.0 - system.interaction(m.branch, s.position, s.velocity, m.region));
 }
@@ -23,14 +40,30 @@ void CycleIntegrals::on_segment(const TappingSystem& system, const Segment& segm
     return std::abs(u) <= tapping::detail::small_angle_limit ? tapping::detail::small_angle_phasor(u)
                                                              : std::polar(1.0, u);
   };
-  gauss_panels<7>(
-      t0, t1, panel_, system.drive_frequency(), phasor,
-      [&](double t, double w, std::complex<double> e) {  // e = e^{−iωt}
-        const TipState s = segment.state(t);
-        first_harmonic += (w * s.position) * e;
-        velocity_square += w * s.velocity * s.velocity;
-      },
-      [](double, double) {});
+  // a whole step of DOP853: its own stages and weights (order 8, no dense output); e^{−iωt} = e^{−iω mid} e^{−iω(t − mid)}
+  struct Stages final : StageVisitor {
+    double omega, mid;
+    std::complex<double> e_mid, harmonic{};
+    double square = 0.0;
+    Stages(double w, double m) : omega(w), mid(m), e_mid(std::polar(1.0, -w * m)) {}
+    void node(double t, double w, const TipState& s) override {
+      harmonic += (w * s.position) * node_phasor(-omega * (t - mid));
+      square += w * s.velocity * s.velocity;
+    }
+  } stages(system.drive_frequency(), 0.5 * (t0 + t1));
+  if (segment.stage_quadrature(stages)) {
+    first_harmonic += stages.harmonic * stages.e_mid;
+    velocity_square += stages.square;
+  } else {
+    gauss_panels<7>(
+        t0, t1, panel_, system.drive_frequency(), phasor,
+        [&](double t, double w, std::complex<double> e) {  // e = e^{−iωt}
+          const TipState s = segment.state(t);
+          first_harmonic += (w * s.position) * e;
+          velocity_square += w * s.velocity * s.velocity;
+        },
+        [](double, double) {});
+  }
   // the largest force: at the ends, and at the bottom of the motion (ẋ rising through 0) inside the segment. A step
   // that continues the last one (same mode, from its end) starts where the force was taken already.
   const Mode m = segment.mode();

@@ -107,14 +107,25 @@ struct ModalField {
 template <class Dense, std::size_t N>
 class DenseSegment final : public Segment {
  public:
-  DenseSegment(double a, double b, Mode m, const Dense& dense) : Segment(a, b, m), dense_(&dense) {}
+  DenseSegment(double a, double b, Mode m, const Dense& dense, bool whole_step)
+      : Segment(a, b, m), dense_(&dense), whole_step_(whole_step) {}
   TipState state(double t) const override {
     dense_->calc_state(t, buffer_);
     return tip_of(buffer_);
   }
+  bool stage_quadrature(StageVisitor& visitor) const override {
+    if constexpr (requires { dense_->visit_stages([](double, double, const std::array<double, N>&) {}); }) {
+      if (!whole_step_) return false;
+      dense_->visit_stages([&](double t, double w, const std::array<double, N>& y) { visitor.node(t, w, tip_of(y)); });
+      return true;
+    } else {
+      return false;
+    }
+  }
 
  private:
   const Dense* dense_;
+  bool whole_step_;  // the segment is the stepper's whole last step (not cut by an event)
   mutable std::array<double, N> buffer_{};
 };
 
@@ -238,7 +249,7 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
       hit = first_crossing(sys, mode, guards, n, t_old, t_new, a, b, state);
       if (!hit) a = b;
       const double seg_end = hit ? hit->time : t_new;
-      if (observer) observer->on_segment(sys, DenseSegment<Stepper, N>(t_old, seg_end, mode, dense));
+      if (observer) observer->on_segment(sys, DenseSegment<Stepper, N>(t_old, seg_end, mode, dense, !hit));
       if (hit || t_new >= t_end) {
         t_stop = seg_end;
         break;

@@ -55,13 +55,13 @@ class Dop853 {
         throw NumericalFailure(fmt::format("tapping simulation (adaptive): step size {:.3g} underflows at t = {:.9g}",
                                            h, t_));
       begin_step(t_);
-      State tmp;
-      for (int s = 1; s < 12; ++s) {
-        combine(y_, h, a[s], s, k_.data(), tmp);
-        field_(tmp, k_[s], t_ + c[s] * h);
-      }
+      // stages 1–11 (unrolled at compile time: the tableau's zeros skipped, the same sums in the same order)
+      [&]<int... S>(std::integer_sequence<int, S...>) {
+        State tmp;
+        ((stage_combine<S + 1>(y_, h, k_.data(), tmp), field_(tmp, k_[S + 1], t_ + c[S + 1] * h)), ...);
+      }(std::make_integer_sequence<int, 11>{});
       State y_new;
-      combine(y_, h, b, 12, k_.data(), y_new);
+      weights_combine(y_, h, k_.data(), y_new);
       const double t_new = clipped ? t_limit : t_ + h;
       field_(y_new, k_[12], t_new);
       // error norm (DOP853): |h| Σ(err5/sk)² / sqrt(N (Σ(err5/sk)² + 0.01 Σ(err3/sk)²))
@@ -131,6 +131,20 @@ class Dop853 {
     }
   }
 
+  /// The last accepted step's stages with nonzero weight b_j: visit(t_j, h b_j, Y_j), Y_j = y_old + h Σ_l a_jl k_l
+  /// the stage state (no evaluation of the field: the stages' k are kept until the next step).
+  template <class Visit>
+  void visit_stages(Visit&& visit) const {
+    using namespace dop853;
+    const double h = h_used_;
+    visit(t_old_, h * b[0], y_old_);
+    // b_1..b_4 = 0; the stages' k_0 is the last step's (k_[0] already holds the next step's)
+    [&]<int... S>(std::integer_sequence<int, S...>) {
+      State y;
+      ((stage_state<S + 5>(h, y), visit(t_old_ + c[S + 5] * h, h * b[S + 5], y)), ...);
+    }(std::make_integer_sequence<int, 7>{});
+  }
+
   double current_time() const { return t_; }
   double current_time_step() const { return h_; }
   const State& current_state() const { return y_; }
@@ -157,6 +171,37 @@ class Dop853 {
       f_[2][i] = 2.0 * dy - h * (k[12][i] + k[0][i]);
     }
     dense_ready_ = true;
+  }
+  /// out = base + h Σ_{j<S} a_Sj k_j, stage S's state, as combine(base, h, a[S], S, k, out) with the zero weights
+  /// skipped at compile time
+  template <int S>
+  static void stage_combine(const State& base, double h, const State* k, State& out) {
+    using namespace dop853;
+    out = base;
+    [&]<int... J>(std::integer_sequence<int, J...>) {
+      ((a[S][J] != 0.0 ? add_weighted(h * a[S][J], k[J], out) : void()), ...);
+    }(std::make_integer_sequence<int, S>{});
+  }
+  /// out = base + h Σ_{j<12} b_j k_j (the 8th-order solution), as combine(base, h, b, 12, k, out)
+  static void weights_combine(const State& base, double h, const State* k, State& out) {
+    using namespace dop853;
+    out = base;
+    [&]<int... J>(std::integer_sequence<int, J...>) {
+      ((b[J] != 0.0 ? add_weighted(h * b[J], k[J], out) : void()), ...);
+    }(std::make_integer_sequence<int, 12>{});
+  }
+  /// stage S's state of the last accepted step (after it: k_0 in k0_old_)
+  template <int S>
+  void stage_state(double h, State& out) const {
+    using namespace dop853;
+    out = y_old_;
+    add_weighted(h * a[S][0], k0_old_, out);
+    [&]<int... J>(std::integer_sequence<int, J...>) {
+      ((a[S][J + 1] != 0.0 ? add_weighted(h * a[S][J + 1], k_[J + 1], out) : void()), ...);
+    }(std::make_integer_sequence<int, S - 1>{});
+  }
+  static void add_weighted(double hw, const State& k, State& out) {
+    for (std::size_t i = 0; i < N; ++i) out[i] += hw * k[i];
   }
   /// out = base + h Σ_{j<count} w_j k_j (zero weights skipped: most of the tableau is zero)
   static void combine(const State& base, double h, const double* w, int count, const State* k, State& out) {

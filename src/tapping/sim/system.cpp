@@ -166,10 +166,6 @@ int TappingSystem::region_of(double gap) const {
   return static_cast<int>(std::upper_bound(switching().begin(), switching().end(), gap) - switching().begin());
 }
 
-double TappingSystem::region_lo(int region) const { return region == 0 ? -infinity : switching()[region - 1]; }
-double TappingSystem::region_hi(int region) const {
-  return region >= static_cast<int>(switching().size()) ? infinity : switching()[region];
-}
 
 double TappingSystem::drive(double t) const { return gamma_ * std::cos(omega_ * t); }
 double TappingSystem::drive_rate(double t) const { return -gamma_ * omega_ * std::sin(omega_ * t); }
@@ -180,12 +176,6 @@ double TappingSystem::interaction(ContactBranch branch, double x, double velocit
   return elastic + model_.law.damping(clamp_gap(gap(x), region)) * velocity;  // h = −H, H ∋ −c(d)ḋ, ḋ = ẋ
 }
 
-double TappingSystem::clamp_gap(double d, int region) const {
-  double dc = std::max(d, region_lo(region));
-  const double hi = region_hi(region);
-  if (dc >= hi) dc = std::nextafter(hi, -infinity);
-  return dc;
-}
 
 double TappingSystem::interaction_rate_slope(ContactBranch branch, double x, int region) const {
   if (!has_damping_ || branch == ContactBranch::sticking) return 0.0;
@@ -270,10 +260,6 @@ double TappingSystem::acceleration(const Mode& mode, double t, TipState s) const
   return acceleration(mode.branch, mode.region, t, s);
 }
 
-double TappingSystem::acceleration_given_drive(const Mode& mode, double drive_term, TipState s) const {
-  return drive_term - damping_ * s.velocity - stiffness_ * s.position -
-         interaction(mode.branch, s.position, s.velocity, mode.region);
-}
 
 Mode TappingSystem::initial_mode(double t, TipState& s) const {
   int region = region_of(gap(s.position));
