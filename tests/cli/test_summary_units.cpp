@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_run.hpp"
+#include "help_walk.hpp"
 
 using afmkit_test::run_cli;
 using afmkit_test::slurp;
@@ -271,6 +272,23 @@ TEST(SummaryUnits, TheSweepArclengthIsALengthInTheSeparationsUnit) {
                 std::abs(points[i].first - points[i - 1].first) * (1.0 - 1e-9))
           << units << " point " << i;
   }
+}
+
+TEST(SummaryUnits, TheSweepHelpGivesTheArclengthStepAsALengthOfTheSeparation) {
+  // --help said "scaled arclength" for max_arclength_step: the step is of the arclength, a length in the unit of the
+  // separation (the test above), and --help says so with the separation's unit
+  std::map<std::string, std::string> description;
+  for (const auto& o : afmkit_test::options_of("tapping sweep")) description[o.name] = o.description;
+  const auto unit_of = [&](const std::string& name) {
+    const std::string& d = description.at(name);
+    const std::size_t at = d.find("[unit: ");
+    return at == std::string::npos ? std::string() : d.substr(at + 7, d.find(';', at) - at - 7);
+  };
+  const std::string& step = description.at("max-arclength-step");
+  EXPECT_EQ(step.find("scaled"), std::string::npos) << step;
+  EXPECT_NE(step.find("arclength, a length in the separation's unit"), std::string::npos) << step;
+  EXPECT_FALSE(unit_of("max-arclength-step").empty()) << step;
+  EXPECT_EQ(unit_of("max-arclength-step"), unit_of("separation-min"));
 }
 
 TEST(SummaryUnits, EveryResultOfSpectroscopyFitHasItsUnit) {
