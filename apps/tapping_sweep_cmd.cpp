@@ -428,7 +428,9 @@ void register_tapping_sweep(CLI::App& tapping) {
                   "instrument (approach then retract, jumps and hysteresis), continuation (pseudo-arclength through "
                   "folds, unstable branches) or both",
                   {"instrument", "continuation", "both"})
-            .real("max_arclength_step", 0.2, "largest continuation step (scaled arclength)", io::Range::positive())
+            .real("max_arclength_step", 0.2,
+                  "largest continuation step: of the arclength, a length in the separation's unit",
+                  io::Range::positive())
             .unit(kLengthUnit)
             .integer("max_continuation_points", 5000, "continuation point budget", 2, 100000000)
             .text("directions", "both",

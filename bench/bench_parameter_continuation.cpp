@@ -25,7 +25,7 @@ void BM_FrequencyContinuation500(benchmark::State& state, bool parallel) {
   ContinuationOptions options;
   options.max_points = 500;
   // (from ω = 0.997, above the corner at 0.9949 where the contact branch turns non-smoothly) steps of at most 0.1
-  // (scaled arclength): 500 points pass both folds and the grazing hop (834 points to ω = 1.1)
+  // (of the arclength, a length in L): 500 points pass both folds and the grazing hop (834 points to ω = 1.1)
   options.max_step = 0.1;
   options.parallel = parallel;
   const int threads = omp_get_max_threads();

@@ -82,11 +82,12 @@ CalibratedCurve calibrate(const io::curves::RawCurve& raw, const Calibration& us
   if (std::isnan(k))
     throw InvalidParameter("spring_constant", fmt::format("{}: the file gives no spring constant: give it with "
                                                           "--spring-constant (N/m)", out.origin));
-  const double k_max = tapping::cantilever_limit(tapping::CantileverSetting::spring_constant).upper;
-  if (!(k > 0) || !(k <= k_max))
-    throw InvalidParameter("spring_constant", fmt::format("{}: the file's spring constant {} N/m is out of range "
-                                                          "(must be > 0 and <= {:g} N/m): give the right one with "
-                                                          "--spring-constant", out.origin, k, k_max));
+  const tapping::CantileverLimit k_max = tapping::cantilever_limit(tapping::CantileverSetting::spring_constant);
+  if (!(k > 0) || !(k <= k_max.upper))
+    throw InvalidParameter("spring_constant", fmt::format("{}: the file's spring constant {} {} is out of range "
+                                                          "(must be > 0 and <= {:g} {}): give the right one with "
+                                                          "--spring-constant", out.origin, k, k_max.unit.name,
+                                                          k_max.upper, k_max.unit.name));
   out.spring_constant = k;
   out.spring_constant_source = user_k ? "option" : "file";
 

@@ -4,14 +4,17 @@
 #include <numbers>
 
 #include "afmkit/core/validate.hpp"
+#include "afmkit/tapping/cantilever_limits.hpp"
 
 namespace afmkit::tapping {
 
 PhysicalCantilever::PhysicalCantilever(double k, double f0, double q, double a_free, double ratio)
-    : spring_constant(validate::positive("spring_constant", k)),
-      resonance_frequency(validate::positive("resonance_frequency", f0)),
-      quality_factor(validate::positive("quality_factor", q)),
-      free_amplitude(validate::positive("free_amplitude", a_free)),
+    // the ranges of the command line and Python (tapping/cantilever_limits.hpp), in this type's units
+    : spring_constant(check_cantilever_setting("spring_constant", CantileverSetting::spring_constant, k, "N/m")),
+      resonance_frequency(
+          check_cantilever_setting("resonance_frequency", CantileverSetting::resonance_frequency, f0, "kHz")),
+      quality_factor(check_cantilever_setting("quality_factor", CantileverSetting::quality_factor, q, "dimensionless")),
+      free_amplitude(check_cantilever_setting("free_amplitude", CantileverSetting::amplitude, a_free, "nm")),
       frequency_ratio(validate::positive("frequency_ratio", ratio)) {}
 
 Drive PhysicalCantilever::drive() const {

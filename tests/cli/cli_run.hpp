@@ -9,6 +9,21 @@
 
 namespace afmkit_test {
 
+/// The sanitizer build (CMake defines AFMKIT_TEST_SANITIZED there; a process runs ~10x slower): a test that runs
+/// many processes takes a deterministic sample of its cases there and runs them all in Release
+/// (docs/development.md).
+#ifdef AFMKIT_TEST_SANITIZED
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+
+/// Under the sanitizers, whether case `index` of a list is left out of the sample that keeps one case in `every`
+/// (indices 0, every, 2·every, …); never in Release.
+inline bool left_out_under_sanitizers(std::size_t index, std::size_t every) {
+  return kSanitized && index % every != 0;
+}
+
 struct RunResult {
   int status;
   std::string out;

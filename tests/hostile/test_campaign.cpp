@@ -26,14 +26,9 @@ const std::set<std::string> kSkipped = {"help", "config", "output"};
 
 // Under the sanitizers (a build ~10x slower per process) the campaign takes a sample: every other option (k even)
 // with one case, number (k/2) mod its number of cases, so that every hostile value is still tried on every command
-// with enough options. Release runs the full product.
+// with enough options. Release runs the full product (kSanitized, left_out_under_sanitizers: cli_run.hpp).
 bool sampled_out(std::size_t option_index, std::size_t case_index, std::size_t cases) {
-#ifdef AFMKIT_TEST_SANITIZED
-  return option_index % 2 != 0 || case_index != (option_index / 2) % cases;
-#else
-  (void)option_index, (void)case_index, (void)cases;
-  return false;
-#endif
+  return left_out_under_sanitizers(option_index, 2) || (kSanitized && case_index != (option_index / 2) % cases);
 }
 
 // Commands whose default run is long (`scan`: 8e6 samples, ~1.5 s CPU, far more under the sanitizers) are probed

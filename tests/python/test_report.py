@@ -150,9 +150,10 @@ def test_no_text_the_page_is_made_of_cites_a_file_outside_the_repository():
 
 
 def test_workers_forked_by_the_report_process_run_cores_over_jobs_openmp_threads():
-    """`afmkit report` forks its workers from itself (no fork server): OMP_NUM_THREADS was read by the OpenMP
-    runtime when the report process loaded afmkit, so each worker sets its own threads (build._worker_init); the
-    report process keeps its own."""
+    """`afmkit report` forks its workers from itself (no fork server: afmkit._pool.forked_pool): OMP_NUM_THREADS was
+    read by the OpenMP runtime when the report process loaded afmkit, so each worker sets its own threads
+    (_pool._forked_init); the report process keeps its own. The workers inherit the objects frozen before the fork
+    (gc.freeze) and run the report's garbage-collector thresholds."""
     import ctypes
     import sys
 
@@ -163,22 +164,22 @@ def test_workers_forked_by_the_report_process_run_cores_over_jobs_openmp_threads
     except OSError:
         pytest.skip("afmkit's module is not built with GNU OpenMP here")
     code = ("import ctypes, os, afmkit\n"
-            "from afmkit.report.build import _forked_pool\n"
+            "from afmkit.report.build import _figure_pool\n"
             "def probe():\n"
             "    g = ctypes.CDLL('libgomp.so.1', mode=os.RTLD_NOLOAD | os.RTLD_LAZY)\n"
             "    import gc\n"
-            "    return g.omp_get_max_threads(), os.getppid(), gc.get_threshold()[0]\n"
+            "    return g.omp_get_max_threads(), os.getppid(), gc.get_threshold()[0], gc.get_freeze_count() > 0\n"
             "if __name__ == '__main__':\n"
-            "    with _forked_pool(1, 1) as pool:\n"
-            "        threads, parent, gc0 = pool.submit(probe).result()\n"
+            "    with _figure_pool(1, 1) as pool:\n"
+            "        threads, parent, gc0, frozen = pool.submit(probe).result()\n"
             "    g = ctypes.CDLL('libgomp.so.1', mode=os.RTLD_NOLOAD | os.RTLD_LAZY)\n"
-            "    print(threads, parent == os.getpid(), g.omp_get_max_threads(), gc0)\n")
+            "    print(threads, parent == os.getpid(), g.omp_get_max_threads(), gc0, frozen)\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
                          env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), OMP_NUM_THREADS="3"))
     assert out.returncode == 0, out.stderr
     from afmkit.report.build import _WORKER_GC_THRESHOLDS
 
-    assert out.stdout.split() == ["1", "True", "3", str(_WORKER_GC_THRESHOLDS[0])]
+    assert out.stdout.split() == ["1", "True", "3", str(_WORKER_GC_THRESHOLDS[0]), "True"]
 
 
 def test_the_speed_numbers_are_measured_in_a_child_while_the_report_process_imports():

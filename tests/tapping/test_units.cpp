@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/tapping/units.hpp"
@@ -43,4 +44,29 @@ TEST(Units, BadPhysicalInputIsNamed) {
   EXPECT_THROW(PhysicalCantilever(40.0, 300.0, std::nan(""), 20.0, 1.0), afmkit::InvalidParameter);
   EXPECT_THROW(Cantilever(1.0, 0.0), afmkit::InvalidParameter);
   EXPECT_THROW(Drive(0.2, -1.0), afmkit::InvalidParameter);
+}
+
+// The C++ API takes the cantilever's settings in the ranges the command line and Python take (docs/bad-input.md:
+// k in (0, 1e6] N/m, f0 in (0, 1e7] kHz, Q in (0, 1e9], A_free in (0, 1e6] nm): a value above the upper bound is
+// refused naming its key and the range in the unit it was given in; the bounds themselves are accepted.
+TEST(Units, PhysicalCantileverTakesTheCommandLinesRanges) {
+  struct Case {
+    const char* key;
+    double k, f0, q, a;
+    const char* range;
+  };
+  for (const Case& c : {Case{"spring_constant", 1.5e6, 300.0, 100.0, 20.0, "<= 1e+06 N/m"},
+                        Case{"resonance_frequency", 40.0, 2e7, 100.0, 20.0, "<= 1e+07 kHz"},
+                        Case{"quality_factor", 40.0, 300.0, 3e9, 20.0, "<= 1e+09"},
+                        Case{"free_amplitude", 40.0, 300.0, 100.0, 1.5e6, "<= 1e+06 nm"}}) {
+    try {
+      PhysicalCantilever(c.k, c.f0, c.q, c.a, 1.0);
+      ADD_FAILURE() << c.key << " above its upper bound was accepted";
+    } catch (const afmkit::InvalidParameter& e) {
+      EXPECT_EQ(e.parameter(), c.key);
+      EXPECT_NE(std::string(e.what()).find(c.range), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(PhysicalCantilever(1e6, 1e7, 1e9, 1e6, 1.0));  // every upper bound itself
+  EXPECT_THROW(PhysicalCantilever(40.0, 300.0, 100.0, 20.0, 0.0), afmkit::InvalidParameter);  // ratio: > 0
 }

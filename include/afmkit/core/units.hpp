@@ -57,8 +57,8 @@ inline constexpr SiUnit kSiUnits[] = {
 };
 
 /// The named unit `name` (std::logic_error when it is not in kSiUnits: a declaration naming an unknown unit is a
-/// programming error, found by the first run that reads it).
-inline const SiUnit& si_unit(std::string_view name) {
+/// programming error, found by the first run that reads it, or by the compiler in a constant expression).
+constexpr const SiUnit& si_unit(std::string_view name) {
   for (const SiUnit& u : kSiUnits)
     if (u.name == name) return u;
   throw std::logic_error("no SI conversion for the unit '" + std::string(name) + "' (afmkit/core/units.hpp)");

@@ -26,12 +26,13 @@ struct UnitScales {
   const char* time_unit = "t";
 };
 
-/// The cantilever and drive as measured on an instrument.
+/// The cantilever and drive as measured on an instrument. The constructor takes the settings in the ranges of the
+/// command line and Python (tapping/cantilever_limits.hpp; InvalidParameter naming the key and the range otherwise).
 struct PhysicalCantilever {
-  double spring_constant;      // k [N/m] > 0
-  double resonance_frequency;  // f0 [kHz] > 0
-  double quality_factor;       // Q > 0
-  double free_amplitude;       // A_free [nm] > 0, free oscillation amplitude at the drive frequency
+  double spring_constant;      // k [N/m] in (0, 1e6]
+  double resonance_frequency;  // f0 [kHz] in (0, 1e7]
+  double quality_factor;       // Q in (0, 1e9]
+  double free_amplitude;       // A_free [nm] in (0, 1e6], free oscillation amplitude at the drive frequency
   double frequency_ratio;      // ω/ω_n > 0
 
   PhysicalCantilever(double spring_constant, double resonance_frequency, double quality_factor,

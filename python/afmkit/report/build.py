@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import concurrent.futures as futures
-import gc
 import importlib
 import os
 import shutil
@@ -159,7 +158,7 @@ def speed_numbers() -> list:
 class _SpeedAhead:
     """speed_numbers() measured in a child forked before the report process imports Matplotlib: it runs on the core
     that import leaves idle instead of after the figures (issue 28 §5). Forked while this process has run no OpenMP
-    parallel region (as the workers, _forked_pool); the child ends with this process. Where there is no fork, or the
+    parallel region (as the workers, _figure_pool); the child ends with this process. Where there is no fork, or the
     child fails, result() measures here."""
 
     def __init__(self, pid: int, fd: int):
@@ -236,7 +235,7 @@ def _in_pool(order, staging, done, tasks, started, jobs: int, forked: bool) -> N
     """`jobs` worker processes, each with cores / jobs OpenMP threads, that have Matplotlib, NumPy, afmkit and the
     figure modules imported before they start; the longest figures are started first.
 
-    ``forked`` (`afmkit report` itself): this process imports them and forks the workers (_forked_pool). Otherwise
+    ``forked`` (`afmkit report` itself): this process imports them and forks the workers (_figure_pool). Otherwise
     (build() called from a Python session, which may have run OpenMP code) the workers are forked from a fork
     server that imports them (afmkit._pool)."""
     from concurrent.futures.process import BrokenProcessPool
@@ -244,7 +243,7 @@ def _in_pool(order, staging, done, tasks, started, jobs: int, forked: bool) -> N
     threads = max(1, (os.cpu_count() or 1) // jobs)
     workers = min(jobs, len(order))
     if forked:
-        pool_cm = _forked_pool(workers, threads)
+        pool_cm = _figure_pool(workers, threads)
     else:
         from .. import _pool
 
@@ -273,30 +272,22 @@ def _in_pool(order, staging, done, tasks, started, jobs: int, forked: bool) -> N
             raise
 
 
-def _forked_pool(workers: int, threads: int):
-    """A pool of `workers` processes forked from this process (the `afmkit report` process) once it has imported
-    what the figures need (_PRELOAD): a fork server would start another interpreter and import afmkit, NumPy and
-    Matplotlib again (issue 28 §5: ~0.2 s more on the way to the first figure). Safe because this process has run no
-    OpenMP parallel region yet (fork after one is not: the child's OpenMP threads would be missing); each worker
-    then sets its OpenMP threads (_worker_init). Where there is no fork (Windows, macOS' default), the fork server
-    or spawn context of afmkit._pool."""
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
+def _figure_pool(workers: int, threads: int):
+    """The figure workers of `afmkit report`: forked from this process (afmkit._pool.forked_pool) once it has imported
+    what the figures need (_PRELOAD) and Matplotlib with its Agg backend, each with `threads` OpenMP threads and
+    the garbage-collector thresholds _WORKER_GC_THRESHOLDS. Safe because this process has run no OpenMP parallel
+    region yet (forked_pool's constraint)."""
+    from .. import _pool
 
-    if "fork" not in multiprocessing.get_all_start_methods() or not sys.platform.startswith("linux"):
-        from .. import _pool
+    return _pool.forked_pool(workers, _PRELOAD, threads, prepare=_matplotlib_agg, gc_thresholds=_WORKER_GC_THRESHOLDS)
 
-        return _pool.pool(workers, _PRELOAD, threads)
-    for module in _PRELOAD:
-        importlib.import_module(module)
+
+def _matplotlib_agg() -> None:
+    """Matplotlib with the Agg backend and pyplot (what _run_figure imports), imported before the workers fork."""
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot  # noqa: F401  (what _run_figure imports)
-
-    gc.freeze()  # the imported modules' objects: never traversed by the workers' collections (nor copied on write)
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
-                               initializer=_worker_init, initargs=(os.getpid(), threads))
+    import matplotlib.pyplot  # noqa: F401
 
 
 #: The cyclic garbage collector of a figure worker: Matplotlib allocates many short-lived objects, and Python's
@@ -304,34 +295,6 @@ def _forked_pool(workers: int, threads: int):
 #: figures, ~0.33 s or 6 % of their CPU; these ~30, 1 and 0 (~0.2 s), for ~10 MB more memory per worker (the cycles
 #: of finished figures are freed later).
 _WORKER_GC_THRESHOLDS = (10_000, 20, 100)
-
-
-def _worker_init(parent: int, threads: int) -> None:
-    """In a worker forked from the report process: ends with it (even by SIGKILL), SIGTERM ends it (the report
-    process's handler, inherited, would turn it into KeyboardInterrupt), and the OpenMP runtime that afmkit's module
-    loaded runs `threads` threads (OMP_NUM_THREADS was read when the module was loaded, before the fork); its garbage
-    collector runs less often (_WORKER_GC_THRESHOLDS)."""
-    import signal
-
-    from .._parent import die_with_parent
-
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    die_with_parent(parent)
-    _set_openmp_threads(threads)
-    gc.set_threshold(*_WORKER_GC_THRESHOLDS)
-
-
-def _set_openmp_threads(threads: int) -> None:
-    """omp_set_num_threads(threads) in the OpenMP runtime already loaded in this process (GNU libgomp, LLVM libomp,
-    Intel libiomp); nothing if none is loaded."""
-    import ctypes
-
-    for name in ("libgomp.so.1", "libomp.so", "libomp.so.5", "libiomp5.so"):
-        try:
-            lib = ctypes.CDLL(name, mode=os.RTLD_NOLOAD | os.RTLD_LAZY)
-        except OSError:
-            continue
-        lib.omp_set_num_threads(ctypes.c_int(threads))
 
 
 def build(output_dir="out/report", jobs: int = 2, figures: str = "all", *, _own_process: bool = False) -> Path:
