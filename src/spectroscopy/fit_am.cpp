@@ -11,6 +11,7 @@
 #include "afmkit/core/numbers.hpp"
 #include "afmkit/spectroscopy/fit.hpp"
 #include "afmkit/spectroscopy/fit_model.hpp"
+#include "afmkit/tapping/cantilever_limits.hpp"
 #include "fit_engine.hpp"
 
 namespace afmkit::spectroscopy {
@@ -28,6 +29,21 @@ FitCurve sorted_curve(const FitCurve& c, const std::vector<std::size_t>& order) 
   return s;
 }
 
+/// The model oscillates with the true free amplitude free_amplitude × amplitude_scale (AmForwardModel::model): at
+/// the values a fit starts from (or a prediction uses) it must lie in the cantilever's range, else the user's
+/// amplitude_scale is refused here (exit 2) rather than the forward model failing at its first evaluation. A trial
+/// value out of range during the fit is a failed step, as any other.
+void check_true_amplitude(const FitSettings& settings, const ModelValues& values) {
+  using tapping::CantileverSetting;
+  const double a = settings.free_amplitude * values.amplitude_scale;
+  const double upper = tapping::cantilever_limit(CantileverSetting::amplitude).upper;
+  if (a > 0.0 && a <= upper) return;  // false for NaN
+  throw InvalidParameter("amplitude_scale",
+                         fmt::format("amplitude_scale = {} with free_amplitude = {} m makes the true free amplitude "
+                                     "{} m, out of range: it must be > 0 and <= {:g} m",
+                                     values.amplitude_scale, settings.free_amplitude, a, upper));
+}
+
 }  // namespace
 
 AmPrediction predict_am_curve(const std::vector<double>& distance, const FitSettings& settings,
@@ -40,6 +56,7 @@ AmPrediction predict_am_curve(const std::vector<double>& distance, const FitSett
   const std::vector<std::size_t> order = engine::sweep_order(distance, options.direction);
   const AmForwardModel model(settings, options, engine::in_order(distance, order));
   const ModelValues v = ModelValues::of(options);
+  check_true_amplitude(settings, v);
   const CurveEvaluation e = model.walk(v);
   if (!e.ok) throw NumericalFailure("forward model: " + e.error);
   AmPrediction out;
@@ -65,6 +82,7 @@ FitResult fit_am_curve(const FitCurve& curve, const FitSettings& settings, const
   FitResult r;
   r.mode = FitMode::am;
   r.parameters = fit_parameter_info(options, FitMode::am);
+  check_true_amplitude(settings, ModelValues::of(options));
   const FitCurve data = sorted_curve(curve, engine::sweep_order(curve.distance, options.direction));
   const std::size_t n = data.distance.size();
   const bool phase = !data.phase.empty();

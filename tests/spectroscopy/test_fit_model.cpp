@@ -94,6 +94,28 @@ TEST(FitModel, CalibrationEntersAsDocumented) {
   EXPECT_NEAR(c.amplitude[0], 20e-9, 4e-12);
 }
 
+// The model oscillates with free_amplitude × amplitude_scale: a start outside the cantilever's amplitude range
+// (<= 1 mm) is the user's amplitude_scale, refused by name before any orbit runs (it was the forward model's numerical
+// failure at the initial values); at the bound it runs.
+TEST(FitModel, ATrueFreeAmplitudeOutOfRangeIsTheUsersAmplitudeScale) {
+  FitSettings s = model_settings();
+  s.free_amplitude = 0.9e-3;  // in range alone
+  FitOptions o = dmt();
+  o.initial["amplitude_scale"] = 1.5;  // 1.35 mm
+  try {
+    (void)predict_am_curve({40e-9, 39e-9, 38e-9}, s, o);
+    ADD_FAILURE() << "an out-of-range true amplitude was accepted";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "amplitude_scale");
+    EXPECT_NE(std::string(e.what()).find("<= 0.001 m"), std::string::npos) << e.what();
+  }
+  FitCurve c;
+  c.distance = {40e-9, 39e-9, 38e-9, 37e-9};
+  c.amplitude = {0.9e-3, 0.9e-3, 0.9e-3, 0.9e-3};
+  o.parameters = {"amplitude_scale"};
+  EXPECT_THROW((void)fit_am_curve(c, s, o), InvalidParameter);
+}
+
 // A warm evaluation stops after the first failing point; how many points it ran (the fit's orbit_evaluations) must not
 // depend on the threads' timing, or a record would not replay. Points after the failure are slowed unevenly so that
 // a thread-timed stop would run a varying number of them.
