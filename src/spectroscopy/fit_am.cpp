@@ -39,8 +39,8 @@ void check_true_amplitude(const FitSettings& settings, const ModelValues& values
   const double upper = tapping::cantilever_limit(CantileverSetting::amplitude).upper;
   if (a > 0.0 && a <= upper) return;  // false for NaN
   throw InvalidParameter("amplitude_scale",
-                         fmt::format("amplitude_scale = {} with free_amplitude = {:.6g} m makes the true free amplitude "
-                                     "{:.6g} m, out of range: it must be > 0 and <= {:g} m",
+                         fmt::format("amplitude_scale = {} with free_amplitude = {:.6g} m makes the true free "
+                                     "amplitude {:.6g} m, out of range: it must be > 0 and <= {:g} m",
                                      values.amplitude_scale, settings.free_amplitude, a, upper));
 }
 
