@@ -71,9 +71,9 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
 /// M − I, until the residual is within the tolerance (or they stop reducing it); try_shoot then starts there, so
 /// the variational equations are integrated at the converged state (usually there only: the two maps differ by
 /// the integrator's tolerance) and the monodromy and multipliers are those of the converged orbit, as try_shoot's.
-/// `iterations` counts both kinds (0: the guess was within the tolerance). The last Broyden step is not evaluated
-/// on the cheap map: it goes to the run with sensitivities directly (judged as try_shoot judges its first
-/// evaluation; Newton goes on from there when it is not yet the orbit). `evaluate_guess` false: the guess is taken
+/// `iterations` counts both kinds (0: the guess was within the tolerance). The last Broyden step (from a residual
+/// within 100 tolerances) is not evaluated on the cheap map: it goes to the run with sensitivities directly (judged
+/// as try_shoot judges its first evaluation; Newton goes on from there when it is not yet the orbit). `evaluate_guess` false: the guess is taken
 /// to be within the tolerance (as a caller's last one was) and goes to that run at once.
 std::optional<PeriodicOrbit> try_shoot_near(const TappingModel& model, TipState guess, const PeriodicOrbit& near,
                                             const ShootingOptions& options = {}, bool evaluate_guess = true);
