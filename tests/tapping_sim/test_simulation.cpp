@@ -139,8 +139,8 @@ TEST(Simulation, SensitivitiesOfADenseTableAreControlledRelativeToTheirFloor) {
 
 TEST(Simulation, SensitivitiesOfASmoothLawTakeFewMoreStepsThanTheStateAndMatchATightRun) {
   // pyDAMPF's DMT + vdW case touching the sample (DOP853): the state is held as the run without sensitivities holds
-  // it, the sensitivities to 100 times the tolerance relative to the identity (held to the tolerance itself they
-  // took 1.75 times the steps of the state, for multipliers ~1e-11 off instead of ~1e-9 at tolerance 1e-10)
+  // it, the sensitivities to 10 times the tolerance relative to the identity (held to the tolerance itself they
+  // took 1.72 times the steps of the state here, 1.47 times now)
   const PhysicalCantilever pc(40.0, 300.0, 400.0, 10.0, 1.0);
   const impact::DmtLaw dmt(1.0, 1.0, 10.0, 6.4e-20, 6.4e-20, 0.165);
   const TappingModel model(pc.cantilever(), pc.drive(), pc.normalised_law(dmt), 6.0);
@@ -152,7 +152,7 @@ TEST(Simulation, SensitivitiesOfASmoothLawTakeFewMoreStepsThanTheStateAndMatchAT
   ASSERT_GE(plain.stats.impacts, 1);  // (it touches)
   o.sensitivity = true;
   const auto with = simulate(model, 0.0, s, model.period(), o);
-  EXPECT_LT(with.stats.steps, 1.4 * plain.stats.steps) << with.stats.steps << " vs " << plain.stats.steps;
+  EXPECT_LT(with.stats.steps, 1.6 * plain.stats.steps) << with.stats.steps << " vs " << plain.stats.steps;
   const double scale = std::max(std::abs(plain.state.position), std::abs(plain.state.velocity));
   EXPECT_NEAR(with.state.position, plain.state.position, 1e-9 * scale);
   EXPECT_NEAR(with.state.velocity, plain.state.velocity, 1e-9 * scale);

@@ -181,7 +181,7 @@ class Dopri5 {
 };
 
 /// The magnitude below which the sensitivities' errors are held to the tolerance relative to this floor (DOP853).
-constexpr double kSensitivityFloor = 100.0;
+constexpr double kSensitivityFloor = 10.0;
 
 template <std::size_t N, template <class, std::size_t> class StepperFor, class Field = ModeField<N>>
 void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationOptions& options,
@@ -196,10 +196,11 @@ void run(const TappingSystem& sys, RunState& rs, double t_end, const SimulationO
   // DOP853 (a smooth law) measures the error by the RMS over the N components: with the sensitivities (N = 8) the
   // state's two terms weigh as in the run without them at half the tolerances (√(8/2) = 2: the state is held as
   // that run holds it), and the six sensitivities, as smooth as the state there, to kSensitivityFloor times the
-  // tolerance: held to the tolerance itself they took 1.75 times the steps of the state (pyDAMPF's DMT sweep at
-  // tolerance 1e-10 against one at 1e-13, 50 / 1000 points: Floquet multipliers within 2.8e-9 / 1.3e-8 instead of
-  // 6e-12 / 3e-10, amplitudes within 1.9e-9 / 8.7e-9 instead of 1.7e-10 / 8.1e-9; measured). Dopri5 (a law only
-  // C¹ at its knots: the sensitivities' right-hand side only C⁰ there) holds them all to the tolerance.
+  // tolerance: held to the tolerance itself they took 1.75 times the steps of the state, 1.36 times now (pyDAMPF's
+  // DMT sweep at tolerance 1e-10 against one at 1e-13, 50 / 1000 points: Floquet multipliers within 1e-10 / 7.3e-9
+  // instead of 6e-12 / 3e-10, amplitudes within 7.7e-10 / 8.1e-9 instead of 1.7e-10 / 8.1e-9; at 100 times the
+  // tolerance 1.2 times the steps, multipliers within 2.8e-9 / 1.3e-8: measured). Dopri5 (a law only C¹ at its
+  // knots: the sensitivities' right-hand side only C⁰ there) holds them all to the tolerance.
   State floor{};
   double tolerance_scale = 1.0;
   if constexpr (N == 8) {
