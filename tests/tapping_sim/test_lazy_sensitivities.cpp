@@ -141,5 +141,37 @@ TEST(LazySensitivities, SweepIsTheEagerSweep) {
   EXPECT_EQ(dmt.approach.size(), 13u);
 }
 
+// On a coarse grid (the spacing of a 50-point sweep over 2 … 10 nm) Newton starts from the Hermite polynomial
+// through the orbits behind and their slopes (sweep.cpp, starting_guess): on the smooth stretch of the branch
+// (4 … 8 nm, touching) the guess is a few tolerances off, and Newton needs one Broyden step on the cheap map at most
+// before the run with sensitivities (from the quadratic through one orbit behind, as before, the guess was ~1e-6
+// off: two steps at every point); the amplitudes are those of a sweep at tolerance 1e-13 to 1e-8.
+TEST(LazySensitivities, CoarseGridGuessesFromTheBranchHistoryNeedOneStepAtMost) {
+  SweepOptions o;
+  o.parallel = false;
+  o.harmonic_balance = false;
+  o.retract = false;
+  SweepOptions tight = o;
+  o.shooting.tolerance = o.shooting.simulation.relative_tolerance = 1e-10;
+  o.shooting.simulation.absolute_tolerance = 1e-11;
+  tight.shooting.tolerance = tight.shooting.simulation.relative_tolerance = 1e-13;
+  tight.shooting.simulation.absolute_tolerance = 1e-14;
+  const double spacing = 8.0 / 49.0;  // nm
+  const int points = 25;
+  const TappingModel model = lazy_dmt_model(10.0);
+  const SweepResult r = sweep_instrument(model, 4.0, 4.0 + (points - 1) * spacing, points, o);
+  const SweepResult reference = sweep_instrument(model, 4.0, 4.0 + (points - 1) * spacing, points, tight);
+  ASSERT_EQ(r.approach.size(), reference.approach.size());
+  int iterations = 0;
+  for (std::size_t k = 0; k < r.approach.size(); ++k) {
+    const SweepPoint& p = r.approach[k];
+    EXPECT_TRUE(p.orbit.stable && !p.jumped) << "l = " << p.separation;
+    EXPECT_NEAR(p.metrics.amplitude, reference.approach[k].metrics.amplitude,
+                1e-8 * reference.approach[k].metrics.amplitude) << "l = " << p.separation;
+    if (k >= 3) iterations += p.orbit.iterations;  // (the first points have less history behind)
+  }
+  EXPECT_LE(iterations, 1.4 * (points - 3)) << "Broyden iterations over " << points - 3 << " points";
+}
+
 }  // namespace
 }  // namespace afmkit::tapping

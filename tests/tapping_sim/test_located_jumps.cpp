@@ -36,14 +36,26 @@ SweepOptions options() {
   return o;
 }
 
-/// The jumps of one direction up to and including the first that lands on a non-periodic response (beyond it the
-/// response is chaotic: where it settles depends on the transient, as on an instrument), in sweep order.
+/// Whether a jump lands on the period-doubled orbit of the one it leaves (n -> 2n): where it lands is then decided
+/// next to the orbit it leaves. Any other landing (another period, or a response that does not settle) is the end
+/// of a chaotic transient whose length depends on the state it starts from to rounding: on retract, where the
+/// period-4 orbit of the cascade loses stability (l ≈ 0.2890 nm), 21 transients from its last stable orbit with x
+/// moved by up to 1e-8 (relative) settle on the period-3 orbit after 312 to more than 4000 periods (3 of 21 not
+/// within the 4000 periods of options(), all 21 within 20000: measured), so the same jump is reported landing on
+/// the period-3 orbit or on a response that did not settle, depending on the orbit's last digits.
+bool lands_by_doubling(const SweepJump& j) {
+  return j.landed_periodic && j.to.period_multiple == 2 * j.from.period_multiple;
+}
+
+/// The jumps of one direction up to and including the first that does not land by period doubling (beyond it the
+/// response went through a chaotic transient: where it settles depends on the transient, as on an instrument), in
+/// sweep order. Their locations are the grid's business; the landing of the last one is not.
 std::vector<SweepJump> deterministic_jumps(const SweepResult& r, SweepDirection d) {
   std::vector<SweepJump> out;
   for (const SweepJump& j : r.jumps) {
     if (j.direction != d) continue;
     out.push_back(j);
-    if (!j.landed_periodic || !j.located) break;
+    if (!lands_by_doubling(j) || !j.located) break;
   }
   return out;
 }
@@ -91,7 +103,7 @@ TEST(LocatedJumps, TheSameJumpsOnEveryGrid) {
         EXPECT_TRUE(jumps[i].located);
         EXPECT_LE(jumps[i].tolerance, tol);
         EXPECT_NEAR(jumps[i].separation, reference[i].separation, 2.0 * tol) << direction_name(d) << " jump " << i;
-        EXPECT_EQ(jumps[i].landed_periodic, reference[i].landed_periodic);
+        EXPECT_EQ(lands_by_doubling(jumps[i]), lands_by_doubling(reference[i])) << direction_name(d) << " jump " << i;
       }
     }
   }

@@ -68,13 +68,13 @@ std::optional<PeriodicOrbit> try_shoot(const TappingModel& model, TipState guess
                                        const ShootingOptions& options = {});
 /// try_shoot from a guess near a known orbit `near` of a neighbouring model (the previous point of a branch): the
 /// first Newton iterations evaluate the map without its sensitivities, with Broyden updates of near's Jacobian
-/// M − I, until the residual is within the tolerance (or they stop reducing it); try_shoot then starts there, so
-/// the variational equations are integrated at the converged state (usually there only: the two maps differ by
-/// the integrator's tolerance) and the monodromy and multipliers are those of the converged orbit, as try_shoot's.
-/// `iterations` counts both kinds (0: the guess was within the tolerance). The last Broyden step is not evaluated
-/// on the cheap map: it goes to the run with sensitivities directly (judged as try_shoot judges its first
-/// evaluation; Newton goes on from there when it is not yet the orbit). `evaluate_guess` false: the guess is taken
-/// to be within the tolerance (as a caller's last one was) and goes to that run at once.
+/// M − I, until the residual is within 100 tolerances (or they stop reducing it); the next step then goes to the
+/// run with sensitivities directly, untested on the cheap map, so the variational equations are integrated at the
+/// converged state (usually there only: the two maps differ by the integrator's tolerance) and the monodromy and
+/// multipliers are those of the converged orbit, as try_shoot's. That run judges the step as try_shoot judges its
+/// first evaluation; Newton goes on from there (try_shoot) when it is not yet the orbit. `iterations` counts both
+/// kinds (0: the guess was within the tolerance). `evaluate_guess` false: the guess is taken to be within the
+/// tolerance (as a caller's last one was) and goes to that run at once.
 std::optional<PeriodicOrbit> try_shoot_near(const TappingModel& model, TipState guess, const PeriodicOrbit& near,
                                             const ShootingOptions& options = {}, bool evaluate_guess = true);
 /// As try_shoot, but non-convergence -> NumericalFailure with the residual in the message.

@@ -175,16 +175,20 @@ constexpr double kMaxMultiplierMove = 0.25;
 
 namespace {
 /// An orbit of the followed branch before the one followed from (scaled state z = (x, ẋ/ω) at the parameter value
-/// `at`): with it Newton starts from the quadratic through both orbits with the tangent of the last one.
+/// `at`): with the orbits behind, Newton starts from the Hermite polynomial through them and the one followed from.
 struct BranchBehind {
   Eigen::Vector2d z;
   double at = 0.0;
   Eigen::Matrix2d monodromy = Eigen::Matrix2d::Identity();  // its M (the Jacobian of Newton's start, extrapolated)
+  std::optional<Eigen::Vector2d> slope;  // dz/dp of its branch where known (free for the separation)
 };
+/// The orbits behind, the nearest first (at most kMaxBehind, each further behind than the one before).
+using BranchHistory = std::vector<BranchBehind>;
+constexpr std::size_t kMaxBehind = 2;
 
 /// follow_stable_branch along any parameter: `from` is an orbit at p = l_from, l_to the value to reach.
 BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit& from, double l_from, double l_to,
-                          const SweepOptions& options, std::optional<BranchBehind> behind = std::nullopt);
+                          const SweepOptions& options, BranchHistory behind = {});
 }  // namespace
 
 BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit& from, double l_to,
@@ -198,30 +202,83 @@ BranchFollow follow_stable_branch(const TappingModel& base, const PeriodicOrbit&
 
 namespace {
 
-/// Newton's starting guess at l_next: the tangent prediction `predicted` from z (at `at`, slope `slope`) plus the
-/// curvature of the branch seen from the orbit behind (the quadratic through both with the tangent at z, O(Δl³)
-/// off a smooth branch instead of O(Δl²)); the tangent prediction where the quadratic term is not the smaller one
-/// (a corner or a fold between: the curvature says nothing there).
-/// `monodromy` (M of the orbit at z on entry): with the quadratic guess, the Jacobian Newton starts from at l_next,
-/// extrapolated linearly in l through both orbits' M (O(Δl²) off instead of O(Δl): at high Q, M − I is nearly
-/// singular and magnifies the Jacobian's error, so Broyden's iterations from M(l) alone were most of the cost of a
-/// coarse grid).
+/// Newton's starting guess at l_next: the tangent prediction `predicted` from z (at `at`, slope `slope`) raised in
+/// order by the orbits behind: the Hermite polynomial through z with its slope and each orbit behind with its slope
+/// where known (Newton's form on the confluent nodes at, at, p₁, p₁, p₂, …), term by term while each term is at most
+/// half the one before (a smooth branch: with the two grid points behind and their slopes O(Δl⁶) off instead of
+/// the quadratic's O(Δl³); at a corner or a fold between the higher terms say nothing and are left out).
+/// `monodromy` (M of the orbit at z on entry): with a guess above the tangent, the Jacobian Newton starts from at
+/// l_next, extrapolated in l through the orbits' M by the same rule (at high Q, M − I is nearly singular and
+/// magnifies the Jacobian's error, so Broyden's iterations from M(l) alone were most of the cost of a coarse grid).
 Eigen::Vector2d starting_guess(const Eigen::Vector2d& predicted, const Eigen::Vector2d& z, const Eigen::Vector2d& slope,
-                               double at, double l_next, const std::optional<BranchBehind>& behind,
-                               Eigen::Matrix2d& monodromy) {
-  if (!behind) return predicted;
-  const double back = behind->at - at, ahead = l_next - at;
-  if (!(back != 0.0) || (back > 0) == (ahead > 0)) return predicted;  // the orbit behind must lie behind
-  const Eigen::Vector2d curvature = (behind->z - z - back * slope) / (back * back);
-  const Eigen::Vector2d quadratic = ahead * ahead * curvature;
-  if (!quadratic.allFinite() || quadratic.norm() > 0.5 * std::abs(ahead) * slope.norm()) return predicted;
-  const Eigen::Matrix2d extrapolated = monodromy + (ahead / back) * (behind->monodromy - monodromy);
+                               double at, double l_next, const BranchHistory& behind, Eigen::Matrix2d& monodromy) {
+  const double ahead = l_next - at;
+  // the nodes: each orbit behind must lie further behind than the one before
+  std::vector<double> t{at, at};
+  std::vector<Eigen::Vector2d> f{z, z};  // divided differences, computed in place (Newton's form)
+  std::vector<Eigen::Matrix2d> m{monodromy};  // M's divided differences on the distinct nodes
+  std::vector<double> tm{at};
+  double last = at;
+  for (const BranchBehind& b : behind) {
+    const double back = b.at - at;
+    if (!(back != 0.0) || (back > 0) == (ahead > 0) || std::abs(b.at - at) <= std::abs(last - at)) break;
+    last = b.at;
+    t.push_back(b.at);
+    f.push_back(b.z);
+    tm.push_back(b.at);
+    m.push_back(b.monodromy);
+    if (!b.slope) break;  // (a value without its slope ends the nodes: the next would need it)
+    t.push_back(b.at);
+    f.push_back(b.z);
+  }
+  if (t.size() == 2) return predicted;
+  // confluent divided differences: f[t_i, t_i] = slope at t_i
+  const std::size_t count = t.size();
+  std::vector<Eigen::Vector2d> slopes(count, Eigen::Vector2d::Zero());
+  slopes[0] = slope;
+  for (std::size_t i = 2, k = 0; i < count; ++i)
+    if (t[i] == t[i - 1]) slopes[i - 1] = *behind[k++].slope;
+  std::vector<Eigen::Vector2d> coefficient{f[0]};
+  for (std::size_t order = 1; order < count; ++order) {
+    for (std::size_t i = count - 1; i >= order; --i) {
+      f[i] = t[i] == t[i - order] ? slopes[i - 1] : Eigen::Vector2d((f[i] - f[i - 1]) / (t[i] - t[i - order]));
+    }
+    coefficient.push_back(f[order]);
+  }
+  // the terms beyond the tangent, while they shrink
+  Eigen::Vector2d guess = predicted;
+  double product = ahead * ahead;  // Π (l_next − t_j), j < order, for order 2
+  double previous = std::abs(ahead) * slope.norm();
+  std::size_t used = 1;
+  for (std::size_t order = 2; order < count; ++order) {
+    const Eigen::Vector2d term = product * coefficient[order];
+    if (!term.allFinite() || term.norm() > 0.5 * previous) break;
+    guess += term;
+    previous = term.norm();
+    used = order;
+    product *= l_next - t[order];
+  }
+  if (used < 2) return predicted;
+  // M through the distinct nodes (as many as the guess used: the quadratic guess extrapolates M linearly)
+  const std::size_t nodes = std::min(tm.size(), used == 2 ? std::size_t{2} : std::size_t{3});
+  for (std::size_t order = 1; order < nodes; ++order)
+    for (std::size_t i = nodes - 1; i >= order; --i) m[i] = (m[i] - m[i - 1]) / (tm[i] - tm[i - order]);
+  Eigen::Matrix2d extrapolated = m[0];
+  double factor = 1.0;
+  double before = std::numeric_limits<double>::infinity();
+  for (std::size_t order = 1; order < nodes; ++order) {
+    factor *= l_next - tm[order - 1];
+    const Eigen::Matrix2d term = factor * m[order];
+    if (!term.allFinite() || (order > 1 && term.norm() > 0.5 * before)) break;
+    extrapolated += term;
+    before = term.norm();
+  }
   if (extrapolated.allFinite()) monodromy = extrapolated;
-  return predicted + quadratic;
+  return guess;
 }
 
 BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit& from, double l_from, double l_to,
-                          const SweepOptions& options, std::optional<BranchBehind> behind) {
+                          const SweepOptions& options, BranchHistory behind) {
   const TappingModel& base = path.base;
   const ShootingOptions& shooting = options.shooting;
   const double omega = base.drive.frequency;
@@ -354,7 +411,8 @@ BranchFollow follow_along(const detail::ParameterPath& path, const PeriodicOrbit
       judge(false);
     }
     if (accepted) {
-      behind = BranchBehind{z, at, current.monodromy};
+      behind.insert(behind.begin(), BranchBehind{z, at, current.monodromy, slope});
+      if (behind.size() > kMaxBehind) behind.pop_back();
       current = *next;
       at = l_next;
       slope = slope_next;
@@ -425,7 +483,7 @@ SweepJump make_jump(const detail::ParameterPath& path, double separation, double
 /// sub-steps of transient_step·A_free until it settles on a periodic orbit.
 SweepPoint continue_point(const detail::ParameterPath& path, double l_to, const SweepPoint& previous,
                           SweepDirection direction, const SweepOptions& options, std::vector<SweepJump>& jumps,
-                          const SweepPoint* before = nullptr) {
+                          const SweepPoint* before = nullptr, const SweepPoint* before2 = nullptr) {
   if (previous.periodic && !previous.orbit.stable) {
     // a neutrally stable periodic response (e.g. a tip resting on the sample) has no stable branch to follow: it
     // settles (or not) at the new value; a jump is known to the grid's resolution only
@@ -461,12 +519,21 @@ SweepPoint continue_point(const detail::ParameterPath& path, double l_to, const 
       l_at = l_next;
       continue;
     }
-    // the point before the previous one, on the same stable branch (no jump, the same period and memory)
-    std::optional<BranchBehind> behind;
-    if (pass == 0 && before && before->periodic && before->orbit.stable && !previous.jumped &&
-        before->orbit.period_multiple == orbit.period_multiple && before->orbit.initial.contact == orbit.initial.contact)
-      behind = BranchBehind{scaled(before->orbit.initial, path.base.drive.frequency), before->parameter,
-                            before->orbit.monodromy};
+    // the points before the previous one, on the same stable branch (no jump, the same period and memory), with
+    // the slopes of their branch where they are free (the separation: the map's column ∂P/∂l at the orbit)
+    BranchHistory behind;
+    if (pass == 0 && !previous.jumped) {
+      const double omega = path.base.drive.frequency;
+      for (const SweepPoint* b : {before, before ? before2 : nullptr}) {
+        if (!(b && b->periodic && b->orbit.stable && b->orbit.period_multiple == orbit.period_multiple &&
+              b->orbit.initial.contact == orbit.initial.contact))
+          break;
+        std::optional<Eigen::Vector2d> slope;
+        if (path.parameter.is_separation()) slope = branch_slope(b->orbit, b->orbit.separation_sensitivity, omega);
+        behind.push_back(BranchBehind{scaled(b->orbit.initial, omega), b->parameter, b->orbit.monodromy, slope});
+        if (b->jumped) break;  // the one before it is on another branch
+      }
+    }
     const BranchFollow f = follow_along(path, orbit, l_at, l_to, options, behind);
     if (f.reached) {
       SweepPoint p;
@@ -514,7 +581,8 @@ std::vector<SweepPoint> run_direction(const detail::ParameterPath& path, const s
   if (options.progress) options.progress(1);
   for (std::size_t k = 1; k < ls.size(); ++k) {
     options.cancellation.check();
-    out.push_back(continue_point(path, ls[k], out[k - 1], direction, options, jumps, k >= 2 ? &out[k - 2] : nullptr));
+    out.push_back(continue_point(path, ls[k], out[k - 1], direction, options, jumps, k >= 2 ? &out[k - 2] : nullptr,
+                                 k >= 3 ? &out[k - 3] : nullptr));
     if (options.progress) options.progress(1);
   }
   return out;
