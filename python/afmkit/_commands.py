@@ -63,7 +63,8 @@ class Result(dict):
     def __init__(self, command: str, raw: dict):
         super().__init__(raw["table"])
         self.command = command
-        self.results: _Summary = _summary(raw["results"])
+        # the summary, or (from a command that makes it where it is read) a callable making it: see `results`
+        self._results = raw["results"]
         self.params: dict = raw["params"]
         self.columns: list[str] = [c[0] for c in raw["columns"]]
         self.units: dict[str, str] = {c[0]: c[1] for c in raw["columns"]}
@@ -72,6 +73,19 @@ class Result(dict):
         #: The grid the command declares its rows to be (its sidecar's "grid": dims, columns, shape, coords), or
         #: None: to_xarray() shapes the table on it.
         self.grid: dict | None = raw.get("grid")
+
+    @property
+    def results(self) -> _Summary:
+        """The summary document (the command's ``--json`` output without the table; keys also as attributes:
+        ``r.results.folds``). Made when first read: a short command's summary of hundreds of values (``tapping
+        orbit``'s search report) costs a noticeable part of the call, which a caller reading only the columns does
+        not pay."""
+        results = self.__dict__["_results"]
+        if callable(results):
+            results = self.__dict__["_results"] = results()
+        if not isinstance(results, _Summary):
+            results = self.__dict__["_results"] = _summary(results)
+        return results
 
     # ---- the mapping (read-only)
     @property

@@ -248,13 +248,19 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
     py::gil_scoped_acquire gil;  // the computation runs without the GIL
     results = json_to_python(document);
   };
+  // or, from a command that makes its summary where it is read, the maker: r.results makes it on first access
+  cli::ResultsMaker make_results;
+  captured.take_results_maker = [&make_results](cli::ResultsMaker maker) { make_results = std::move(maker); };
   try {
     interrupts.run([&] { s.run(p, &captured); });
   } catch (const PythonLawError& e) {  // the user's law failed: their error (exit-2 style), not a crash
     throw InvalidParameter("law", e.what());
   }
   py::dict out;
-  out["results"] = results ? results : json_to_python(captured.results);
+  if (make_results)  // a callable making the summary (afmkit.Result.results calls it once, when first read)
+    out["results"] = py::cpp_function([make = std::move(make_results)] { return json_to_python(make()); });
+  else
+    out["results"] = results ? results : json_to_python(captured.results);
   py::list columns;
   py::dict table;
   for (std::size_t c = 0; c < captured.columns.size(); ++c) {
