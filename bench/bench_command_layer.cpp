@@ -50,7 +50,8 @@ cli::Captured handed_over(std::size_t& values, cli::ResultsMaker& maker, bool re
     maker = std::move(m);
     if (!read) return;
     values = 0;
-    for (const auto& item : maker().items()) values += item.value().size();
+    const nlohmann::json document = maker();
+    for (const auto& item : document.items()) values += item.value().size();
   };
   return c;
 }
