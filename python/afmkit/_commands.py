@@ -65,7 +65,7 @@ class Result(dict):
         self.command = command
         # the summary, or (from a command that makes it where it is read) a callable making it: see `results`
         self._results = raw["results"]
-        self.params: dict = raw["params"]
+        self._params = raw["params"]  # the record, or a callable making it: see `params`
         self.columns: list[str] = [c[0] for c in raw["columns"]]
         self.units: dict[str, str] = {c[0]: c[1] for c in raw["columns"]}
         self.meaning: dict[str, str] = {c[0]: c[2] for c in raw["columns"]}
@@ -86,6 +86,15 @@ class Result(dict):
         if not isinstance(results, _Summary):
             results = self.__dict__["_results"] = _summary(results)
         return results
+
+    @property
+    def params(self) -> dict:
+        """The parameters as run (``f(**r.params)`` repeats the run; computed defaults filled in, as the sidecar
+        records them). Made when first read, as ``results``."""
+        params = self.__dict__["_params"]
+        if callable(params):
+            params = self.__dict__["_params"] = params()
+        return params
 
     # ---- the mapping (read-only)
     @property
@@ -330,8 +339,9 @@ def make_command(path: str):
     keys = {p["key"] for p in spec["params"]}
 
     def command(**kwargs) -> Result:
-        if "law" in keys:  # law= an afmkit.laws object: the keywords it stands for
-            from . import laws
+        law = kwargs.get("law")
+        if law is not None and not isinstance(law, str) and "law" in keys:  # an afmkit.laws object: its keywords
+            from . import laws  # here (afmkit.laws imports this module), and only for a law object (it costs)
             kwargs = laws.expand(path, kwargs, keys)
         # None: not given (the default, which for some keys is another key's value or computed: _signature_default)
         return Result(path, _afmkit.run(path, {k: v for k, v in kwargs.items() if v is not None}))

@@ -275,7 +275,12 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   // the parameters as the run used them (computed defaults filled in), as its sidecar records them
   nlohmann::json params = captured.parameters.is_null() ? p.to_json() : std::move(captured.parameters);
   params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)
-  out["params"] = json_to_python(params);
+  if (make_results)  // with a summary made where it is read, the record too: a callable making its dict
+    out["params"] = py::cpp_function([record = std::make_shared<const nlohmann::json>(std::move(params))] {
+      return json_to_python(*record);
+    });
+  else
+    out["params"] = json_to_python(params);
   return out;
 }
 
@@ -311,7 +316,9 @@ void bind_commands(py::module_& m) {
       "InvalidParameter naming `parameter` when value x bytes_per_unit exceeds the memory afmkit may use (half of "
       "what is available, capped by AFMKIT_MEMORY_LIMIT), as the commands check their sizes.");
   m.def("run", &run, py::arg("path"), py::arg("kwargs"),
-        "Runs one command with keyword arguments named as its TOML keys; returns results, columns, table, params.");
+        "Runs one command with keyword arguments named as its TOML keys; returns results, columns, table, params "
+        "(from a command that makes its summary where it is read, results and params are callables making them: "
+        "afmkit.Result calls each when it is first read).");
 }
 
 }  // namespace afmkit::python
