@@ -63,9 +63,9 @@ class Result(dict):
     def __init__(self, command: str, raw: dict):
         super().__init__(raw["table"])
         self.command = command
-        # the summary, or (from a command that makes it where it is read) a callable making it: see `results`
+        # the summary, or (from a command that makes it where it is read) its maker: see `results`
         self._results = raw["results"]
-        self._params = raw["params"]  # the record, or a callable making it: see `params`
+        self.params: dict = raw["params"]
         self.columns: list[str] = [c[0] for c in raw["columns"]]
         self.units: dict[str, str] = {c[0]: c[1] for c in raw["columns"]}
         self.meaning: dict[str, str] = {c[0]: c[2] for c in raw["columns"]}
@@ -81,20 +81,11 @@ class Result(dict):
         orbit``'s search report) costs a noticeable part of the call, which a caller reading only the columns does
         not pay."""
         results = self.__dict__["_results"]
-        if callable(results):
-            results = self.__dict__["_results"] = results()
+        if not isinstance(results, dict):  # the maker (a capsule): the summary made now, once
+            results = self.__dict__["_results"] = _afmkit.made_summary(results)
         if not isinstance(results, _Summary):
             results = self.__dict__["_results"] = _summary(results)
         return results
-
-    @property
-    def params(self) -> dict:
-        """The parameters as run (``f(**r.params)`` repeats the run; computed defaults filled in, as the sidecar
-        records them). Made when first read, as ``results``."""
-        params = self.__dict__["_params"]
-        if callable(params):
-            params = self.__dict__["_params"] = params()
-        return params
 
     # ---- the mapping (read-only)
     @property

@@ -221,6 +221,24 @@ void progress_to_python(const std::string& line, SignalPoll& interrupts) {
   }
 }
 
+/// The name of the capsules holding a summary's maker (run(), made_summary()).
+constexpr const char* kMakerCapsule = "afmkit.results_maker";
+
+/// A summary's maker as a Python object that owns it: a capsule, the cheapest such object (a function object made
+/// and freed per call costs a short command ~0.2 %: bench/command_layer.py).
+py::capsule maker_capsule(cli::ResultsMaker maker) {
+  return py::capsule(new cli::ResultsMaker(std::move(maker)), kMakerCapsule, [](PyObject* o) {
+    delete static_cast<cli::ResultsMaker*>(PyCapsule_GetPointer(o, kMakerCapsule));
+  });
+}
+
+/// The summary the maker in `capsule` makes, as Python objects.
+py::object made_summary(const py::capsule& capsule) {
+  if (capsule.name() == nullptr || std::string(capsule.name()) != kMakerCapsule)
+    throw py::type_error("made_summary() takes the results of run() for a command that makes its summary when read");
+  return json_to_python((*capsule.get_pointer<cli::ResultsMaker>())());
+}
+
 /// Runs command `path` with `kwargs` (TOML keys; `config`: a TOML file loaded first, as --config).
 py::dict run(const std::string& path, const py::dict& kwargs) {
   std::string name = "afmkit." + path;
@@ -257,8 +275,8 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
     throw InvalidParameter("law", e.what());
   }
   py::dict out;
-  if (make_results)  // a callable making the summary (afmkit.Result.results calls it once, when first read)
-    out["results"] = py::cpp_function([make = std::move(make_results)] { return json_to_python(make()); });
+  if (make_results)  // the maker (afmkit.Result.results makes the summary with it, once, when first read)
+    out["results"] = maker_capsule(std::move(make_results));
   else
     out["results"] = results ? results : json_to_python(captured.results);
   py::list columns;
@@ -275,12 +293,7 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   // the parameters as the run used them (computed defaults filled in), as its sidecar records them
   nlohmann::json params = captured.parameters.is_null() ? p.to_json() : std::move(captured.parameters);
   params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)
-  if (make_results)  // with a summary made where it is read, the record too: a callable making its dict
-    out["params"] = py::cpp_function([record = std::make_shared<const nlohmann::json>(std::move(params))] {
-      return json_to_python(*record);
-    });
-  else
-    out["params"] = json_to_python(params);
+  out["params"] = json_to_python(params);
   return out;
 }
 
@@ -317,8 +330,10 @@ void bind_commands(py::module_& m) {
       "what is available, capped by AFMKIT_MEMORY_LIMIT), as the commands check their sizes.");
   m.def("run", &run, py::arg("path"), py::arg("kwargs"),
         "Runs one command with keyword arguments named as its TOML keys; returns results, columns, table, params "
-        "(from a command that makes its summary where it is read, results and params are callables making them: "
-        "afmkit.Result calls each when it is first read).");
+        "(from a command that makes its summary where it is read, results is a capsule holding its maker: "
+        "made_summary(results) makes it; afmkit.Result does when r.results is first read).");
+  m.def("made_summary", &made_summary, py::arg("results"),
+        "The summary document a run's results capsule makes (run() of a command that makes its summary when read).");
 }
 
 }  // namespace afmkit::python
