@@ -66,10 +66,16 @@ class Result(dict):
         # the summary, or (from a command that makes it where it is read) its maker: see `results`
         self._results = raw["results"]
         self.params: dict = raw["params"]
-        self.columns: list[str] = [c[0] for c in raw["columns"]]
-        self.units: dict[str, str] = {c[0]: c[1] for c in raw["columns"]}
-        self.meaning: dict[str, str] = {c[0]: c[2] for c in raw["columns"]}
-        self._raw_columns = [tuple(c) for c in raw["columns"]]
+        if "column_units" in raw:  # made by the module (_afmkit.run), fresh for this result
+            self.columns: list[str] = raw["column_names"]
+            self.units: dict[str, str] = raw["column_units"]
+            self.meaning: dict[str, str] = raw["column_meaning"]
+            self._raw_columns = raw["columns"]
+        else:  # a copy, a pickle
+            self.columns = [c[0] for c in raw["columns"]]
+            self.units = {c[0]: c[1] for c in raw["columns"]}
+            self.meaning = {c[0]: c[2] for c in raw["columns"]}
+            self._raw_columns = [tuple(c) for c in raw["columns"]]
         #: The grid the command declares its rows to be (its sidecar's "grid": dims, columns, shape, coords), or
         #: None: to_xarray() shapes the table on it.
         self.grid: dict | None = raw.get("grid")
