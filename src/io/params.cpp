@@ -663,7 +663,9 @@ nlohmann::json ParamSet::to_json() const {
   // in the keys' order (entries_ and the JSON object sort them alike): each added at the end, no lookups
   const std::vector<std::string_view> gone = replaced();
   auto& object = j.get_ref<nlohmann::json::object_t&>();
-  for (const auto& [key, e] : entries_) {
+  for (const auto& kv : entries_) {  // (no structured binding: clang 14 cannot capture one in the lambda below)
+    const std::string& key = kv.first;
+    const Entry& e = kv.second;
     if (!recorded(key, e, gone)) continue;
     const Entry& used = e.set || e.used || e.follows.empty() ? e : current(key);
     std::visit([&](const auto& v) { object.emplace_hint(object.end(), key, v); }, used.value);
