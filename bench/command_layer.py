@@ -68,12 +68,14 @@ def python_path(repeat: int):
 
 def cpp_path(binary: str):
     """Library, Command, CommandReused, CommandFiles times (seconds, wall and CPU) from the C++ benchmark program,
-    or None."""
+    or None: medians of repetitions interleaved at random (each variant meets the same moments of a shared
+    machine's load)."""
     if not binary or not os.path.exists(binary):
         return None
     out = subprocess.run([binary, "--benchmark_format=json", "--benchmark_min_time=1",
                           "--benchmark_filter=^(Library|Command|CommandReused|CommandFiles)$",
-                          "--benchmark_repetitions=3", "--benchmark_report_aggregates_only=true"],
+                          "--benchmark_repetitions=5", "--benchmark_enable_random_interleaving=true",
+                          "--benchmark_report_aggregates_only=true"],
                          check=True, capture_output=True, text=True).stdout
     times = {}
     for b in json.loads(out)["benchmarks"]:
