@@ -80,7 +80,7 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
     if (capture_->take_results) capture_->take_results(results);
     else capture_->results = results;
     capture_->grid = grid;
-    capture_->columns = columns_;
+    capture_->columns = std::move(columns_);
     capture_->rows = std::move(rows_);
     capture_->parameters = params_.to_json();
     return;
@@ -103,6 +103,19 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
     throw std::runtime_error(fmt::format("cannot write the results to standard output: {}", e.code().message()));
   }
   require_answer(results);
+}
+
+void CommandOutput::finish(ResultsMaker make_results, const std::string& summary) {
+  if (capture_ == nullptr || !capture_->take_results_maker || file_) {
+    finish(make_results(), summary);
+    return;
+  }
+  outputs_.commit();
+  capture_->take_results_maker(std::move(make_results));
+  capture_->grid = grid_.empty() ? nlohmann::json() : grid_.json();
+  capture_->columns = std::move(columns_);
+  capture_->rows = std::move(rows_);
+  capture_->parameters = params_.to_json();
 }
 
 void require_answer(const nlohmann::json& results) {

@@ -33,6 +33,11 @@ class ForceLawModel;
 
 namespace afmkit::cli {
 
+/// A command's summary document made when it is read (CommandOutput::finish(ResultsMaker, ...)): it owns what it
+/// needs (the computation's result), so that a caller who never reads the summary does not pay for building it.
+/// Each call makes the same document.
+using ResultsMaker = std::function<nlohmann::json()>;
+
 /// What a command hands back when a program runs it rather than a person (the Python module): the summary document
 /// (what --json prints, without the table), the table's columns and its rows. Nothing is printed; the table file is
 /// written only when its path is given.
@@ -42,6 +47,11 @@ struct Captured {
   /// Set: CommandOutput::finish hands the summary document to it instead of copying it into `results` (the Python
   /// module converts it to Python objects there; a copy of a large document costs as much as a short run).
   std::function<void(const nlohmann::json&)> take_results;
+  /// Set: a command that makes its summary on demand (finish(ResultsMaker, ...)) hands the maker to it instead of
+  /// the document (the Python module makes r.results on first access: a ~1 ms command's summary of hundreds of
+  /// values costs several per cent of it, bench/command_layer.py). Commands that make their document at once give it
+  /// to take_results (or `results`) as before.
+  std::function<void(ResultsMaker)> take_results_maker;
   std::vector<io::Column> columns;
   nlohmann::json rows = nlohmann::json::array();
   /// Stop request of the caller (Python: Ctrl-C); the long computations check it once per point. The command line
@@ -179,6 +189,10 @@ class CommandOutput {
   /// where the table went. When `results` has a "status" other than "ok", throws NoAnswer with its "note"
   /// afterwards (command line only).
   void finish(const nlohmann::json& results, const std::string& summary);
+  /// The same with the summary made by `make_results` where it is read: at once for the files, the standard output
+  /// and a capture without take_results_maker (the same outputs as finish(make_results(), summary)); handed to the
+  /// capture's take_results_maker otherwise (not made unless the caller reads it).
+  void finish(ResultsMaker make_results, const std::string& summary);
 
  private:
   template <class Row>

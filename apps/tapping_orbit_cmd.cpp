@@ -145,6 +145,46 @@ OrbitStatus orbit_status(const tapping::OrbitSearchResult& r, double separation,
                       r.orbits.size(), summary_value(separation, length))};
 }
 
+/// The command's summary document (--json, the sidecar's results, r.results): the HB solutions, the orbits, the
+/// transients and the search report, every entry with its unit.
+nlohmann::json orbit_summary(const tapping::OrbitSearchResult& r, const TappingUnits& u, double separation,
+                             double free_amplitude, const OrbitStatus& status) {
+  // every entry with its unit (the sidecar's "units", per results key: docs/study.md#outputs)
+  // the rows of each array without units (UnitTagged::values_only), moved into the document (no copies)
+  const auto row = [] { return UnitTagged(UnitTagged::values_only); };
+  nlohmann::json orbits = nlohmann::json::array();
+  for (const tapping::FoundOrbit& f : r.orbits) orbits.push_back(orbit_record(row(), f, r.report, u).values());
+  nlohmann::json hb = nlohmann::json::array();
+  for (const tapping::HbPoint& h : r.harmonic_balance) hb.push_back(hb_record(row(), h, u).values());
+  nlohmann::json transients = nlohmann::json::array();
+  for (const tapping::TransientOutcome& t : r.transients) transients.push_back(transient_record(row(), t).values());
+  // the units of the rows of each array: those of a record with every field
+  const tapping::FoundOrbit any_orbit{};
+  tapping::TransientOutcome any_transient;
+  any_transient.orbit = tapping::PeriodicOrbit{};
+  UnitTagged results;
+  results.add("separation", separation, u.length)
+      .add("free_amplitude", free_amplitude, u.length)
+      .add("harmonic_balance", std::move(hb))
+      .unit("harmonic_balance", hb_record(UnitTagged(), tapping::HbPoint{}, u).units())
+      .add("orbits", std::move(orbits))
+      .unit("orbits", orbit_record(UnitTagged(), any_orbit, r.report, u).units())
+      .add("transients", std::move(transients))
+      .unit("transients", transient_record(UnitTagged(), any_transient).units())
+      .add("search", search_record(r.report, u))
+      .add("status", status.status)
+      .add("note", status.note)
+      // the units of the whole run
+      .unit("length", u.length.name)
+      .unit("velocity", u.velocity.name)
+      .unit("force", u.force.name)
+      .unit("energy", u.energy.name)
+      .unit("time", u.time.name)
+      .unit("phase", "rad")
+      .unit("seconds", "s");
+  return std::move(results).summary();
+}
+
 /// The table: one row per orbit found.
 io::TableOf<tapping::FoundOrbit> orbit_table(const TappingUnits& u) {
   using F = tapping::FoundOrbit;
@@ -202,44 +242,16 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
                         estimate > kProgressAfterSeconds && !p.flag("json"));
   options.transient.on_periods = [&progress](int n) { progress.advance(n); };
   options.cancellation = cancellation_of(capture);
-  const tapping::OrbitSearchResult r = tapping::find_orbits(model, options);
+  tapping::OrbitSearchResult r_searched = tapping::find_orbits(model, options);
   progress.finish();
-  const OrbitStatus status = orbit_status(r, p.real("separation"), u.length);
 
-  // every entry with its unit (the sidecar's "units", per results key: docs/study.md#outputs)
-  // the rows of each array without units (UnitTagged::values_only), moved into the document (no copies)
-  const auto row = [] { return UnitTagged(UnitTagged::values_only); };
-  nlohmann::json orbits = nlohmann::json::array();
-  for (const tapping::FoundOrbit& f : r.orbits) orbits.push_back(orbit_record(row(), f, r.report, u).values());
-  nlohmann::json hb = nlohmann::json::array();
-  for (const tapping::HbPoint& h : r.harmonic_balance) hb.push_back(hb_record(row(), h, u).values());
-  nlohmann::json transients = nlohmann::json::array();
-  for (const tapping::TransientOutcome& t : r.transients) transients.push_back(transient_record(row(), t).values());
-  // the units of the rows of each array: those of a record with every field
-  const tapping::FoundOrbit any_orbit{};
-  tapping::TransientOutcome any_transient;
-  any_transient.orbit = tapping::PeriodicOrbit{};
-  UnitTagged results;
-  results.add("separation", p.real("separation"), u.length)
-      .add("free_amplitude", model.free_amplitude(), u.length)
-      .add("harmonic_balance", std::move(hb))
-      .unit("harmonic_balance", hb_record(UnitTagged(), tapping::HbPoint{}, u).units())
-      .add("orbits", std::move(orbits))
-      .unit("orbits", orbit_record(UnitTagged(), any_orbit, r.report, u).units())
-      .add("transients", std::move(transients))
-      .unit("transients", transient_record(UnitTagged(), any_transient).units())
-      .add("search", search_record(r.report, u))
-      .add("status", status.status)
-      .add("note", status.note)
-      // the units of the whole run
-      .unit("length", u.length.name)
-      .unit("velocity", u.velocity.name)
-      .unit("force", u.force.name)
-      .unit("energy", u.energy.name)
-      .unit("time", u.time.name)
-      .unit("phase", "rad")
-      .unit("seconds", "s");
-  const nlohmann::json summary = std::move(results).summary();
+  // the summary, made where it is read (a caller that never reads it does not pay for its ~550 values: Captured::
+  // take_results_maker); it owns the search's result
+  const auto found = std::make_shared<const tapping::OrbitSearchResult>(std::move(r_searched));
+  const tapping::OrbitSearchResult& r = *found;
+  const OrbitStatus status = orbit_status(r, p.real("separation"), u.length);
+  const ResultsMaker summary = [found, u, separation = p.real("separation"), free_amplitude = model.free_amplitude(),
+                                status] { return orbit_summary(*found, u, separation, free_amplitude, status); };
   CommandOutput out(p, capture, "tapping orbit");
   out.open(orbit_table(u)).add_all(r.orbits);
   if (p.flag("json")) {

@@ -2,10 +2,11 @@
 // setting where the orbit search takes about a millisecond, run
 //   * Library:       tapping::find_orbits on a model and options built once (the computation alone);
 //   * Command:       the command's run on a ParamSet (declare, defaults, resolve, the keyword values, checks), the
-//                    table captured and the summary document handed over as to the Python module (take_results:
-//                    read where it is made, not copied; no process start, nothing printed);
+//                    table captured and the summary document made and read as the Python module hands it over
+//                    (no process start, nothing printed);
 //   * CommandReused: the same with the parameters declared once and their values reset per call
-//                    (ParamSet::reset_values), as the Python module runs a command again;
+//                    (ParamSet::reset_values), as the Python module runs a command again; the summary is made
+//                    where it is read (Captured::take_results_maker), and not read (CommandReusedRead: read);
 //   * CommandFiles:  the same writing the CSV table and its JSON sidecar (what the command line does; no process).
 // bench/command_layer.py runs this program and afmkit.tapping.orbit in one run and prints the ratios.
 //   build/bin/bench_command_layer --benchmark_min_time=1
@@ -36,11 +37,20 @@ const std::map<std::string, std::string>& orbit_case() {
 }
 
 /// A capture as the Python module makes it: the summary document handed over (its values counted) where the
-/// command makes it, not copied into the capture.
-cli::Captured handed_over(std::size_t& values) {
+/// command makes it, not copied into the capture; from a command that makes its summary where it is read
+/// (CommandOutput::finish(ResultsMaker)), the maker, kept as afmkit.Result keeps it until r.results is read, and
+/// called only when `read` (the summary read: its values counted).
+cli::Captured handed_over(std::size_t& values, cli::ResultsMaker& maker, bool read) {
   cli::Captured c;
   c.take_results = [&values](const nlohmann::json& document) {
     values = 0;
+    for (const auto& item : document.items()) values += item.value().size();
+  };
+  c.take_results_maker = [&values, &maker, read](cli::ResultsMaker m) {
+    maker = std::move(m);
+    if (!read) return;
+    values = 0;
+    const nlohmann::json document = maker();
     for (const auto& item : document.items()) values += item.value().size();
   };
   return c;
@@ -86,9 +96,11 @@ void Library(benchmark::State& state) {
 }
 BENCHMARK(Library)->Unit(benchmark::kMicrosecond);
 
-// One run of the command with the summary handed over as Python takes it; the rows it gave.
-std::size_t run_once(const cli::CommandSpec& spec, const io::ParamSet& p, std::size_t& values) {
-  cli::Captured captured = handed_over(values);
+// One run of the command with the summary handed over as Python takes it (`read`: and read, as r.results is); the
+// rows it gave. The maker (what a Result holds) is released at the end, as Python releases a Result.
+std::size_t run_once(const cli::CommandSpec& spec, const io::ParamSet& p, std::size_t& values, bool read = false) {
+  cli::ResultsMaker maker;
+  cli::Captured captured = handed_over(values, maker, read);
   spec.run(p, &captured);
   benchmark::DoNotOptimize(captured);
   return captured.rows.size();
@@ -98,7 +110,7 @@ void Command(benchmark::State& state) {
   const cli::CommandSpec& spec = orbit_spec();
   std::size_t rows = 0;
   std::size_t values = 0;
-  for (auto _ : state) rows = run_once(spec, orbit_params(""), values);
+  for (auto _ : state) rows = run_once(spec, orbit_params(""), values, true);
   benchmark::DoNotOptimize(values);
   state.counters["orbits"] = static_cast<double>(rows);
 }
@@ -106,7 +118,7 @@ BENCHMARK(Command)->Unit(benchmark::kMicrosecond);
 
 // Command with the declarations made once (as the Python module does: python/src/params_from_python.cpp), the values
 // reset and given again per call.
-void CommandReused(benchmark::State& state) {
+void command_reused(benchmark::State& state, bool read) {
   const cli::CommandSpec& spec = orbit_spec();
   const io::ParamSet declared = declared_params("");
   io::ParamSet p = declared;
@@ -116,12 +128,17 @@ void CommandReused(benchmark::State& state) {
     p.resolve();
     for (const auto& [k, v] : orbit_case()) p.set_from_string(k, v);
     p.check_files();
-    rows = run_once(spec, p, values);
+    rows = run_once(spec, p, values, read);
   }
   benchmark::DoNotOptimize(values);
   state.counters["orbits"] = static_cast<double>(rows);
 }
+void CommandReused(benchmark::State& state) { command_reused(state, false); }
 BENCHMARK(CommandReused)->Unit(benchmark::kMicrosecond);
+
+// CommandReused with the summary document read after each run (as r.results is when a caller reads it).
+void CommandReusedRead(benchmark::State& state) { command_reused(state, true); }
+BENCHMARK(CommandReusedRead)->Unit(benchmark::kMicrosecond);
 
 // The part of Command that builds the ParamSet (declare, defaults, resolve, values, checks).
 void Params(benchmark::State& state) {

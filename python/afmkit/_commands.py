@@ -63,15 +63,35 @@ class Result(dict):
     def __init__(self, command: str, raw: dict):
         super().__init__(raw["table"])
         self.command = command
-        self.results: _Summary = _summary(raw["results"])
+        # the summary, or (from a command that makes it where it is read) its maker: see `results`
+        self._results = raw["results"]
         self.params: dict = raw["params"]
-        self.columns: list[str] = [c[0] for c in raw["columns"]]
-        self.units: dict[str, str] = {c[0]: c[1] for c in raw["columns"]}
-        self.meaning: dict[str, str] = {c[0]: c[2] for c in raw["columns"]}
-        self._raw_columns = [tuple(c) for c in raw["columns"]]
+        if "column_units" in raw:  # made by the module (_afmkit.run), fresh for this result
+            self.columns: list[str] = raw["column_names"]
+            self.units: dict[str, str] = raw["column_units"]
+            self.meaning: dict[str, str] = raw["column_meaning"]
+            self._raw_columns = raw["columns"]
+        else:  # a copy, a pickle
+            self.columns = [c[0] for c in raw["columns"]]
+            self.units = {c[0]: c[1] for c in raw["columns"]}
+            self.meaning = {c[0]: c[2] for c in raw["columns"]}
+            self._raw_columns = [tuple(c) for c in raw["columns"]]
         #: The grid the command declares its rows to be (its sidecar's "grid": dims, columns, shape, coords), or
         #: None: to_xarray() shapes the table on it.
         self.grid: dict | None = raw.get("grid")
+
+    @property
+    def results(self) -> _Summary:
+        """The summary document (the command's ``--json`` output without the table; keys also as attributes:
+        ``r.results.folds``). Made when first read: a short command's summary of hundreds of values (``tapping
+        orbit``'s search report) costs a noticeable part of the call, which a caller reading only the columns does
+        not pay."""
+        results = self.__dict__["_results"]
+        if not isinstance(results, dict):  # the maker (a capsule): the summary made now, once
+            results = self.__dict__["_results"] = _afmkit.made_summary(results)
+        if not isinstance(results, _Summary):
+            results = self.__dict__["_results"] = _summary(results)
+        return results
 
     # ---- the mapping (read-only)
     @property
@@ -316,8 +336,9 @@ def make_command(path: str):
     keys = {p["key"] for p in spec["params"]}
 
     def command(**kwargs) -> Result:
-        if "law" in keys:  # law= an afmkit.laws object: the keywords it stands for
-            from . import laws
+        law = kwargs.get("law")
+        if law is not None and not isinstance(law, str) and "law" in keys:  # an afmkit.laws object: its keywords
+            from . import laws  # here (afmkit.laws imports this module), and only for a law object (it costs)
             kwargs = laws.expand(path, kwargs, keys)
         # None: not given (the default, which for some keys is another key's value or computed: _signature_default)
         return Result(path, _afmkit.run(path, {k: v for k, v in kwargs.items() if v is not None}))

@@ -133,11 +133,25 @@ bool flag_column(const io::Column& column, const nlohmann::json& rows, std::size
   return true;
 }
 
+/// A new 1-D NumPy array of `n` elements of type T (float64, bool), made by NumPy's C API as pybind11's array_t(n)
+/// makes it, without its shape and strides containers (a third of the cost, per column of every call).
+template <class T>
+py::array_t<T> new_column(py::ssize_t n) {
+  const auto& api = py::detail::npy_api::get();
+  PyObject* descr = api.PyArray_DescrFromType_(py::detail::npy_format_descriptor<T>::value);
+  if (descr == nullptr) throw py::error_already_set();
+  Py_intptr_t shape[1] = {static_cast<Py_intptr_t>(n)};
+  // C order, owning its data, writeable (NumPy's defaults for data it allocates); takes the reference to descr
+  PyObject* a = api.PyArray_NewFromDescr_(api.PyArray_Type_, descr, 1, shape, nullptr, nullptr, 0, nullptr);
+  if (a == nullptr) throw py::error_already_set();
+  return py::reinterpret_steal<py::array_t<T>>(a);
+}
+
 /// Column `c` of the rows: bool for a flag column (flag_column), float64 when every cell is a number, a boolean or
 /// null (NaN), else an array of str.
 py::object column_array(const io::Column& column, const nlohmann::json& rows, std::size_t c) {
   if (flag_column(column, rows, c)) {
-    py::array_t<bool> a(static_cast<py::ssize_t>(rows.size()));
+    py::array_t<bool> a = new_column<bool>(static_cast<py::ssize_t>(rows.size()));
     auto w = a.mutable_unchecked<1>();
     py::ssize_t i = 0;
     for (const auto& r : rows) w(i++) = r[c].is_boolean() ? r[c].get<bool>() : r[c].get<double>() == 1.0;
@@ -147,7 +161,7 @@ py::object column_array(const io::Column& column, const nlohmann::json& rows, st
   for (const auto& r : rows)
     if (!(r[c].is_number() || r[c].is_boolean() || r[c].is_null())) numeric = false;
   if (numeric) {
-    py::array_t<double> a(static_cast<py::ssize_t>(rows.size()));
+    py::array_t<double> a = new_column<double>(static_cast<py::ssize_t>(rows.size()));
     auto w = a.mutable_unchecked<1>();
     py::ssize_t i = 0;
     for (const auto& r : rows) {
@@ -221,6 +235,24 @@ void progress_to_python(const std::string& line, SignalPoll& interrupts) {
   }
 }
 
+/// The name of the capsules holding a summary's maker (run(), made_summary()).
+constexpr const char* kMakerCapsule = "afmkit.results_maker";
+
+/// A summary's maker as a Python object that owns it: a capsule, the cheapest such object (a function object made
+/// and freed per call costs a short command ~0.2 %: bench/command_layer.py).
+py::capsule maker_capsule(cli::ResultsMaker maker) {
+  return py::capsule(new cli::ResultsMaker(std::move(maker)), kMakerCapsule, [](PyObject* o) {
+    delete static_cast<cli::ResultsMaker*>(PyCapsule_GetPointer(o, kMakerCapsule));
+  });
+}
+
+/// The summary the maker in `capsule` makes, as Python objects.
+py::object made_summary(const py::capsule& capsule) {
+  if (capsule.name() == nullptr || std::string(capsule.name()) != kMakerCapsule)
+    throw py::type_error("made_summary() takes the results of run() for a command that makes its summary when read");
+  return json_to_python((*capsule.get_pointer<cli::ResultsMaker>())());
+}
+
 /// Runs command `path` with `kwargs` (TOML keys; `config`: a TOML file loaded first, as --config).
 py::dict run(const std::string& path, const py::dict& kwargs) {
   std::string name = "afmkit." + path;
@@ -248,21 +280,36 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
     py::gil_scoped_acquire gil;  // the computation runs without the GIL
     results = json_to_python(document);
   };
+  // or, from a command that makes its summary where it is read, the maker: r.results makes it on first access
+  cli::ResultsMaker make_results;
+  captured.take_results_maker = [&make_results](cli::ResultsMaker maker) { make_results = std::move(maker); };
   try {
     interrupts.run([&] { s.run(p, &captured); });
   } catch (const PythonLawError& e) {  // the user's law failed: their error (exit-2 style), not a crash
     throw InvalidParameter("law", e.what());
   }
   py::dict out;
-  out["results"] = results ? results : json_to_python(captured.results);
-  py::list columns;
-  py::dict table;
+  if (make_results)  // the maker (afmkit.Result.results makes the summary with it, once, when first read)
+    out["results"] = maker_capsule(std::move(make_results));
+  else
+    out["results"] = results ? results : json_to_python(captured.results);
+  // the columns (name, unit, description), and made here for afmkit.Result (a Python loop over them costs a short
+  // command ~0.3 %): their names in order, name -> unit, name -> description
+  py::list columns, names;
+  py::dict table, units, meaning;
   for (std::size_t c = 0; c < captured.columns.size(); ++c) {
     const io::Column& col = captured.columns[c];
-    columns.append(py::make_tuple(col.name, col.unit, col.description));
-    table[py::str(col.name)] = column_array(col, captured.rows, c);
+    const py::str name(col.name), unit(col.unit), description(col.description);
+    columns.append(py::make_tuple(name, unit, description));
+    names.append(name);
+    units[name] = unit;
+    meaning[name] = description;
+    table[name] = column_array(col, captured.rows, c);
   }
   out["columns"] = columns;
+  out["column_names"] = names;
+  out["column_units"] = units;
+  out["column_meaning"] = meaning;
   out["table"] = table;
   // a table declared as a grid (io::TableOf::grid): its dims, shape and coordinates (None otherwise)
   out["grid"] = json_to_python(captured.grid);
@@ -305,7 +352,11 @@ void bind_commands(py::module_& m) {
       "InvalidParameter naming `parameter` when value x bytes_per_unit exceeds the memory afmkit may use (half of "
       "what is available, capped by AFMKIT_MEMORY_LIMIT), as the commands check their sizes.");
   m.def("run", &run, py::arg("path"), py::arg("kwargs"),
-        "Runs one command with keyword arguments named as its TOML keys; returns results, columns, table, params.");
+        "Runs one command with keyword arguments named as its TOML keys; returns results, columns, table, params "
+        "(from a command that makes its summary where it is read, results is a capsule holding its maker: "
+        "made_summary(results) makes it; afmkit.Result does when r.results is first read).");
+  m.def("made_summary", &made_summary, py::arg("results"),
+        "The summary document a run's results capsule makes (run() of a command that makes its summary when read).");
 }
 
 }  // namespace afmkit::python

@@ -586,11 +586,25 @@ void ParamSet::resolve() {
     constexpr std::uintmax_t max_config_bytes = 16u << 20;  // a parameter file, not data
     load_toml_text(files::read_input_file(config_path_, "--config file", max_config_bytes), config_path_);
   }
-  for (const auto& key : order_) {
-    Entry& e = entries_[key];
-    if (e.cli_text) set_from_string(key, *e.cli_text);
+  // in declaration order (the first flag or value refused is the one reported), looked up only when there is
+  // something to do: a front end that resets a set and resolves it per call (the Python module) checks ~140 values
+  // (bench/command_layer.py)
+  if (std::any_of(entries_.begin(), entries_.end(), [](const auto& kv) { return kv.second.cli_text.has_value(); }))
+    for (const auto& key : order_) {
+      Entry& e = entries_[key];
+      if (e.cli_text) set_from_string(key, *e.cli_text);
+    }
+  bool valid = true;
+  for (const auto& [key, e] : entries_) {
+    try {
+      check(key, e, "");
+    } catch (const InvalidParameter&) {
+      valid = false;
+      break;
+    }
   }
-  for (const auto& key : order_) check(key, entries_.at(key), "");
+  if (!valid)
+    for (const auto& key : order_) check(key, entries_.at(key), "");
   check_files();
 }
 
@@ -613,7 +627,9 @@ std::vector<std::string_view> ParamSet::replaced() const {
   return out;
 }
 bool ParamSet::recorded(const std::string& key, const std::vector<std::string_view>& replaced) const {
-  const Entry& e = entry(key);
+  return recorded(key, entry(key), replaced);
+}
+bool ParamSet::recorded(const std::string& key, const Entry& e, const std::vector<std::string_view>& replaced) const {
   if (e.only_if_given && !e.set) return false;
   for (const auto& [on, values] : e.applies)  // a key of another unit system or law than the run's
     if (std::find(values.begin(), values.end(), std::get<std::string>(current(on).value)) == values.end())
@@ -644,9 +660,15 @@ nlohmann::json ParamSet::to_json() const {
   nlohmann::json j = nlohmann::json::object();
   // the values the run used: a key that follows another records the followed value, a value recorded by
   // record_used replaces the default, an alternative not given is left out (params.hpp)
+  // in the keys' order (entries_ and the JSON object sort them alike): each added at the end, no lookups
   const std::vector<std::string_view> gone = replaced();
-  for (const auto& key : order_) {
-    if (recorded(key, gone)) std::visit([&](const auto& v) { j[key] = v; }, current(key).value);
+  auto& object = j.get_ref<nlohmann::json::object_t&>();
+  for (const auto& kv : entries_) {  // (no structured binding: clang 14 cannot capture one in the lambda below)
+    const std::string& key = kv.first;
+    const Entry& e = kv.second;
+    if (!recorded(key, e, gone)) continue;
+    const Entry& used = e.set || e.used || e.follows.empty() ? e : current(key);
+    std::visit([&](const auto& v) { object.emplace_hint(object.end(), key, v); }, used.value);
   }
   return j;
 }

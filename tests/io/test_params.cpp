@@ -302,3 +302,29 @@ TEST(ParamSetResetValues, GivesTheDeclaredValuesAgainKeepingTheDeclarations) {
   other.real("quality_factor", 1.0, "Q");
   EXPECT_THROW(p.reset_values(other), std::logic_error);
 }
+
+// resolve() checks every value without looking each up in declaration order (the Python module resolves a reset
+// set per call); a set with values refused still reports the first in declaration order, not in the keys' order.
+TEST(ParamSetResolve, ReportsTheFirstValueRefusedInDeclarationOrder) {
+  ParamSet p;
+  p.real("zeta", -1.0, "declared first, refused", Range::positive()).unit("dimensionless");
+  p.real("middle", 1.0, "accepted", Range::positive()).unit("dimensionless");
+  p.real("alpha", -2.0, "declared last, refused", Range::positive()).unit("dimensionless");
+  try {
+    p.resolve();
+    FAIL() << "refused values accepted";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "zeta");
+  }
+  p.set_value("zeta", 1.0);
+  try {
+    p.resolve();
+    FAIL() << "a refused value accepted";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "alpha");
+  }
+  p.set_value("alpha", 2.0);
+  EXPECT_NO_THROW(p.resolve());
+  // the record lists the keys in order, each value as used
+  EXPECT_EQ(p.to_json().dump(), R"({"alpha":2.0,"middle":1.0,"zeta":1.0})");
+}

@@ -1,6 +1,8 @@
 """afmkit.Result as people already use tables (docs/python.md#the-result-object): a read-only mapping of columns,
 attribute access, bool flags, pandas and xarray with units, an HTML view. Small runs (well under a second each)."""
 import copy
+import json
+import os
 import pickle
 import subprocess
 import sys
@@ -169,3 +171,36 @@ def test_a_sweep_in_another_parameter_describes_each_column_by_its_name():
     assert r.meaning["direction"].startswith("down (from parameter_max")
     assert r.meaning["amplitude"] == "first-harmonic amplitude B of the periodic orbit"
     assert set(r.direction) <= {"down", "up", "continuation"}
+
+
+def _timeless(results):
+    out = dict(results)
+    out["search"] = dict(out["search"], seconds=0.0)  # the search's wall time: the one value two runs differ in
+    return out
+
+
+def test_a_summary_made_where_it_is_read_is_the_document_of_the_run():
+    # tapping orbit makes its summary (~550 values: the search report lists every seed) when r.results is first
+    # read: a caller reading only the columns does not pay for it (issue 26: the command layer adds <= 5 % to a
+    # 1 ms command, bench/command_layer.py). Read, pickled or copied, it is the run's document.
+    case = dict(quality_factor=2.0, separation=5.0, max_period_multiple=1)
+    r = afmkit.tapping.orbit(**case)
+    assert not isinstance(r.__dict__["_results"], dict)  # not made yet
+    assert r.columns[0] == "source" and len(r) == 1  # the table, the params, the units without it
+    assert r.params["quality_factor"] == 2.0 and r.units["amplitude"] == "L"
+    made = r.results
+    assert isinstance(made, dict) and made is r.results  # made once, kept
+    assert len(made.search.seeds) == made.search.seeds_total > 10 and made.status == "ok"
+    assert {"kind", "orbits", "initial_position"} <= set(made.search.seeds[0])
+    assert made.units.search.seeds.initial_position == "L"
+    # the document the same run gives at once (the --config replay of its record; a result pickled before the
+    # summary was read)
+    fresh = afmkit.tapping.orbit(**r.params)
+    for other in (pickle.loads(pickle.dumps(fresh)), copy.deepcopy(afmkit.tapping.orbit(**case)), fresh):
+        assert _timeless(other.results) == _timeless(made)
+    out = subprocess.run([os.environ["AFMKIT_CLI"], "tapping", "orbit", "--quality-factor=2", "--separation=5",
+                          "--max-period-multiple=1", "--output", "", "--json"], capture_output=True, text=True, check=True)
+    printed = json.loads(out.stdout)
+    del printed["table"]
+    assert _timeless(printed) == _timeless(made)
+

@@ -209,6 +209,7 @@ class ParamSet {
   /// once per record, not once per key.
   std::vector<std::string_view> replaced() const;
   bool recorded(const std::string& key, const std::vector<std::string_view>& replaced) const;
+  bool recorded(const std::string& key, const Entry& e, const std::vector<std::string_view>& replaced) const;
   std::map<std::string, Entry> entries_;
   std::vector<std::string> order_;
   std::string config_path_;
