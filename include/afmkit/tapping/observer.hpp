@@ -84,7 +84,8 @@ class EventRecorder : public TrajectoryObserver {
   std::vector<Event> events_;
 };
 
-/// Integrals over the trajectory by Gauss–Legendre quadrature on every segment (sub-intervals no longer than
+/// Integrals over the trajectory: on a whole step of DOP853 no longer than `max_panel` by its own stages
+/// (Segment::stage_quadrature), else by Gauss–Legendre quadrature on the dense output (sub-intervals no longer than
 /// `max_panel`): Fourier coefficients of x at kω (k = 0..5), energy terms, contact time, extrema.
 class OrbitIntegrals : public TrajectoryObserver {
  public:
@@ -104,6 +105,7 @@ class OrbitIntegrals : public TrajectoryObserver {
  private:
   double max_panel_;
   void extremum(const TappingSystem& system, const Segment& segment, double a, double b);
+  bool stage_integrals(const TappingSystem& system, const Segment& segment);
 };
 
 }  // namespace afmkit::tapping
