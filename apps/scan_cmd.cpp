@@ -185,7 +185,17 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       .add("predicted", budget.predicted, "m")
       .add("pole", budget.pole, "dimensionless")
       .add("settle_samples", budget.settle_samples, "count");
+  // No answer (docs/commands.md#exit-status): fewer than three valid pixels leave no image to level or compare
+  const long valid_pixels = static_cast<long>(result.topography.valid_count());
+  const bool no_image = valid_pixels < 3;
+  const std::string note =
+      no_image ? fmt::format("{} valid pixel(s): the detector saturated on {:.3g} % of the samples (detector_range "
+                             "{}, detector_noise {}), so the images carry no height and every error is null",
+                             valid_pixels, 100.0 * result.saturated_fraction,
+                             io::quantity(instrument.detector.range, "m"), io::quantity(instrument.detector.noise, "m"))
+               : std::string();
   UnitTagged tagged;
+  tagged.add("status", no_image ? "no_image" : "ok").add("note", note);
   tagged.add("samples", result.run.samples, "count")
       .add("turns", result.turns, "count")
       .add("pitch", instrument.spiral.pitch(), "m")
@@ -204,7 +214,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
       .add("sample_rms_height", result.sample_rms_height, "m")
       .add("error_budget", std::move(error_budget))
       .add("deflection_rms", result.deflection_rms, "m")
-      .add("valid_pixels", result.topography.valid_count(), "count")
+      .add("valid_pixels", valid_pixels, "count")
       .add("loop_spectral_abscissa", abscissa, "1/s")
       .add("filter_skipped_samples", result.run.filter_skipped, "count")
       .add("point_cloud_points", n_points, "count")
@@ -244,7 +254,7 @@ void run_simulated(const io::ParamSet& p, Captured* capture) {
                     : std::string(),
       io::quantity(budget.predicted, "m"),
       files.empty() ? std::string() : fmt::format("; wrote {} files with prefix {}", files.size(), prefix));
-  out.finish(results, summary);
+  out.finish(results, no_image ? summary + "; status no_image: " + note : summary);
 }
 
 void run_scan(const io::ParamSet& p, Captured* capture) {

@@ -124,6 +124,20 @@ TEST(ScanCli, WithoutControlTheDetectorSaturatesAndTheImageHasHoles) {
   EXPECT_EQ(dir.count_files(), 0u);
 }
 
+// A detector saturated on every sample leaves no image: not a silent success but "no answer" (exit 1, status and
+// note in the results, docs/commands.md#exit-status); a partly saturated scan stays ok (the test above).
+TEST(ScanCli, ADetectorSaturatedEverywhereIsNoAnswer) {
+  TempDir dir;
+  const auto r = run_cli(kSmall + "--detector-noise 1e-3 --output \"\" --image-output \"\" --json", dir);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("no answer: status no_image: 0 valid pixel(s)"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["status"], "no_image");
+  EXPECT_EQ(j["valid_pixels"].get<long>(), 0);
+  EXPECT_TRUE(j["topography_rms_error"].is_null());
+  EXPECT_GT(j["saturated_fraction"].get<double>(), 0.99);
+}
+
 TEST(ScanCli, RecordedSpiralRunsThroughTheFilter) {
   TempDir dir;
   const std::string source = std::string(AFMKIT_SOURCE_DIR) + "/examples/recorded/";
