@@ -11,23 +11,6 @@
 
 namespace afmkit::tapping::image {
 
-namespace {
-/// e^{iu} for the stage nodes' rotations from the step's middle, |u| <= ω h/2 (π/12 at the cycles' largest step):
-/// Taylor to degree 12/13 in u (error below 1e-19 for |u| <= 0.27; beyond it std::polar).
-std::complex<double> node_phasor(double u) {
-  if (!(std::abs(u) <= 0.27)) return std::polar(1.0, u);
-  const double u2 = u * u;
-  double c = 1.0 / 479001600.0, s = 1.0 / 6227020800.0;  // 1/12!, 1/13!
-  constexpr double even[6] = {1.0 / 3628800.0, 1.0 / 40320.0, 1.0 / 720.0, 1.0 / 24.0, 1.0 / 2.0, 1.0};
-  constexpr double odd[6] = {1.0 / 39916800.0, 1.0 / 362880.0, 1.0 / 5040.0, 1.0 / 120.0, 1.0 / 6.0, 1.0};
-  for (int k = 0; k < 6; ++k) {
-    c = even[k] - u2 * c;
-    s = odd[k] - u2 * s;
-  }
-  return {c, u * s};
-}
-}  // namespace
-
 void CycleIntegrals::force_at(const TappingSystem& system, const Mode& m, const TipState& s) {
   peak_force = std::max(peak_force, 0.0 - system.interaction(m.branch, s.position, s.velocity, m.region));
 }
@@ -47,7 +30,7 @@ void CycleIntegrals::on_segment(const TappingSystem& system, const Segment& segm
     double square = 0.0;
     Stages(double w, double m) : omega(w), mid(m), e_mid(std::polar(1.0, -w * m)) {}
     void node(double t, double w, const TipState& s) override {
-      harmonic += (w * s.position) * node_phasor(-omega * (t - mid));
+      harmonic += (w * s.position) * tapping::detail::stage_rotation(-omega * (t - mid));
       square += w * s.velocity * s.velocity;
     }
   } stages(system.drive_frequency(), 0.5 * (t0 + t1));

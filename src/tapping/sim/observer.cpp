@@ -41,12 +41,6 @@ std::complex<double> small_phasor(double u) {
   return detail::small_angle_phasor(u);
 }
 
-/// The same for the stages' smaller rotations (a shorter series).
-std::complex<double> stage_phasor(double u) {
-  if (!(std::abs(u) <= detail::stage_angle_limit)) return std::polar(1.0, u);
-  return detail::stage_angle_phasor(u);
-}
-
 }  // namespace
 
 OrbitIntegrals::OrbitIntegrals(double max_panel) : max_panel_(validate::positive("max_panel", max_panel)) {}
@@ -88,7 +82,7 @@ bool OrbitIntegrals::stage_integrals(const TappingSystem& system, const Segment&
         : system(s), mode(m), omega(w), mid(c), contact_gap(s.contact_gap()), count_contact(!s.contact_is_region_zero()),
           cos_mid(std::cos(w * c)), sin_mid(-std::sin(w * c)) {}
     void node(double t, double w, const TipState& s) override {
-      const std::complex<double> r = stage_phasor(-omega * (t - mid));
+      const std::complex<double> r = detail::stage_rotation(-omega * (t - mid));
       const double x = s.position, v = s.velocity, wx = w * x;
       double pr = 1.0, pi = 0.0;
       for (int k = 0; k < 6; ++k) {

@@ -2,6 +2,7 @@
 // e^{iu} for the small angles of the drive clock (the adaptive stepper's steps, the observer's quadrature panels):
 // the Taylor series of cos u and sin u to degree 16/17, below 1e-19 for |u| ≤ small_angle_limit — cheaper than
 // std::cos/std::sin and exact to rounding there.
+#include <cmath>
 #include <complex>
 
 namespace afmkit::tapping::detail {
@@ -38,6 +39,13 @@ inline std::complex<double> stage_angle_phasor(double u) {
     s = odd[k] - u2 * s;
   }
   return {c, u * s};
+}
+
+/// e^{iu} for any u: the stages' series within stage_angle_limit, std::polar beyond (the image engine's lock-in and
+/// the orbit analysis both rotate by the stages' offsets from a step's middle).
+inline std::complex<double> stage_rotation(double u) {
+  if (!(std::abs(u) <= stage_angle_limit)) return std::polar(1.0, u);
+  return stage_angle_phasor(u);
 }
 
 }  // namespace afmkit::tapping::detail
