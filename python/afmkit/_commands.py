@@ -61,24 +61,28 @@ class Result(dict):
     """
 
     def __init__(self, command: str, raw: dict):
+        # A copy or a pickle (__reduce__) comes here; a command's run makes its Result in the module (_afmkit.run
+        # with result_type=Result), with the same attributes.
         super().__init__(raw["table"])
         self.command = command
         # the summary, or (from a command that makes it where it is read) its maker: see `results`
         self._results = raw["results"]
-        self.params: dict = raw["params"]
-        if "column_units" in raw:  # made by the module (_afmkit.run), fresh for this result
-            self.columns: list[str] = raw["column_names"]
-            self.units: dict[str, str] = raw["column_units"]
-            self.meaning: dict[str, str] = raw["column_meaning"]
-            self._raw_columns = raw["columns"]
-        else:  # a copy, a pickle
-            self.columns = [c[0] for c in raw["columns"]]
-            self.units = {c[0]: c[1] for c in raw["columns"]}
-            self.meaning = {c[0]: c[2] for c in raw["columns"]}
-            self._raw_columns = [tuple(c) for c in raw["columns"]]
+        self._params = raw["params"]
+        self.columns: list[str] = [c[0] for c in raw["columns"]]
+        self.units: dict[str, str] = {c[0]: c[1] for c in raw["columns"]}
+        self.meaning: dict[str, str] = {c[0]: c[2] for c in raw["columns"]}
         #: The grid the command declares its rows to be (its sidecar's "grid": dims, columns, shape, coords), or
         #: None: to_xarray() shapes the table on it.
         self.grid: dict | None = raw.get("grid")
+
+    @property
+    def params(self) -> dict:
+        """The parameters as run (computed defaults filled in, only the keys of the unit system and law in use):
+        ``f(**r.params)`` repeats the run. Made when first read (a run hands over its record unconverted)."""
+        params = self.__dict__["_params"]
+        if not isinstance(params, dict):  # the record's capsule: the dict made now, once
+            params = self.__dict__["_params"] = _afmkit.made_params(params)
+        return params
 
     @property
     def results(self) -> _Summary:
@@ -119,8 +123,8 @@ class Result(dict):
     clear = pop = popitem = setdefault = update = _read_only
 
     def __reduce__(self):  # copy, pickle (Dask, multiprocessing)
-        raw = {"results": self.results, "params": self.params, "columns": self._raw_columns, "table": dict(self),
-               "grid": self.grid}
+        raw = {"results": self.results, "params": self.params, "table": dict(self), "grid": self.grid,
+               "columns": [(c, self.units[c], self.meaning[c]) for c in self.columns]}
         return (Result, (self.command, raw))
 
     def __getattr__(self, name: str):
@@ -341,7 +345,7 @@ def make_command(path: str):
             from . import laws  # here (afmkit.laws imports this module), and only for a law object (it costs)
             kwargs = laws.expand(path, kwargs, keys)
         # None: not given (the default, which for some keys is another key's value or computed: _signature_default)
-        return Result(path, _afmkit.run(path, {k: v for k, v in kwargs.items() if v is not None}))
+        return _afmkit.run(path, kwargs, Result)
 
     name = path.split()[-1]
     command.__name__ = name

@@ -3,6 +3,8 @@
 // results come back as the summary document, the column descriptions and the table as NumPy arrays.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <map>
 #include <string>
 #include <utility>
 #include <variant>
@@ -124,6 +126,45 @@ py::object json_to_python(const nlohmann::json& j) {
   return py::reinterpret_steal<py::object>(o);
 }
 
+/// The str objects of a command's column texts (name, unit, description), kept from its last call: a command's table
+/// has the same texts on every call (made and freed per call they cost a short command ~1 %: bench/command_layer.py),
+/// so a text equal to the last call's at the same place is the same str (a str is immutable: sharing it is
+/// invisible to the caller). Texts are compared, not hashed (most differ in length at once; an equal one is a
+/// memcmp). The caller holds the GIL.
+class ColumnTexts {
+ public:
+  /// The str of text `i` (3 per column: name, unit, description), a new reference; nullptr with a Python error set.
+  PyObject* get(std::size_t i, const std::string& text) {
+    if (i >= made_.size()) made_.resize(i + 1);
+    auto& [kept, str] = made_[i];
+    if (str == nullptr || kept != text) {
+      PyObject* s = PyUnicode_FromStringAndSize(text.data(), static_cast<Py_ssize_t>(text.size()));
+      if (s == nullptr) return nullptr;
+      Py_XSETREF(str, s);
+      kept = text;
+    }
+    Py_INCREF(str);
+    return str;
+  }
+
+ private:
+  std::vector<std::pair<std::string, PyObject*>> made_;  // owns one reference to each str
+};
+
+/// Command `path`'s ColumnTexts (never destroyed: its str objects live as long as the interpreter; the commands
+/// are few).
+ColumnTexts& column_texts(const std::string& path) {
+  static auto* texts = new std::map<std::string, ColumnTexts, std::less<>>;
+  return (*texts)[path];
+}
+
+/// `text` as a str made once per process (Result's attribute names), a borrowed reference.
+PyObject* interned(const char* text) {
+  PyObject* s = PyUnicode_InternFromString(text);
+  if (s == nullptr) throw py::error_already_set();
+  return s;  // the interned table keeps it (the static that holds the pointer never releases it)
+}
+
 /// Whether column `c` is a flag (unit "boolean", "boolean (0/1)") holding only booleans or 0/1 (no NaN).
 bool flag_column(const io::Column& column, const nlohmann::json& rows, std::size_t c) {
   if (column.unit.rfind("boolean", 0) != 0) return false;
@@ -170,9 +211,28 @@ py::object column_array(const io::Column& column, const nlohmann::json& rows, st
     }
     return a;
   }
-  py::list l;
-  for (const auto& r : rows) l.append(r[c].is_string() ? py::str(r[c].get<std::string>()) : py::str(r[c].dump()));
-  return py::module_::import("numpy").attr("array")(l, "str");
+  // an array of str as numpy.array(cells, "str") makes it (dtype '<U' of the longest cell, at least 1), made here
+  // (the Python call costs a short command ~1 %)
+  std::vector<py::str> cells;
+  cells.reserve(rows.size());
+  Py_ssize_t longest = 1;
+  for (const auto& r : rows) {
+    cells.push_back(r[c].is_string() ? py::str(r[c].get_ref<const std::string&>()) : py::str(r[c].dump()));
+    longest = std::max(longest, PyUnicode_GET_LENGTH(cells.back().ptr()));
+  }
+  const auto& api = py::detail::npy_api::get();
+  const py::dtype type("<U" + std::to_string(longest));
+  Py_intptr_t shape[1] = {static_cast<Py_intptr_t>(cells.size())};
+  auto a = py::reinterpret_steal<py::array>(api.PyArray_NewFromDescr_(api.PyArray_Type_, type.inc_ref().ptr(), 1, shape,
+                                                                      nullptr, nullptr, 0, nullptr));  // takes descr
+  if (!a) throw py::error_already_set();
+  auto* data = static_cast<char*>(a.mutable_data());
+  const std::size_t width = static_cast<std::size_t>(longest) * sizeof(Py_UCS4);
+  std::memset(data, 0, width * cells.size());  // shorter cells end in zeros
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    if (PyUnicode_AsUCS4(cells[i].ptr(), reinterpret_cast<Py_UCS4*>(data + i * width), longest, 0) == nullptr)
+      throw py::error_already_set();
+  return a;
 }
 
 /// Every leaf command of the program, in registration order (the registry: commands.hpp, program.cpp).
@@ -253,8 +313,113 @@ py::object made_summary(const py::capsule& capsule) {
   return json_to_python((*capsule.get_pointer<cli::ResultsMaker>())());
 }
 
-/// Runs command `path` with `kwargs` (TOML keys; `config`: a TOML file loaded first, as --config).
-py::dict run(const std::string& path, const py::dict& kwargs) {
+/// A new reference `s` (nullptr: a Python error is set) as a py::object.
+py::object owned(PyObject* s) {
+  if (s == nullptr) throw py::error_already_set();
+  return py::reinterpret_steal<py::object>(s);
+}
+
+void set_item(const py::handle& d, const py::handle& key, const py::handle& value) {
+  if (PyDict_SetItem(d.ptr(), key.ptr(), value.ptr()) != 0) throw py::error_already_set();
+}
+
+/// The name of the capsules holding a run's parameter record (run(), made_params()).
+constexpr const char* kParamsCapsule = "afmkit.params_record";
+
+/// A run's parameter record as a Python object that owns it: afmkit.Result.params converts it when first read (a
+/// record of ~20 values made into a dict on every call costs a short command ~0.5 %: bench/command_layer.py).
+py::capsule params_capsule(nlohmann::json record) {
+  return py::capsule(new nlohmann::json(std::move(record)), kParamsCapsule, [](PyObject* o) {
+    delete static_cast<nlohmann::json*>(PyCapsule_GetPointer(o, kParamsCapsule));
+  });
+}
+
+/// The parameter record in `capsule` as Python objects.
+py::object made_params(const py::capsule& capsule) {
+  if (capsule.name() == nullptr || std::string(capsule.name()) != kParamsCapsule)
+    throw py::type_error("made_params() takes the params capsule of a Result made by run()");
+  return json_to_python(*capsule.get_pointer<nlohmann::json>());
+}
+
+/// What a run gave, as the dict run() returns without a result type: results (or the summary's maker), columns
+/// (name, unit, description), column_names, column_units, column_meaning, table, grid, params.
+py::dict raw_result(const std::string& path, cli::Captured& captured, py::object summary, nlohmann::json params) {
+  ColumnTexts& texts = column_texts(path);
+  py::dict out;
+  out["results"] = std::move(summary);
+  py::list columns, names;
+  py::dict table, units, meaning;
+  for (std::size_t c = 0; c < captured.columns.size(); ++c) {
+    const io::Column& col = captured.columns[c];
+    const py::object name = owned(texts.get(3 * c, col.name)), unit = owned(texts.get(3 * c + 1, col.unit)),
+                     description = owned(texts.get(3 * c + 2, col.description));
+    columns.append(py::make_tuple(name, unit, description));
+    names.append(name);
+    set_item(units, name, unit);
+    set_item(meaning, name, description);
+    set_item(table, name, column_array(col, captured.rows, c));
+  }
+  out["columns"] = columns;
+  out["column_names"] = names;
+  out["column_units"] = units;
+  out["column_meaning"] = meaning;
+  out["table"] = table;
+  out["grid"] = json_to_python(captured.grid);
+  out["params"] = json_to_python(params);
+  return out;
+}
+
+/// What a run gave as an instance of `type` (afmkit.Result: a dict subclass), made here rather than by its
+/// __init__ from the dict raw_result() gives (a Python frame, a copy of the table and a dozen attributes per call
+/// cost a short command ~1.5 %: bench/command_layer.py): the table's columns are its items; its attributes command,
+/// _results (the summary or its maker), _params (the record's capsule: Result.params makes the dict when first read),
+/// columns, units, meaning and grid, as Result.__init__ sets them.
+py::object typed_result(const py::handle& type, const std::string& path, cli::Captured& captured, py::object summary,
+                        nlohmann::json params) {
+  if (!PyType_Check(type.ptr()) || !PyType_IsSubtype(reinterpret_cast<PyTypeObject*>(type.ptr()), &PyDict_Type))
+    throw py::type_error("run(): result_type must be a subclass of dict (afmkit.Result)");
+  auto* t = reinterpret_cast<PyTypeObject*>(type.ptr());
+  const py::tuple no_args;
+  py::object r = py::reinterpret_steal<py::object>(t->tp_new(t, no_args.ptr(), nullptr));  // dict.__new__
+  if (!r) throw py::error_already_set();
+  ColumnTexts& texts = column_texts(path);
+  const auto n = static_cast<Py_ssize_t>(captured.columns.size());
+  py::list names(n);
+  // dicts of their final size (growing one entry at a time resizes each a few times)
+  const py::object units = owned(_PyDict_NewPresized(n)), meaning = owned(_PyDict_NewPresized(n)),
+                   table = owned(_PyDict_NewPresized(n));
+  for (std::size_t c = 0; c < captured.columns.size(); ++c) {
+    const io::Column& col = captured.columns[c];
+    const py::object name = owned(texts.get(3 * c, col.name));
+    PyList_SET_ITEM(names.ptr(), static_cast<Py_ssize_t>(c), name.inc_ref().ptr());  // steals the new reference
+    set_item(units, name, owned(texts.get(3 * c + 1, col.unit)));
+    set_item(meaning, name, owned(texts.get(3 * c + 2, col.description)));
+    set_item(table, name, column_array(col, captured.rows, c));
+  }
+  // the table as the result's own items (its __setitem__ refuses): an empty dict takes a copy of the keys at once
+  if (PyDict_Update(r.ptr(), table.ptr()) != 0) throw py::error_already_set();
+  static PyObject* const command_key = interned("command");
+  static PyObject* const results_key = interned("_results");
+  static PyObject* const params_key = interned("_params");
+  static PyObject* const columns_key = interned("columns");
+  static PyObject* const units_key = interned("units");
+  static PyObject* const meaning_key = interned("meaning");
+  static PyObject* const grid_key = interned("grid");
+  py::dict attributes;
+  set_item(attributes, command_key, py::str(path));
+  set_item(attributes, results_key, summary);
+  set_item(attributes, params_key, params_capsule(std::move(params)));
+  set_item(attributes, columns_key, names);
+  set_item(attributes, units_key, units);
+  set_item(attributes, meaning_key, meaning);
+  set_item(attributes, grid_key, captured.grid.is_null() ? py::none() : json_to_python(captured.grid));
+  if (PyObject_SetAttrString(r.ptr(), "__dict__", attributes.ptr()) != 0) throw py::error_already_set();
+  return r;
+}
+
+/// Runs command `path` with `kwargs` (TOML keys; `config`: a TOML file loaded first, as --config; a value None is
+/// not given). Returns an instance of `result_type` (typed_result) or, when it is None, the dict of raw_result().
+py::object run(const std::string& path, const py::dict& kwargs, const py::object& result_type) {
   std::string name = "afmkit." + path;
   std::replace(name.begin(), name.end(), ' ', '.');
   const CommandSpec& s = command_spec(path);
@@ -288,36 +453,14 @@ py::dict run(const std::string& path, const py::dict& kwargs) {
   } catch (const PythonLawError& e) {  // the user's law failed: their error (exit-2 style), not a crash
     throw InvalidParameter("law", e.what());
   }
-  py::dict out;
-  if (make_results)  // the maker (afmkit.Result.results makes the summary with it, once, when first read)
-    out["results"] = maker_capsule(std::move(make_results));
-  else
-    out["results"] = results ? results : json_to_python(captured.results);
-  // the columns (name, unit, description), and made here for afmkit.Result (a Python loop over them costs a short
-  // command ~0.3 %): their names in order, name -> unit, name -> description
-  py::list columns, names;
-  py::dict table, units, meaning;
-  for (std::size_t c = 0; c < captured.columns.size(); ++c) {
-    const io::Column& col = captured.columns[c];
-    const py::str name(col.name), unit(col.unit), description(col.description);
-    columns.append(py::make_tuple(name, unit, description));
-    names.append(name);
-    units[name] = unit;
-    meaning[name] = description;
-    table[name] = column_array(col, captured.rows, c);
-  }
-  out["columns"] = columns;
-  out["column_names"] = names;
-  out["column_units"] = units;
-  out["column_meaning"] = meaning;
-  out["table"] = table;
-  // a table declared as a grid (io::TableOf::grid): its dims, shape and coordinates (None otherwise)
-  out["grid"] = json_to_python(captured.grid);
+  // the maker (afmkit.Result.results makes the summary with it, once, when first read), or the summary
+  py::object summary = make_results ? py::object(maker_capsule(std::move(make_results)))
+                                    : results ? results : json_to_python(captured.results);
   // the parameters as the run used them (computed defaults filled in), as its sidecar records them
   nlohmann::json params = captured.parameters.is_null() ? p.to_json() : std::move(captured.parameters);
   params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)
-  out["params"] = json_to_python(params);
-  return out;
+  if (result_type.is_none()) return raw_result(path, captured, std::move(summary), std::move(params));
+  return typed_result(result_type, path, captured, std::move(summary), std::move(params));
 }
 
 }  // namespace
@@ -351,10 +494,14 @@ void bind_commands(py::module_& m) {
       py::arg("parameter"), py::arg("value"), py::arg("bytes_per_unit"),
       "InvalidParameter naming `parameter` when value x bytes_per_unit exceeds the memory afmkit may use (half of "
       "what is available, capped by AFMKIT_MEMORY_LIMIT), as the commands check their sizes.");
-  m.def("run", &run, py::arg("path"), py::arg("kwargs"),
-        "Runs one command with keyword arguments named as its TOML keys; returns results, columns, table, params "
-        "(from a command that makes its summary where it is read, results is a capsule holding its maker: "
-        "made_summary(results) makes it; afmkit.Result does when r.results is first read).");
+  m.def("run", &run, py::arg("path"), py::arg("kwargs"), py::arg("result_type") = py::none(),
+        "Runs one command with keyword arguments named as its TOML keys (None: not given). With result_type "
+        "(afmkit.Result) returns an instance of it; else a dict of results, columns, table, params (from a command "
+        "that makes its summary where it is read, results is a capsule holding its maker: made_summary(results) makes "
+        "it; afmkit.Result does when r.results is first read).");
+  m.def("made_params", &made_params, py::arg("params"),
+        "The parameter record (a dict) of the capsule a Result made by run(result_type=...) holds until r.params is "
+        "first read.");
   m.def("made_summary", &made_summary, py::arg("results"),
         "The summary document a run's results capsule makes (run() of a command that makes its summary when read).");
 }

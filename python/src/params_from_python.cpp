@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <unordered_map>
 #include <variant>
 #include <vector>
 
@@ -153,6 +154,8 @@ namespace detail {
 struct Prototype {
   io::ParamSet params;
   std::vector<io::ParamSet::Description> described;
+  /// key -> its place in `described` (a keyword's description found without comparing it with every key)
+  std::unordered_map<std::string, std::size_t> place;
   /// Copies of `params` that runs gave back (RunParams), reused with their values reset (ParamSet::reset_values):
   /// a copy allocates hundreds of strings (help texts, choices), as much work as a short run's summary.
   mutable std::mutex spare_mutex;
@@ -182,6 +185,7 @@ const Prototype& prototype(const cli::CommandSpec& spec) {
     auto made = std::make_unique<Prototype>();
     made->params = std::move(p);
     made->described = std::move(described);
+    for (std::size_t i = 0; i < made->described.size(); ++i) made->place.emplace(made->described[i].key, i);
     slot = std::move(made);
   }
   return *slot;
@@ -229,7 +233,7 @@ void RunParams::fill(const std::string& name, const py::dict& kwargs, const std:
   auto visible = [&](const std::string& key) {
     return key != "json" && std::find(hidden.begin(), hidden.end(), key) == hidden.end();
   };
-  if (kwargs.contains("config")) {
+  if (kwargs.contains("config") && !kwargs["config"].is_none()) {
     const py::object c = kwargs["config"];
     if (!py::isinstance<py::str>(c) && !py::hasattr(c, "__fspath__"))
       throw py::type_error(name + "(): config must be a path (str or os.PathLike) of a TOML file");
@@ -240,9 +244,8 @@ void RunParams::fill(const std::string& name, const py::dict& kwargs, const std:
     if (!py::isinstance<py::str>(k)) throw py::type_error(name + "(): keywords must be strings");
     const std::string key = utf8("keyword", k);
     if (key == "config") continue;
-    const io::ParamSet::Description* d = nullptr;
-    for (const auto& x : described)
-      if (x.key == key && visible(key)) d = &x;
+    const auto at = declared.place.find(key);
+    const io::ParamSet::Description* d = at != declared.place.end() && visible(key) ? &described[at->second] : nullptr;
     if (d == nullptr) {
       std::string allowed;
       for (const auto& x : described)
@@ -250,6 +253,7 @@ void RunParams::fill(const std::string& name, const py::dict& kwargs, const std:
       throw py::type_error(name + "() got an unexpected keyword argument '" + key + "' (allowed: config, " + allowed +
                            ")");
     }
+    if (v.is_none()) continue;  // not given (the default; Python signatures show None where it follows another key)
     p.set_value(key, value_from_python(name, *d, v));
   }
   p.check_files();  // the keyword arguments came after resolve(): no output may replace an input

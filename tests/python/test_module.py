@@ -60,6 +60,7 @@ def test_every_command_of_the_program_is_a_function_with_its_toml_keys():
     ("tapping sweep", {"points": 15}),
     ("tapping fm", {"points": 9}),
     ("impact", {"restitution": 0.7, "points": 300}),
+    ("tapping orbit", {"quality_factor": 2.0, "separation": 5.0}),
 ])
 def test_result_equals_the_command_lines_table_bit_for_bit(command, args):
     module, _, name = command.rpartition(" ")
@@ -79,8 +80,9 @@ def test_result_equals_the_command_lines_table_bit_for_bit(command, args):
         elif r[col].dtype.kind == "b":  # a flag: true/false (or 0/1) in the document
             assert r.units[col].startswith("boolean") and all(c in (0, 1) for c in cells), col
             assert list(r[col]) == [c == 1 for c in cells], col
-        else:
-            assert list(r[col]) == [str(c) for c in cells], col
+        else:  # text: the array numpy.array(list of str, "str") makes (dtype '<U' of the longest)
+            want = np.array([str(c) for c in cells], "str")
+            assert r[col].dtype == want.dtype and list(r[col]) == list(want), col
         assert r.units[col] == doc["columns"][i]["unit"] and r.meaning[col] == doc["columns"][i]["description"]
 
 

@@ -204,3 +204,33 @@ def test_a_summary_made_where_it_is_read_is_the_document_of_the_run():
     del printed["table"]
     assert _timeless(printed) == _timeless(made)
 
+
+
+def test_a_result_made_by_the_module_owns_its_mappings_and_makes_params_when_read(tmp_path):
+    # the module makes the Result itself (not Result.__init__), shares the column texts between calls (str objects,
+    # immutable) and converts the parameter record when r.params is first read: none of that may show
+    case = dict(quality_factor=2.0, separation=5.0, max_period_multiple=1)
+    a, b = afmkit.tapping.orbit(**case), afmkit.tapping.orbit(**case)
+    assert type(a) is afmkit.Result and a.command == "tapping orbit" and a.grid is None
+    assert a.units == b.units and a.units is not b.units and a.meaning is not b.meaning and a.columns is not b.columns
+    dict.__setitem__(a.units, "amplitude", "changed")  # a caller's change to one result's mapping stays there
+    a.columns.append("x")
+    assert b.units["amplitude"] == "L" and b.columns[-1] != "x"
+    assert not isinstance(b.__dict__["_params"], dict)  # not made yet
+    params = b.params
+    assert params is b.params and params["quality_factor"] == 2.0  # made once
+    # the record is the command line's (its sidecar), key for key
+    out = tmp_path / "orbit.csv"
+    cli = os.environ.get("AFMKIT_CLI")
+    if cli:
+        subprocess.run([cli, "tapping", "orbit", "--quality-factor", "2.0", "--separation", "5.0",
+                        "--max-period-multiple", "1", "--output", str(out)], check=True, capture_output=True)
+        sidecar = json.loads((tmp_path / "orbit.csv.json").read_text())
+        recorded = dict(sidecar["parameters"])
+        recorded.pop("json", None)
+        recorded["output"] = ""
+        assert params == recorded
+    # None is "not given", as in the signature; an unknown keyword is refused even when None
+    assert afmkit.tapping.orbit(**case, drive_amplitude=None).params == params
+    with pytest.raises(TypeError, match="unexpected keyword argument 'nothing'"):
+        afmkit.tapping.orbit(**case, nothing=None)
