@@ -166,6 +166,8 @@ def main() -> int:
     ap.add_argument("--cli", default=os.path.join(here, "..", "build", "bin", "afmkit"),
                     help="the afmkit program, timed as a process (skipped when missing)")
     args = ap.parse_args()
+    # absolute: the process path runs the program in a temporary folder
+    args.bench, args.cli = (os.path.abspath(x) if x else x for x in (args.bench, args.cli))
 
     print(f"before: {load()}")
     rounds = [one_round(args) for _ in range(args.rounds)]
