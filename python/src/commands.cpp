@@ -418,9 +418,7 @@ py::object typed_result(const py::handle& type, const std::string& path, cli::Ca
   ColumnTexts& texts = column_texts(path);
   const auto n = static_cast<Py_ssize_t>(captured.columns.size());
   py::list names(n);
-  // dicts of their final size (growing one entry at a time resizes each a few times)
-  const py::object units = owned(_PyDict_NewPresized(n)), meaning = owned(_PyDict_NewPresized(n)),
-                   table = owned(_PyDict_NewPresized(n));
+  py::dict units, meaning;
   NumberBlock numbers(captured.columns.size(), captured.rows.size());
   for (std::size_t c = 0; c < captured.columns.size(); ++c) {
     const io::Column& col = captured.columns[c];
@@ -428,10 +426,8 @@ py::object typed_result(const py::handle& type, const std::string& path, cli::Ca
     PyList_SET_ITEM(names.ptr(), static_cast<Py_ssize_t>(c), name.inc_ref().ptr());  // steals the new reference
     set_item(units, name, owned(texts.get(3 * c + 1, col.unit)));
     set_item(meaning, name, owned(texts.get(3 * c + 2, col.description)));
-    set_item(table, name, column_array(col, captured.rows, c, numbers));
+    set_item(r, name, column_array(col, captured.rows, c, numbers));  // the dict's own storage (its __setitem__ refuses)
   }
-  // the table as the result's own items (its __setitem__ refuses): an empty dict takes a copy of the keys at once
-  if (PyDict_Update(r.ptr(), table.ptr()) != 0) throw py::error_already_set();
   static PyObject* const command_key = interned("command");
   static PyObject* const results_key = interned("_results");
   static PyObject* const params_key = interned("_params");
