@@ -126,29 +126,61 @@ py::object json_to_python(const nlohmann::json& j) {
   return py::reinterpret_steal<py::object>(o);
 }
 
-/// The str objects of a command's column texts (name, unit, description), kept from its last call: a command's table
-/// has the same texts on every call (made and freed per call they cost a short command ~1 %: bench/command_layer.py),
-/// so a text equal to the last call's at the same place is the same str (a str is immutable: sharing it is
-/// invisible to the caller). Texts are compared, not hashed (most differ in length at once; an equal one is a
-/// memcmp). The caller holds the GIL.
+/// A command's column names, units and meanings as Python objects, kept from its last call: a command's table has
+/// the same columns on every call (made and freed per call, ~60 str objects and two dicts cost a short command ~2 %:
+/// bench/command_layer.py), so a call whose columns have the last call's texts gets copies of the last call's list
+/// and dicts (a dict copy clones its table at once), holding the same str objects (immutable: sharing them is
+/// invisible to the caller). Texts are compared, not hashed (most differ in length at once). The caller holds the GIL.
 class ColumnTexts {
  public:
-  /// The str of text `i` (3 per column: name, unit, description), a new reference; nullptr with a Python error set.
-  PyObject* get(std::size_t i, const std::string& text) {
-    if (i >= made_.size()) made_.resize(i + 1);
-    auto& [kept, str] = made_[i];
-    if (str == nullptr || kept != text) {
-      PyObject* s = PyUnicode_FromStringAndSize(text.data(), static_cast<Py_ssize_t>(text.size()));
-      if (s == nullptr) return nullptr;
-      Py_XSETREF(str, s);
-      kept = text;
-    }
-    Py_INCREF(str);
-    return str;
+  /// New objects for this call: the names in order, name -> unit, name -> description.
+  struct Made {
+    py::list names;
+    py::dict units, meaning;
+  };
+  template <class Columns>
+  Made of(const Columns& columns) {
+    if (!same(columns)) remake(columns);
+    Made out;
+    out.names = py::reinterpret_steal<py::list>(PyList_GetSlice(names_.ptr(), 0, PyList_GET_SIZE(names_.ptr())));
+    out.units = py::reinterpret_steal<py::dict>(PyDict_Copy(units_.ptr()));
+    out.meaning = py::reinterpret_steal<py::dict>(PyDict_Copy(meaning_.ptr()));
+    if (!out.names || !out.units || !out.meaning) throw py::error_already_set();
+    return out;
   }
 
  private:
-  std::vector<std::pair<std::string, PyObject*>> made_;  // owns one reference to each str
+  template <class Columns>
+  bool same(const Columns& columns) const {
+    if (!made_ || kept_.size() != 3 * columns.size()) return false;
+    std::size_t i = 0;
+    for (const io::Column& c : columns)
+      if (kept_[i++] != c.name || kept_[i++] != c.unit || kept_[i++] != c.description) return false;
+    return true;
+  }
+  template <class Columns>
+  void remake(const Columns& columns) {
+    py::list names;
+    py::dict units, meaning;
+    std::vector<std::string> kept;
+    for (const io::Column& c : columns) {
+      const py::str name(c.name);
+      names.append(name);
+      units[name] = py::str(c.unit);
+      meaning[name] = py::str(c.description);
+      kept.insert(kept.end(), {c.name, c.unit, c.description});
+    }
+    names_ = std::move(names);
+    units_ = std::move(units);
+    meaning_ = std::move(meaning);
+    kept_ = std::move(kept);
+    made_ = true;
+  }
+
+  bool made_ = false;
+  std::vector<std::string> kept_;  // name, unit, description of each column of the last call
+  py::list names_;
+  py::dict units_, meaning_;
 };
 
 /// Command `path`'s ColumnTexts (never destroyed: its str objects live as long as the interpreter; the commands
@@ -345,12 +377,6 @@ py::object made_summary(const py::capsule& capsule) {
   return json_to_python((*capsule.get_pointer<cli::ResultsMaker>())());
 }
 
-/// A new reference `s` (nullptr: a Python error is set) as a py::object.
-py::object owned(PyObject* s) {
-  if (s == nullptr) throw py::error_already_set();
-  return py::reinterpret_steal<py::object>(s);
-}
-
 void set_item(const py::handle& d, const py::handle& key, const py::handle& value) {
   if (PyDict_SetItem(d.ptr(), key.ptr(), value.ptr()) != 0) throw py::error_already_set();
 }
@@ -376,26 +402,21 @@ py::object made_params(const py::capsule& capsule) {
 /// What a run gave, as the dict run() returns without a result type: results (or the summary's maker), columns
 /// (name, unit, description), column_names, column_units, column_meaning, table, grid, params.
 py::dict raw_result(const std::string& path, cli::Captured& captured, py::object summary, nlohmann::json params) {
-  ColumnTexts& texts = column_texts(path);
+  ColumnTexts::Made texts = column_texts(path).of(captured.columns);
   py::dict out;
   out["results"] = std::move(summary);
-  py::list columns, names;
-  py::dict table, units, meaning;
+  py::list columns;
+  py::dict table;
   NumberBlock numbers(captured.columns.size(), captured.rows.size());
   for (std::size_t c = 0; c < captured.columns.size(); ++c) {
-    const io::Column& col = captured.columns[c];
-    const py::object name = owned(texts.get(3 * c, col.name)), unit = owned(texts.get(3 * c + 1, col.unit)),
-                     description = owned(texts.get(3 * c + 2, col.description));
-    columns.append(py::make_tuple(name, unit, description));
-    names.append(name);
-    set_item(units, name, unit);
-    set_item(meaning, name, description);
-    set_item(table, name, column_array(col, captured.rows, c, numbers));
+    const py::handle name = PyList_GET_ITEM(texts.names.ptr(), static_cast<Py_ssize_t>(c));
+    columns.append(py::make_tuple(name, texts.units[name], texts.meaning[name]));
+    set_item(table, name, column_array(captured.columns[c], captured.rows, c, numbers));
   }
   out["columns"] = columns;
-  out["column_names"] = names;
-  out["column_units"] = units;
-  out["column_meaning"] = meaning;
+  out["column_names"] = texts.names;
+  out["column_units"] = texts.units;
+  out["column_meaning"] = texts.meaning;
   out["table"] = table;
   out["grid"] = json_to_python(captured.grid);
   out["params"] = json_to_python(params);
@@ -415,18 +436,12 @@ py::object typed_result(const py::handle& type, const std::string& path, cli::Ca
   const py::tuple no_args;
   py::object r = py::reinterpret_steal<py::object>(t->tp_new(t, no_args.ptr(), nullptr));  // dict.__new__
   if (!r) throw py::error_already_set();
-  ColumnTexts& texts = column_texts(path);
-  const auto n = static_cast<Py_ssize_t>(captured.columns.size());
-  py::list names(n);
-  py::dict units, meaning;
+  ColumnTexts::Made texts = column_texts(path).of(captured.columns);
   NumberBlock numbers(captured.columns.size(), captured.rows.size());
   for (std::size_t c = 0; c < captured.columns.size(); ++c) {
-    const io::Column& col = captured.columns[c];
-    const py::object name = owned(texts.get(3 * c, col.name));
-    PyList_SET_ITEM(names.ptr(), static_cast<Py_ssize_t>(c), name.inc_ref().ptr());  // steals the new reference
-    set_item(units, name, owned(texts.get(3 * c + 1, col.unit)));
-    set_item(meaning, name, owned(texts.get(3 * c + 2, col.description)));
-    set_item(r, name, column_array(col, captured.rows, c, numbers));  // the dict's own storage (its __setitem__ refuses)
+    const py::handle name = PyList_GET_ITEM(texts.names.ptr(), static_cast<Py_ssize_t>(c));
+    // the dict's own storage (its __setitem__ refuses)
+    set_item(r, name, column_array(captured.columns[c], captured.rows, c, numbers));
   }
   static PyObject* const command_key = interned("command");
   static PyObject* const results_key = interned("_results");
@@ -439,9 +454,9 @@ py::object typed_result(const py::handle& type, const std::string& path, cli::Ca
   set_item(attributes, command_key, py::str(path));
   set_item(attributes, results_key, summary);
   set_item(attributes, params_key, params_capsule(std::move(params)));
-  set_item(attributes, columns_key, names);
-  set_item(attributes, units_key, units);
-  set_item(attributes, meaning_key, meaning);
+  set_item(attributes, columns_key, texts.names);
+  set_item(attributes, units_key, texts.units);
+  set_item(attributes, meaning_key, texts.meaning);
   set_item(attributes, grid_key, captured.grid.is_null() ? py::none() : json_to_python(captured.grid));
   if (PyObject_SetAttrString(r.ptr(), "__dict__", attributes.ptr()) != 0) throw py::error_already_set();
   return r;

@@ -234,3 +234,15 @@ def test_a_result_made_by_the_module_owns_its_mappings_and_makes_params_when_rea
     assert afmkit.tapping.orbit(**case, drive_amplitude=None).params == params
     with pytest.raises(TypeError, match="unexpected keyword argument 'nothing'"):
         afmkit.tapping.orbit(**case, nothing=None)
+
+
+def test_column_texts_kept_from_the_last_call_follow_the_columns_of_this_one():
+    # the module keeps a command's column names/units/meanings from its last call and copies them when this call's
+    # columns have the same texts: a call with other columns (a sweep in another parameter) must get its own
+    plain = dict(points=3, quiet=True)
+    moved = dict(parameter="drive_frequency", parameter_min=0.95, parameter_max=1.05, points=3, quiet=True)
+    for kwargs, first in ((plain, "separation"), (moved, "drive_frequency"), (plain, "separation"),
+                          (plain, "separation"), (moved, "drive_frequency")):
+        r = afmkit.tapping.sweep(**kwargs)
+        assert r.columns[0] == first and list(r) == r.columns == list(r.units) == list(r.meaning)
+        assert ("fixed: the sweep moves drive_frequency" in r.meaning["separation"]) == (first != "separation")
