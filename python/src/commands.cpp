@@ -220,8 +220,6 @@ py::array_t<T> new_column(py::ssize_t n) {
   return py::reinterpret_steal<py::array_t<T>>(a);
 }
 
-/// Column `c` of the rows: bool for a flag column (flag_column), float64 when every cell is a number, a boolean or
-/// null (NaN), else an array of str.
 /// The numeric columns of a table as the rows of one float64 block (columns x rows, C order), each column a view of
 /// its row: one allocation for the table's numbers rather than one per column (a short command's 20 columns cost
 /// ~1 % of it: bench/command_layer.py). The views are writeable, C-contiguous float64 arrays like any other; their
@@ -256,6 +254,8 @@ class NumberBlock {
   double* data_ = nullptr;
 };
 
+/// Column `c` of the rows: bool for a flag column (flag_column), float64 (a row of `numbers`) when every cell is a
+/// number, a boolean or null (NaN), else an array of str.
 py::object column_array(const io::Column& column, const nlohmann::json& rows, std::size_t c, NumberBlock& numbers) {
   if (flag_column(column, rows, c)) {
     py::array_t<bool> a = new_column<bool>(static_cast<py::ssize_t>(rows.size()));
