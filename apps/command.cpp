@@ -62,9 +62,11 @@ CommandOutput::CommandOutput(const io::ParamSet& params, Captured* capture, std:
   keep_rows_ = capture_ != nullptr ? capture_->want_rows : json_ && path_.empty();
 }
 
-void CommandOutput::open(std::vector<io::Column> columns) {
+void CommandOutput::open(std::vector<io::Column> columns) { open_columns(io::ColumnList(std::move(columns))); }
+
+void CommandOutput::open_columns(io::ColumnList columns) {
   columns_ = std::move(columns);
-  if (!path_.empty()) file_.emplace(path_, columns_);
+  if (!path_.empty()) file_.emplace(path_, columns_.vector());
 }
 
 void CommandOutput::finish(const nlohmann::json& results, const std::string& summary) {
@@ -89,7 +91,7 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
     if (json_) {
       nlohmann::json document = results;
       if (keep_rows_) {
-        document["table"] = {{"columns", io::columns_json(columns_)}, {"rows", rows_}};
+        document["table"] = {{"columns", io::columns_json(columns_.vector())}, {"rows", rows_}};
         if (!grid.is_null()) document["table"]["grid"] = grid;
       }
       else if (!path_.empty()) document["output"] = path_;

@@ -52,7 +52,9 @@ struct Captured {
   /// values costs several per cent of it, bench/command_layer.py). Commands that make their document at once give it
   /// to take_results (or `results`) as before.
   std::function<void(ResultsMaker)> take_results_maker;
-  std::vector<io::Column> columns;
+  /// The table's columns: a range of io::Column (size(), [c], begin/end), shared with the command's declaration
+  /// (a table declared once per unit system hands its list over without copying a string).
+  io::ColumnList columns;
   nlohmann::json rows = nlohmann::json::array();
   /// Stop request of the caller (Python: Ctrl-C); the long computations check it once per point. The command line
   /// has no capture and keeps its signal handling.
@@ -135,7 +137,7 @@ class CommandOutput {
   template <class Row>
   class Rows {
    public:
-    void add(const Row& row) { out_->add_row(table_, row); }
+    void add(const Row& row) { add_row(row); }
     template <class Range>
     void add_all(const Range& rows) {
       for (const auto& row : rows) add(row);
@@ -143,9 +145,10 @@ class CommandOutput {
 
    private:
     friend class CommandOutput;
-    Rows(CommandOutput& out, io::TableOf<Row> table) : out_(&out), table_(std::move(table)) {}
+    Rows(CommandOutput& out, io::SharedTable<Row> table) : out_(&out), table_(std::move(table)) {}
+    void add_row(const Row& row) { out_->add_row(table_.table(), row); }
     CommandOutput* out_;
-    io::TableOf<Row> table_;
+    io::SharedTable<Row> table_;
   };
 
   /// Opens the table (file or memory) with its declared columns (io::TableOf: name, unit, description and the
@@ -153,14 +156,23 @@ class CommandOutput {
   /// (io::TableOf::grid) is recorded as such (the sidecar's and the capture's "grid").
   template <class Row>
   [[nodiscard]] Rows<Row> open(io::TableOf<Row> table) {
-    open(table.columns());
-    grid_ = io::GridRecord(table.grid());
-    for (const io::GridDimension& d : table.grid()) {
-      const auto& entries = table.entries();
-      for (std::size_t c = 0; c < entries.size(); ++c)
-        if (entries[c].column.name == d.column) grid_columns_.push_back(c);
+    return open(io::SharedTable<Row>(std::move(table)));
+  }
+  /// The same with a declaration made once and shared (io::SharedTable: a table declared once per unit system): its
+  /// columns are handed over without copying them.
+  template <class Row>
+  [[nodiscard]] Rows<Row> open(io::SharedTable<Row> shared) {
+    open_columns(shared.columns());
+    const io::TableOf<Row>& table = shared.table();
+    if (!table.grid().empty()) {
+      grid_ = io::GridRecord(table.grid());
+      for (const io::GridDimension& d : table.grid()) {
+        const auto& entries = table.entries();
+        for (std::size_t c = 0; c < entries.size(); ++c)
+          if (entries[c].column.name == d.column) grid_columns_.push_back(c);
+      }
     }
-    return Rows<Row>(*this, std::move(table));
+    return Rows<Row>(*this, std::move(shared));
   }
   /// Opens the table (file or memory) with its columns; call once before adding rows with row().
   void open(std::vector<io::Column> columns);
@@ -199,6 +211,7 @@ class CommandOutput {
   void add_row(const io::TableOf<Row>& table, const Row& row) {
     nlohmann::json cells = keep_rows_ ? nlohmann::json::array() : nlohmann::json();
     const auto& entries = table.entries();
+    if (keep_rows_) cells.get_ref<nlohmann::json::array_t&>().reserve(entries.size());
     for (std::size_t c = 0; c < entries.size(); ++c) {
       const io::Cell cell = entries[c].value(row);
       if (file_) io::write_cell(*file_, cell);
@@ -216,6 +229,7 @@ class CommandOutput {
     if (const long* n = std::get_if<long>(&cell)) return static_cast<double>(*n);
     throw std::logic_error("a grid dimension's column must hold numbers");
   }
+  void open_columns(io::ColumnList columns);
   template <class T>
   static auto cell_value(const T& v) {
     if constexpr (std::is_convertible_v<T, std::string_view> && !std::is_arithmetic_v<T>) return std::string(v);
@@ -227,7 +241,7 @@ class CommandOutput {
   std::string path_;
   bool json_ = false;
   bool keep_rows_ = false;
-  std::vector<io::Column> columns_;
+  io::ColumnList columns_;
   io::GridRecord grid_;                    // of a table declared as a grid (else empty)
   std::vector<std::size_t> grid_columns_;  // the column of each grid dimension
   std::optional<io::TableWriter> file_;

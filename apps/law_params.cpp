@@ -65,10 +65,22 @@ void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const 
   }
 }
 
+LawChoice::LawChoice(const io::ParamSet& p, const impact::LawRegistry& registry) : spec(registry.find(p.text("law"))) {
+  const auto& keys = registry.keys();
+  given.reserve(keys.size());
+  for (const auto& k : keys) given.push_back(static_cast<char>(p.was_set(k.key)));
+}
+
 impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistry& registry,
                                  const LawKeyAliases& aliases, std::shared_ptr<const impact::ForceLawModel> object) {
-  const std::string& name = p.text("law");
-  const impact::LawSpec& spec = registry.find(name);
+  return law_from_params(p, registry, LawChoice(p, registry), aliases, std::move(object));
+}
+
+impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistry& registry, const LawChoice& choice,
+                                 const LawKeyAliases& aliases, std::shared_ptr<const impact::ForceLawModel> object) {
+  const impact::LawSpec& spec = choice.spec;
+  const std::string& name = spec.name;
+  const auto& keys = registry.keys();
   impact::LawArguments args;
   args.allow_energy_gain = p.flag("allow_energy_gain");
   args.force_curve = p.text("force_curve");
@@ -76,8 +88,8 @@ impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistr
   args.model = std::move(object);
   auto reads = [&](const std::string& key) { return std::find(spec.keys.begin(), spec.keys.end(), key) != spec.keys.end(); };
   std::vector<std::string> replaced;  // keys a given alternative stands for (restitution -> departure_stiffness)
-  for (const auto& k : registry.keys())
-    if (!k.replaces.empty() && p.was_set(k.key)) replaced.push_back(k.replaces);
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    if (!keys[i].replaces.empty() && choice.given[i]) replaced.push_back(keys[i].replaces);
   const auto is_replaced = [&](const std::string& key) {
     return std::find(replaced.begin(), replaced.end(), key) != replaced.end();
   };
@@ -90,9 +102,10 @@ impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistr
   // every key the law reads, with the command's value (given, or its default — a command may change defaults);
   // keys that follow another key or count only when given are passed only when given; given keys of other laws
   // are passed so that the registry names them
-  for (const auto& k : registry.keys()) {
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const impact::LawKey& k = keys[i];
     if (args.values.count(k.key)) continue;
-    const bool pass = p.was_set(k.key) || (reads(k.key) && k.follows.empty() && !k.only_if_given && !is_replaced(k.key));
+    const bool pass = choice.given[i] || (reads(k.key) && k.follows.empty() && !k.only_if_given && !is_replaced(k.key));
     if (pass) args.values[k.key] = p.real(k.key);
   }
   try {

@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "afmkit/impact/law_registry.hpp"
 #include "afmkit/io/params.hpp"
@@ -36,10 +37,23 @@ void add_law_key_param(io::ParamSet& p, const impact::LawRegistry& registry, con
 /// (restitution) leaves the command key it replaces out of the records too.
 void add_law_params(io::ParamSet& p, const impact::LawRegistry& registry, const std::string& default_law,
                     const std::vector<std::string>& skip = {}, const LawKeyAliases& aliases = {});
+/// What a run asks of the registry, read from its parameters once and shared by the checks of the run (a command's
+/// own, law_from_params'): the law chosen (`law`) and which registry keys were given.
+struct LawChoice {
+  /// `p` declares `law` and every registry key (add_law_params); InvalidParameter("law") for an unknown law.
+  LawChoice(const io::ParamSet& p, const impact::LawRegistry& registry);
+  const impact::LawSpec& spec;
+  std::vector<char> given;  ///< per key of registry.keys(), in order: given (ParamSet::was_set)
+};
+
 /// The law the parameters describe (InvalidParameter naming the key for a key of another law, a value out of
 /// range or an unknown law). `aliases`: command keys whose values stand for registry keys.
 /// `object`: the law object of law = python (the caller's, law_object_of; null on the command line).
 impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistry& registry,
+                                 const LawKeyAliases& aliases = {},
+                                 std::shared_ptr<const impact::ForceLawModel> object = nullptr);
+/// The same for a choice already read (LawChoice(p, registry)).
+impact::ForceLaw law_from_params(const io::ParamSet& p, const impact::LawRegistry& registry, const LawChoice& choice,
                                  const LawKeyAliases& aliases = {},
                                  std::shared_ptr<const impact::ForceLawModel> object = nullptr);
 

@@ -21,6 +21,7 @@
 #include "afmkit/tapping/hb_approximations.hpp"
 #include "command.hpp"
 #include "commands.hpp"
+#include "table_cache.hpp"
 #include "tapping_params.hpp"
 #include "tapping_tables.hpp"
 #include "unit_tagged.hpp"
@@ -48,7 +49,9 @@ std::string hb_note(bool empty_curve, bool no_solution_at_separation, double q_m
                      q_max, no_solution_at_separation ? "no solution either" : "solutions (results)", separation);
 }
 
-void run_hb(const io::ParamSet& p, Captured* capture) {
+using HbTables = TableCache<tapping::HbPoint, TappingUnits>;
+
+void run_hb(const io::ParamSet& p, Captured* capture, HbTables& tables) {
   const double q_min = p.real("q_min");
   const double q_max = p.real("q_max");
   if (!(q_min < q_max))
@@ -71,7 +74,7 @@ void run_hb(const io::ParamSet& p, Captured* capture) {
   // (the streamed chunk is checked too: a malformed AFMKIT_MEMORY_LIMIT is refused as on every run)
   if (out.holds_rows()) memory::require_fits("points", static_cast<double>(options.points), 2.0 * kHeldRowBytes);
   else memory::require_fits("points", static_cast<double>(std::min(options.points, kChunkPoints)), sizeof(tapping::HbPoint));
-  auto rows = out.open(hb_table(u));
+  auto rows = out.open(tables.get(u));
   const std::size_t count = tapping::harmonic_balance_curve_chunks(
       model, options, [&](std::span<const tapping::HbPoint> chunk) { rows.add_all(chunk); }, kChunkPoints);
 
@@ -132,7 +135,10 @@ void register_tapping_hb(CLI::App& tapping) {
                   "exists");
         add_output_params(p, "out/tapping_hb.csv", "harmonic-balance curve");
       },
-      run_hb);
+      // the table declared once per units, shared by this registration's runs
+      [tables = std::make_shared<HbTables>(hb_table)](const io::ParamSet& p, Captured* capture) {
+        run_hb(p, capture, *tables);
+      });
 }
 
 }  // namespace afmkit::cli

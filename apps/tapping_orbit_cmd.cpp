@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -18,6 +19,7 @@
 #include "afmkit/io/quantity.hpp"
 #include "afmkit/io/table.hpp"
 #include "command.hpp"
+#include "table_cache.hpp"
 #include "work_budget.hpp"
 #include "commands.hpp"
 #include "tapping_params.hpp"
@@ -145,10 +147,22 @@ OrbitStatus orbit_status(const tapping::OrbitSearchResult& r, double separation,
                       r.orbits.size(), summary_value(separation, length))};
 }
 
+/// What a run found and what its summary is made of (owned by the summary's maker: Captured::take_results_maker).
+struct OrbitRun {
+  tapping::OrbitSearchResult result;
+  TappingUnits units;
+  double separation;
+  double free_amplitude;
+  OrbitStatus status;
+};
+
 /// The command's summary document (--json, the sidecar's results, r.results): the HB solutions, the orbits, the
 /// transients and the search report, every entry with its unit.
-nlohmann::json orbit_summary(const tapping::OrbitSearchResult& r, const TappingUnits& u, double separation,
-                             double free_amplitude, const OrbitStatus& status) {
+nlohmann::json orbit_summary(const OrbitRun& run) {
+  const tapping::OrbitSearchResult& r = run.result;
+  const TappingUnits& u = run.units;
+  const double separation = run.separation, free_amplitude = run.free_amplitude;
+  const OrbitStatus& status = run.status;
   // every entry with its unit (the sidecar's "units", per results key: docs/study.md#outputs)
   // the rows of each array without units (UnitTagged::values_only), moved into the document (no copies)
   const auto row = [] { return UnitTagged(UnitTagged::values_only); };
@@ -185,7 +199,7 @@ nlohmann::json orbit_summary(const tapping::OrbitSearchResult& r, const TappingU
   return std::move(results).summary();
 }
 
-/// The table: one row per orbit found.
+/// The table: one row per orbit found (declared once per units: OrbitTables).
 io::TableOf<tapping::FoundOrbit> orbit_table(const TappingUnits& u) {
   using F = tapping::FoundOrbit;
   return {
@@ -228,9 +242,11 @@ io::TableOf<tapping::FoundOrbit> orbit_table(const TappingUnits& u) {
        [](const F& f) { return tapping::tip_trapped(f.metrics); }}};
 }
 
-void run_orbit(const io::ParamSet& p, Captured* capture) {
+using OrbitTables = TableCache<tapping::FoundOrbit, TappingUnits>;
+
+void run_orbit(const io::ParamSet& p, Captured* capture, OrbitTables& tables) {
   const tapping::TappingModel model = tapping_model_from(p, law_object_of(capture));
-  const TappingUnits u(tapping_scales_from(p));
+  TappingUnits u(tapping_scales_from(p));
   tapping::OrbitSearchOptions options;
   options.shooting = shooting_options_from(p);
   options.transient = transient_options_from(p);
@@ -247,20 +263,22 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
 
   // the summary, made where it is read (a caller that never reads it does not pay for its ~550 values: Captured::
   // take_results_maker); it owns the search's result
-  const auto found = std::make_shared<const tapping::OrbitSearchResult>(std::move(r_searched));
-  const tapping::OrbitSearchResult& r = *found;
-  const OrbitStatus status = orbit_status(r, p.real("separation"), u.length);
-  const ResultsMaker summary = [found, u, separation = p.real("separation"), free_amplitude = model.free_amplitude(),
-                                status] { return orbit_summary(*found, u, separation, free_amplitude, status); };
+  const double separation = p.real("separation");
+  OrbitStatus status = orbit_status(r_searched, separation, u.length);
+  const auto run = std::make_shared<const OrbitRun>(
+      OrbitRun{std::move(r_searched), std::move(u), separation, model.free_amplitude(), std::move(status)});
+  const tapping::OrbitSearchResult& r = run->result;
+  const TappingUnits& units = run->units;
+  ResultsMaker summary = [run] { return orbit_summary(*run); };
   CommandOutput out(p, capture, "tapping orbit");
-  out.open(orbit_table(u)).add_all(r.orbits);
+  out.open(tables.get(units)).add_all(r.orbits);
   if (p.flag("json")) {
-    out.finish(summary, "");
+    out.finish(std::move(summary), "");
     return;
   }
   // lengths by magnitude in physical units, said to be normalised otherwise (docs/units.md#summaries)
-  const auto len = [&](double model_length) { return summary_value(model_length, u.length, 6); };
-  fmt::print("separation {}: {} HB solution(s), {} periodic orbit(s); phases in rad\n", len(p.real("separation")),
+  const auto len = [&](double model_length) { return summary_value(model_length, units.length, 6); };
+  fmt::print("separation {}: {} HB solution(s), {} periodic orbit(s); phases in rad\n", len(separation),
              r.harmonic_balance.size(), r.orbits.size());
   for (const tapping::HbPoint& h : r.harmonic_balance)
     fmt::print("  HB {:5s} amplitude {}  offset {}  phase {:.6g} rad\n", tapping::branch_name(h.branch),
@@ -273,7 +291,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
                len(f.metrics.amplitude), len(f.metrics.offset), f.metrics.phase,
                f.orbit.stable ? "stable" : "unstable", f.orbit.floquet_max, f.metrics.contact_fraction,
                f.seeds.size());
-  if (status.status != "ok") fmt::print("  {}\n", status.note);
+  if (run->status.status != "ok") fmt::print("  {}\n", run->status.note);
   for (const tapping::TransientOutcome& t : r.transients)
     if (t.kind != tapping::ResponseKind::periodic) fmt::print("  transient: {}\n", t.message);
   {
@@ -290,7 +308,7 @@ void run_orbit(const io::ParamSet& p, Captured* capture) {
                rep.seeds.size(), converged, kinds, rep.continuation_runs, len(rep.bracket_min), len(rep.bracket_max),
                io::quantity(rep.seconds, "s", 3));
   }
-  out.finish(summary, "");
+  out.finish(std::move(summary), "");
 }
 
 }  // namespace
@@ -305,7 +323,10 @@ void register_tapping_orbit(CLI::App& tapping) {
         add_tapping_sim_params(p);
         add_output_params(p, "out/tapping_orbit.csv", "orbits");
       },
-      run_orbit);
+      // the table declared once per units, shared by this registration's runs
+      [tables = std::make_shared<OrbitTables>(orbit_table)](const io::ParamSet& p, Captured* capture) {
+        run_orbit(p, capture, *tables);
+      });
 }
 
 }  // namespace afmkit::cli

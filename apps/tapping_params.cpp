@@ -1,5 +1,6 @@
 #include "tapping_params.hpp"
 
+#include <algorithm>
 #include <vector>
 
 #include <fmt/format.h>
@@ -18,9 +19,31 @@ const std::vector<const char*> physical_cantilever_keys = {"spring_constant", "r
                                                            "sample_stiffness_approach", "sample_stiffness_departure",
                                                            "adhesion_approach", "adhesion_departure"};
 
+/// The built-in laws (fixed: built once, not per run).
+const impact::LawRegistry& builtin_laws() {
+  static const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  return registry;
+}
+
+/// A key of one unit system only, and its index among the registry's keys (-1: none), whose LawChoice::given says
+/// whether it was given (read once per run).
+struct ForeignKey {
+  std::string key;
+  int law_key = -1;
+};
+std::vector<ForeignKey> foreign_keys(const std::vector<std::string>& keys) {
+  const auto& law_keys = builtin_laws().keys();
+  std::vector<ForeignKey> out;
+  for (const std::string& k : keys) {
+    const auto it = std::find_if(law_keys.begin(), law_keys.end(), [&](const impact::LawKey& l) { return l.key == k; });
+    out.push_back({k, it == law_keys.end() ? -1 : static_cast<int>(it - law_keys.begin())});
+  }
+  return out;
+}
+
 /// Keys that exist only in physical units: the cantilever's and those of the laws that need physical units.
 std::vector<std::string> physical_keys() {
-  const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  const impact::LawRegistry& registry = builtin_laws();
   std::vector<std::string> keys(physical_cantilever_keys.begin(), physical_cantilever_keys.end());
   for (const auto& k : registry.keys()) {
     bool piecewise = false;
@@ -31,23 +54,22 @@ std::vector<std::string> physical_keys() {
   return keys;
 }
 
-/// physical_keys(), worked out once (the built-in laws are fixed): every run checks them.
-const std::vector<std::string>& physical_keys_once() {
-  static const std::vector<std::string> keys = physical_keys();
-  return keys;
+/// The keys a run in physical (`physical_run`) or normalised units must not be given, worked out once (the built-in
+/// laws are fixed): every run checks them.
+const std::vector<ForeignKey>& foreign_keys_once(bool physical_run) {
+  static const std::vector<ForeignKey> in_physical =
+      foreign_keys(std::vector<std::string>(normalised_keys.begin(), normalised_keys.end()));
+  static const std::vector<ForeignKey> in_normalised = foreign_keys(physical_keys());
+  return physical_run ? in_physical : in_normalised;
 }
 
 bool physical(const io::ParamSet& p) { return p.text("units") == "physical"; }
 
-void reject_foreign_keys(const io::ParamSet& p) {
-  const bool phys = physical(p);
-  std::vector<std::string> foreign;
-  if (phys) foreign.assign(normalised_keys.begin(), normalised_keys.end());
-  else foreign = physical_keys_once();
-  for (const std::string& k : foreign) {
-    if (p.was_set(k))
-      throw InvalidParameter(k, fmt::format("{} applies only with units = {}; this run uses units = {}", k,
-                                            phys ? "normalised" : "physical", p.text("units")));
+void reject_foreign_keys(const io::ParamSet& p, bool phys, const LawChoice& law) {
+  for (const ForeignKey& k : foreign_keys_once(phys)) {
+    if (k.law_key >= 0 ? law.given[static_cast<std::size_t>(k.law_key)] != 0 : p.was_set(k.key))
+      throw InvalidParameter(k.key, fmt::format("{} applies only with units = {}; this run uses units = {}", k.key,
+                                                phys ? "normalised" : "physical", p.text("units")));
   }
 }
 
@@ -58,20 +80,20 @@ const LawKeyAliases physical_aliases = {{"sample_stiffness_approach", "approach_
                                         {"adhesion_approach", "approach_adhesion"},
                                         {"adhesion_departure", "departure_adhesion"}};
 
-impact::ForceLaw law_from(const io::ParamSet& p, const tapping::PhysicalCantilever* pc,
+impact::ForceLaw law_from(const io::ParamSet& p, const LawChoice& law, const tapping::PhysicalCantilever* pc,
                           const std::shared_ptr<const impact::ForceLawModel>& object) {
-  static const impact::LawRegistry registry = impact::LawRegistry::builtin();  // fixed: built once, not per run
+  const impact::LawRegistry& registry = builtin_laws();
   // law = python without its object (the command line): say so first, whatever the units
-  if (registry.find(p.text("law")).needs_object && !object) return law_from_params(p, registry, {}, object);
+  if (law.spec.needs_object && !object) return law_from_params(p, registry, law, {}, object);
   if (!pc) {
-    if (!registry.find(p.text("law")).piecewise_linear)
+    if (!law.spec.piecewise_linear)
       throw InvalidParameter("law", fmt::format("law = {} needs physical units (units = physical): its parameters are "
                                                 "in GPa, nm, J (docs/force-laws.md)",
-                                                p.text("law")));
-    return law_from_params(p, registry, {}, object);
+                                                law.spec.name));
+    return law_from_params(p, registry, law, {}, object);
   }
   // physical law (nm, nN, nm/s) -> per unit mass (nm·ω_n²) in normalised time (1/ω_n)
-  return pc->normalised_law(law_from_params(p, registry, physical_aliases, object));
+  return pc->normalised_law(law_from_params(p, registry, law, physical_aliases, object));
 }
 
 tapping::PhysicalCantilever physical_cantilever(const io::ParamSet& p) {
@@ -125,7 +147,7 @@ void add_tapping_model_params(io::ParamSet& p) {
       .real("drive_amplitude", 0.2, "[normalised] drive Γ (per unit mass)", below(1e12))
       .unit("L/t^2");
   // the hysteresis law's keys per unit mass (the registry's keys, in normalised units: add_law_params skips them)
-  const impact::LawRegistry registry = impact::LawRegistry::builtin();
+  const impact::LawRegistry& registry = builtin_laws();
   const auto per_unit_mass = [&](const char* key, const char* unit, const char* help) {
     add_law_key_param(p, registry, key,
                       {.help = help, .default_value = {}, .range = Range::closed(0.0, 1e12), .unit = unit});
@@ -159,14 +181,16 @@ void add_tapping_model_params(io::ParamSet& p) {
 }
 
 tapping::TappingModel tapping_model_from(const io::ParamSet& p, std::shared_ptr<const impact::ForceLawModel> law_object) {
-  reject_foreign_keys(p);
-  if (physical(p)) {
+  const LawChoice law(p, builtin_laws());  // the law and the law keys given, read once
+  const bool phys = physical(p);
+  reject_foreign_keys(p, phys, law);
+  if (phys) {
     const auto pc = physical_cantilever(p);
-    return {pc.cantilever(), pc.drive(), law_from(p, &pc, law_object), p.real("separation")};
+    return {pc.cantilever(), pc.drive(), law_from(p, law, &pc, law_object), p.real("separation")};
   }
   const double wn = p.real("natural_frequency");
   return {tapping::Cantilever(wn, p.real("quality_factor")), tapping::Drive(p.real("drive_amplitude"), p.real("frequency_ratio") * wn),
-          law_from(p, nullptr, law_object), p.real("separation")};
+          law_from(p, law, nullptr, law_object), p.real("separation")};
 }
 
 TappingScales tapping_scales_from(const io::ParamSet& p) {

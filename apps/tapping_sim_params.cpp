@@ -31,11 +31,12 @@ double require_transient_work(const io::ParamSet& p, const tapping::TransientOpt
                               const std::string& what) {
   const double quality = p.real("quality_factor");
   const double periods = static_cast<double>(transient.max_periods);
-  return require_work("max_transient_periods", periods,
-                      transients * kTransientPeriodSeconds * std::min(1.0, quality / periods),
-                      fmt::format("{} of min(max_transient_periods, quality_factor) drive periods, quality_factor = {}, "
-                                  "at least {:.2g} s per period",
-                                  what, quality, kTransientPeriodSeconds));
+  return require_work_with("max_transient_periods", periods,
+                           transients * kTransientPeriodSeconds * std::min(1.0, quality / periods), [&] {
+                             return fmt::format("{} of min(max_transient_periods, quality_factor) drive periods, "
+                                                "quality_factor = {}, at least {:.2g} s per period",
+                                                what, quality, kTransientPeriodSeconds);
+                           });
 }
 
 }  // namespace afmkit::cli

@@ -22,6 +22,7 @@
 #include "afmkit/tapping/sweep.hpp"
 #include "command.hpp"
 #include "commands.hpp"
+#include "table_cache.hpp"
 #include "tapping_params.hpp"
 #include "tapping_sim_params.hpp"
 #include "tapping_sweep_parameter.hpp"
@@ -296,7 +297,10 @@ void run_parameter_sweep(const io::ParamSet& p, Captured* capture) {
   out.finish(results.with_units(), summary);
 }
 
-void run_sweep(const io::ParamSet& p, Captured* capture) {
+/// The table of separation sweeps, declared once per units (sweep_table), shared by a registration's runs.
+using SweepTables = TableCache<tapping::SweepPoint, TappingUnits>;
+
+void run_sweep(const io::ParamSet& p, Captured* capture, SweepTables& tables) {
   if (p.text("parameter") != "separation") return run_parameter_sweep(p, capture);
   for (const char* key : {"parameter_min", "parameter_max"})
     if (p.was_set(key))
@@ -326,7 +330,7 @@ void run_sweep(const io::ParamSet& p, Captured* capture) {
   const bool beside = hb_beside(p, base);
 
   CommandOutput out(p, capture, "tapping sweep");
-  auto rows = out.open(sweep_table(u));
+  auto rows = out.open(tables.get(u));
   long trapped = 0;  // rows on which the tip does not tap (column trapped)
   const auto write_rows = [&](const std::vector<tapping::SweepPoint>& points) {
     rows.add_all(points);
@@ -463,7 +467,8 @@ void register_tapping_sweep(CLI::App& tapping) {
         add_output_params(p, "out/tapping_sweep.csv", "sweep");
         add_quiet_flag(p);
       },
-      run_sweep);
+      [tables = std::make_shared<SweepTables>(+[](const TappingUnits& u) { return sweep_table(u); })](
+          const io::ParamSet& p, Captured* capture) { run_sweep(p, capture, *tables); });
 }
 
 }  // namespace afmkit::cli

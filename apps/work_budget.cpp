@@ -34,9 +34,13 @@ double work_limit_seconds() {
   return value;
 }
 
+double work_estimate(double value, double seconds_per_unit, double exponent) {
+  return seconds_per_unit * std::pow(value, exponent);
+}
+
 double require_work(const std::string& parameter, double value, double seconds_per_unit, const std::string& model,
                     double exponent) {
-  const double estimate = seconds_per_unit * std::pow(value, exponent);
+  const double estimate = work_estimate(value, seconds_per_unit, exponent);
   const double limit = work_limit_seconds();
   if (!(estimate <= limit)) {
     const double largest = std::floor(std::pow(limit / seconds_per_unit, 1.0 / exponent));

@@ -18,6 +18,17 @@ double work_limit_seconds();
 /// Returns the estimate in seconds (for deciding to show progress).
 double require_work(const std::string& parameter, double value, double seconds_per_unit, const std::string& model,
                     double exponent = 1.0);
+/// The estimate require_work compares with the work limit: seconds_per_unit · value^exponent.
+double work_estimate(double value, double seconds_per_unit, double exponent = 1.0);
+/// require_work with the cost model's text made only when the request is refused (`model()`: a run within the limit
+/// formats no message).
+template <class ModelText>
+double require_work_with(const std::string& parameter, double value, double seconds_per_unit, ModelText model,
+                         double exponent = 1.0) {
+  const double estimate = work_estimate(value, seconds_per_unit, exponent);
+  if (estimate <= work_limit_seconds()) return estimate;
+  return require_work(parameter, value, seconds_per_unit, model(), exponent);  // throws
+}
 
 /// Runs estimated above this many seconds show progress on stderr.
 inline constexpr double kProgressAfterSeconds = 2.0;

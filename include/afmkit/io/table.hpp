@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <functional>
 #include <initializer_list>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -125,6 +126,45 @@ class TableOf {
       if (c.column.name == name) return c;
     throw std::logic_error("table has no column '" + std::string(name) + "'");
   }
+};
+
+/// The columns of a table, shared and read-only: a list made once (a table declared once per unit system,
+/// SharedTable) is handed to each run and its caller without copying a string. A range of Column (size(),
+/// operator[], begin()/end()); vector() gives the list itself.
+class ColumnList {
+ public:
+  ColumnList() = default;
+  ColumnList(std::vector<Column> columns)  // NOLINT(google-explicit-constructor): a list of columns is one
+      : columns_(std::make_shared<const std::vector<Column>>(std::move(columns))) {}
+
+  const std::vector<Column>& vector() const& { return columns_ ? *columns_ : none(); }
+  std::size_t size() const { return vector().size(); }
+  bool empty() const { return vector().empty(); }
+  const Column& operator[](std::size_t i) const& { return vector()[i]; }
+  auto begin() const& { return vector().begin(); }
+  auto end() const& { return vector().end(); }
+
+ private:
+  std::shared_ptr<const std::vector<Column>> columns_;
+  static const std::vector<Column>& none() {
+    static const std::vector<Column> empty;
+    return empty;
+  }
+};
+
+/// A table declaration built once and shared by the runs that use it (a command's table in one unit system): its
+/// accessors and its columns (ColumnList) are not copied per run. Read-only.
+template <class Row>
+class SharedTable {
+ public:
+  explicit SharedTable(TableOf<Row> table)
+      : table_(std::make_shared<const TableOf<Row>>(std::move(table))), columns_(table_->columns()) {}
+  const TableOf<Row>& table() const& { return *table_; }
+  const ColumnList& columns() const& { return columns_; }
+
+ private:
+  std::shared_ptr<const TableOf<Row>> table_;
+  ColumnList columns_;
 };
 
 /// Writes one cell (TableWriter::cell of its kind).
