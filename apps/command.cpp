@@ -84,7 +84,7 @@ void CommandOutput::finish(const nlohmann::json& results, const std::string& sum
     capture_->grid = grid;
     capture_->columns = std::move(columns_);
     capture_->rows = std::move(rows_);
-    capture_->parameters = params_.to_json();
+    if (capture_->record_later != &params_) capture_->parameters = params_.to_json();
     return;
   }
   try {
@@ -117,7 +117,7 @@ void CommandOutput::finish(ResultsMaker make_results, const std::string& summary
   capture_->grid = grid_.empty() ? nlohmann::json() : grid_.json();
   capture_->columns = std::move(columns_);
   capture_->rows = std::move(rows_);
-  capture_->parameters = params_.to_json();
+  if (capture_->record_later != &params_) capture_->parameters = params_.to_json();
 }
 
 void require_answer(const nlohmann::json& results) {

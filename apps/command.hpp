@@ -63,6 +63,12 @@ struct Captured {
   nlohmann::json grid;
   /// The parameters as run (what the sidecar records: computed defaults filled in); null until the command finishes.
   nlohmann::json parameters;
+  /// The set the caller ran the command with, when it records it itself: if the command's output records this very
+  /// set, CommandOutput::finish leaves `parameters` null and the caller makes the record when it needs it (the Python
+  /// module: when r.params is first read; a record made per call costs a short command ~1 %,
+  /// bench/command_layer.py). A command that records another set (its parameters as run, with computed values:
+  /// ParamSet::record_used on a copy) still sets `parameters`.
+  const io::ParamSet* record_later = nullptr;
   /// law = python: the force law the caller gave as an object (afmkit.laws.Python), built into the run's law.
   std::shared_ptr<const impact::ForceLawModel> law;
 };

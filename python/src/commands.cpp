@@ -384,11 +384,26 @@ void set_item(const py::handle& d, const py::handle& key, const py::handle& valu
 /// The name of the capsules holding a run's parameter record (run(), made_params()).
 constexpr const char* kParamsCapsule = "afmkit.params_record";
 
-/// A run's parameter record as a Python object that owns it: afmkit.Result.params converts it when first read (a
-/// record of ~20 values made into a dict on every call costs a short command ~0.5 %: bench/command_layer.py).
-py::capsule params_capsule(nlohmann::json record) {
-  return py::capsule(new nlohmann::json(std::move(record)), kParamsCapsule, [](PyObject* o) {
-    delete static_cast<nlohmann::json*>(PyCapsule_GetPointer(o, kParamsCapsule));
+/// A run's parameter record, or the parameter set it is made from (lent: made when first read).
+struct ParamsRecord {
+  std::unique_ptr<LentParams> lent;
+  nlohmann::json json;
+  /// The record without `json` (not a keyword from Python: r.params replays as f(**r.params)).
+  const nlohmann::json& made() {
+    if (lent) {
+      json = lent->record();
+      lent.reset();  // the set goes back to the command's spare sets
+    }
+    json.erase("json");
+    return json;
+  }
+};
+
+/// A run's parameter record as a Python object that owns it: afmkit.Result.params makes the dict when first read (a
+/// record of ~20 values made and converted on every call costs a short command ~1.5 %: bench/command_layer.py).
+py::capsule params_capsule(ParamsRecord record) {
+  return py::capsule(new ParamsRecord(std::move(record)), kParamsCapsule, [](PyObject* o) {
+    delete static_cast<ParamsRecord*>(PyCapsule_GetPointer(o, kParamsCapsule));
   });
 }
 
@@ -396,7 +411,7 @@ py::capsule params_capsule(nlohmann::json record) {
 py::object made_params(const py::capsule& capsule) {
   if (capsule.name() == nullptr || std::string(capsule.name()) != kParamsCapsule)
     throw py::type_error("made_params() takes the params capsule of a Result made by run()");
-  return json_to_python(*capsule.get_pointer<nlohmann::json>());
+  return json_to_python(capsule.get_pointer<ParamsRecord>()->made());
 }
 
 /// What a run gave, as the dict run() returns without a result type: results (or the summary's maker), columns
@@ -429,7 +444,7 @@ py::dict raw_result(const std::string& path, cli::Captured& captured, py::object
 /// _results (the summary or its maker), _params (the record's capsule: Result.params makes the dict when first read),
 /// columns, units, meaning and grid, as Result.__init__ sets them.
 py::object typed_result(const py::handle& type, const std::string& path, cli::Captured& captured, py::object summary,
-                        nlohmann::json params) {
+                        ParamsRecord params) {
   if (!PyType_Check(type.ptr()) || !PyType_IsSubtype(reinterpret_cast<PyTypeObject*>(type.ptr()), &PyDict_Type))
     throw py::type_error("run(): result_type must be a subclass of dict (afmkit.Result)");
   auto* t = reinterpret_cast<PyTypeObject*>(type.ptr());
@@ -479,8 +494,9 @@ py::object run(const std::string& path, const py::dict& kwargs, const py::object
     given = py::dict();
     for (const auto& [k, v] : kwargs) given[k] = py::str(k).cast<std::string>() == "law" ? py::str("python") : v;
   }
-  const RunParams run_params(path, name, given);  // a set this command's runs reuse
+  RunParams run_params(path, name, given);  // a set this command's runs reuse
   const io::ParamSet& p = run_params.get();
+  if (!result_type.is_none()) captured.record_later = &p;  // ParamsRecord: made from the set when r.params is read
   SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
   captured.cancellation = interrupts.cancellation();
   // progress lines to sys.stderr (Jupyter), not to descriptor 2
@@ -502,9 +518,16 @@ py::object run(const std::string& path, const py::dict& kwargs, const py::object
   py::object summary = make_results ? py::object(maker_capsule(std::move(make_results)))
                                     : results ? results : json_to_python(captured.results);
   // the parameters as the run used them (computed defaults filled in), as its sidecar records them
-  nlohmann::json params = captured.parameters.is_null() ? p.to_json() : std::move(captured.parameters);
-  params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)
-  if (result_type.is_none()) return raw_result(path, captured, std::move(summary), std::move(params));
+  if (result_type.is_none()) {
+    nlohmann::json params = captured.parameters.is_null() ? p.to_json() : std::move(captured.parameters);
+    params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)
+    return raw_result(path, captured, std::move(summary), std::move(params));
+  }
+  // a Result: its record made when r.params is first read, from the set the run used (lent), unless the command
+  // recorded other values or the command has lent as many sets as it lends
+  ParamsRecord params;
+  if (!captured.parameters.is_null()) params.json = std::move(captured.parameters);
+  else if (!(params.lent = run_params.lend())) params.json = p.to_json();
   return typed_result(result_type, path, captured, std::move(summary), std::move(params));
 }
 

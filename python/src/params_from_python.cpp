@@ -160,6 +160,8 @@ struct Prototype {
   /// a copy allocates hundreds of strings (help texts, choices), as much work as a short run's summary.
   mutable std::mutex spare_mutex;
   mutable std::vector<std::unique_ptr<io::ParamSet>> spare;
+  /// How many sets are lent out (RunParams::lend), under spare_mutex.
+  mutable std::size_t lent = 0;
 };
 }  // namespace detail
 
@@ -224,6 +226,42 @@ RunParams::~RunParams() {
   if (!params_) return;
   const std::lock_guard<std::mutex> lock(prototype_->spare_mutex);
   if (prototype_->spare.size() < kSpareSets) prototype_->spare.push_back(std::move(params_));
+}
+
+namespace {
+/// At most this many sets of one command lent out at once (a loop keeping its Results holds one per Result whose
+/// r.params was not read; beyond, the record is made at once: no set per Result, and no copy of the declarations).
+constexpr std::size_t kLentSets = 8;
+}  // namespace
+
+std::unique_ptr<LentParams> RunParams::lend() {
+  {
+    const std::lock_guard<std::mutex> lock(prototype_->spare_mutex);
+    if (prototype_->lent >= kLentSets) return nullptr;
+    ++prototype_->lent;
+  }
+  return std::make_unique<LentParams>(prototype_, std::move(params_));
+}
+
+LentParams::LentParams(const detail::Prototype* prototype, std::unique_ptr<io::ParamSet> params)
+    : prototype_(prototype), params_(std::move(params)) {}
+
+LentParams::~LentParams() { give_back(); }
+
+const nlohmann::json& LentParams::record() {
+  if (params_) {
+    record_ = params_->to_json();
+    give_back();
+  }
+  return record_;
+}
+
+void LentParams::give_back() {
+  if (!params_) return;
+  const std::lock_guard<std::mutex> lock(prototype_->spare_mutex);
+  --prototype_->lent;
+  if (prototype_->spare.size() < kSpareSets) prototype_->spare.push_back(std::move(params_));
+  params_.reset();
 }
 
 void RunParams::fill(const std::string& name, const py::dict& kwargs, const std::vector<std::string>& hidden) {

@@ -246,3 +246,17 @@ def test_column_texts_kept_from_the_last_call_follow_the_columns_of_this_one():
         r = afmkit.tapping.sweep(**kwargs)
         assert r.columns[0] == first and list(r) == r.columns == list(r.units) == list(r.meaning)
         assert ("fixed: the sweep moves drive_frequency" in r.meaning["separation"]) == (first != "separation")
+
+
+def test_a_record_made_when_read_is_the_runs_own_however_many_results_are_kept():
+    # a Result holds the parameter set its run used until r.params is first read (a command lends at most a few
+    # sets; beyond, the record is made at once): no other run may change what a kept Result records
+    kept = [afmkit.tapping.orbit(quality_factor=2.0 + 0.25 * i, separation=5.0, max_period_multiple=1)
+            for i in range(12)]
+    assert sum(not isinstance(r.__dict__["_params"], dict) for r in kept) == 12  # none made yet
+    for i, r in reversed(list(enumerate(kept))):  # read in another order than made
+        assert r.params["quality_factor"] == 2.0 + 0.25 * i and r.params["separation"] == 5.0
+    again = afmkit.tapping.orbit(**kept[5].params)
+    assert again.params == kept[5].params and np.array_equal(again.amplitude, kept[5].amplitude)
+    del kept  # the lent sets go back: later runs record as before
+    assert afmkit.tapping.orbit(quality_factor=3.0, separation=5.0).params["quality_factor"] == 3.0
