@@ -285,7 +285,11 @@ py::object column_array(const io::Column& column, const nlohmann::json& rows, st
     longest = std::max(longest, PyUnicode_GET_LENGTH(cells.back().ptr()));
   }
   const auto& api = py::detail::npy_api::get();
-  const py::dtype type("<U" + std::to_string(longest));
+  // the dtype of that width, made once per width (parsing "<U7" costs as much as the array); dtypes are immutable
+  static auto* made = new std::map<Py_ssize_t, py::dtype>;
+  auto at = made->find(longest);
+  if (at == made->end()) at = made->emplace(longest, py::dtype("<U" + std::to_string(longest))).first;
+  const py::dtype& type = at->second;
   Py_intptr_t shape[1] = {static_cast<Py_intptr_t>(cells.size())};
   auto a = py::reinterpret_steal<py::array>(api.PyArray_NewFromDescr_(api.PyArray_Type_, type.inc_ref().ptr(), 1, shape,
                                                                       nullptr, nullptr, 0, nullptr));  // takes descr
