@@ -29,32 +29,61 @@ std::string dashed(std::string key) {
   return key;
 }
 
-/// A 64-bit hash of a key, 8 bytes at a time (keys are short: a few words with underscores).
-std::uint64_t key_hash(std::string_view key) noexcept {
-  constexpr std::uint64_t k1 = 0xbf58476d1ce4e5b9ull, k2 = 0x94d049bb133111ebull;
-  std::uint64_t h = 0x9e3779b97f4a7c15ull ^ key.size();
+/// A 64-bit hash of a key from at most three 8-byte words (the first, the middle and the last: every byte of a key
+/// of up to 24 characters, the length of the rest); keys are short, a few words with underscores, and the key found
+/// is compared whole (same_key).
+[[gnu::always_inline]] inline std::uint64_t key_hash(std::string_view key) noexcept {
+  const std::size_t n = key.size();
   const char* p = key.data();
-  std::size_t n = key.size();
-  const auto mix = [&](std::uint64_t w) {
-    h = (h ^ w) * k1;
-    h ^= h >> 31;
-  };
-  for (; n >= 8; p += 8, n -= 8) {
+  const auto load8 = [](const char* at) {
     std::uint64_t w;
-    std::memcpy(&w, p, 8);
-    mix(w);
+    std::memcpy(&w, at, 8);
+    return w;
+  };
+  const auto load4 = [](const char* at) {
+    std::uint32_t w;
+    std::memcpy(&w, at, 4);
+    return std::uint64_t{w};
+  };
+  std::uint64_t a = 0, b = 0, c = 0;
+  if (n >= 8) {
+    a = load8(p);
+    b = load8(p + n - 8);
+    if (n > 16) c = load8(p + n / 2 - 4);
+  } else if (n >= 4) {
+    a = load4(p);
+    b = load4(p + n - 4);
+  } else if (n > 0) {
+    a = std::uint64_t{static_cast<unsigned char>(p[0])} | std::uint64_t{static_cast<unsigned char>(p[n / 2])} << 8 |
+        std::uint64_t{static_cast<unsigned char>(p[n - 1])} << 16;
   }
-  if (n > 0) {
-    std::uint64_t w = 0;
-    if (key.size() >= 8) {
-      std::memcpy(&w, key.data() + key.size() - 8, 8);  // the last 8 bytes (overlapping the previous word)
-    } else {
-      for (std::size_t i = 0; i < n; ++i) w |= std::uint64_t(static_cast<unsigned char>(p[i])) << (8 * i);
-    }
-    mix(w);
+  constexpr std::uint64_t k1 = 0xbf58476d1ce4e5b9ull, k2 = 0x94d049bb133111ebull, k3 = 0x9e3779b97f4a7c15ull;
+  std::uint64_t h = (a ^ k3) * k1;
+  h = (h ^ (h >> 31) ^ b) * k2;
+  h = (h ^ (h >> 29) ^ c ^ n) * k1;
+  return h ^ (h >> 32);
+}
+
+/// Whether `a` and `b` hold the same characters, 8 bytes at a time without a call (the key found by its hash is
+/// almost always the one looked up: this comparison confirms it).
+[[gnu::always_inline]] inline bool same_key(const std::string& a, std::string_view b) noexcept {
+  const std::size_t n = b.size();
+  if (a.size() != n) return false;
+  const char* p = a.data();
+  const char* q = b.data();
+  if (n < 8) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (p[i] != q[i]) return false;
+    return true;
   }
-  h *= k2;
-  return h ^ (h >> 29);
+  const auto word = [](const char* at) {
+    std::uint64_t w;
+    std::memcpy(&w, at, 8);
+    return w;
+  };
+  for (std::size_t i = 0; i + 8 < n; i += 8)
+    if (word(p + i) != word(q + i)) return false;
+  return word(p + n - 8) == word(q + n - 8);  // the last 8 bytes (overlapping the previous word)
 }
 
 /// The same value, bit for bit (-0.0 is not 0.0; a NaN is itself): reset_values keeps a value that passed check().
@@ -186,7 +215,7 @@ std::uint32_t ParamSet::find(std::string_view key) const noexcept {
     if (slot == 0) return kNone;
     if ((slot & ~std::uint64_t{0xffffffff}) != tag) continue;
     const auto at = static_cast<std::uint32_t>(slot) - 1;
-    if (entries_[at].key == key) return at;
+    if (same_key(entries_[at].key, key)) return at;
   }
 }
 
@@ -391,7 +420,7 @@ void ParamSet::add_options(CLI::App& app) {
   }
   app.add_option("--config", config_path_, "TOML file with parameters (keys as below, with underscores)")
       ->type_name("FILE");
-  for (Entry& e : entries_) {  // (the callbacks below keep &e: a deque's entries stay where they are)
+  for (Entry& e : entries_) {  // (the callbacks below keep &e: entries stay where they are)
     const std::string& key = e.key;
     std::string desc = e.help;
     std::string type;
@@ -538,9 +567,9 @@ void ParamSet::reset_values(const ParamSet& declared) {
   // the same keys in the same order (a copy of `declared`): compared by their signature, not key by key
   if (entries_.size() != declared.entries_.size() || keys_signature_ != declared.keys_signature_)
     throw std::logic_error("ParamSet::reset_values: another set of parameters");
-  auto from = declared.entries_.begin();
-  for (Entry& e : entries_) {
-    const Entry& d = *from++;
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    Entry& e = entries_[i];
+    const Entry& d = declared.entries_[i];
     if (!same_value(e.value, d.value)) {  // a value the last run changed; one kept stays checked (resolve)
       e.value = d.value;                  // a text keeps its buffer
       e.checked = d.checked;
@@ -696,11 +725,11 @@ void ParamSet::resolve() {
     constexpr std::uintmax_t max_config_bytes = 16u << 20;  // a parameter file, not data
     load_toml_text(files::read_input_file(config_path_, "--config file", max_config_bytes), config_path_);
   }
-  // in declaration order (the first flag or value refused is the one reported); a value that passed check() since it
-  // last changed is not checked again: a front end that resets a set and resolves it per call (the Python module:
-  // reset_values keeps the values the last call did not change) checks only the few values given
+  // in declaration order (the first flag, else the first value refused is the one reported); a value that passed
+  // check() since it last changed is not checked again: a front end that resets a set and resolves it per call (the
+  // Python module: reset_values keeps the values the last call did not change) checks only the few values given
   for (Entry& e : entries_)
-    if (e.cli_text) set_from_string(e.key, *e.cli_text);
+    if (e.cli_text) set_from_string(e.key, *e.cli_text);  // checks it
   for (Entry& e : entries_) {
     if (!e.checked) {
       check(e.key, e, "");
@@ -727,7 +756,9 @@ const ParamSet::Entry& ParamSet::current_at(std::uint32_t at) const {
 const ParamSet::Entry& ParamSet::current(std::string_view key) const {
   const std::uint32_t at = find(key);
   if (at == kNone) throw std::logic_error("ParamSet: no parameter named '" + std::string(key) + "'");
-  return current_at(at);
+  const Entry* e = &entries_[at];  // (current_at's loop, without a call: ~100 values read per command call)
+  while (!e->set && !e->used && e->follows_at != kNone) e = &entries_[e->follows_at];
+  return *e;
 }
 std::vector<std::string_view> ParamSet::replaced() const {
   std::vector<std::string_view> out;  // few: only_if_given alternatives that were given
@@ -738,8 +769,9 @@ std::vector<std::string_view> ParamSet::replaced() const {
 bool ParamSet::recorded(const Entry& e, const std::vector<std::string_view>& replaced) const {
   if (e.only_if_given && !e.set) return false;
   for (const Applies& a : e.applies) {  // a key of another unit system or law than the run's
-    const Entry& on = a.at != kNone ? current_at(a.at) : current(a.key);
-    if (std::find(a.values.begin(), a.values.end(), std::get<std::string>(on.value)) == a.values.end()) return false;
+    const std::string& value = std::get<std::string>((a.at != kNone ? current_at(a.at) : current(a.key)).value);
+    if (std::none_of(a.values.begin(), a.values.end(), [&](const std::string& v) { return same_key(v, value); }))
+      return false;
   }
   for (const auto& condition : e.applies_if)  // a key of another controller than the run's
     if (!condition(*this)) return false;
@@ -753,7 +785,11 @@ bool ParamSet::flag(std::string_view key) const { return std::get<bool>(current(
 const std::vector<double>& ParamSet::reals(std::string_view key) const& {
   return std::get<std::vector<double>>(current(key).value);
 }
-bool ParamSet::was_set(std::string_view key) const { return entry(key).set; }
+bool ParamSet::was_set(std::string_view key) const {
+  const std::uint32_t at = find(key);
+  if (at == kNone) throw std::logic_error("ParamSet: no parameter named '" + std::string(key) + "'");
+  return entries_[at].set;
+}
 
 nlohmann::json ParamSet::units_json() const {
   nlohmann::json j = nlohmann::json::object();
@@ -772,7 +808,8 @@ nlohmann::json ParamSet::to_json() const {
   auto& object = j.get_ref<nlohmann::json::object_t&>();
   for (const std::uint32_t at : by_key_) {
     const Entry& e = entries_[at];
-    if (!recorded(e, gone)) continue;
+    const bool conditional = e.only_if_given || !e.applies.empty() || !e.applies_if.empty() || !gone.empty();
+    if (conditional && !recorded(e, gone)) continue;
     const std::string& key = e.key;
     const Entry& used = current_at(at);
     std::visit([&](const auto& v) { object.emplace_hint(object.end(), key, v); }, used.value);

@@ -399,6 +399,19 @@ TEST(ParamSetIndex, ResolveChecksEveryValueThatChangedSinceItsLastCheck) {
   q.reset_values(declared);
   q.set_value("gain", 3.0);
   EXPECT_NO_THROW(q.resolve());
+  // a flag refused is reported before a value refused that is declared before it (the flags are applied first)
+  ParamSet r;
+  r.real("first", -1.0, "declared first, refused", Range::positive()).unit("m");
+  r.real("second", 1.0, "given as a flag, refused", Range::positive()).unit("m");
+  CLI::App app;
+  r.add_options(app);
+  app.parse(std::vector<std::string>{"0", "--second"});  // CLI11 takes the arguments in reverse order
+  try {
+    r.resolve();
+    FAIL() << "a refused flag accepted";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "second");
+  }
 }
 
 TEST(ParamSetIndex, ResetValuesRefusesTheSameKeysDeclaredInAnotherOrder) {

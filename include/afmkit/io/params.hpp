@@ -5,9 +5,10 @@
 // Unknown TOML keys, malformed TOML, a missing file, a wrong type or a value out of range raise
 // afmkit::InputError / afmkit::InvalidParameter naming the key (or file) and the allowed range.
 #include <cstdint>
-#include <deque>
+#include <algorithm>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include "afmkit/core/source_location.hpp"
 #include <string>
@@ -227,10 +228,51 @@ class ParamSet {
   /// Whether `e` goes into the records (to_json, units_json).
   bool recorded(const Entry& e, const std::vector<std::string_view>& replaced) const;
   Entry& last(const char* what);
-  // The parameters in declaration order (a deque: an entry keeps its address when others are declared after it, as
-  // add_options' callbacks need), found by key through `slots_`; indices into it, never pointers, elsewhere, so
-  // that a copy or a moved-to set answers from its own entries with the default copy and move.
-  std::deque<Entry> entries_;
+  /// The parameters in declaration order, each on the heap: an entry keeps its address when others are declared
+  /// after it and when the set is moved (add_options' callbacks hold it); a copy copies every entry (a copied set
+  /// has its own). Elsewhere entries are named by index, never by pointer, so that the default copy and move of
+  /// ParamSet give a set that answers from its own entries.
+  class Entries {
+   public:
+    Entries() = default;
+    Entries(const Entries& other) { *this = other; }
+    Entries& operator=(const Entries& other) {
+      if (this == &other) return *this;
+      items_.resize(std::min(items_.size(), other.items_.size()));
+      for (std::size_t i = 0; i < items_.size(); ++i) *items_[i] = *other.items_[i];  // kept where they are
+      for (std::size_t i = items_.size(); i < other.items_.size(); ++i)
+        items_.push_back(std::make_unique<Entry>(*other.items_[i]));
+      return *this;
+    }
+    Entries(Entries&&) noexcept = default;
+    Entries& operator=(Entries&&) noexcept = default;
+    ~Entries() = default;
+    Entry& operator[](std::size_t i) { return *items_[i]; }
+    const Entry& operator[](std::size_t i) const { return *items_[i]; }
+    std::size_t size() const { return items_.size(); }
+    Entry& back() { return *items_.back(); }
+    void emplace_back() { items_.push_back(std::make_unique<Entry>()); }
+    template <class E, class It>
+    struct Iterator {
+      It it;
+      E& operator*() const { return **it; }
+      Iterator& operator++() {
+        ++it;
+        return *this;
+      }
+      bool operator!=(const Iterator& other) const { return it != other.it; }
+    };
+    using iterator = Iterator<Entry, std::vector<std::unique_ptr<Entry>>::iterator>;
+    using const_iterator = Iterator<const Entry, std::vector<std::unique_ptr<Entry>>::const_iterator>;
+    iterator begin() { return {items_.begin()}; }
+    iterator end() { return {items_.end()}; }
+    const_iterator begin() const { return {items_.begin()}; }
+    const_iterator end() const { return {items_.end()}; }
+
+   private:
+    std::vector<std::unique_ptr<Entry>> items_;
+  };
+  Entries entries_;
   std::vector<std::uint32_t> by_key_;  // indices of entries_ in the keys' order (the order of a JSON object)
   std::vector<std::uint32_t> files_;   // indices of the file parameters (check_files)
   // Open-addressing hash table (linear probing, at most half full): 0 empty, else (high 32 bits of the key's hash
