@@ -206,6 +206,16 @@ ParamSet::Entry ParamSet::make_entry(Value value, const std::string& help, Range
 }
 
 std::uint32_t ParamSet::find(std::string_view key) const noexcept {
+  static_assert(LookupCache::size == 256, "the slot is the top 8 bits of a product");
+  // the index found last time for a key at this address (a literal), confirmed by the key itself
+  std::atomic<std::uint32_t>& recent =
+      recent_.slots[(reinterpret_cast<std::uintptr_t>(key.data()) * 0x9e3779b97f4a7c15ull) >> 56];
+  const std::uint32_t guess = recent.load(std::memory_order_relaxed);
+  if (guess < entries_.size() && same_key(entries_[guess].key, key)) [[likely]]
+    return guess;
+  return find_by_hash(key, recent);
+}
+std::uint32_t ParamSet::find_by_hash(std::string_view key, std::atomic<std::uint32_t>& recent) const noexcept {
   if (slots_.empty()) return kNone;
   const std::uint64_t h = key_hash(key);
   const std::uint64_t tag = h & ~std::uint64_t{0xffffffff};
@@ -215,7 +225,10 @@ std::uint32_t ParamSet::find(std::string_view key) const noexcept {
     if (slot == 0) return kNone;
     if ((slot & ~std::uint64_t{0xffffffff}) != tag) continue;
     const auto at = static_cast<std::uint32_t>(slot) - 1;
-    if (same_key(entries_[at].key, key)) return at;
+    if (same_key(entries_[at].key, key)) {
+      recent.store(at, std::memory_order_relaxed);
+      return at;
+    }
   }
 }
 
@@ -570,7 +583,10 @@ void ParamSet::reset_values(const ParamSet& declared) {
   for (std::size_t i = 0; i < entries_.size(); ++i) {
     Entry& e = entries_[i];
     const Entry& d = declared.entries_[i];
-    if (!same_value(e.value, d.value)) {  // a value the last run changed; one kept stays checked (resolve)
+    const double* x = std::get_if<double>(&e.value);
+    const double* y = std::get_if<double>(&d.value);
+    const bool same = x && y ? std::memcmp(x, y, sizeof(double)) == 0 : same_value(e.value, d.value);
+    if (!same) {  // a value the last run changed; one kept stays checked (resolve)
       e.value = d.value;                  // a text keeps its buffer
       e.checked = d.checked;
     }
@@ -769,7 +785,9 @@ std::vector<std::string_view> ParamSet::replaced() const {
 bool ParamSet::recorded(const Entry& e, const std::vector<std::string_view>& replaced) const {
   if (e.only_if_given && !e.set) return false;
   for (const Applies& a : e.applies) {  // a key of another unit system or law than the run's
-    const std::string& value = std::get<std::string>((a.at != kNone ? current_at(a.at) : current(a.key)).value);
+    const Entry* on = a.at != kNone ? &entries_[a.at] : &current(a.key);
+    while (!on->set && !on->used && on->follows_at != kNone) on = &entries_[on->follows_at];  // (current_at)
+    const std::string& value = std::get<std::string>(on->value);
     if (std::none_of(a.values.begin(), a.values.end(), [&](const std::string& v) { return same_key(v, value); }))
       return false;
   }

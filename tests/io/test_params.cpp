@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -423,4 +424,24 @@ TEST(ParamSetIndex, ResetValuesRefusesTheSameKeysDeclaredInAnotherOrder) {
   c.set_value("y", 5.0);
   c.reset_values(a);
   EXPECT_EQ(c.real("y"), 2.0);
+}
+
+// A key is looked up first where the same address found it last time (a literal's): another key at that address, or
+// the same key in another set, is confirmed against the keys, never taken on trust.
+TEST(ParamSetIndex, AKeyAtAnAddressUsedBeforeIsConfirmedNotTrusted) {
+  const ParamSet p = make();
+  char buffer[16] = "points";
+  EXPECT_EQ(p.integer(std::string_view(buffer, 6)), 10);
+  std::memcpy(buffer, "verbose", 7);
+  EXPECT_FALSE(p.flag(std::string_view(buffer, 7)));
+  std::memcpy(buffer, "pointz", 6);
+  EXPECT_THROW(p.integer(std::string_view(buffer, 6)), std::logic_error);
+  std::memcpy(buffer, "law", 3);
+  EXPECT_EQ(p.text(std::string_view(buffer, 3)), "hysteresis");
+  ParamSet other;  // the same literal in another set: that set's own entry
+  other.text("units", "physical", "u").text("law", "dmt", "l");
+  EXPECT_EQ(other.text("law"), "dmt");
+  EXPECT_EQ(p.text("law"), "hysteresis");
+  EXPECT_EQ(other.text("law"), "dmt");
+  EXPECT_THROW(other.integer("points"), std::logic_error);
 }

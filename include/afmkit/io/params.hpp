@@ -6,6 +6,7 @@
 // afmkit::InputError / afmkit::InvalidParameter naming the key (or file) and the allowed range.
 #include <cstdint>
 #include <algorithm>
+#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
@@ -216,7 +217,8 @@ class ParamSet {
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
   /// Index of `key` in entries_, kNone if not declared: one hash of the key, one comparison with the key found.
-  std::uint32_t find(std::string_view key) const noexcept;
+  [[gnu::always_inline]] inline std::uint32_t find(std::string_view key) const noexcept;
+  std::uint32_t find_by_hash(std::string_view key, std::atomic<std::uint32_t>& recent) const noexcept;
   const Entry& entry(std::string_view key) const;
   Entry& entry(std::string_view key);
   /// The entry whose value entries_[at] has now: its own, or (not given, following another key) the followed one's.
@@ -278,6 +280,23 @@ class ParamSet {
   // Open-addressing hash table (linear probing, at most half full): 0 empty, else (high 32 bits of the key's hash
   // << 32) | (index + 1).
   std::vector<std::uint64_t> slots_;
+  /// The index last found for a key at a given address (a literal's: the same on every call), tried before the hash
+  /// and confirmed by comparing the key (a stale or foreign guess costs one comparison, never a wrong answer).
+  /// Relaxed atomics: lookups of one set from several threads are safe. A copy starts empty.
+  struct LookupCache {
+    static constexpr std::size_t size = 256;
+    std::atomic<std::uint32_t> slots[size];
+    LookupCache() noexcept { clear(); }
+    LookupCache(const LookupCache&) noexcept : LookupCache() {}
+    LookupCache& operator=(const LookupCache&) noexcept {
+      clear();
+      return *this;
+    }
+    void clear() noexcept {
+      for (auto& s : slots) s.store(kNone, std::memory_order_relaxed);
+    }
+  };
+  mutable LookupCache recent_;
   std::uint64_t keys_signature_ = 0;  // a hash of the keys in declaration order (reset_values)
   std::string config_path_;
   std::string group_ = "Options";
