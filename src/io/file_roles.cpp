@@ -103,7 +103,7 @@ void require_writable_kind(const Named& out) {
 std::vector<WrittenPath> table_and_sidecar(const std::string& path) { return {{path}, {path + ".json"}}; }
 
 ParamSet& ParamSet::writes(WrittenPaths paths) {
-  if (last_.empty() || !entries_[last_].is_file)
+  if (last_ == kNone || !entries_[last_].is_file)
     throw std::logic_error("ParamSet::writes: the last declared parameter is not a file");
   entries_[last_].written = true;
   entries_[last_].written_paths = std::move(paths);
@@ -112,14 +112,17 @@ ParamSet& ParamSet::writes(WrittenPaths paths) {
 
 void ParamSet::check_files() const {
   // no path given (a front end that writes no file: the Python module's defaults): nothing to compare or check
-  if (config_path_.empty() && std::none_of(entries_.begin(), entries_.end(), [](const auto& kv) {
-        return kv.second.is_file && !std::get<std::string>(kv.second.value).empty();
-      }))
-    return;
+  // (files_: the file parameters' indices in declaration order; a key declared again as another kind is no file)
+  const auto given = [this](std::uint32_t at) {
+    const Entry& e = entries_[at];
+    return e.is_file && !std::get<std::string>(e.value).empty();
+  };
+  if (config_path_.empty() && std::none_of(files_.begin(), files_.end(), given)) return;
   std::vector<Named> inputs, outputs;
   if (!config_path_.empty()) inputs.push_back({"config", config_path_, {config_path_}});
-  for (const auto& key : order_) {
-    const Entry& e = entries_.at(key);
+  for (const std::uint32_t at : files_) {
+    const Entry& e = entries_[at];
+    const std::string& key = e.key;
     if (!e.is_file) continue;
     const std::string& value = std::get<std::string>(e.value);
     if (value.empty()) continue;

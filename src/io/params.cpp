@@ -1,9 +1,11 @@
 #include "afmkit/io/params.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -25,6 +27,80 @@ namespace {
 std::string dashed(std::string key) {
   std::replace(key.begin(), key.end(), '_', '-');
   return key;
+}
+
+/// A 64-bit hash of a key from at most three 8-byte words (the first, the middle and the last: every byte of a key
+/// of up to 24 characters, the length of the rest); keys are short, a few words with underscores, and the key found
+/// is compared whole (same_key).
+[[gnu::always_inline]] inline std::uint64_t key_hash(std::string_view key) noexcept {
+  const std::size_t n = key.size();
+  const char* p = key.data();
+  const auto load8 = [](const char* at) {
+    std::uint64_t w;
+    std::memcpy(&w, at, 8);
+    return w;
+  };
+  const auto load4 = [](const char* at) {
+    std::uint32_t w;
+    std::memcpy(&w, at, 4);
+    return std::uint64_t{w};
+  };
+  std::uint64_t a = 0, b = 0, c = 0;
+  if (n >= 8) {
+    a = load8(p);
+    b = load8(p + n - 8);
+    if (n > 16) c = load8(p + n / 2 - 4);
+  } else if (n >= 4) {
+    a = load4(p);
+    b = load4(p + n - 4);
+  } else if (n > 0) {
+    a = std::uint64_t{static_cast<unsigned char>(p[0])} | std::uint64_t{static_cast<unsigned char>(p[n / 2])} << 8 |
+        std::uint64_t{static_cast<unsigned char>(p[n - 1])} << 16;
+  }
+  constexpr std::uint64_t k1 = 0xbf58476d1ce4e5b9ull, k2 = 0x94d049bb133111ebull, k3 = 0x9e3779b97f4a7c15ull;
+  std::uint64_t h = (a ^ k3) * k1;
+  h = (h ^ (h >> 31) ^ b) * k2;
+  h = (h ^ (h >> 29) ^ c ^ n) * k1;
+  return h ^ (h >> 32);
+}
+
+/// Whether `a` and `b` hold the same characters, 8 bytes at a time without a call (the key found by its hash is
+/// almost always the one looked up: this comparison confirms it).
+[[gnu::always_inline]] inline bool same_key(const std::string& a, std::string_view b) noexcept {
+  const std::size_t n = b.size();
+  if (a.size() != n) return false;
+  const char* p = a.data();
+  const char* q = b.data();
+  if (n < 8) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (p[i] != q[i]) return false;
+    return true;
+  }
+  const auto word = [](const char* at) {
+    std::uint64_t w;
+    std::memcpy(&w, at, 8);
+    return w;
+  };
+  for (std::size_t i = 0; i + 8 < n; i += 8)
+    if (word(p + i) != word(q + i)) return false;
+  return word(p + n - 8) == word(q + n - 8);  // the last 8 bytes (overlapping the previous word)
+}
+
+/// The same value, bit for bit (-0.0 is not 0.0; a NaN is itself): reset_values keeps a value that passed check().
+bool same_value(const ParamSet::Value& a, const ParamSet::Value& b) {
+  if (a.index() != b.index()) return false;
+  const auto same_real = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+  switch (a.index()) {
+    case 0: return same_real(std::get<double>(a), std::get<double>(b));
+    case 1: return std::get<long>(a) == std::get<long>(b);
+    case 2: return std::get<std::string>(a) == std::get<std::string>(b);
+    case 3: return std::get<bool>(a) == std::get<bool>(b);
+    default: {
+      const auto& x = std::get<std::vector<double>>(a);
+      const auto& y = std::get<std::vector<double>>(b);
+      return x.size() == y.size() && std::equal(x.begin(), x.end(), y.begin(), same_real);
+    }
+  }
 }
 
 double real_of(const std::string& key, const std::string& text, const std::string& origin, const Range& range) {
@@ -129,15 +205,72 @@ ParamSet::Entry ParamSet::make_entry(Value value, const std::string& help, Range
   return e;
 }
 
+std::uint32_t ParamSet::find(std::string_view key) const noexcept {
+  static_assert(LookupCache::size == 256, "the slot is the top 8 bits of a product");
+  // the index found last time for a key at this address (a literal), confirmed by the key itself
+  std::atomic<std::uint32_t>& recent =
+      recent_.slots[(reinterpret_cast<std::uintptr_t>(key.data()) * 0x9e3779b97f4a7c15ull) >> 56];
+  const std::uint32_t guess = recent.load(std::memory_order_relaxed);
+  if (guess < entries_.size() && same_key(entries_[guess].key, key)) [[likely]]
+    return guess;
+  return find_by_hash(key, recent);
+}
+std::uint32_t ParamSet::find_by_hash(std::string_view key, std::atomic<std::uint32_t>& recent) const noexcept {
+  if (slots_.empty()) return kNone;
+  const std::uint64_t h = key_hash(key);
+  const std::uint64_t tag = h & ~std::uint64_t{0xffffffff};
+  const std::size_t mask = slots_.size() - 1;
+  for (std::size_t s = h & mask;; s = (s + 1) & mask) {  // at most half full: an empty slot ends the probe
+    const std::uint64_t slot = slots_[s];
+    if (slot == 0) return kNone;
+    if ((slot & ~std::uint64_t{0xffffffff}) != tag) continue;
+    const auto at = static_cast<std::uint32_t>(slot) - 1;
+    if (same_key(entries_[at].key, key)) {
+      recent.store(at, std::memory_order_relaxed);
+      return at;
+    }
+  }
+}
+
 void ParamSet::declare(const std::string& key, Entry e, const afmkit::SourceLocation& where) {
+  e.key = key;
   e.group = group_;
   if (const auto c = group_conditions_.find(group_); c != group_conditions_.end())
-    e.applies.push_back({c->second.first, {c->second.second}});
-  if (const auto old = entries_.find(key); old == entries_.end()) order_.push_back(key);
-  else e.declared_at = old->second.declared_at;  // declared again: both places are kept (the test names them)
+    e.applies.push_back({c->second.first, find(c->second.first), {c->second.second}});
+  std::uint32_t at = find(key);
+  if (at != kNone) {
+    e.declared_at = std::move(entries_[at].declared_at);  // declared again: both places are kept (the test names them)
+  } else {
+    at = static_cast<std::uint32_t>(entries_.size());
+    if (at == kNone - 1) throw std::logic_error("ParamSet: too many parameters");
+    entries_.emplace_back();
+    entries_.back().key = key;
+    if (2 * entries_.size() > slots_.size()) {  // grow: at most half full
+      slots_.assign(std::bit_ceil(std::max<std::size_t>(16, 4 * entries_.size())), 0);  // a power of 2 (masks)
+      for (std::uint32_t i = 0; i < entries_.size(); ++i) {
+        const std::uint64_t h = key_hash(entries_[i].key);
+        std::size_t s = h & (slots_.size() - 1);
+        while (slots_[s] != 0) s = (s + 1) & (slots_.size() - 1);
+        slots_[s] = (h & ~std::uint64_t{0xffffffff}) | (i + 1);
+      }
+    } else {
+      const std::uint64_t h = key_hash(key);
+      std::size_t s = h & (slots_.size() - 1);
+      while (slots_[s] != 0) s = (s + 1) & (slots_.size() - 1);
+      slots_[s] = (h & ~std::uint64_t{0xffffffff}) | (at + 1);
+    }
+    by_key_.insert(std::lower_bound(by_key_.begin(), by_key_.end(), key,
+                                    [this](std::uint32_t i, const std::string& k) { return entries_[i].key < k; }),
+                   at);
+    keys_signature_ = (keys_signature_ ^ key_hash(key)) * 0x9e3779b97f4a7c15ull + 1;
+  }
   e.declared_at.push_back(fmt::format("{}:{}", where.file_name(), where.line()));
-  entries_[key] = std::move(e);
-  last_ = key;
+  entries_[at] = std::move(e);
+  last_ = at;
+}
+ParamSet::Entry& ParamSet::last(const char* what) {
+  if (last_ == kNone) throw std::logic_error(fmt::format("ParamSet::{} before any parameter", what));
+  return entries_[last_];
 }
 ParamSet& ParamSet::group(const std::string& name) {
   group_ = name;
@@ -174,81 +307,81 @@ class ConditionalGroupFormatter : public CLI::Formatter {
 };
 }  // namespace
 ParamSet& ParamSet::default_text(const std::string& text) {
-  if (last_.empty()) throw std::logic_error("ParamSet::default_text before any parameter");
-  entries_[last_].default_text = text;
+  last("default_text").default_text = text;
   return *this;
 }
 ParamSet& ParamSet::follows(const std::string& key) {
-  if (last_.empty()) throw std::logic_error("ParamSet::follows before any parameter");
-  const auto it = entries_.find(key);
-  if (it == entries_.end() || key == last_)
-    throw std::logic_error(fmt::format("ParamSet::follows: '{}' follows '{}', which is not declared before it", last_, key));
-  Entry& e = entries_[last_];
-  if (it->second.value.index() != e.value.index())
-    throw std::logic_error(fmt::format("ParamSet::follows: '{}' and '{}' are not of the same kind", last_, key));
+  Entry& e = last("follows");
+  const std::uint32_t at = find(key);
+  if (at == kNone || at == last_)
+    throw std::logic_error(fmt::format("ParamSet::follows: '{}' follows '{}', which is not declared before it", e.key, key));
+  if (entries_[at].value.index() != e.value.index())
+    throw std::logic_error(fmt::format("ParamSet::follows: '{}' and '{}' are not of the same kind", e.key, key));
   e.follows = key;
+  e.follows_at = at;
   if (e.default_text.empty()) e.default_text = "= " + key;
   return *this;
 }
 ParamSet& ParamSet::only_if_given(std::vector<std::string> instead_of) {
-  if (last_.empty()) throw std::logic_error("ParamSet::only_if_given before any parameter");
-  Entry& e = entries_[last_];
+  Entry& e = last("only_if_given");
   e.only_if_given = true;
   e.instead_of = std::move(instead_of);
   return *this;
 }
 ParamSet& ParamSet::applies_when(const std::string& param, const std::string& key, std::vector<std::string> values) {
-  const auto it = entries_.find(param);
-  const auto on = entries_.find(key);
-  if (it == entries_.end() || on == entries_.end() || !std::holds_alternative<std::string>(on->second.value))
+  const std::uint32_t it = find(param);
+  const std::uint32_t on = find(key);
+  if (it == kNone || on == kNone || !std::holds_alternative<std::string>(entries_[on].value))
     throw std::logic_error(fmt::format("ParamSet::applies_when: '{}' or the text parameter '{}' is not declared",
                                        param, key));
-  it->second.applies.push_back({key, std::move(values)});
+  entries_[it].applies.push_back({key, on, std::move(values)});
   return *this;
 }
 ParamSet& ParamSet::applies_if(const std::string& param, std::function<bool(const ParamSet&)> condition) {
-  const auto it = entries_.find(param);
-  if (it == entries_.end() || !condition)
+  const std::uint32_t it = find(param);
+  if (it == kNone || !condition)
     throw std::logic_error(fmt::format("ParamSet::applies_if: '{}' is not declared or has no condition", param));
-  it->second.applies_if.push_back(std::move(condition));
+  entries_[it].applies_if.push_back(std::move(condition));
   return *this;
 }
 ParamSet& ParamSet::recorded_only_if_given(const std::string& param) {
-  const auto it = entries_.find(param);
-  if (it == entries_.end())
+  const std::uint32_t it = find(param);
+  if (it == kNone)
     throw std::logic_error(fmt::format("ParamSet::recorded_only_if_given: '{}' is not declared", param));
-  it->second.only_if_given = true;
+  entries_[it].only_if_given = true;
   return *this;
 }
 void ParamSet::record_used(const std::string& key, Value value) {
-  auto it = entries_.find(key);
-  if (it == entries_.end()) throw std::logic_error("ParamSet::record_used: no parameter named '" + key + "'");
-  Entry& e = it->second;
+  const std::uint32_t it = find(key);
+  if (it == kNone) throw std::logic_error("ParamSet::record_used: no parameter named '" + key + "'");
+  Entry& e = entries_[it];
   if (std::holds_alternative<double>(e.value) && std::holds_alternative<long>(value))
     value = static_cast<double>(std::get<long>(value));
   if (value.index() != e.value.index())
     throw std::logic_error(fmt::format("ParamSet::record_used: '{}' recorded with a value of another kind", key));
   e.value = std::move(value);
   e.used = true;
+  e.checked = false;
   check(key, e, "");
+  e.checked = true;
 }
 ParamSet& ParamSet::positional() {
-  if (last_.empty() || !std::holds_alternative<std::string>(entries_[last_].value))
+  if (last_ == kNone || !std::holds_alternative<std::string>(entries_[last_].value))
     throw std::logic_error("ParamSet::positional: the last declared parameter is not a text or file");
-  for (const auto& [key, e] : entries_)
-    if (e.positional && key != last_) throw std::logic_error("ParamSet::positional: only one positional parameter");
+  for (std::uint32_t i = 0; i < entries_.size(); ++i)
+    if (entries_[i].positional && i != last_)
+      throw std::logic_error("ParamSet::positional: only one positional parameter");
   entries_[last_].positional = true;
   return *this;
 }
 ParamSet& ParamSet::unit(const std::string& unit) {
-  if (last_.empty()) throw std::logic_error("ParamSet::unit before any parameter");
-  Entry& e = entries_[last_];
+  Entry& e = last("unit");
   if (std::holds_alternative<std::string>(e.value) || std::holds_alternative<bool>(e.value))
-    throw std::logic_error(fmt::format("ParamSet::unit: '{}' is not a number", last_));
+    throw std::logic_error(fmt::format("ParamSet::unit: '{}' is not a number", e.key));
   e.unit = unit;
   return *this;
 }
-const std::string& ParamSet::unit_of(const std::string& key) const& { return entry(key).unit; }
+const std::string& ParamSet::unit_of(std::string_view key) const& { return entry(key).unit; }
 ParamSet& ParamSet::real(const std::string& key, double def, const std::string& help, Range range,
                          afmkit::SourceLocation where) {
   declare(key, make_entry(def, help, range), where);
@@ -273,7 +406,10 @@ ParamSet& ParamSet::text(const std::string& key, const std::string& def, const s
 ParamSet& ParamSet::file(const std::string& key, const std::string& def, const std::string& help,
                          afmkit::SourceLocation where) {
   text(key, def, help, {}, where);
-  entries_[key].is_file = true;
+  entries_[last_].is_file = true;
+  // in declaration order (check_files reports the first clash in that order)
+  if (const auto at = std::lower_bound(files_.begin(), files_.end(), last_); at == files_.end() || *at != last_)
+    files_.insert(at, last_);
   return *this;
 }
 ParamSet& ParamSet::flag(const std::string& key, bool def, const std::string& help, afmkit::SourceLocation where) {
@@ -290,15 +426,15 @@ void ParamSet::add_options(CLI::App& app) {
   if (!group_conditions_.empty()) {
     std::map<std::string, ConditionalGroupFormatter::Condition> conditions;
     for (const auto& [group, condition] : group_conditions_) {
-      const Entry& e = entry(condition.first);
+      const Entry& e = std::as_const(*this).entry(condition.first);
       conditions[group] = {"--" + dashed(condition.first), condition.second, std::get<std::string>(e.value)};
     }
     app.formatter(std::make_shared<ConditionalGroupFormatter>(&app, std::move(conditions)));
   }
   app.add_option("--config", config_path_, "TOML file with parameters (keys as below, with underscores)")
       ->type_name("FILE");
-  for (const auto& key : order_) {
-    Entry& e = entries_[key];
+  for (Entry& e : entries_) {  // (the callbacks below keep &e: entries stay where they are)
+    const std::string& key = e.key;
     std::string desc = e.help;
     std::string type;
     auto shown = [&](const auto& value) { return e.default_text.empty() ? fmt::format("{}", value) : e.default_text; };
@@ -371,9 +507,10 @@ void ParamSet::check(const std::string& key, const Entry& e, const std::string& 
 }
 
 void ParamSet::set_from_string(const std::string& key, const std::string& text) {
-  auto it = entries_.find(key);
-  if (it == entries_.end()) throw InputError(fmt::format("unknown parameter '{}'", key));
-  Entry& e = it->second;
+  const std::uint32_t it = find(key);
+  if (it == kNone) throw InputError(fmt::format("unknown parameter '{}'", key));
+  Entry& e = entries_[it];
+  e.checked = false;
   const std::string origin = "--" + dashed(key);
   std::visit(
       [&](auto& v) {
@@ -405,16 +542,26 @@ void ParamSet::set_from_string(const std::string& key, const std::string& text) 
       e.value);
   e.set = true;
   check(key, e, "");
+  e.checked = true;
 }
 
+namespace {
+/// The keys of `entries` in declaration order (messages naming the keys allowed).
+template <class Entries>
+std::vector<std::string> keys_of(const Entries& entries) {
+  std::vector<std::string> out;
+  out.reserve(entries.size());
+  for (const auto& e : entries) out.push_back(e.key);
+  return out;
+}
+}  // namespace
+
 void ParamSet::set_value(const std::string& key, Value value, const std::string& origin) {
-  auto it = entries_.find(key);
-  if (it == entries_.end()) {
-    std::vector<std::string> known(order_.begin(), order_.end());
+  const std::uint32_t it = find(key);
+  if (it == kNone)
     throw InputError(fmt::format("{}{}unknown parameter '{}' (allowed: {})", origin, origin.empty() ? "" : ": ", key,
-                                 fmt::join(known, ", ")));
-  }
-  Entry& e = it->second;
+                                 fmt::join(keys_of(entries_), ", ")));
+  Entry& e = entries_[it];
   if (std::holds_alternative<double>(e.value) && std::holds_alternative<long>(value))
     value = static_cast<double>(std::get<long>(value));
   if (value.index() != e.value.index()) {
@@ -424,29 +571,36 @@ void ParamSet::set_value(const std::string& key, Value value, const std::string&
   }
   e.value = std::move(value);
   e.set = true;
+  e.checked = false;
   check(key, e, origin);
+  e.checked = true;
 }
 
 void ParamSet::reset_values(const ParamSet& declared) {
-  if (entries_.size() != declared.entries_.size())
+  // the same keys in the same order (a copy of `declared`): compared by their signature, not key by key
+  if (entries_.size() != declared.entries_.size() || keys_signature_ != declared.keys_signature_)
     throw std::logic_error("ParamSet::reset_values: another set of parameters");
-  auto from = declared.entries_.begin();
-  for (auto& [key, e] : entries_) {
-    if (key != from->first) throw std::logic_error("ParamSet::reset_values: another set of parameters");
-    const Entry& d = from->second;
-    e.value = d.value;  // a text keeps its buffer
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    Entry& e = entries_[i];
+    const Entry& d = declared.entries_[i];
+    const double* x = std::get_if<double>(&e.value);
+    const double* y = std::get_if<double>(&d.value);
+    const bool same = x && y ? std::memcmp(x, y, sizeof(double)) == 0 : same_value(e.value, d.value);
+    if (!same) {  // a value the last run changed; one kept stays checked (resolve)
+      e.value = d.value;                  // a text keeps its buffer
+      e.checked = d.checked;
+    }
     e.set = d.set;
-    e.cli_text = d.cli_text;
+    if (e.cli_text || d.cli_text) e.cli_text = d.cli_text;
     e.used = d.used;
-    ++from;
   }
   config_path_ = declared.config_path_;
 }
 
 std::vector<ParamSet::Description> ParamSet::describe() const {
   std::vector<Description> out;
-  for (const auto& key : order_) {
-    const Entry& e = entries_.at(key);
+  for (const Entry& e : entries_) {
+    const std::string& key = e.key;
     Description d{key, "", e.value, e.default_text, e.help, e.unit, "", e.group, e.choices, e.follows, e.declared_at};
     switch (e.value.index()) {
       case 0: d.kind = "real"; d.allowed = e.range.describe(); break;
@@ -466,7 +620,7 @@ std::vector<ParamSet::Description> ParamSet::describe() const {
 
 void ParamSet::set_default(const std::string& key, const std::string& text) {
   set_from_string(key, text);
-  entries_.at(key).set = false;
+  entry(key).set = false;
 }
 
 namespace {
@@ -529,12 +683,12 @@ void ParamSet::load_toml_text(const std::string& text, const std::string& origin
   for (auto&& item : tbl) {  // (no structured binding: clang 14 cannot capture one in the lambda below)
     const std::string key(item.first.str());
     const toml::node& node = item.second;
-    auto it = entries_.find(key);
-    if (it == entries_.end()) {
-      std::vector<std::string> known(order_.begin(), order_.end());
-      throw InputError(fmt::format("{}: unknown key '{}' (allowed keys: {})", origin, key, fmt::join(known, ", ")));
-    }
-    Entry& e = it->second;
+    const std::uint32_t it = find(key);
+    if (it == kNone)
+      throw InputError(fmt::format("{}: unknown key '{}' (allowed keys: {})", origin, key,
+                                   fmt::join(keys_of(entries_), ", ")));
+    Entry& e = entries_[it];
+    e.checked = false;
     auto type_error = [&](const char* want) {
       throw InvalidParameter(key, fmt::format("{}: key '{}' must be {}", origin, key, want));
     };
@@ -576,6 +730,7 @@ void ParamSet::load_toml_text(const std::string& text, const std::string& origin
         e.value);
     e.set = true;
     check(key, e, origin);
+    e.checked = true;
   }
 }
 
@@ -586,73 +741,79 @@ void ParamSet::resolve() {
     constexpr std::uintmax_t max_config_bytes = 16u << 20;  // a parameter file, not data
     load_toml_text(files::read_input_file(config_path_, "--config file", max_config_bytes), config_path_);
   }
-  // in declaration order (the first flag or value refused is the one reported), looked up only when there is
-  // something to do: a front end that resets a set and resolves it per call (the Python module) checks ~140 values
-  // (bench/command_layer.py)
-  if (std::any_of(entries_.begin(), entries_.end(), [](const auto& kv) { return kv.second.cli_text.has_value(); }))
-    for (const auto& key : order_) {
-      Entry& e = entries_[key];
-      if (e.cli_text) set_from_string(key, *e.cli_text);
-    }
-  bool valid = true;
-  for (const auto& [key, e] : entries_) {
-    try {
-      check(key, e, "");
-    } catch (const InvalidParameter&) {
-      valid = false;
-      break;
+  // in declaration order (the first flag, else the first value refused is the one reported); a value that passed
+  // check() since it last changed is not checked again: a front end that resets a set and resolves it per call (the
+  // Python module: reset_values keeps the values the last call did not change) checks only the few values given
+  for (Entry& e : entries_)
+    if (e.cli_text) set_from_string(e.key, *e.cli_text);  // checks it
+  for (Entry& e : entries_) {
+    if (!e.checked) {
+      check(e.key, e, "");
+      e.checked = true;
     }
   }
-  if (!valid)
-    for (const auto& key : order_) check(key, entries_.at(key), "");
   check_files();
 }
 
-const ParamSet::Entry& ParamSet::entry(const std::string& key) const {
-  auto it = entries_.find(key);
-  if (it == entries_.end()) throw std::logic_error("ParamSet: no parameter named '" + key + "'");
-  return it->second;
+const ParamSet::Entry& ParamSet::entry(std::string_view key) const {
+  const std::uint32_t at = find(key);
+  if (at == kNone) throw std::logic_error("ParamSet: no parameter named '" + std::string(key) + "'");
+  return entries_[at];
 }
-const ParamSet::Entry& ParamSet::current(const std::string& key) const {
-  const Entry* e = &entry(key);
+ParamSet::Entry& ParamSet::entry(std::string_view key) {
+  return const_cast<Entry&>(std::as_const(*this).entry(key));
+}
+const ParamSet::Entry& ParamSet::current_at(std::uint32_t at) const {
+  const Entry* e = &entries_[at];
   // a chain of follows ends: each followed key is declared before its follower
-  while (!e->set && !e->used && !e->follows.empty()) e = &entry(e->follows);
+  while (!e->set && !e->used && e->follows_at != kNone) e = &entries_[e->follows_at];
   return *e;
 }
-bool ParamSet::recorded(const std::string& key) const { return recorded(key, replaced()); }
+const ParamSet::Entry& ParamSet::current(std::string_view key) const {
+  const std::uint32_t at = find(key);
+  if (at == kNone) throw std::logic_error("ParamSet: no parameter named '" + std::string(key) + "'");
+  const Entry* e = &entries_[at];  // (current_at's loop, without a call: ~100 values read per command call)
+  while (!e->set && !e->used && e->follows_at != kNone) e = &entries_[e->follows_at];
+  return *e;
+}
 std::vector<std::string_view> ParamSet::replaced() const {
   std::vector<std::string_view> out;  // few: only_if_given alternatives that were given
-  for (const auto& [other, o] : entries_)
+  for (const Entry& o : entries_)
     if (o.only_if_given && o.set) out.insert(out.end(), o.instead_of.begin(), o.instead_of.end());
   return out;
 }
-bool ParamSet::recorded(const std::string& key, const std::vector<std::string_view>& replaced) const {
-  return recorded(key, entry(key), replaced);
-}
-bool ParamSet::recorded(const std::string& key, const Entry& e, const std::vector<std::string_view>& replaced) const {
+bool ParamSet::recorded(const Entry& e, const std::vector<std::string_view>& replaced) const {
   if (e.only_if_given && !e.set) return false;
-  for (const auto& [on, values] : e.applies)  // a key of another unit system or law than the run's
-    if (std::find(values.begin(), values.end(), std::get<std::string>(current(on).value)) == values.end())
+  for (const Applies& a : e.applies) {  // a key of another unit system or law than the run's
+    const Entry* on = a.at != kNone ? &entries_[a.at] : &current(a.key);
+    while (!on->set && !on->used && on->follows_at != kNone) on = &entries_[on->follows_at];  // (current_at)
+    const std::string& value = std::get<std::string>(on->value);
+    if (std::none_of(a.values.begin(), a.values.end(), [&](const std::string& v) { return same_key(v, value); }))
       return false;
+  }
   for (const auto& condition : e.applies_if)  // a key of another controller than the run's
     if (!condition(*this)) return false;
   // given, an alternative stands for these keys (only_if_given(instead_of))
-  return std::find(replaced.begin(), replaced.end(), std::string_view(key)) == replaced.end();
+  return std::find(replaced.begin(), replaced.end(), std::string_view(e.key)) == replaced.end();
 }
-double ParamSet::real(const std::string& key) const { return std::get<double>(current(key).value); }
-long ParamSet::integer(const std::string& key) const { return std::get<long>(current(key).value); }
-const std::string& ParamSet::text(const std::string& key) const& { return std::get<std::string>(current(key).value); }
-bool ParamSet::flag(const std::string& key) const { return std::get<bool>(current(key).value); }
-const std::vector<double>& ParamSet::reals(const std::string& key) const& {
+double ParamSet::real(std::string_view key) const { return std::get<double>(current(key).value); }
+long ParamSet::integer(std::string_view key) const { return std::get<long>(current(key).value); }
+const std::string& ParamSet::text(std::string_view key) const& { return std::get<std::string>(current(key).value); }
+bool ParamSet::flag(std::string_view key) const { return std::get<bool>(current(key).value); }
+const std::vector<double>& ParamSet::reals(std::string_view key) const& {
   return std::get<std::vector<double>>(current(key).value);
 }
-bool ParamSet::was_set(const std::string& key) const { return entry(key).set; }
+bool ParamSet::was_set(std::string_view key) const {
+  const std::uint32_t at = find(key);
+  if (at == kNone) throw std::logic_error("ParamSet: no parameter named '" + std::string(key) + "'");
+  return entries_[at].set;
+}
 
 nlohmann::json ParamSet::units_json() const {
   nlohmann::json j = nlohmann::json::object();
   const std::vector<std::string_view> gone = replaced();
-  for (const auto& key : order_)
-    if (!entries_.at(key).unit.empty() && recorded(key, gone)) j[key] = entries_.at(key).unit;
+  for (const Entry& e : entries_)
+    if (!e.unit.empty() && recorded(e, gone)) j[e.key] = e.unit;
   return j;
 }
 
@@ -663,11 +824,12 @@ nlohmann::json ParamSet::to_json() const {
   // in the keys' order (entries_ and the JSON object sort them alike): each added at the end, no lookups
   const std::vector<std::string_view> gone = replaced();
   auto& object = j.get_ref<nlohmann::json::object_t&>();
-  for (const auto& kv : entries_) {  // (no structured binding: clang 14 cannot capture one in the lambda below)
-    const std::string& key = kv.first;
-    const Entry& e = kv.second;
-    if (!recorded(key, e, gone)) continue;
-    const Entry& used = e.set || e.used || e.follows.empty() ? e : current(key);
+  for (const std::uint32_t at : by_key_) {
+    const Entry& e = entries_[at];
+    const bool conditional = e.only_if_given || !e.applies.empty() || !e.applies_if.empty() || !gone.empty();
+    if (conditional && !recorded(e, gone)) continue;
+    const std::string& key = e.key;
+    const Entry& used = current_at(at);
     std::visit([&](const auto& v) { object.emplace_hint(object.end(), key, v); }, used.value);
   }
   return j;

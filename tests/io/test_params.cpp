@@ -1,13 +1,18 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <string_view>
 
 #include "afmkit/core/error.hpp"
 #include "afmkit/io/params.hpp"
 
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 using afmkit::InputError;
@@ -327,4 +332,116 @@ TEST(ParamSetResolve, ReportsTheFirstValueRefusedInDeclarationOrder) {
   EXPECT_NO_THROW(p.resolve());
   // the record lists the keys in order, each value as used
   EXPECT_EQ(p.to_json().dump(), R"({"alpha":2.0,"middle":1.0,"zeta":1.0})");
+}
+
+// The keys are found through a hash index of positions (never pointers): a copy, a moved-to set and an assigned set
+// answer from their own values, also after the original is changed or destroyed, and after more keys are declared.
+TEST(ParamSetIndex, CopiesAndMovesAnswerFromTheirOwnValues) {
+  auto original = std::make_unique<ParamSet>(make());
+  for (int i = 0; i < 40; ++i)  // enough keys to grow the index several times
+    original->real(fmt::format("extra_parameter_number_{}", i), i, "extra").unit("m");
+  ParamSet copy = *original;
+  ParamSet assigned;
+  assigned.real("something_else", 1.0, "x").unit("m");
+  assigned = *original;
+  original->set_value("quality_factor", 5.0);
+  original->set_value("extra_parameter_number_17", -3.0);
+  original->set_value("law", std::string("linear"));
+  EXPECT_EQ(copy.real("quality_factor"), 100.0);
+  EXPECT_EQ(assigned.real("extra_parameter_number_17"), 17.0);
+  original.reset();  // destroyed: the copies keep answering
+  for (int i = 0; i < 40; ++i) {
+    const std::string key = fmt::format("extra_parameter_number_{}", i);
+    EXPECT_EQ(copy.real(key), i) << key;
+    EXPECT_EQ(assigned.real(key), i) << key;
+  }
+  EXPECT_EQ(copy.text("law"), "hysteresis");
+  EXPECT_THROW(assigned.real("something_else"), std::logic_error);  // the assigned set's own keys are gone
+  // a key given as a view into a longer text is the key, not the text
+  const std::string longer = "pointsXYZ";
+  EXPECT_EQ(copy.integer(std::string_view(longer).substr(0, 6)), 10);
+  EXPECT_THROW(copy.integer(std::string_view(longer).substr(0, 5)), std::logic_error);
+  EXPECT_THROW(copy.real(""), std::logic_error);
+  // moved: the moved-to set has the values; a key declared after the copy is the copy's only
+  ParamSet moved = std::move(copy);
+  moved.set_value("points", 7L);
+  moved.integer("declared_later", 3, "n", 0, 9);
+  EXPECT_EQ(moved.integer("points"), 7);
+  EXPECT_EQ(moved.integer("declared_later"), 3);
+  EXPECT_THROW(assigned.integer("declared_later"), std::logic_error);
+  EXPECT_EQ(assigned.integer("points"), 10);
+  // the record lists every key once, in the keys' order, whatever the declaration order
+  std::vector<std::string> keys;
+  const nlohmann::json record = moved.to_json();
+  for (const auto& item : record.items()) keys.push_back(item.key());
+  EXPECT_TRUE(std::is_sorted(keys.begin(), keys.end()));
+  EXPECT_EQ(keys.size(), 5u + 40u + 1u);
+}
+
+// resolve() skips the values that passed the check since they last changed: a value refused when given stays refused
+// at resolve(), and reset_values gives back the declared value bit for bit (-0.0 is not 0.0) with its own check.
+TEST(ParamSetIndex, ResolveChecksEveryValueThatChangedSinceItsLastCheck) {
+  ParamSet p = make();
+  EXPECT_THROW(p.set_value("quality_factor", -1.0), InvalidParameter);
+  EXPECT_THROW(p.resolve(), InvalidParameter);  // the refused value is still there
+  ParamSet declared;
+  declared.real("offset", 0.0, "o", Range::non_negative()).unit("m");
+  declared.real("gain", -1.0, "declared out of range", Range::positive()).unit("m");
+  ParamSet q = declared;
+  q.set_value("gain", 2.0);
+  q.set_value("offset", -0.0);
+  EXPECT_NO_THROW(q.resolve());
+  q.reset_values(declared);
+  EXPECT_FALSE(std::signbit(q.real("offset")));
+  EXPECT_EQ(q.to_json().dump(), R"({"gain":-1.0,"offset":0.0})");
+  EXPECT_THROW(q.resolve(), InvalidParameter);  // the declared value is checked again
+  q.set_value("gain", 3.0);
+  EXPECT_NO_THROW(q.resolve());
+  q.reset_values(declared);
+  q.set_value("gain", 3.0);
+  EXPECT_NO_THROW(q.resolve());
+  // a flag refused is reported before a value refused that is declared before it (the flags are applied first)
+  ParamSet r;
+  r.real("first", -1.0, "declared first, refused", Range::positive()).unit("m");
+  r.real("second", 1.0, "given as a flag, refused", Range::positive()).unit("m");
+  CLI::App app;
+  r.add_options(app);
+  app.parse(std::vector<std::string>{"0", "--second"});  // CLI11 takes the arguments in reverse order
+  try {
+    r.resolve();
+    FAIL() << "a refused flag accepted";
+  } catch (const InvalidParameter& e) {
+    EXPECT_EQ(e.parameter(), "second");
+  }
+}
+
+TEST(ParamSetIndex, ResetValuesRefusesTheSameKeysDeclaredInAnotherOrder) {
+  ParamSet a, b;
+  a.real("x", 1.0, "x").unit("m").real("y", 2.0, "y").unit("m");
+  b.real("y", 2.0, "y").unit("m").real("x", 1.0, "x").unit("m");
+  EXPECT_THROW(a.reset_values(b), std::logic_error);
+  ParamSet c = a;
+  c.set_value("y", 5.0);
+  c.reset_values(a);
+  EXPECT_EQ(c.real("y"), 2.0);
+}
+
+// A key is looked up first where the same address found it last time (a literal's): another key at that address, or
+// the same key in another set, is confirmed against the keys, never taken on trust.
+TEST(ParamSetIndex, AKeyAtAnAddressUsedBeforeIsConfirmedNotTrusted) {
+  const ParamSet p = make();
+  char buffer[16] = "points";
+  EXPECT_EQ(p.integer(std::string_view(buffer, 6)), 10);
+  std::memcpy(buffer, "verbose", 7);
+  EXPECT_FALSE(p.flag(std::string_view(buffer, 7)));
+  std::memcpy(buffer, "pointz", 6);
+  EXPECT_THROW(p.integer(std::string_view(buffer, 6)), std::logic_error);
+  std::memcpy(buffer, "law", 3);
+  EXPECT_EQ(p.text(std::string_view(buffer, 3)), "hysteresis");
+  ParamSet other;  // the same literal in another set: that set's own entry
+  other.text("units", "physical", "u").text("law", "dmt", "l");
+  EXPECT_EQ(other.text("law"), "dmt");
+  EXPECT_EQ(p.text("law"), "hysteresis");
+  EXPECT_EQ(other.text("law"), "dmt");
+  EXPECT_THROW(other.integer("points"), std::logic_error);
 }

@@ -4,8 +4,12 @@
 //   TOML key  `quality_factor = 400`      <->  flag `--quality-factor 400`
 // Unknown TOML keys, malformed TOML, a missing file, a wrong type or a value out of range raise
 // afmkit::InputError / afmkit::InvalidParameter naming the key (or file) and the allowed range.
+#include <cstdint>
+#include <algorithm>
+#include <atomic>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include "afmkit/core/source_location.hpp"
 #include <string>
@@ -111,7 +115,7 @@ class ParamSet {
   /// file). InvalidParameter naming the output. resolve() calls it; a front end that sets values
   /// after resolve() calls it again.
   void check_files() const;
-  const std::string& unit_of(const std::string& key) const&;
+  const std::string& unit_of(std::string_view key) const&;
 
   /// Adds `--config FILE` and one `--<key-with-dashes>` option per parameter to `app`.
   void add_options(CLI::App& app);
@@ -134,7 +138,7 @@ class ParamSet {
   /// The values of `declared` again (as given, defaults, config path), the declarations kept: what copying
   /// `declared` gives when this set has its declarations (a copy of it reused), without copying hundreds of help
   /// texts, choices and ranges again (the Python module reuses a command's sets: bench/command_layer.py).
-  /// std::logic_error when the declared keys differ.
+  /// std::logic_error when the declared keys differ (the same keys, declared in the same order).
   void reset_values(const ParamSet& declared);
 
   /// One parameter as --help describes it, for other front ends (Python signatures and docstrings).
@@ -156,16 +160,18 @@ class ParamSet {
   /// Every parameter in declaration order.
   std::vector<Description> describe() const;
   /// The value of any parameter.
-  const Value& value(const std::string& key) const& { return current(key).value; }
+  /// (Lookups by key take a std::string_view: a key given as a literal is not copied into a std::string first, and
+  /// a key is found by its hash, without comparing it with other keys: the command layer reads ~100 values per call.)
+  const Value& value(std::string_view key) const& { return current(key).value; }
 
-  double real(const std::string& key) const;
-  long integer(const std::string& key) const;
-  const std::string& text(const std::string& key) const&;
-  std::string text(const std::string& key) const&& { return text(key); }  // a temporary gives a copy
-  bool flag(const std::string& key) const;
-  const std::vector<double>& reals(const std::string& key) const&;
-  std::vector<double> reals(const std::string& key) const&& { return reals(key); }
-  bool was_set(const std::string& key) const;  ///< given by TOML or flag (not the default)
+  double real(std::string_view key) const;
+  long integer(std::string_view key) const;
+  const std::string& text(std::string_view key) const&;
+  std::string text(std::string_view key) const&& { return text(key); }  // a temporary gives a copy
+  bool flag(std::string_view key) const;
+  const std::vector<double>& reals(std::string_view key) const&;
+  std::vector<double> reals(std::string_view key) const&& { return reals(key); }
+  bool was_set(std::string_view key) const;  ///< given by TOML or flag (not the default)
 
   /// All parameters and their values, for the JSON sidecar.
   nlohmann::json to_json() const;
@@ -176,13 +182,22 @@ class ParamSet {
   std::string config_path() const&& { return config_path_; }
 
  private:
+  static constexpr std::uint32_t kNone = UINT32_MAX;
+  /// A condition of applies_when (or of a group with a condition): the text parameter `key` has one of `values`.
+  struct Applies {
+    std::string key;
+    std::uint32_t at = kNone;  // index of `key` in entries_ (kNone: not declared yet when the condition was made)
+    std::vector<std::string> values;
+  };
   struct Entry {
+    std::string key;
     Value value;
     std::string help;
     Range range;
     long ilo = 0, ihi = 0;
     std::vector<std::string> choices;
     bool set = false;
+    bool checked = false;                 // the value passed check() since it last changed (resolve skips it)
     std::optional<std::string> cli_text;  // raw flag text captured by CLI11
     std::string group;                    // heading in --help
     std::string default_text;             // shown instead of the value in --help, if set
@@ -192,29 +207,100 @@ class ParamSet {
     bool written = false;                 // a file parameter that is an output (writes())
     WrittenPaths written_paths;           // what its value writes (empty: the file itself)
     std::string follows;                  // not given: the value of this parameter
+    std::uint32_t follows_at = kNone;     // its index in entries_ (declared before)
     bool only_if_given = false;           // not given: not recorded
     std::vector<std::string> instead_of;  // given: these parameters are not recorded
     bool used = false;                    // value recorded by record_used
-    std::vector<std::pair<std::string, std::vector<std::string>>> applies;  // (text key, values): applies_when
-    std::vector<std::function<bool(const ParamSet&)>> applies_if;           // applies_if
+    std::vector<Applies> applies;         // applies_when
+    std::vector<std::function<bool(const ParamSet&)>> applies_if;  // applies_if
     std::vector<std::string> declared_at;  // "file:line" of each declaration (Description::declared_at)
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
-  const Entry& entry(const std::string& key) const;
-  /// The entry whose value `key` has now: its own, or (not given, following another key) the followed one's.
-  const Entry& current(const std::string& key) const;
-  /// Whether `key` goes into the records (to_json, units_json).
-  bool recorded(const std::string& key) const;
+  /// Index of `key` in entries_, kNone if not declared: one hash of the key, one comparison with the key found.
+  [[gnu::always_inline]] inline std::uint32_t find(std::string_view key) const noexcept;
+  std::uint32_t find_by_hash(std::string_view key, std::atomic<std::uint32_t>& recent) const noexcept;
+  const Entry& entry(std::string_view key) const;
+  Entry& entry(std::string_view key);
+  /// The entry whose value entries_[at] has now: its own, or (not given, following another key) the followed one's.
+  const Entry& current_at(std::uint32_t at) const;
+  const Entry& current(std::string_view key) const;
   /// The keys that alternatives given stand for (only_if_given(instead_of)): left out of the records. Computed
   /// once per record, not once per key.
   std::vector<std::string_view> replaced() const;
-  bool recorded(const std::string& key, const std::vector<std::string_view>& replaced) const;
-  bool recorded(const std::string& key, const Entry& e, const std::vector<std::string_view>& replaced) const;
-  std::map<std::string, Entry> entries_;
-  std::vector<std::string> order_;
+  /// Whether `e` goes into the records (to_json, units_json).
+  bool recorded(const Entry& e, const std::vector<std::string_view>& replaced) const;
+  Entry& last(const char* what);
+  /// The parameters in declaration order, each on the heap: an entry keeps its address when others are declared
+  /// after it and when the set is moved (add_options' callbacks hold it); a copy copies every entry (a copied set
+  /// has its own). Elsewhere entries are named by index, never by pointer, so that the default copy and move of
+  /// ParamSet give a set that answers from its own entries.
+  class Entries {
+   public:
+    Entries() = default;
+    Entries(const Entries& other) { *this = other; }
+    Entries& operator=(const Entries& other) {
+      if (this == &other) return *this;
+      items_.resize(std::min(items_.size(), other.items_.size()));
+      for (std::size_t i = 0; i < items_.size(); ++i) *items_[i] = *other.items_[i];  // kept where they are
+      for (std::size_t i = items_.size(); i < other.items_.size(); ++i)
+        items_.push_back(std::make_unique<Entry>(*other.items_[i]));
+      return *this;
+    }
+    Entries(Entries&&) noexcept = default;
+    Entries& operator=(Entries&&) noexcept = default;
+    ~Entries() = default;
+    Entry& operator[](std::size_t i) { return *items_[i]; }
+    const Entry& operator[](std::size_t i) const { return *items_[i]; }
+    std::size_t size() const { return items_.size(); }
+    Entry& back() { return *items_.back(); }
+    void emplace_back() { items_.push_back(std::make_unique<Entry>()); }
+    template <class E, class It>
+    struct Iterator {
+      It it;
+      E& operator*() const { return **it; }
+      Iterator& operator++() {
+        ++it;
+        return *this;
+      }
+      bool operator!=(const Iterator& other) const { return it != other.it; }
+    };
+    using iterator = Iterator<Entry, std::vector<std::unique_ptr<Entry>>::iterator>;
+    using const_iterator = Iterator<const Entry, std::vector<std::unique_ptr<Entry>>::const_iterator>;
+    iterator begin() { return {items_.begin()}; }
+    iterator end() { return {items_.end()}; }
+    const_iterator begin() const { return {items_.begin()}; }
+    const_iterator end() const { return {items_.end()}; }
+
+   private:
+    std::vector<std::unique_ptr<Entry>> items_;
+  };
+  Entries entries_;
+  std::vector<std::uint32_t> by_key_;  // indices of entries_ in the keys' order (the order of a JSON object)
+  std::vector<std::uint32_t> files_;   // indices of the file parameters (check_files)
+  // Open-addressing hash table (linear probing, at most half full): 0 empty, else (high 32 bits of the key's hash
+  // << 32) | (index + 1).
+  std::vector<std::uint64_t> slots_;
+  /// The index last found for a key at a given address (a literal's: the same on every call), tried before the hash
+  /// and confirmed by comparing the key (a stale or foreign guess costs one comparison, never a wrong answer).
+  /// Relaxed atomics: lookups of one set from several threads are safe. A copy starts empty.
+  struct LookupCache {
+    static constexpr std::size_t size = 256;
+    std::atomic<std::uint32_t> slots[size];
+    LookupCache() noexcept { clear(); }
+    LookupCache(const LookupCache&) noexcept : LookupCache() {}
+    LookupCache& operator=(const LookupCache&) noexcept {
+      clear();
+      return *this;
+    }
+    void clear() noexcept {
+      for (auto& s : slots) s.store(kNone, std::memory_order_relaxed);
+    }
+  };
+  mutable LookupCache recent_;
+  std::uint64_t keys_signature_ = 0;  // a hash of the keys in declaration order (reset_values)
   std::string config_path_;
   std::string group_ = "Options";
-  std::string last_;  // the parameter default_text() and unit() apply to
+  std::uint32_t last_ = kNone;  // the parameter default_text() and unit() apply to
   std::map<std::string, std::pair<std::string, std::string>> group_conditions_;  // group -> (key, value)
   void declare(const std::string& key, Entry e, const afmkit::SourceLocation& where);
   static Entry make_entry(Value value, const std::string& help, Range range);
