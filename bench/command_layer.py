@@ -16,9 +16,10 @@ and prints each path's time and its overhead over the bare kernel (the library c
 (the CPU time a call takes is far less disturbed by other processes on a shared machine than its wall time), with
 the machine's load average before and after; `--rounds` repeats the whole measurement and prints the medians over
 the rounds, then one line per front end: its overhead and whether the target holds. The target: <= 5 % (judged on
-the medians of the CPU-time ratios) for the Python call and for the C++ command's part without I/O. Exit status 1
-when either exceeds it. Run it on an otherwise idle machine. The orbit search runs on one thread (OMP_NUM_THREADS=1
-unless set): on a busy machine its OpenMP threads wait on each other for far longer than the search takes, which
+the medians over the rounds) for the Python call (its wall time over the search's inside the same call: one
+process, one moment) and for the C++ command's part without I/O (CPU, interleaved with the kernel in one process).
+Exit status 1 when either exceeds it. Run it on an otherwise idle machine. The orbit search runs on one thread
+(OMP_NUM_THREADS=1 unless set): on a busy machine its OpenMP threads wait on each other for far longer than the search takes, which
 would hide the layer's cost.
 
 The baseline is the kernel alone: find_orbits on a model built once (C++), or the search time the call reports
@@ -175,13 +176,19 @@ def main() -> int:
     medians = {k: statistics.median(r[k] for r in rounds if k in r) for k in rounds[0]}
     for k, v in medians.items():
         print(f"  {k:20s} {v:.3f}   (rounds: {', '.join(f'{r[k]:.3f}' for r in rounds if k in r)})")
-    python = medians.get("python cpu", medians["python wall"])
-    judged = [("Python afmkit.tapping.orbit(...)", python, "CPU" if "python cpu" in medians else "wall")]
+    # The Python call is judged against the search inside the same call (same process, same moment: the ratio per
+    # call); its CPU time against the C++ benchmark's kernel compares two processes (their heaps, caches and clock
+    # differ: the same search runs a few per cent slower or faster in one than in the other) and is shown, not judged.
+    judged = [("Python afmkit.tapping.orbit(...)", medians["python wall"], "wall, in-process")]
     if "CommandReused cpu" in medians:
         judged.append(("C++ command without I/O", medians["CommandReused cpu"], "CPU"))
     print(f"overhead of the command layer over the bare kernel (target <= {percent(TARGET)}; {load()}):")
     for what, ratio, kind in judged:
         print(f"  {what:34s} {percent(ratio):>9s} {kind}   {'met' if ratio <= TARGET else 'NOT met'}")
+    if "python cpu" in medians:
+        spread = [r["python cpu"] for r in rounds if "python cpu" in r]
+        print(f"  {'Python call over the C++ kernel':34s} {percent(medians['python cpu']):>9s} CPU   (two processes, "
+              f"rounds {percent(min(spread))} to {percent(max(spread))}: not judged)")
     if "CommandFiles cpu" in medians:
         print(f"  {'C++ command writing its files':34s} {percent(medians['CommandFiles cpu']):>9s} CPU   "
               "(I/O: two fsyncs, not judged)")
