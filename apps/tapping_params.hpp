@@ -63,13 +63,7 @@ struct TappingUnits {
         velocity(length.per(time)) {}
 
   /// The same names and factors (a table declared for one is the other's: TableCache).
-  friend bool operator==(const TappingUnits& a, const TappingUnits& b) {
-    const auto same = [](const units::Unit& x, const units::Unit& y) {
-      return x.multiply == y.multiply && x.divide == y.divide && x.name == y.name;
-    };
-    return same(a.length, b.length) && same(a.force, b.force) && same(a.energy, b.energy) && same(a.time, b.time) &&
-           same(a.velocity, b.velocity);
-  }
+  friend bool operator==(const TappingUnits&, const TappingUnits&) = default;
 };
 
 }  // namespace afmkit::cli

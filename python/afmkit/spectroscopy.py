@@ -27,6 +27,7 @@ import sys
 import numpy as np
 
 from . import _afmkit
+from ._commands import Result
 
 # keyword options given in SI units here, in the command's units (nm) there
 _SI_TO_COMMAND = {"invols": 1e9, "tip_radius": 1e9, "bin_width": 1e9}
@@ -156,8 +157,8 @@ def prepare_file(input, **options) -> PreparedCurve:
     """Prepares every curve of the instrument file ``input`` (JPK .jpk-force, Asylum .ibw, text exports with
     ``format``, ``height_column``, … as the command's keys). Options as ``prepare`` (SI units: ``invols`` [m/V],
     ``tip_radius`` [m], ``bin_width`` [m]); ``spring_constant`` [N/m] and ``invols`` override the file's."""
-    raw = _afmkit.run("spectroscopy prepare", _options(dict(options, input=input)))
-    return PreparedCurve(raw["results"], raw["params"], _law_from_columns(raw["table"]))
+    r = _afmkit.run("spectroscopy prepare", _options(dict(options, input=input)), Result)
+    return PreparedCurve(dict(r.results), r.params, _law_from_columns(dict(r)))
 
 
 def _file_signature():

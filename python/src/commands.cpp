@@ -418,32 +418,8 @@ py::object made_params(const py::capsule& capsule) {
   return json_to_python(capsule.get_pointer<ParamsRecord>()->made());
 }
 
-/// What a run gave, as the dict run() returns without a result type: results (or the summary's maker), columns
-/// (name, unit, description), column_names, column_units, column_meaning, table, grid, params.
-py::dict raw_result(const std::string& path, cli::Captured& captured, py::object summary, nlohmann::json params) {
-  ColumnTexts::Made texts = column_texts(path).of(captured.columns);
-  py::dict out;
-  out["results"] = std::move(summary);
-  py::list columns;
-  py::dict table;
-  NumberBlock numbers(captured.columns.size(), captured.rows.size());
-  for (std::size_t c = 0; c < captured.columns.size(); ++c) {
-    const py::handle name = PyList_GET_ITEM(texts.names.ptr(), static_cast<Py_ssize_t>(c));
-    columns.append(py::make_tuple(name, texts.units[name], texts.meaning[name]));
-    set_item(table, name, column_array(captured.columns[c], captured.rows, c, numbers));
-  }
-  out["columns"] = columns;
-  out["column_names"] = texts.names;
-  out["column_units"] = texts.units;
-  out["column_meaning"] = texts.meaning;
-  out["table"] = table;
-  out["grid"] = json_to_python(captured.grid);
-  out["params"] = json_to_python(params);
-  return out;
-}
-
 /// What a run gave as an instance of `type` (afmkit.Result: a dict subclass), made here rather than by its
-/// __init__ from the dict raw_result() gives (a Python frame, a copy of the table and a dozen attributes per call
+/// __init__ from a dict of what the run gave (a Python frame, a copy of the table and a dozen attributes per call
 /// cost a short command ~1.5 %: bench/command_layer.py): the table's columns are its items; its attributes command,
 /// _results (the summary or its maker), _params (the record's capsule: Result.params makes the dict when first read),
 /// columns, units, meaning and grid, as Result.__init__ sets them.
@@ -482,7 +458,7 @@ py::object typed_result(const py::handle& type, const std::string& path, cli::Ca
 }
 
 /// Runs command `path` with `kwargs` (TOML keys; `config`: a TOML file loaded first, as --config; a value None is
-/// not given). Returns an instance of `result_type` (typed_result) or, when it is None, the dict of raw_result().
+/// not given). Returns an instance of `result_type` (typed_result).
 py::object run(const std::string& path, const py::dict& kwargs, const py::object& result_type) {
   std::string name = "afmkit." + path;
   std::replace(name.begin(), name.end(), ' ', '.');
@@ -500,7 +476,7 @@ py::object run(const std::string& path, const py::dict& kwargs, const py::object
   }
   RunParams run_params(path, name, given);  // a set this command's runs reuse
   const io::ParamSet& p = run_params.get();
-  if (!result_type.is_none()) captured.record_later = &p;  // ParamsRecord: made from the set when r.params is read
+  captured.record_later = &p;  // ParamsRecord: made from the set when r.params is read
   SignalPoll interrupts;  // Ctrl-C stops the computation at its next check (KeyboardInterrupt)
   captured.cancellation = interrupts.cancellation();
   // progress lines to sys.stderr (Jupyter), not to descriptor 2
@@ -521,14 +497,9 @@ py::object run(const std::string& path, const py::dict& kwargs, const py::object
   // the maker (afmkit.Result.results makes the summary with it, once, when first read), or the summary
   py::object summary = make_results ? py::object(maker_capsule(std::move(make_results)))
                                     : results ? results : json_to_python(captured.results);
-  // the parameters as the run used them (computed defaults filled in), as its sidecar records them
-  if (result_type.is_none()) {
-    nlohmann::json params = captured.parameters.is_null() ? p.to_json() : std::move(captured.parameters);
-    params.erase("json");  // not a keyword argument (always on from Python): r.params replays as f(**r.params)
-    return raw_result(path, captured, std::move(summary), std::move(params));
-  }
-  // a Result: its record made when r.params is first read, from the set the run used (lent), unless the command
-  // recorded other values or the command has lent as many sets as it lends
+  // the parameters as the run used them (computed defaults filled in), as its sidecar records them: made when
+  // r.params is first read, from the set the run used (lent), unless the command recorded other values or the
+  // command has lent as many sets as it lends
   ParamsRecord params;
   if (!captured.parameters.is_null()) params.json = std::move(captured.parameters);
   else if (!(params.lent = run_params.lend())) params.json = p.to_json();
@@ -566,16 +537,15 @@ void bind_commands(py::module_& m) {
       py::arg("parameter"), py::arg("value"), py::arg("bytes_per_unit"),
       "InvalidParameter naming `parameter` when value x bytes_per_unit exceeds the memory afmkit may use (half of "
       "what is available, capped by AFMKIT_MEMORY_LIMIT), as the commands check their sizes.");
-  m.def("run", &run, py::arg("path"), py::arg("kwargs"), py::arg("result_type") = py::none(),
-        "Runs one command with keyword arguments named as its TOML keys (None: not given). With result_type "
-        "(afmkit.Result) returns an instance of it; else a dict of results, columns, table, params (from a command "
-        "that makes its summary where it is read, results is a capsule holding its maker: made_summary(results) makes "
-        "it; afmkit.Result does when r.results is first read).");
+  m.def("run", &run, py::arg("path"), py::arg("kwargs"), py::arg("result_type"),
+        "Runs one command with keyword arguments named as its TOML keys (None: not given); returns an instance of "
+        "result_type (afmkit.Result), whose summary and parameter record are made when first read (made_summary, "
+        "made_params).");
   m.def("made_params", &made_params, py::arg("params"),
-        "The parameter record (a dict) of the capsule a Result made by run(result_type=...) holds until r.params is "
+        "The parameter record (a dict) of the capsule a Result made by run() holds until r.params is "
         "first read.");
   m.def("made_summary", &made_summary, py::arg("results"),
-        "The summary document a run's results capsule makes (run() of a command that makes its summary when read).");
+        "The summary document a Result's results capsule makes (run() of a command that makes its summary when read).");
 }
 
 }  // namespace afmkit::python

@@ -1,7 +1,6 @@
 #include "afmkit/io/params.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -27,63 +26,6 @@ namespace {
 std::string dashed(std::string key) {
   std::replace(key.begin(), key.end(), '_', '-');
   return key;
-}
-
-/// A 64-bit hash of a key from at most three 8-byte words (the first, the middle and the last: every byte of a key
-/// of up to 24 characters, the length of the rest); keys are short, a few words with underscores, and the key found
-/// is compared whole (same_key).
-[[gnu::always_inline]] inline std::uint64_t key_hash(std::string_view key) noexcept {
-  const std::size_t n = key.size();
-  const char* p = key.data();
-  const auto load8 = [](const char* at) {
-    std::uint64_t w;
-    std::memcpy(&w, at, 8);
-    return w;
-  };
-  const auto load4 = [](const char* at) {
-    std::uint32_t w;
-    std::memcpy(&w, at, 4);
-    return std::uint64_t{w};
-  };
-  std::uint64_t a = 0, b = 0, c = 0;
-  if (n >= 8) {
-    a = load8(p);
-    b = load8(p + n - 8);
-    if (n > 16) c = load8(p + n / 2 - 4);
-  } else if (n >= 4) {
-    a = load4(p);
-    b = load4(p + n - 4);
-  } else if (n > 0) {
-    a = std::uint64_t{static_cast<unsigned char>(p[0])} | std::uint64_t{static_cast<unsigned char>(p[n / 2])} << 8 |
-        std::uint64_t{static_cast<unsigned char>(p[n - 1])} << 16;
-  }
-  constexpr std::uint64_t k1 = 0xbf58476d1ce4e5b9ull, k2 = 0x94d049bb133111ebull, k3 = 0x9e3779b97f4a7c15ull;
-  std::uint64_t h = (a ^ k3) * k1;
-  h = (h ^ (h >> 31) ^ b) * k2;
-  h = (h ^ (h >> 29) ^ c ^ n) * k1;
-  return h ^ (h >> 32);
-}
-
-/// Whether `a` and `b` hold the same characters, 8 bytes at a time without a call (the key found by its hash is
-/// almost always the one looked up: this comparison confirms it).
-[[gnu::always_inline]] inline bool same_key(const std::string& a, std::string_view b) noexcept {
-  const std::size_t n = b.size();
-  if (a.size() != n) return false;
-  const char* p = a.data();
-  const char* q = b.data();
-  if (n < 8) {
-    for (std::size_t i = 0; i < n; ++i)
-      if (p[i] != q[i]) return false;
-    return true;
-  }
-  const auto word = [](const char* at) {
-    std::uint64_t w;
-    std::memcpy(&w, at, 8);
-    return w;
-  };
-  for (std::size_t i = 0; i + 8 < n; i += 8)
-    if (word(p + i) != word(q + i)) return false;
-  return word(p + n - 8) == word(q + n - 8);  // the last 8 bytes (overlapping the previous word)
 }
 
 /// The same value, bit for bit (-0.0 is not 0.0; a NaN is itself): reset_values keeps a value that passed check().
@@ -211,25 +153,15 @@ std::uint32_t ParamSet::find(std::string_view key) const noexcept {
   std::atomic<std::uint32_t>& recent =
       recent_.slots[(reinterpret_cast<std::uintptr_t>(key.data()) * 0x9e3779b97f4a7c15ull) >> 56];
   const std::uint32_t guess = recent.load(std::memory_order_relaxed);
-  if (guess < entries_.size() && same_key(entries_[guess].key, key)) [[likely]]
+  if (guess < entries_.size() && entries_[guess].key == key) [[likely]]
     return guess;
   return find_by_hash(key, recent);
 }
 std::uint32_t ParamSet::find_by_hash(std::string_view key, std::atomic<std::uint32_t>& recent) const noexcept {
-  if (slots_.empty()) return kNone;
-  const std::uint64_t h = key_hash(key);
-  const std::uint64_t tag = h & ~std::uint64_t{0xffffffff};
-  const std::size_t mask = slots_.size() - 1;
-  for (std::size_t s = h & mask;; s = (s + 1) & mask) {  // at most half full: an empty slot ends the probe
-    const std::uint64_t slot = slots_[s];
-    if (slot == 0) return kNone;
-    if ((slot & ~std::uint64_t{0xffffffff}) != tag) continue;
-    const auto at = static_cast<std::uint32_t>(slot) - 1;
-    if (same_key(entries_[at].key, key)) {
-      recent.store(at, std::memory_order_relaxed);
-      return at;
-    }
-  }
+  const auto it = index_.find(key);
+  if (it == index_.end()) return kNone;
+  recent.store(it->second, std::memory_order_relaxed);
+  return it->second;
 }
 
 void ParamSet::declare(const std::string& key, Entry e, const afmkit::SourceLocation& where) {
@@ -245,24 +177,11 @@ void ParamSet::declare(const std::string& key, Entry e, const afmkit::SourceLoca
     if (at == kNone - 1) throw std::logic_error("ParamSet: too many parameters");
     entries_.emplace_back();
     entries_.back().key = key;
-    if (2 * entries_.size() > slots_.size()) {  // grow: at most half full
-      slots_.assign(std::bit_ceil(std::max<std::size_t>(16, 4 * entries_.size())), 0);  // a power of 2 (masks)
-      for (std::uint32_t i = 0; i < entries_.size(); ++i) {
-        const std::uint64_t h = key_hash(entries_[i].key);
-        std::size_t s = h & (slots_.size() - 1);
-        while (slots_[s] != 0) s = (s + 1) & (slots_.size() - 1);
-        slots_[s] = (h & ~std::uint64_t{0xffffffff}) | (i + 1);
-      }
-    } else {
-      const std::uint64_t h = key_hash(key);
-      std::size_t s = h & (slots_.size() - 1);
-      while (slots_[s] != 0) s = (s + 1) & (slots_.size() - 1);
-      slots_[s] = (h & ~std::uint64_t{0xffffffff}) | (at + 1);
-    }
+    index_.emplace(key, at);
     by_key_.insert(std::lower_bound(by_key_.begin(), by_key_.end(), key,
                                     [this](std::uint32_t i, const std::string& k) { return entries_[i].key < k; }),
                    at);
-    keys_signature_ = (keys_signature_ ^ key_hash(key)) * 0x9e3779b97f4a7c15ull + 1;
+    keys_signature_ = (keys_signature_ ^ std::hash<std::string_view>{}(key)) * 0x9e3779b97f4a7c15ull + 1;
   }
   e.declared_at.push_back(fmt::format("{}:{}", where.file_name(), where.line()));
   entries_[at] = std::move(e);
@@ -788,7 +707,7 @@ bool ParamSet::recorded(const Entry& e, const std::vector<std::string_view>& rep
     const Entry* on = a.at != kNone ? &entries_[a.at] : &current(a.key);
     while (!on->set && !on->used && on->follows_at != kNone) on = &entries_[on->follows_at];  // (current_at)
     const std::string& value = std::get<std::string>(on->value);
-    if (std::none_of(a.values.begin(), a.values.end(), [&](const std::string& v) { return same_key(v, value); }))
+    if (std::none_of(a.values.begin(), a.values.end(), [&](const std::string& v) { return v == value; }))
       return false;
   }
   for (const auto& condition : e.applies_if)  // a key of another controller than the run's

@@ -12,28 +12,9 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "orbit_as_python.hpp"
 
 namespace {
-
-const afmkit::cli::CommandSpec& results_maker_orbit_spec() {
-  static const std::vector<afmkit::cli::CommandSpec> specs = afmkit::cli::command_specs();
-  for (const auto& s : specs)
-    if (s.path == "tapping orbit") return s;
-  throw std::logic_error("no command tapping orbit");
-}
-
-/// `tapping orbit` at a ~1 ms setting (48 seeds), as the Python module runs it; `output`: the table file ("" none).
-afmkit::io::ParamSet results_maker_params(const std::string& output) {
-  afmkit::io::ParamSet p;
-  results_maker_orbit_spec().declare(p);
-  p.set_default("output", output);
-  p.set_default("json", "true");
-  p.resolve();
-  p.set_value("quality_factor", 2.0);
-  p.set_value("separation", 5.0);
-  p.set_value("max_period_multiple", 1L);
-  return p;
-}
 
 /// The document without the search's wall time (the one value two runs do not share).
 nlohmann::json results_maker_timeless(nlohmann::json j) {
@@ -42,7 +23,7 @@ nlohmann::json results_maker_timeless(nlohmann::json j) {
 }
 
 TEST(ResultsMaker, TappingOrbitHandsItsSummaryUnmadeAndMakesTheDocumentOthersGet) {
-  const afmkit::io::ParamSet p = results_maker_params("");
+  const afmkit::io::ParamSet p = afmkit_test::orbit_params_as_python("");
   // a capture that takes a maker: handed over, not made; the document not given to take_results either
   afmkit::cli::Captured lazy;
   afmkit::cli::ResultsMaker maker;
@@ -52,7 +33,7 @@ TEST(ResultsMaker, TappingOrbitHandsItsSummaryUnmadeAndMakesTheDocumentOthersGet
     maker = std::move(m);
   };
   lazy.take_results = [&](const nlohmann::json&) { ++eager; };
-  results_maker_orbit_spec().run(p, &lazy);
+  afmkit_test::orbit_command_spec().run(p, &lazy);
   ASSERT_EQ(handed, 1);
   EXPECT_EQ(eager, 0);
   ASSERT_TRUE(maker);
@@ -69,7 +50,7 @@ TEST(ResultsMaker, TappingOrbitHandsItsSummaryUnmadeAndMakesTheDocumentOthersGet
 
   // a capture without the hook (the study batch): the document at once, the same one
   afmkit::cli::Captured at_once;
-  results_maker_orbit_spec().run(p, &at_once);
+  afmkit_test::orbit_command_spec().run(p, &at_once);
   EXPECT_EQ(results_maker_timeless(made), results_maker_timeless(at_once.results));
   EXPECT_EQ(lazy.parameters, at_once.parameters);
 }
@@ -78,13 +59,13 @@ TEST(ResultsMaker, AFileWrittenRecordsTheDocumentInItsSidecarAndTheCaptureGetsIt
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "afmkit_test_results_maker";
   std::filesystem::create_directories(dir);
   const std::string csv = (dir / "orbit.csv").string();
-  const afmkit::io::ParamSet p = results_maker_params(csv);
+  const afmkit::io::ParamSet p = afmkit_test::orbit_params_as_python(csv);
   afmkit::cli::Captured c;
   int handed = 0;
   nlohmann::json taken;
   c.take_results_maker = [&](afmkit::cli::ResultsMaker) { ++handed; };
   c.take_results = [&](const nlohmann::json& j) { taken = j; };
-  results_maker_orbit_spec().run(p, &c);
+  afmkit_test::orbit_command_spec().run(p, &c);
   EXPECT_EQ(handed, 0);  // made for the sidecar: handed over made
   std::ifstream in(csv + ".json");
   const nlohmann::json sidecar = nlohmann::json::parse(in);

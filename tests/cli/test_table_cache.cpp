@@ -12,41 +12,21 @@
 #include "afmkit/impact/law_registry.hpp"
 #include "command.hpp"
 #include "law_params.hpp"
+#include "orbit_as_python.hpp"
 #include "table_cache.hpp"
 #include "work_budget.hpp"
 
 namespace {
 
-const afmkit::cli::CommandSpec& table_cache_orbit_spec() {
-  static const std::vector<afmkit::cli::CommandSpec> specs = afmkit::cli::command_specs();
-  for (const auto& s : specs)
-    if (s.path == "tapping orbit") return s;
-  throw std::logic_error("no command tapping orbit");
-}
-
-/// `tapping orbit` at a ~1 ms setting, no file, in `units` ("normalised" or "physical"), as the Python module runs it.
-afmkit::io::ParamSet table_cache_orbit_params(const std::string& units) {
-  afmkit::io::ParamSet p;
-  table_cache_orbit_spec().declare(p);
-  p.set_default("output", "");
-  p.set_default("json", "true");  // as the Python module runs it: no summary lines printed
-  p.resolve();
-  p.set_value("units", units);
-  p.set_value("quality_factor", 2.0);
-  p.set_value("max_period_multiple", 1L);
-  p.set_value("separation", units == "physical" ? 10.0 : 5.0);
-  return p;
-}
-
 afmkit::cli::Captured table_cache_run(const afmkit::io::ParamSet& p) {
   afmkit::cli::Captured c;
-  table_cache_orbit_spec().run(p, &c);
+  afmkit_test::orbit_command_spec().run(p, &c);
   return c;
 }
 
 TEST(TableCache, RunsInTheSameUnitsShareOneColumnListAndOtherUnitsGetTheirOwn) {
-  const afmkit::io::ParamSet normalised = table_cache_orbit_params("normalised");
-  const afmkit::io::ParamSet physical = table_cache_orbit_params("physical");
+  const afmkit::io::ParamSet normalised = afmkit_test::orbit_params_as_python("", "normalised");
+  const afmkit::io::ParamSet physical = afmkit_test::orbit_params_as_python("", "physical");
   const afmkit::cli::Captured a = table_cache_run(normalised);
   const afmkit::cli::Captured b = table_cache_run(normalised);
   const afmkit::cli::Captured c = table_cache_run(physical);
@@ -104,7 +84,7 @@ TEST(TableCache, AnEmptyColumnListIsAnEmptyRange) {
 }
 
 TEST(TableCache, LawChoiceReadsTheLawAndTheKeysGivenOnce) {
-  afmkit::io::ParamSet p = table_cache_orbit_params("normalised");
+  afmkit::io::ParamSet p = afmkit_test::orbit_params_as_python("", "normalised");
   p.set_value("restitution", 0.5);
   const afmkit::impact::LawRegistry registry = afmkit::impact::LawRegistry::builtin();
   const afmkit::cli::LawChoice choice(p, registry);

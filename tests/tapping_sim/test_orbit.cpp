@@ -30,6 +30,27 @@ PeriodicOrbit contact_orbit(const TappingModel& model) {
   return shoot(model, guess_from(hb.back(), model.drive.frequency), 1);
 }
 
+/// The orbit's states at n instants evenly spread over one period, sampled on the dense output.
+std::vector<TipState> sampled_period(const TappingModel& model, const PeriodicOrbit& orbit, int n) {
+  std::vector<double> times(n);
+  for (int k = 0; k < n; ++k) times[k] = model.period() * k / n;
+  SampleRecorder rec(times);
+  simulate(model, 0.0, orbit.initial, model.period(), {}, &rec);
+  return rec.states();
+}
+
+/// The DFT coefficients c_h = (1/n) Σ_k x_k e^{−2πihk/n}, h = 0..5, of the positions of n evenly spread states.
+std::vector<std::complex<double>> position_fourier(const std::vector<TipState>& states) {
+  const auto n = static_cast<double>(states.size());
+  std::vector<std::complex<double>> c(6);
+  for (int h = 0; h <= 5; ++h) {
+    for (std::size_t k = 0; k < states.size(); ++k)
+      c[h] += states[k].position * std::polar(1.0, -2 * std::numbers::pi * h * static_cast<double>(k) / n);
+    c[h] /= n;
+  }
+  return c;
+}
+
 TEST(Orbit, FreeOrbitFloquetMultipliersAreLinearOscillatorExponentials) {
   // no contact (l > free amplitude 20): M = e^{A T}, multipliers e^{λT}, λ = −ξω_n ± iω_n√(1 − ξ²)
   for (double omega : {1.0, 0.9}) {
@@ -122,15 +143,11 @@ TEST(Orbit, HarmonicsMatchDiscreteFourierTransformOfSampledOrbit) {
   const auto orbit = contact_orbit(model);
   const auto m = analyse_orbit(model, orbit);
   const int n = 1 << 14;
-  std::vector<double> times(n);
-  for (int k = 0; k < n; ++k) times[k] = model.period() * k / n;
-  SampleRecorder rec(times);
-  simulate(model, 0.0, orbit.initial, model.period(), {}, &rec);
-  ASSERT_EQ(rec.states().size(), static_cast<std::size_t>(n));
+  const std::vector<TipState> states = sampled_period(model, orbit, n);
+  ASSERT_EQ(states.size(), static_cast<std::size_t>(n));
+  const auto fourier = position_fourier(states);
   for (int h = 0; h <= 5; ++h) {
-    std::complex<double> c = 0;
-    for (int k = 0; k < n; ++k) c += rec.states()[k].position * std::polar(1.0, -2 * std::numbers::pi * h * k / n);
-    c /= n;
+    const std::complex<double> c = fourier[h];
     // the DFT of a function with kinks (contact) converges as 1/n²: a few 1e-7 here
     if (h == 0) {
       EXPECT_NEAR(m.offset, c.real(), 1e-6);
@@ -165,15 +182,11 @@ TEST(Orbit, StageQuadratureOfASmoothLawMatchesTheSampledOrbit) {
     const auto m = analyse_orbit(model, orbit);
     ASSERT_GT(m.contact_fraction, 0.0);  // it taps
     const int n = 1 << 13;
-    std::vector<double> times(n);
-    for (int k = 0; k < n; ++k) times[k] = model.period() * k / n;
-    SampleRecorder rec(times);
-    simulate(model, 0.0, orbit.initial, model.period(), {}, &rec);
-    ASSERT_EQ(rec.states().size(), static_cast<std::size_t>(n));
+    const std::vector<TipState> states = sampled_period(model, orbit, n);
+    ASSERT_EQ(states.size(), static_cast<std::size_t>(n));
+    const auto fourier = position_fourier(states);
     for (int h = 0; h <= 5; ++h) {
-      std::complex<double> c = 0;
-      for (int k = 0; k < n; ++k) c += rec.states()[k].position * std::polar(1.0, -2 * std::numbers::pi * h * k / n);
-      c /= n;
+      const std::complex<double> c = fourier[h];
       const double tolerance = 1e-8 * m.amplitude;
       if (h == 0) EXPECT_NEAR(m.offset, c.real(), tolerance);
       if (h == 1) {
@@ -190,9 +203,9 @@ TEST(Orbit, StageQuadratureOfASmoothLawMatchesTheSampledOrbit) {
     // the extremes of the motion: the lowest and the highest sample, then 4001 samples over the two sample intervals
     // beside each (the force of this law peaks at one of them: in contact at the bottom, outside at the top)
     std::size_t lowest = 0, highest = 0;
-    for (std::size_t k = 1; k < rec.states().size(); ++k) {
-      if (rec.states()[k].position < rec.states()[lowest].position) lowest = k;
-      if (rec.states()[k].position > rec.states()[highest].position) highest = k;
+    for (std::size_t k = 1; k < states.size(); ++k) {
+      if (states[k].position < states[lowest].position) lowest = k;
+      if (states[k].position > states[highest].position) highest = k;
     }
     double largest = -1e300, smallest = 1e300;
     for (const std::size_t centre : {lowest, highest}) {

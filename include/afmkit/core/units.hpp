@@ -30,6 +30,8 @@ struct Unit {
     if (divide != 1.0 || time.divide != 1.0) throw std::logic_error("Unit::per of a unit with a divisor");
     return {name + "/" + time.name, multiply, time.multiply};
   }
+  /// The same name and factors.
+  friend bool operator==(const Unit&, const Unit&) = default;
 };
 
 /// The unit of numbers shown as they are computed (dimensionless, counts, rad, and SI values shown in SI).

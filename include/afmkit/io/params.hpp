@@ -14,6 +14,7 @@
 #include "afmkit/core/source_location.hpp"
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <variant>
 #include <vector>
 
@@ -216,7 +217,8 @@ class ParamSet {
     std::vector<std::string> declared_at;  // "file:line" of each declaration (Description::declared_at)
   };
   void check(const std::string& key, const Entry& e, const std::string& origin) const;
-  /// Index of `key` in entries_, kNone if not declared: one hash of the key, one comparison with the key found.
+  /// Index of `key` in entries_, kNone if not declared: the index last found at the key's address (recent_), else
+  /// the index_'s.
   [[gnu::always_inline]] inline std::uint32_t find(std::string_view key) const noexcept;
   std::uint32_t find_by_hash(std::string_view key, std::atomic<std::uint32_t>& recent) const noexcept;
   const Entry& entry(std::string_view key) const;
@@ -277,9 +279,12 @@ class ParamSet {
   Entries entries_;
   std::vector<std::uint32_t> by_key_;  // indices of entries_ in the keys' order (the order of a JSON object)
   std::vector<std::uint32_t> files_;   // indices of the file parameters (check_files)
-  // Open-addressing hash table (linear probing, at most half full): 0 empty, else (high 32 bits of the key's hash
-  // << 32) | (index + 1).
-  std::vector<std::uint64_t> slots_;
+  /// Key -> index in entries_ (looked up by a std::string_view: a literal key is not copied into a std::string).
+  struct KeyHash {
+    using is_transparent = void;
+    std::size_t operator()(std::string_view key) const noexcept { return std::hash<std::string_view>{}(key); }
+  };
+  std::unordered_map<std::string, std::uint32_t, KeyHash, std::equal_to<>> index_;
   /// The index last found for a key at a given address (a literal's: the same on every call), tried before the hash
   /// and confirmed by comparing the key (a stale or foreign guess costs one comparison, never a wrong answer).
   /// Relaxed atomics: lookups of one set from several threads are safe. A copy starts empty.
