@@ -25,7 +25,8 @@ double check_cantilever_setting(const char* key, CantileverSetting setting, doub
   // the upper end in `unit` by the command line's arithmetic (apps/cantilever_params.cpp); in SI: the limit itself
   const double upper = units::from_si(unit)(cantilever_limit(setting).upper);
   if (value > 0.0 && value <= upper) return value;  // false for NaN
-  const std::string shown = unit == "dimensionless" ? std::string() : " " + std::string(unit);
+  const std::string shown = unit == "dimensionless" ? std::string() : fmt::format(" {}", unit);  // (GCC 12's
+  // -Wrestrict false positive on " " + std::string under unity inlining)
   throw InvalidParameter(key, fmt::format("{} = {}{} is out of range: must be > 0 and <= {:g}{}", key, value, shown,
                                           upper, shown));
 }

@@ -188,12 +188,16 @@ TEST(Orbit, StageQuadratureOfASmoothLawMatchesTheSampledOrbit) {
     for (int h = 0; h <= 5; ++h) {
       const std::complex<double> c = fourier[h];
       const double tolerance = 1e-8 * m.amplitude;
-      if (h == 0) EXPECT_NEAR(m.offset, c.real(), tolerance);
+      if (h == 0) {
+        EXPECT_NEAR(m.offset, c.real(), tolerance);
+      }
       if (h == 1) {
         EXPECT_NEAR(m.amplitude, 2 * std::abs(c), tolerance);
         EXPECT_NEAR(m.phase, -std::arg(c), 1e-8);
       }
-      if (h >= 2) EXPECT_NEAR(m.harmonics[h - 2], 2 * std::abs(c), tolerance) << "harmonic " << h;
+      if (h >= 2) {
+        EXPECT_NEAR(m.harmonics[h - 2], 2 * std::abs(c), tolerance) << "harmonic " << h;
+      }
     }
     EXPECT_GT(m.harmonics[0], 1e-4 * m.amplitude);  // contact makes real higher harmonics
     // (the drive work is 1/Q of the energy the contact force exchanges with the tip each period: 1e-10 of that is
