@@ -182,10 +182,11 @@ def _pilot(study: Study, measure: bool = True):
     (wall s per point, the outputs' units, CPU s per point). The CPU time decides whether local workers pay (the
     machine's load does not make a short study look long)."""
     from .. import _afmkit
+    from .._commands import Result
 
     params = parameters_of(study.command)
     first = {a.name: int(a.values[0]) if params[a.name]["kind"] == "integer" else a.values[0] for a in study.axes}
-    _afmkit.run(study.command, {**study.parameters, **first})  # the parameters checked, errors naming them
+    _afmkit.run(study.command, {**study.parameters, **first}, Result)  # the parameters checked, errors naming them
     # the first ≤ 64 points of the grid, for up to 0.3 s (only the first when the cost is not wanted): checks
     # the output selectors and measures the cost of a point
     points = _points(study, zstore.chunk_slices(study.shape, zstore.chunk_shape(study.shape, 64 if measure else 1), 0))
